@@ -1,0 +1,70 @@
+// Temporal extrusion: a triangle mesh at rest, swept along its worldlines, becomes a static
+// tetrahedral 3-manifold in 4D, the object's history (Black et al. 2007, section III; DESIGN.md
+// sections 1 and 3).
+//
+// Each rest vertex q_i gives two lab events, E(i, a) = labFromRest(tau_a, q_i) and
+// E(i, b) = labFromRest(tau_b, q_i), stored once at index 2 i + cap. The segment between them is
+// a piece of the vertex's worldline (a timelike "lateral" edge). Each triangle (i, j, k) gives a
+// prism with caps at tau_a and tau_b, cut into three tetrahedra by the standard staircase split
+// over its vertices sorted by global id: with i < j < k,
+//     {ia, ja, ka, kb}, {ia, ja, jb, kb}, {ia, ib, jb, kb}.
+// Sorting by id makes the diagonal chosen on each lateral quad depend on the quad's two vertex
+// ids only, so the prisms of neighbouring triangles share their quad diagonals exactly and the
+// tetrahedra form a conforming complex.
+//
+// Only the proper-time span [tau_a, tau_b] the frames can see is extruded (DESIGN.md section 7).
+// A cap is "real" where the object begins or ends existing there, and "open" where the span was
+// cut to what the frames see: only real caps clip the apparent surface.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "boost.h"
+#include "event.h"
+#include "lightcone.h"
+
+namespace mesh4d {
+
+// A triangle mesh in the object's rest frame (after rotation and scale), vertices indexed from 0.
+struct RestMesh {
+    std::vector<Vec3> positions;
+    std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+// An undirected mesh edge, lo < hi.
+struct Edge {
+    uint32_t lo = 0, hi = 0;
+};
+
+struct World4D {
+    Motion motion;
+    RestMesh mesh;
+    double tau_a = 0, tau_b = 0;     // extruded proper-time span, tau_a < tau_b
+    bool cap_a_real = false;         // the object begins existing at tau_a
+    bool cap_b_real = false;         // the object ends existing at tau_b
+    std::vector<Event> events;       // 2 per rest vertex: index 2 i + 0 (cap a), 2 i + 1 (cap b)
+    std::vector<std::array<uint32_t, 4>> tets;  // 3 per triangle, indices into events
+    std::vector<Edge> edges;                    // unique undirected edges of the mesh
+    std::vector<std::array<uint32_t, 3>> triangle_edges;  // edge of (v0,v1), (v1,v2), (v2,v0)
+    std::vector<uint8_t> vertex_used;           // 1 where a triangle references the rest vertex
+    bool empty() const { return mesh.triangles.empty() || !(tau_a < tau_b); }
+};
+
+// Builds the 4D history of `mesh` under `motion` over proper times [tau_a, tau_b].
+// Preconditions: tau_a < tau_b, every triangle index < mesh.positions.size().
+World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
+                bool cap_a_real, bool cap_b_real);
+
+// The proper times at which the rest vertices' worldlines cross the first and the last view
+// surface of a sequence: [min over vertices at `first`, max over vertices at `last`]. Crossing
+// times grow monotonically with the camera time (a timelike worldline meets later cones later),
+// so every frame in between sees vertex emissions inside this span. Precondition: beta < 1 for
+// cone views; mesh non-empty.
+struct ProperTimeSpan {
+    double lo = 0, hi = 0;
+};
+ProperTimeSpan spanSeen(const RestMesh& mesh, const Motion& motion, const ViewSurface& first, const ViewSurface& last);
+
+}  // namespace mesh4d

@@ -1,0 +1,87 @@
+#include "lightcone.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "robust.h"
+
+namespace mesh4d {
+
+double viewSide(const ViewSurface& view, const Event& e) {
+    const double dt = view.t_c - e.t;
+    if (view.kind == ViewKind::Hyperplane) return dt;
+    return dt - norm(e.x - view.apex);
+}
+
+double retardedDelay(const Vec3& e, const Vec3& v, double one_minus_b2) {
+    const double ee = norm2(e);
+    if (ee == 0) return 0;
+    const double ev = dot(e, v);
+    const double s = std::sqrt(ev * ev + one_minus_b2 * ee);
+    // Choose the branch that adds quantities of the same sign (DESIGN.md section 5).
+    if (ev >= 0) return ee / (ev + s);
+    return (s - ev) / one_minus_b2;
+}
+
+WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Vec3& v, double one_minus_b2) {
+    // Move to the camera first: e is where the point is at t_c, relative to C.
+    const double dt_now = view.t_c - anchor.t;
+    WorldlineCut cut;
+    if (view.kind == ViewKind::Hyperplane) {
+        cut.event = {view.t_c, anchor.x + v * dt_now};
+        return cut;
+    }
+    const Vec3 e = (anchor.x - view.apex) + v * dt_now;
+    const double d = retardedDelay(e, v, one_minus_b2);
+    cut.event = {view.t_c - d, view.apex + (e - v * d)};
+    return cut;
+}
+
+// Bisection on the side function; h changes sign on [0, 1] by precondition. 64 halvings reach
+// the spacing of doubles in [0, 1] near any root away from 0.
+static double bisectSide(const ViewSurface& view, const Event& p0, const Event& p1) {
+    double lo = 0, hi = 1;
+    const bool lo_positive = viewSide(view, p0) > 0;
+    for (int it = 0; it < 64; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        const bool mid_positive = viewSide(view, lerp(p0, p1, mid)) > 0;
+        if (mid_positive == lo_positive) lo = mid; else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+double cutSegment(const ViewSurface& view, const Event& p0, const Event& p1) {
+    // Step 1: the two end values decide the trivial cases.
+    const double h0 = viewSide(view, p0), h1 = viewSide(view, p1);
+    if (h0 == 0) return 0;
+    if (h1 == 0) return 1;
+    if (view.kind == ViewKind::Hyperplane) return std::clamp(h0 / (h0 - h1), 0.0, 1.0);
+
+    // Step 2: the cone. Relative to the camera, dt(s) = A + s B and dx(s) = P + s Q; the cone
+    // condition dt^2 - |dx|^2 = 0 reads a s^2 + 2 hh s + k = 0.
+    const double A = view.t_c - p0.t, B = p0.t - p1.t;
+    const Vec3 P = p0.x - view.apex, Q = p1.x - p0.x;
+    const double a = B * B - norm2(Q);
+    const double hh = A * B - dot(P, Q);
+    const double k = A * A - norm2(P);
+    const QuadraticRoots roots = solveQuadratic(a, hh, k);
+
+    // Step 3: keep the root inside the segment and on the past sheet (dt >= 0). By concavity of h
+    // there is exactly one; allow rounding slack of a few ulps at the ends.
+    constexpr double kSlack = 1e-12;  // in units of the segment parameter, far above 1 ulp of 1
+    double best = -1;
+    int found = 0;
+    for (int r = 0; r < roots.count; ++r) {
+        const double s = r == 0 ? roots.r0 : roots.r1;
+        if (!(s >= -kSlack && s <= 1 + kSlack)) continue;
+        if (A + s * B < 0) continue;
+        best = s;
+        ++found;
+        if (roots.r0 == roots.r1) break;
+    }
+    if (found == 1) return std::clamp(best, 0.0, 1.0);
+    return bisectSide(view, p0, p1);
+}
+
+}  // namespace mesh4d

@@ -1,0 +1,57 @@
+// The view hypersurfaces a frame is cut with, and the exact cuts of worldlines and segments.
+//
+// Past lightcone of the camera event (t_c, C): the events with t = t_c - |x - C| (past sheet only,
+// c = 1). Hyperplane: the events with t = t_c (infinite light speed). For both we use the side
+// function
+//     h(E) = (t_c - E.t) - |E.x - C|     (cone)        h(E) = t_c - E.t     (hyperplane)
+// h > 0: E is inside the past cone (its light has already passed the camera); h < 0: E is still
+// outside it (in the future of the view surface); h = 0: on the surface.
+//
+// A subluminal worldline x(t) = a + v (t - t_a) meets the past cone exactly once (h decreases
+// strictly along it, at rate <= -(1 - |v|)). With e = a + v (t_c - t_a) - C, where the point is
+// "now" seen from the camera, the light delay d = t_c - t_e >= 0 is the non-negative root of
+//     (1 - b^2) d^2 + 2 (e.v) d - |e|^2 = 0,
+// taken in the cancellation-free form of DESIGN.md section 5:
+//     s = sqrt((e.v)^2 + (1 - b^2)|e|^2);  e.v >= 0: d = |e|^2 / (e.v + s);  else d = (s - e.v)/(1 - b^2).
+// The apparent point is y = C + e - v d. A point at the camera (e = 0) gives d = 0, y = C.
+// A spacelike segment whose end events lie on opposite sides (h changes sign) crosses the view
+// surface exactly once, because h is concave along any segment (affine minus a norm); the crossing
+// is the root of a quadratic in the segment parameter, chosen on the past sheet.
+// Reference: Black et al., Am. J. Phys. 2007, section III.B; DESIGN.md sections 5 and 6.
+#pragma once
+
+#include "event.h"
+
+namespace mesh4d {
+
+enum class ViewKind { PastCone, Hyperplane };
+
+struct ViewSurface {
+    ViewKind kind = ViewKind::PastCone;
+    double t_c = 0;  // camera time of the frame
+    Vec3 apex;       // camera position C (unused for the hyperplane)
+};
+
+// Side function h(E) above.
+double viewSide(const ViewSurface& view, const Event& e);
+
+// Light delay d >= 0 for a point seen from the camera at relative position e ("now" minus C),
+// moving at v with 1 - |v|^2 = one_minus_b2 > 0. Relative error a few ulps (no cancellation).
+double retardedDelay(const Vec3& e, const Vec3& v, double one_minus_b2);
+
+struct WorldlineCut {
+    Event event;  // the crossing: emission time and apparent position
+};
+
+// The crossing of the worldline through `anchor` with velocity v (|v| < 1) and the view surface.
+// one_minus_b2 = 1 - |v|^2 computed without cancellation by the caller.
+WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Vec3& v, double one_minus_b2);
+
+// The parameter s in [0, 1] where the segment p0 -> p1 crosses the view surface.
+// Precondition: viewSide(p0) and viewSide(p1) have opposite signs or one is zero; the segment is
+// spacelike or lies in a hyperplane of constant t. Returns the root of the exact quadratic
+// (cone) or linear (hyperplane) equation, clamped to [0, 1]; if rounding moves the quadratic's
+// root off the past sheet or out of the segment, bisection on h decides instead.
+double cutSegment(const ViewSurface& view, const Event& p0, const Event& p1);
+
+}  // namespace mesh4d

@@ -1,0 +1,138 @@
+#include "pipeline/cli.h"
+
+#include <ostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "pipeline/render.h"
+
+namespace apparent {
+
+namespace {
+
+constexpr const char* kDescription =
+    "apparent: what objects moving near the speed of light look like, as 3D geometry.\n"
+    "Extrudes meshes in uniform motion into 4D histories, cuts them with the camera's past\n"
+    "lightcone for every frame and exports the apparent shapes (Black et al., Am. J. Phys. 2007).\n"
+    "Units: light-seconds and seconds, c = 1.";
+
+constexpr const char* kRenderFooter =
+    "Models:\n"
+    "  instant       infinite light speed: every object where it is at the frame time\n"
+    "  finite        finite light speed, Galilean objects (classical aberration only)\n"
+    "  relativistic  finite light speed, Lorentz-boosted objects (what special relativity shows)\n"
+    "  contracted    the Lorentz-contracted shape at the frame time (measured, never seen)\n"
+    "Outputs in DIR:\n"
+    "  <model>.glb                      one animated glTF holding every frame (STEP scale channels)\n"
+    "  <model>/frame_NNNNN.ply|.obj     per frame, all objects; PLY vertex 'quality' = emission time\n"
+    "Exit codes: 0 success, 2 bad usage or bad input, 3 output could not be written.";
+
+bool parseFrames(const std::string& text, long long* from, long long* to) {
+    const auto colon = text.find(':');
+    if (colon == std::string::npos) return false;
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    try {
+        size_t used = 0;
+        *from = a.empty() ? 0 : std::stoll(a, &used);
+        if (!a.empty() && used != a.size()) return false;
+        *to = b.empty() ? -1 : std::stoll(b, &used);
+        if (!b.empty() && used != b.size()) return false;
+    } catch (const std::exception&) {
+        return false;
+    }
+    return *from >= 0 && (*to < 0 || *to > *from);
+}
+
+}  // namespace
+
+int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+    CLI::App app(kDescription, "apparent");
+    app.set_version_flag("--version", "apparent 0.1.0");
+    app.require_subcommand(1);
+
+    RenderSettings rs;
+    std::string model_text, format_text = "glb", frames_text, tolerance_text;
+    long long max_vertices = (long long)rs.limits.max_vertices, max_faces = (long long)rs.limits.max_faces;
+    CLI::App* render_cmd = app.add_subcommand("render", "Render a scene's apparent shapes into DIR");
+    render_cmd->add_option("scene", rs.scene_path, "Scene file (JSON, see README 'Scene format')")->required();
+    render_cmd->add_option("--out", rs.out_dir, "Output folder (created if missing)")->capture_default_str();
+    render_cmd->add_option("--model", model_text,
+                           "instant|finite|relativistic|contracted|all, or a comma list (default: the scene's model)");
+    render_cmd->add_option("--format", format_text, "Comma list of glb, ply, obj")->capture_default_str();
+    render_cmd->add_option("--tolerance", tolerance_text,
+                           "Accuracy target in light-seconds (overrides the scene's; accepted and recorded, "
+                           "vertex mode: exact vertices joined by straight edges)");
+    render_cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
+    render_cmd->add_flag("--quiet,-q", rs.quiet, "No progress or summary");
+    render_cmd->add_flag("--verbose,-v", rs.verbose, "Mesh topology and export precision");
+    render_cmd->add_option("--max-frames", rs.max_frames, "Refuse scenes with more frames")->capture_default_str();
+    render_cmd->add_option("--max-vertices", max_vertices, "Refuse meshes with more vertices")->capture_default_str();
+    render_cmd->add_option("--max-faces", max_faces, "Refuse meshes with more faces")->capture_default_str();
+    render_cmd->footer(kRenderFooter);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        out << app.help();
+        return kExitOk;
+    } catch (const CLI::CallForAllHelp&) {
+        out << app.help("", CLI::AppFormatMode::All);
+        return kExitOk;
+    } catch (const CLI::CallForVersion&) {
+        out << "apparent 0.1.0\n";
+        return kExitOk;
+    } catch (const CLI::ParseError& e) {
+        // CLI11 throws the subcommand's help as CallForHelp too; everything else is bad usage.
+        err << "error: " << e.what() << "\n" << "Run 'apparent --help' or 'apparent render --help'.\n";
+        return kExitBadInput;
+    }
+    if (!render_cmd->parsed()) return kExitBadInput;
+
+    // Step: turn the option strings into settings, one clear line per problem.
+    auto usage = [&](const std::string& msg) {
+        err << "error: " << msg << "\n";
+        return kExitBadInput;
+    };
+    if (!model_text.empty()) {
+        std::stringstream ss(model_text);
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+            Model m;
+            if (item == "all") rs.all_models = true;
+            else if (parseModel(item, &m)) rs.models.push_back(m);
+            else return usage("--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)");
+        }
+    }
+    rs.write_glb = false;
+    {
+        std::stringstream ss(format_text);
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+            if (item == "glb") rs.write_glb = true;
+            else if (item == "ply") rs.write_ply = true;
+            else if (item == "obj") rs.write_obj = true;
+            else return usage("--format: unknown format '" + item + "' (glb, ply, obj)");
+        }
+        if (!rs.write_glb && !rs.write_ply && !rs.write_obj) return usage("--format: no format given (glb, ply, obj)");
+    }
+    if (!tolerance_text.empty()) {
+        try {
+            size_t used = 0;
+            rs.tolerance = std::stod(tolerance_text, &used);
+            if (used != tolerance_text.size() || !(rs.tolerance > 0) || !std::isfinite(rs.tolerance)) throw 0;
+        } catch (...) {
+            return usage("--tolerance: '" + tolerance_text + "' is not a positive number of light-seconds");
+        }
+        rs.has_tolerance = true;
+    }
+    if (!frames_text.empty() && !parseFrames(frames_text, &rs.frame_from, &rs.frame_to))
+        return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
+    if (max_vertices <= 0 || max_faces <= 0 || rs.max_frames <= 0)
+        return usage("--max-vertices, --max-faces and --max-frames must be positive");
+    rs.limits.max_vertices = size_t(max_vertices);
+    rs.limits.max_faces = size_t(max_faces);
+    return render(rs, out, err);
+}
+
+}  // namespace apparent

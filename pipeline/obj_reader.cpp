@@ -1,0 +1,155 @@
+#include "pipeline/obj_reader.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include "pipeline/mesh_check.h"
+
+namespace apparent {
+
+namespace {
+
+struct DoubleTraits : OpenMesh::DefaultTraits {
+    typedef OpenMesh::Vec3d Point;
+    typedef OpenMesh::Vec3d Normal;
+};
+typedef OpenMesh::TriMesh_ArrayKernelT<DoubleTraits> ObjMesh;
+
+struct ScanResult {
+    size_t vertices = 0;
+    size_t faces = 0;              // faces OpenMesh should keep
+    size_t triangles = 0;          // triangles those faces give after fan triangulation
+    size_t polygons = 0;
+    size_t repeated_index = 0;
+};
+
+bool parseFinite(const std::string& token, double* out) {
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
+    *out = v;
+    return true;
+}
+
+// Scans the OBJ text for what OpenMesh would drop without a word.
+Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* scan) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return Status::failure(path + ": cannot open mesh file");
+    std::string line;
+    size_t line_no = 0;
+    auto fail = [&](const std::string& problem) {
+        return Status::failure(path + ":" + std::to_string(line_no) + ": " + problem);
+    };
+    while (std::getline(in, line)) {
+        ++line_no;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        std::istringstream ls(line);
+        std::string key;
+        if (!(ls >> key) || key[0] == '#') continue;
+        if (key == "v") {
+            std::string tok;
+            double xyz[3];
+            for (int i = 0; i < 3; ++i) {
+                if (!(ls >> tok) || !parseFinite(tok, &xyz[i]))
+                    return fail("v: expected 3 finite numbers, got '" + line + "'");
+            }
+            if (++scan->vertices > limits.max_vertices)
+                return fail("v: more than " + std::to_string(limits.max_vertices) + " vertices (raise with --max-vertices)");
+        } else if (key == "f") {
+            std::vector<long> idx;
+            std::string tok;
+            while (ls >> tok) {
+                // "i", "i/t", "i//n", "i/t/n": the position index comes first; negatives count back.
+                const std::string head = tok.substr(0, tok.find('/'));
+                char* end = nullptr;
+                errno = 0;
+                const long i = std::strtol(head.c_str(), &end, 10);
+                if (head.empty() || *end != '\0' || errno == ERANGE || i == 0)
+                    return fail("f: bad vertex index '" + tok + "'");
+                const long resolved = i > 0 ? i : long(scan->vertices) + 1 + i;
+                if (resolved < 1 || resolved > long(scan->vertices))
+                    return fail("f: vertex index " + std::to_string(i) + " is out of range (valid 1.." +
+                                std::to_string(scan->vertices) + " so far, or -1..-" + std::to_string(scan->vertices) + ")");
+                idx.push_back(resolved);
+            }
+            if (idx.size() < 3) return fail("f: a face needs at least 3 vertices, got " + std::to_string(idx.size()));
+            if (std::set<long>(idx.begin(), idx.end()).size() != idx.size()) {
+                ++scan->repeated_index;  // OpenMesh drops it; we count it as degenerate
+                continue;
+            }
+            ++scan->faces;
+            scan->triangles += idx.size() - 2;
+            if (idx.size() > 3) ++scan->polygons;
+            if (scan->faces > limits.max_faces)
+                return fail("f: more than " + std::to_string(limits.max_faces) + " faces (raise with --max-faces)");
+        }
+    }
+    if (scan->vertices == 0) return Status::failure(path + ": no vertices ('v' lines)");
+    if (scan->faces == 0) return Status::failure(path + ": no usable faces ('f' lines)");
+    return Status::success();
+}
+
+}  // namespace
+
+std::vector<std::string> MeshWarnings::lines() const {
+    std::vector<std::string> out;
+    if (polygons_triangulated) out.push_back(std::to_string(polygons_triangulated) + " polygons triangulated");
+    if (degenerate_dropped) out.push_back(std::to_string(degenerate_dropped) + " degenerate triangles dropped");
+    if (nonmanifold_split)
+        out.push_back(std::to_string(nonmanifold_split) + " non-manifold faces given their own vertices");
+    return out;
+}
+
+Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
+    // Step: scan for what the library would drop silently.
+    ScanResult scan;
+    if (Status s = scanObj(path, limits, &scan); !s.ok) return s;
+
+    // Step: read with OpenMesh; its own log lines become our counts.
+    omerr().disable();
+    omlog().disable();
+    ObjMesh om;
+    OpenMesh::IO::Options opt;
+    if (!OpenMesh::IO::read_mesh(om, path, opt)) return Status::failure(path + ": OpenMesh could not read the OBJ file");
+
+    mesh->positions.clear();
+    mesh->triangles.clear();
+    mesh->positions.reserve(om.n_vertices());
+    for (auto v : om.vertices()) {
+        const auto& p = om.point(v);
+        mesh->positions.push_back({p[0], p[1], p[2]});
+    }
+    for (auto f : om.faces()) {
+        std::array<uint32_t, 3> tri{};
+        int c = 0;
+        for (auto v : om.fv_range(f)) tri[c++] = uint32_t(v.idx());
+        mesh->triangles.push_back(tri);
+    }
+
+    // Step: count what changed. OpenMesh gives a face that would make an edge non-manifold copies of
+    // its vertices (so the vertex count grows), and drops faces it cannot add at all.
+    warnings->polygons_triangulated += scan.polygons;
+    warnings->degenerate_dropped += scan.repeated_index;
+    for (const auto& tri : mesh->triangles)
+        if (tri[0] >= scan.vertices || tri[1] >= scan.vertices || tri[2] >= scan.vertices) ++warnings->nonmanifold_split;
+    if (mesh->triangles.size() < scan.triangles)
+        return Status::failure(path + ": OpenMesh dropped " + std::to_string(scan.triangles - mesh->triangles.size()) +
+                               " of " + std::to_string(scan.triangles) + " triangles (malformed faces)");
+
+    // Step: zero-area triangles (exact predicate), dropped and counted.
+    const size_t dropped = dropDegenerateTriangles(mesh);
+    warnings->degenerate_dropped += dropped;
+    if (mesh->triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
+    return Status::success();
+}
+
+}  // namespace apparent

@@ -1,0 +1,280 @@
+#include "pipeline/render.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "exporters/gltf.h"
+#include "exporters/obj.h"
+#include "exporters/ply.h"
+#include "pipeline/mesh_check.h"
+
+namespace apparent {
+
+using mesh4d::Vec3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Rotation by Euler angles in degrees, applied about X, then Y, then Z (fixed axes).
+Vec3 rotateXYZ(const Vec3& p, const Vec3& deg) {
+    const double ax = deg.x * kPi / 180, ay = deg.y * kPi / 180, az = deg.z * kPi / 180;
+    Vec3 r = p;
+    r = {r.x, std::cos(ax) * r.y - std::sin(ax) * r.z, std::sin(ax) * r.y + std::cos(ax) * r.z};
+    r = {std::cos(ay) * r.x + std::sin(ay) * r.z, r.y, -std::sin(ay) * r.x + std::cos(ay) * r.z};
+    r = {std::cos(az) * r.x - std::sin(az) * r.y, std::sin(az) * r.x + std::cos(az) * r.y, r.z};
+    return r;
+}
+
+mesh4d::Kinematics kinematicsOf(Model m) {
+    return (m == Model::Relativistic || m == Model::Contracted) ? mesh4d::Kinematics::Lorentz
+                                                                 : mesh4d::Kinematics::Galilean;
+}
+
+std::string humanBytes(size_t n) {
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(1);
+    if (n >= 1 << 20) os << double(n) / (1 << 20) << " MiB";
+    else if (n >= 1 << 10) os << double(n) / (1 << 10) << " KiB";
+    else os << n << " B";
+    return os.str();
+}
+
+// Progress on a terminal: frames done, rate, time left. Silent when stderr is not a terminal.
+class Progress {
+public:
+    Progress(std::ostream& err, bool enabled, std::string label, long long total)
+        : err_(err), enabled_(enabled && ::isatty(2)), label_(std::move(label)), total_(total),
+          start_(std::chrono::steady_clock::now()) {}
+
+    void update(long long done) {
+        if (!enabled_) return;
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        if (done < total_ && elapsed - last_ < 0.2) return;  // at most 5 updates a second
+        last_ = elapsed;
+        const double rate = elapsed > 0 ? double(done) / elapsed : 0;
+        err_ << "\r" << label_ << ": frame " << done << "/" << total_ << std::fixed << std::setprecision(1)
+             << " (" << rate << " frames/s, " << (rate > 0 ? double(total_ - done) / rate : 0) << " s left)   "
+             << std::flush;
+        if (done == total_) err_ << "\n";
+    }
+
+private:
+    std::ostream& err_;
+    bool enabled_;
+    std::string label_;
+    long long total_;
+    std::chrono::steady_clock::time_point start_;
+    double last_ = -1;
+};
+
+void appendMesh(const mesh4d::ApparentMesh& part, mesh4d::ApparentMesh* all) {
+    const uint32_t base = uint32_t(all->positions.size());
+    all->positions.insert(all->positions.end(), part.positions.begin(), part.positions.end());
+    all->emission_times.insert(all->emission_times.end(), part.emission_times.begin(), part.emission_times.end());
+    for (const auto& t : part.triangles) all->triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    all->clipped_triangles += part.clipped_triangles;
+}
+
+std::string frameFileName(long long k, const char* ext) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "frame_%05lld.%s", k, ext);
+    return buf;
+}
+
+}  // namespace
+
+Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<PreparedObject>* objects,
+                      std::ostream& log, bool quiet) {
+    std::map<std::string, mesh4d::RestMesh> cache;  // one read per mesh file
+    for (const ObjectSpec& spec : scene.objects) {
+        auto it = cache.find(spec.mesh_path);
+        if (it == cache.end()) {
+            mesh4d::RestMesh mesh;
+            MeshWarnings warnings;
+            if (Status s = readObj(spec.mesh_path, limits, &mesh, &warnings); !s.ok) return s;
+            if (!quiet)
+                for (const std::string& w : warnings.lines()) log << "warning: " << spec.mesh_path << ": " << w << "\n";
+            it = cache.emplace(spec.mesh_path, std::move(mesh)).first;
+        }
+        PreparedObject obj;
+        obj.spec = spec;
+        obj.rest = it->second;
+        for (Vec3& p : obj.rest.positions)
+            p = rotateXYZ({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z}, spec.rotation_deg);
+        // A negative scale determinant mirrors the mesh: flip triangles to keep outward orientation.
+        if (spec.scale.x * spec.scale.y * spec.scale.z < 0)
+            for (auto& t : obj.rest.triangles) std::swap(t[1], t[2]);
+        objects->push_back(std::move(obj));
+    }
+    return Status::success();
+}
+
+mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
+    mesh4d::ViewSurface view;
+    view.kind = (model == Model::Finite || model == Model::Relativistic) ? mesh4d::ViewKind::PastCone
+                                                                         : mesh4d::ViewKind::Hyperplane;
+    view.t_c = frameTime(scene.frames, k);
+    view.apex = scene.camera.position;
+    return view;
+}
+
+mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
+                           long long last_frame) {
+    const ObjectSpec& s = object.spec;
+    const mesh4d::Motion motion = mesh4d::makeMotion(kinematicsOf(model), s.t0, s.position, s.velocity);
+    // Step: the proper-time span the requested frames can see, padded by the object's own light
+    // crossing time so that rounding in the vertex crossings never reaches an artificial cap.
+    const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(object.rest, motion, viewForFrame(scene, model, first_frame),
+                                                         viewForFrame(scene, model, last_frame));
+    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (const Vec3& p : object.rest.positions) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    const double pad = mesh4d::norm(hi - lo) + 1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
+    const double open_a = seen.lo - pad, open_b = seen.hi + pad;
+    // Step: clip the span to the object's existence; only those ends are real caps.
+    const bool cap_a_real = s.exists_from > open_a;
+    const bool cap_b_real = s.exists_to < open_b;
+    const double tau_a = cap_a_real ? s.exists_from : open_a;
+    const double tau_b = cap_b_real ? s.exists_to : open_b;
+    if (!(tau_a < tau_b)) {
+        mesh4d::World4D empty;
+        empty.motion = motion;
+        return empty;
+    }
+    return mesh4d::extrude(object.rest, motion, tau_a, tau_b, cap_a_real, cap_b_real);
+}
+
+int render(const RenderSettings& settings, std::ostream& log, std::ostream& err) {
+    // Step: load and validate the scene.
+    Scene scene;
+    if (Status s = loadScene(settings.scene_path, &scene); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
+    if (settings.has_tolerance) scene.tolerance = settings.tolerance;
+    std::vector<Model> models = settings.models;
+    if (settings.all_models) models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};
+    if (models.empty()) models = {scene.model};
+    for (Model m : models) {
+        if (Status s = checkSceneForModel(scene, m); !s.ok) {
+            err << "error: " << s.message << "\n";
+            return kExitBadInput;
+        }
+    }
+    const long long total_frames = frameCount(scene.frames);
+    if (total_frames > settings.max_frames) {
+        err << "error: " << scene.path << ": frames: " << total_frames << " frames requested, more than the limit of "
+            << settings.max_frames << " (raise it with --max-frames)\n";
+        return kExitBadInput;
+    }
+    const long long first = settings.frame_from;
+    const long long last_excl = settings.frame_to < 0 ? total_frames : settings.frame_to;
+    if (!(first >= 0 && first < last_excl && last_excl <= total_frames)) {
+        err << "error: --frames: " << first << ":" << last_excl << " is outside the scene's frames 0:" << total_frames
+            << "\n";
+        return kExitBadInput;
+    }
+
+    // Step: load the meshes (once each) and apply rotation and scale.
+    std::vector<PreparedObject> objects;
+    if (Status s = prepareObjects(scene, settings.limits, &objects, err, settings.quiet); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
+    if (settings.verbose) {
+        for (const auto& o : objects) {
+            const Topology t = analyzeTopology(o.rest.positions, o.rest.triangles);
+            log << o.spec.name << ": " << t.vertices << " vertices, " << t.faces << " triangles, "
+                << (t.closed ? "closed" : (t.manifold ? "open" : "non-manifold")) << ", speed "
+                << mesh4d::norm(o.spec.velocity) << " c\n";
+        }
+    }
+
+    std::error_code ec;
+    std::filesystem::create_directories(settings.out_dir, ec);
+    if (ec) {
+        err << "error: " << settings.out_dir << ": cannot create output folder: " << ec.message() << "\n";
+        return kExitOutputError;
+    }
+
+    for (Model model : models) {
+        const std::string name = modelName(model);
+        // Step: build the static 4D world once per model.
+        std::vector<mesh4d::World4D> worlds;
+        for (const auto& o : objects) worlds.push_back(buildWorld(o, model, scene, first, last_excl - 1));
+        const std::string frame_dir = (std::filesystem::path(settings.out_dir) / name).string();
+        if (settings.write_ply || settings.write_obj) {
+            std::filesystem::create_directories(frame_dir, ec);
+            if (ec) {
+                err << "error: " << frame_dir << ": cannot create output folder: " << ec.message() << "\n";
+                return kExitOutputError;
+            }
+        }
+
+        // Step: per frame, cut every world with the view surface, then export.
+        std::vector<ExportFrame> frames;
+        Progress progress(err, !settings.quiet, name, last_excl - first);
+        size_t max_triangles = 0;
+        for (long long k = first; k < last_excl; ++k) {
+            ExportFrame frame;
+            frame.index = k;
+            frame.t_c = frameTime(scene.frames, k);
+            const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
+            for (const auto& w : worlds) appendMesh(mesh4d::sliceWorld(w, view), &frame.mesh);
+            max_triangles = std::max(max_triangles, frame.mesh.triangles.size());
+            std::string error;
+            if (settings.write_ply &&
+                !writePly((std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string(), frame, &error)) {
+                err << "error: " << error << "\n";
+                return kExitOutputError;
+            }
+            if (settings.write_obj &&
+                !writeObj((std::filesystem::path(frame_dir) / frameFileName(k, "obj")).string(), frame, &error)) {
+                err << "error: " << error << "\n";
+                return kExitOutputError;
+            }
+            if (settings.write_glb) frames.push_back(std::move(frame));
+            progress.update(k - first + 1);
+        }
+
+        // Step: the animated sequence.
+        std::string summary;
+        if (settings.write_glb) {
+            SequenceInfo info;
+            info.model = name;
+            info.tolerance = scene.tolerance;
+            info.fps = scene.frames.fps;
+            info.scene_path = scene.path;
+            GlbStats stats;
+            std::string error;
+            const std::string glb = (std::filesystem::path(settings.out_dir) / (name + ".glb")).string();
+            if (!writeAnimatedGlb(glb, frames, info, &stats, &error)) {
+                err << "error: " << error << "\n";
+                return kExitOutputError;
+            }
+            summary = ", " + glb + " (" + humanBytes(stats.bytes) + ")";
+            if (settings.verbose) {
+                std::ostringstream os;
+                os << "; float32 position error <= " << std::setprecision(3) << stats.max_position_error << " ls";
+                summary += os.str();
+            }
+        }
+        if (!settings.quiet)
+            log << name << ": " << (last_excl - first) << " frames, up to " << max_triangles << " triangles"
+                << summary << "\n";
+    }
+    return kExitOk;
+}
+
+}  // namespace apparent

@@ -1,0 +1,71 @@
+// The scene file: camera, frame range, model, tolerance and the moving objects (README "Scene
+// format"). Units: light-seconds and seconds, c = 1, velocities as fractions of c.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mesh4d/event.h"
+#include "pipeline/status.h"
+
+namespace apparent {
+
+enum class Model { Instant, Finite, Relativistic, Contracted };
+
+const char* modelName(Model m);
+bool parseModel(const std::string& name, Model* out);
+
+struct CameraSpec {
+    mesh4d::Vec3 position{0, 0, 0};
+    mesh4d::Vec3 look_at{0, 0, -1};
+    mesh4d::Vec3 up{0, 1, 0};
+    double fov_deg = 60;
+};
+
+struct FrameSpec {
+    double start = 0;
+    double end = 20;
+    double fps = 10;
+};
+
+struct ObjectSpec {
+    std::string name;
+    std::string mesh_path;             // resolved against the scene file's folder
+    mesh4d::Vec3 position;             // lab position of the mesh origin at lab time t0
+    double t0 = 0;
+    mesh4d::Vec3 velocity;             // lab frame, units of c
+    mesh4d::Vec3 rotation_deg;         // rest-frame rotation, degrees, applied X then Y then Z
+    mesh4d::Vec3 scale{1, 1, 1};       // rest-frame scale, applied before the rotation
+    // Interval of existence on the object's own clock (0 at t0): proper time for the relativistic
+    // and contracted models, lab time since t0 for the instant and finite models.
+    double exists_from = -std::numeric_limits<double>::infinity();
+    double exists_to = std::numeric_limits<double>::infinity();
+};
+
+struct Scene {
+    std::string path;                  // the scene file, as given
+    CameraSpec camera;
+    FrameSpec frames;
+    Model model = Model::Relativistic;
+    double tolerance = 1e-3;
+    std::vector<ObjectSpec> objects;
+};
+
+// Maximum number of frames a scene may ask for (a typo such as fps = 1e9 would otherwise run for
+// days); raise it with --max-frames.
+constexpr long long kDefaultMaxFrames = 100000;
+
+// Reads and validates a scene file. On failure the message names the file, the field (a JSON
+// path such as objects[1].velocity) and the problem with the valid range.
+Status loadScene(const std::string& path, Scene* scene);
+
+// Checks what depends on the model: |velocity| < 1 wherever light or a Lorentz boost is involved.
+Status checkSceneForModel(const Scene& scene, Model model);
+
+// Number of frames: k = 0, 1, ... while start + k / fps < end.
+long long frameCount(const FrameSpec& frames);
+// Camera time of global frame k: start + k / fps (never accumulated).
+double frameTime(const FrameSpec& frames, long long k);
+
+}  // namespace apparent

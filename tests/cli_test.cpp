@@ -1,0 +1,229 @@
+// End to end: the `apparent` command run in-process on shipped scenes and fixtures. Checks the
+// output layout, exit codes, one-line errors, no partial files, and reads the outputs back with
+// the libraries that wrote them (OpenMesh for PLY/OBJ, tinygltf for GLB).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <tiny_gltf.h>
+
+#include "mesh4d/event.h"
+#include "pipeline/cli.h"
+#include "pipeline/scene.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string source(const std::string& rel) { return std::string(APPARENT_SOURCE_DIR) + "/" + rel; }
+
+struct CommandResult {
+    int code = -1;
+    std::string out, err;
+};
+
+CommandResult apparentRun(std::vector<std::string> args) {
+    args.insert(args.begin(), "apparent");
+    std::vector<const char*> argv;
+    for (const auto& a : args) argv.push_back(a.c_str());
+    std::ostringstream out, err;
+    CommandResult r;
+    r.code = apparent::runCommandLine(int(argv.size()), argv.data(), out, err);
+    r.out = out.str();
+    r.err = err.str();
+    return r;
+}
+
+class TempDir {
+public:
+    TempDir() {
+        path_ = fs::temp_directory_path() /
+                ("apparent_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
+        fs::remove_all(path_);
+    }
+    ~TempDir() { fs::remove_all(path_); }
+    std::string str() const { return path_.string(); }
+    fs::path operator/(const std::string& s) const { return path_ / s; }
+
+private:
+    fs::path path_;
+    static inline int counter_ = 0;
+};
+
+std::vector<std::string> listFiles(const fs::path& dir) {
+    std::vector<std::string> names;
+    if (!fs::exists(dir)) return names;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file()) names.push_back(fs::relative(e.path(), dir).string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+struct PlyTraits : OpenMesh::DefaultTraits {
+    typedef OpenMesh::Vec3d Point;
+};
+typedef OpenMesh::TriMesh_ArrayKernelT<PlyTraits> PlyMesh;
+
+}  // namespace
+
+TEST(Cli, HelpAndVersionExitZero) {
+    CommandResult r = apparentRun({"--help"});
+    EXPECT_EQ(r.code, 0);
+    EXPECT_NE(r.out.find("render"), std::string::npos);
+    r = apparentRun({"render", "--help"});
+    EXPECT_EQ(r.code, 0);
+    for (const char* opt : {"--out", "--model", "--format", "--tolerance", "--frames", "relativistic", "quality"})
+        EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+    EXPECT_EQ(apparentRun({"--version"}).code, 0);
+}
+
+TEST(Cli, BadUsageExitsTwo) {
+    const std::string scene = source("data/fixtures/scene_tetra.json");
+    EXPECT_EQ(apparentRun({}).code, 2);
+    EXPECT_EQ(apparentRun({"render"}).code, 2);
+    EXPECT_EQ(apparentRun({"render", scene, "--bogus"}).code, 2);
+    CommandResult r = apparentRun({"render", scene, "--model", "newtonian"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--model: unknown model 'newtonian'"), std::string::npos) << r.err;
+    r = apparentRun({"render", scene, "--format", "stl"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--format: unknown format 'stl'"), std::string::npos) << r.err;
+    r = apparentRun({"render", scene, "--frames", "3-4"});
+    EXPECT_EQ(r.code, 2);
+    r = apparentRun({"render", scene, "--tolerance", "-1"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--tolerance"), std::string::npos) << r.err;
+}
+
+// The layout the issue spells out: DIR/<model>.glb and DIR/<model>/frame_NNNNN.ply|.obj, with
+// --frames A:B keeping global frame numbers.
+TEST(Cli, OutputLayoutAndFrameNumbers) {
+    TempDir dir;
+    const CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(), "--model",
+                               "all", "--format", "glb,ply,obj", "--frames", "2:4", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::vector<std::string> expected;
+    for (const char* m : {"contracted", "finite", "instant", "relativistic"}) {
+        expected.push_back(std::string(m) + ".glb");
+        for (const char* f : {"frame_00002", "frame_00003"})
+            for (const char* ext : {".obj", ".ply"}) expected.push_back(std::string(m) + "/" + f + ext);
+    }
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(listFiles(dir / ""), expected);  // and no temporary files left behind
+}
+
+// PLY: binary little-endian, per-vertex `quality` = emission time, which OpenMesh reads back;
+// each vertex satisfies |y - C| = t_c - t_e to float precision (positions are float in PLY).
+TEST(Cli, PlyCarriesEmissionTimeAsQuality) {
+    TempDir dir;
+    ASSERT_EQ(apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(), "--format", "ply",
+                           "--quiet"}).code, 0);
+    const fs::path ply = dir / "relativistic/frame_00001.ply";
+    std::ifstream head(ply, std::ios::binary);
+    std::string header((std::istreambuf_iterator<char>(head)), {});
+    header = header.substr(0, header.find("end_header"));
+    EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos) << header;
+    EXPECT_NE(header.find("property double quality"), std::string::npos) << header;
+
+    PlyMesh m;
+    OpenMesh::IO::Options opt(OpenMesh::IO::Options::Custom);
+    ASSERT_TRUE(OpenMesh::IO::read_mesh(m, ply.string(), opt));
+    OpenMesh::VPropHandleT<double> quality;
+    ASSERT_TRUE(m.get_property_handle(quality, "quality"));
+    EXPECT_EQ(m.n_faces(), 4u);
+    const double t_c = 10.1;  // frame 1 of the scene: start 10, fps 10
+    for (auto v : m.vertices()) {
+        const auto p = m.point(v);
+        const double dist = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        EXPECT_NEAR(dist, t_c - m.property(quality, v), 1e-5 * dist);
+    }
+}
+
+// GLB: one node and mesh per frame, one STEP scale channel per node, positions relative to the
+// node's translation; the file reloads with tinygltf and records the frame times in extras.
+TEST(Cli, GlbHoldsEveryFrameAsAStepAnimation) {
+    TempDir dir;
+    ASSERT_EQ(apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(), "--quiet"}).code, 0);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir / "relativistic.glb").string())) << err;
+    ASSERT_EQ(model.nodes.size(), 5u);
+    ASSERT_EQ(model.animations.size(), 1u);
+    ASSERT_EQ(model.animations[0].channels.size(), 5u);
+    for (size_t k = 0; k < 5; ++k) {
+        const auto& ch = model.animations[0].channels[k];
+        EXPECT_EQ(ch.target_node, int(k));
+        EXPECT_EQ(ch.target_path, "scale");
+        EXPECT_EQ(model.animations[0].samplers[ch.sampler].interpolation, "STEP");
+        ASSERT_GE(model.nodes[k].mesh, 0);
+        EXPECT_EQ(model.nodes[k].translation.size(), 3u);
+    }
+    const auto& extras = model.scenes[0].extras;
+    ASSERT_TRUE(extras.Has("frame_times"));
+    EXPECT_DOUBLE_EQ(extras.Get("frame_times").Get(2).GetNumberAsDouble(), 10.2);
+    EXPECT_EQ(extras.Get("model").Get<std::string>(), "relativistic");
+}
+
+// Bad input: exit 2, one line naming file and field, and nothing written at all.
+TEST(Cli, BadInputExitsTwoAndWritesNothing) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"scene_superluminal.json", "objects[0].velocity"},
+        {"scene_malformed.json", "invalid JSON"},
+        {"scene_missing_mesh.json", "does_not_exist.obj: cannot open mesh file"},
+        {"scene_unknown_field.json", "objects[0].velocty"},
+    };
+    for (const auto& [file, expected] : cases) {
+        TempDir dir;
+        const CommandResult r = apparentRun({"render", source(std::string("data/fixtures/") + file), "--out", dir.str()});
+        EXPECT_EQ(r.code, 2) << file;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_TRUE(listFiles(dir / "").empty()) << file;
+    }
+    // A malformed mesh behind a valid scene.
+    TempDir dir;
+    fs::create_directories(dir / "");
+    fs::copy_file(source("data/fixtures/bad_index.obj"), dir / "bad_index.obj");
+    std::ofstream(dir / "scene.json") << R"({ "objects": [ { "mesh": "bad_index.obj" } ] })";
+    const CommandResult r = apparentRun({"render", (dir / "scene.json").string(), "--out", (dir / "out").string()});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("bad_index.obj:5: f: vertex index 9 is out of range"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+// An object existing for proper time [0, 3] appears, shows clipped (open) frames and disappears.
+TEST(Cli, ExistenceWindowGivesClippedFrames) {
+    TempDir dir;
+    ASSERT_EQ(apparentRun({"render", source("data/fixtures/scene_exists_window.json"), "--out", dir.str(), "--format",
+                           "ply", "--quiet"}).code, 0);
+    int empty = 0, full = 0, partial = 0;
+    for (int k = 0; k < 120; ++k) {
+        char name[64];
+        std::snprintf(name, sizeof name, "relativistic/frame_%05d.ply", k);
+        PlyMesh m;
+        OpenMesh::IO::Options opt;
+        ASSERT_TRUE(OpenMesh::IO::read_mesh(m, (dir / name).string(), opt)) << name;
+        if (m.n_faces() == 0) ++empty;
+        else if (m.n_faces() == 4 && m.n_vertices() == 4) ++full;
+        else ++partial;
+    }
+    EXPECT_GT(empty, 0);
+    EXPECT_GT(full, 0);
+    EXPECT_GT(partial, 0);
+}
+
+// The default scene renders in every model.
+TEST(Cli, DefaultSceneRendersInEveryModel) {
+    TempDir dir;
+    const CommandResult r = apparentRun({"render", source("data/scenes/flanges.json"), "--out", dir.str(), "--model", "all",
+                               "--frames", "95:105"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char* m : {"instant", "finite", "relativistic", "contracted"})
+        EXPECT_TRUE(fs::exists(dir / (std::string(m) + ".glb"))) << m;
+    EXPECT_NE(r.out.find("relativistic: 10 frames"), std::string::npos) << r.out;
+}

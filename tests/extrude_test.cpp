@@ -1,0 +1,114 @@
+// Tests of the temporal extrusion: prisms of three tetrahedra forming a conforming complex.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+#include "mesh4d/extrude.h"
+#include "test_meshes.h"
+
+using namespace mesh4d;
+
+namespace {
+std::set<std::pair<uint32_t, uint32_t>> tetEdges(const std::array<uint32_t, 4>& t) {
+    std::set<std::pair<uint32_t, uint32_t>> e;
+    for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) e.insert(std::minmax(t[a], t[b]));
+    return e;
+}
+}  // namespace
+
+TEST(Extrude, EventsLieOnTheWorldlinesAtBothCaps) {
+    const RestMesh mesh = testmesh::icosphere(1, 2.0);
+    const Motion m = makeMotion(Kinematics::Lorentz, 1.0, {3, 0, -20}, {0.5, 0.2, 0});
+    const World4D w = extrude(mesh, m, -3.0, 4.0, true, false);
+    ASSERT_EQ(w.events.size(), 2 * mesh.positions.size());
+    ASSERT_EQ(w.tets.size(), 3 * mesh.triangles.size());
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+        EXPECT_NEAR(properTimeAt(m, mesh.positions[i], w.events[2 * i].t), -3.0, 1e-12);
+        EXPECT_NEAR(properTimeAt(m, mesh.positions[i], w.events[2 * i + 1].t), 4.0, 1e-12);
+        // The lateral edge is timelike: the worldline of a subluminal point.
+        EXPECT_LT(interval2(w.events[2 * i], w.events[2 * i + 1]), 0);
+    }
+    // Euler: every edge appears once, V - E + F = 2 for the sphere.
+    EXPECT_EQ(long(mesh.positions.size()) - long(w.edges.size()) + long(mesh.triangles.size()), 2);
+}
+
+// Neighbouring prisms choose the same diagonal on their shared lateral quad: the one from the
+// lower vertex id at cap a to the higher id at cap b, and never the other.
+TEST(Extrude, SharedLateralQuadsUseTheSameDiagonal) {
+    const RestMesh mesh = testmesh::torus(9, 7, 3.0, 1.0);
+    const World4D w = extrude(mesh, makeMotion(Kinematics::Galilean, 0, {}, {0.3, 0, 0}), 0, 1, false, false);
+    for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+        std::set<std::pair<uint32_t, uint32_t>> edges;
+        for (int k = 0; k < 3; ++k)
+            for (auto e : tetEdges(w.tets[3 * f + k])) edges.insert(e);
+        for (int c = 0; c < 3; ++c) {
+            const uint32_t lo = std::min(mesh.triangles[f][c], mesh.triangles[f][(c + 1) % 3]);
+            const uint32_t hi = std::max(mesh.triangles[f][c], mesh.triangles[f][(c + 1) % 3]);
+            EXPECT_TRUE(edges.count({2 * lo, 2 * hi + 1})) << "face " << f << " edge " << lo << "-" << hi;
+            EXPECT_FALSE(edges.count({2 * lo + 1, 2 * hi})) << "face " << f << " edge " << lo << "-" << hi;
+        }
+    }
+}
+
+// The three tetrahedra tile the prism: in the prism's parameter space (triangle barycentrics
+// and s in [0, 1] along the worldlines) a random point lies in exactly one of them, and the
+// three volumes add up to the prism's.
+TEST(Extrude, ThreeTetsTileThePrism) {
+    RestMesh tri;
+    tri.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    for (auto order : {std::array<uint32_t, 3>{0, 1, 2}, {2, 0, 1}, {1, 2, 0}}) {
+        tri.triangles = {order};
+        const World4D w = extrude(tri, makeMotion(Kinematics::Galilean, 0, {}, {}), 0, 1, false, false);
+        // Parameter-space coordinates of event 2 i + cap: (x, y) of the rest vertex, and cap as s.
+        auto param = [&](uint32_t ev) {
+            const Vec3& p = tri.positions[ev / 2];
+            return Vec3{p.x, p.y, double(ev % 2)};
+        };
+        double volume = 0;
+        std::vector<std::array<Vec3, 4>> tets;
+        for (const auto& t : w.tets) {
+            std::array<Vec3, 4> v{param(t[0]), param(t[1]), param(t[2]), param(t[3])};
+            volume += std::fabs(dot(v[1] - v[0], cross(v[2] - v[0], v[3] - v[0]))) / 6;
+            tets.push_back(v);
+        }
+        EXPECT_NEAR(volume, 0.5, 1e-15);  // triangle area 1/2 times height 1
+        std::mt19937_64 rng(7);
+        std::uniform_real_distribution<double> u(0, 1);
+        for (int i = 0; i < 1000; ++i) {
+            double a = u(rng), b = u(rng);
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            const Vec3 p{a, b, u(rng)};
+            int inside = 0;
+            for (const auto& v : tets) {
+                const double vol = dot(v[1] - v[0], cross(v[2] - v[0], v[3] - v[0]));
+                bool in = true;
+                for (int k = 0; k < 4 && in; ++k) {
+                    auto w4 = v;
+                    w4[k] = p;
+                    in = dot(w4[1] - w4[0], cross(w4[2] - w4[0], w4[3] - w4[0])) / vol >= -1e-12;
+                }
+                inside += in;
+            }
+            EXPECT_EQ(inside, 1) << "point " << i;
+        }
+    }
+}
+
+TEST(Extrude, SpanSeenCoversEveryFrameBetween) {
+    const RestMesh mesh = testmesh::icosphere(1, 1.0);
+    const Motion m = makeMotion(Kinematics::Lorentz, 0, {-10, 0, -20}, {0.9, 0, 0});
+    const ViewSurface first{ViewKind::PastCone, 0.0, {}}, last{ViewKind::PastCone, 30.0, {}};
+    const ProperTimeSpan span = spanSeen(mesh, m, first, last);
+    const double one_minus_b2 = (1 - 0.9) * (1 + 0.9);
+    for (double t_c = 0; t_c <= 30; t_c += 0.5) {
+        for (const Vec3& q : mesh.positions) {
+            const double t_e = cutWorldline({ViewKind::PastCone, t_c, {}}, labFromRest(m, 0, q), m.velocity,
+                                            one_minus_b2).event.t;
+            const double tau = properTimeAt(m, q, t_e);
+            EXPECT_GE(tau, span.lo - 1e-12);
+            EXPECT_LE(tau, span.hi + 1e-12);
+        }
+    }
+}

@@ -1,0 +1,73 @@
+// Scene loading: valid scenes load with their fields; each malformed fixture fails with one line
+// naming the file, the field and the problem.
+#include <gtest/gtest.h>
+
+#include "pipeline/scene.h"
+
+using namespace apparent;
+
+namespace {
+std::string fixture(const std::string& name) { return std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/" + name; }
+}  // namespace
+
+TEST(Scene, LoadsTheDefaultFlangeScene) {
+    Scene s;
+    const std::string path = std::string(APPARENT_SOURCE_DIR) + "/data/scenes/flanges.json";
+    const Status st = loadScene(path, &s);
+    ASSERT_TRUE(st.ok) << st.message;
+    EXPECT_EQ(s.model, Model::Relativistic);
+    ASSERT_EQ(s.objects.size(), 3u);
+    EXPECT_DOUBLE_EQ(s.objects[0].velocity.x, 0.866);
+    EXPECT_EQ(frameCount(s.frames), 200);
+    // Relative mesh paths resolve against the scene's folder.
+    EXPECT_NE(s.objects[0].mesh_path.find("data/meshes/flange.obj"), std::string::npos) << s.objects[0].mesh_path;
+    EXPECT_TRUE(s.objects[0].exists_from < -1e300 && s.objects[0].exists_to > 1e300);
+}
+
+TEST(Scene, FrameCountFollowsTheDefinition) {
+    // k = 0, 1, ... while start + k / fps < end.
+    EXPECT_EQ(frameCount({0, 20, 10}), 200);
+    EXPECT_EQ(frameCount({0, 1, 3}), 3);           // 0, 1/3, 2/3
+    EXPECT_EQ(frameCount({0, 1.05, 10}), 11);      // 0 .. 1.0
+    EXPECT_EQ(frameCount({10, 10.5, 10}), 5);      // 10.0 .. 10.4
+    EXPECT_EQ(frameCount({0, 0.3, 10}), 3);        // 0, 0.1, 0.2 (0.3 excluded even with rounding)
+    EXPECT_DOUBLE_EQ(frameTime({5, 10, 4}, 3), 5.75);
+}
+
+struct BadScene {
+    const char* file;
+    const char* expected;  // a substring of the one-line message
+};
+
+class SceneErrors : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(SceneErrors, NameFileFieldAndProblem) {
+    Scene s;
+    Status st = loadScene(fixture(GetParam().file), &s);
+    if (st.ok) st = checkSceneForModel(s, Model::Relativistic);
+    ASSERT_FALSE(st.ok);
+    EXPECT_NE(st.message.find(GetParam().file), std::string::npos) << st.message;
+    EXPECT_NE(st.message.find(GetParam().expected), std::string::npos) << st.message;
+    EXPECT_EQ(st.message.find('\n'), std::string::npos) << "one line: " << st.message;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Fixtures, SceneErrors,
+    ::testing::Values(BadScene{"scene_malformed.json", "invalid JSON"},
+                      BadScene{"scene_malformed.json", "line 3"},
+                      BadScene{"scene_superluminal.json", "objects[0].velocity: |velocity| = 1.2 must be < 1"},
+                      BadScene{"scene_unknown_field.json", "objects[0].velocty: unknown field"},
+                      BadScene{"scene_bad_exists.json", "objects[0].exists: from (5) must be less than to (1)"},
+                      BadScene{"scene_bad_vector.json", "objects[0].position: expected an array of 3 numbers"},
+                      BadScene{"no_such_scene.json", "cannot open scene file"}),
+    [](const ::testing::TestParamInfo<BadScene>& info) {
+        std::string name = std::string(info.param.file).substr(0, std::string(info.param.file).find('.'));
+        return name + "_" + std::to_string(info.index);
+    });
+
+TEST(Scene, SuperluminalIsAllowedOnlyInTheInstantModel) {
+    Scene s;
+    ASSERT_TRUE(loadScene(fixture("scene_superluminal.json"), &s).ok);
+    EXPECT_TRUE(checkSceneForModel(s, Model::Instant).ok);
+    for (Model m : {Model::Finite, Model::Relativistic, Model::Contracted}) EXPECT_FALSE(checkSceneForModel(s, m).ok);
+}

@@ -1,0 +1,206 @@
+// Tests of one frame's cut against closed forms (DESIGN.md section 10) and against the inverse map.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "mesh4d/robust.h"
+#include "mesh4d/slice.h"
+#include "pipeline/mesh_check.h"
+#include "test_meshes.h"
+
+using namespace mesh4d;
+
+namespace {
+
+World4D alwaysExisting(const RestMesh& mesh, const Motion& m, double t_c) {
+    // A span far wider than any delay in these tests, with open (non-clipping) caps.
+    (void)t_c;
+    return extrude(mesh, m, -1e4, 1e4, false, false);
+}
+
+// Distance from p to triangle (a, b, c), by projection and clamping to the edges.
+double pointTriangleDistance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 n = cross(b - a, c - a);
+    const Vec3 proj = p - n * (dot(p - a, n) / norm2(n));
+    const bool inside = dot(cross(b - a, proj - a), n) >= 0 && dot(cross(c - b, proj - b), n) >= 0 &&
+                        dot(cross(a - c, proj - c), n) >= 0;
+    if (inside) return norm(p - proj);
+    auto seg = [&](const Vec3& s0, const Vec3& s1) {
+        const double t = std::clamp(dot(p - s0, s1 - s0) / norm2(s1 - s0), 0.0, 1.0);
+        return norm(p - (s0 + (s1 - s0) * t));
+    };
+    return std::min({seg(a, b), seg(b, c), seg(c, a)});
+}
+
+double distanceToMesh(const Vec3& p, const RestMesh& m) {
+    double best = INFINITY;
+    for (const auto& t : m.triangles)
+        best = std::min(best, pointTriangleDistance(p, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]));
+    return best;
+}
+
+}  // namespace
+
+// Every output vertex lies on the camera's past cone, |y - C| = t_c - t_e, and on the object's
+// worldtube: un-retarding it (restFromLab at its emission time) lands on the input surface.
+TEST(Slice, OutputVerticesAreOnConeAndWorldtube) {
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        for (int seed = 0; seed < 40; ++seed) {
+            std::mt19937_64 rng(seed);
+            std::uniform_real_distribution<double> u(-1, 1);
+            const RestMesh mesh = testmesh::icosphere(2, 1.0 + 2 * std::fabs(u(rng)));
+            Vec3 dir{u(rng), u(rng), u(rng)};
+            const double beta = seed % 5 == 0 ? 0.999 : 0.95 * std::fabs(u(rng));
+            const Motion m = makeMotion(k, u(rng), Vec3{u(rng), u(rng), u(rng)} * 40.0, dir * (beta / norm(dir)));
+            const ViewSurface view{ViewKind::PastCone, 10 * u(rng), Vec3{u(rng), u(rng), u(rng)}};
+            const ApparentMesh out = sliceWorld(alwaysExisting(mesh, m, view.t_c), view);
+            ASSERT_EQ(out.positions.size(), mesh.positions.size());
+            ASSERT_EQ(out.triangles.size(), mesh.triangles.size());
+            for (size_t i = 0; i < out.positions.size(); ++i) {
+                const Vec3 y = out.positions[i];
+                const double dist = norm(y - view.apex);
+                const double delay = view.t_c - out.emission_times[i];
+                EXPECT_NEAR(dist, delay, 1e-9 * dist) << "seed " << seed << " vertex " << i;
+                const Vec3 q = restFromLab(m, y, out.emission_times[i]);
+                EXPECT_LE(distanceToMesh(q, mesh), 1e-9 * (dist + 1)) << "seed " << seed << " vertex " << i;
+            }
+        }
+    }
+}
+
+// Lampa (1924), DESIGN.md section 10: a rod of rest length L on the line of sight appears
+// L/(1-b) approaching and L/(1+b) receding with finite light speed alone, and
+// L sqrt((1+b)/(1-b)), L sqrt((1-b)/(1+b)) with the Lorentz contraction too.
+TEST(Slice, RodOnTheLineOfSight) {
+    const double L = 2.0;
+    const RestMesh rod = testmesh::rod(L, 1e-3);
+    for (double b : {0.1, 0.5, 0.866, 0.99}) {
+        for (int approach : {1, -1}) {
+            for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+                // The rod's near end is 100 light-seconds down the -z axis at t0 = 0.
+                const Motion m = makeMotion(k, 0.0, {0, 0, -100}, {0, 0, approach * b});
+                const ViewSurface view{ViewKind::PastCone, 0.0, {0, 0, 0}};
+                const ApparentMesh out = sliceWorld(alwaysExisting(rod, m, 0), view);
+                ASSERT_EQ(out.triangles.size(), 1u);
+                // Output vertices follow the triangle's corners: 0 and 1 are the rod's ends.
+                const double apparent = norm(out.positions[1] - out.positions[0]);
+                double expected;
+                if (k == Kinematics::Galilean) expected = approach > 0 ? L / (1 - b) : L / (1 + b);
+                else expected = approach > 0 ? L * std::sqrt((1 + b) / (1 - b)) : L * std::sqrt((1 - b) / (1 + b));
+                EXPECT_NEAR(apparent, expected, 1e-10 * expected)
+                    << "b " << b << (approach > 0 ? " approaching " : " receding ")
+                    << (k == Kinematics::Galilean ? "finite" : "relativistic");
+            }
+        }
+    }
+}
+
+// At b = 0 every model returns the input mesh moved to its position, and the instant model
+// (hyperplane t = t_c, Galilean) is an exact translation by X0 + v (t_c - t0) at any speed.
+TEST(Slice, RestIsIdentityAndInstantIsTranslation) {
+    const RestMesh mesh = testmesh::torus(12, 8, 3.0, 1.0);
+    const Vec3 X0{5, -2, -30};
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        for (ViewKind vk : {ViewKind::PastCone, ViewKind::Hyperplane}) {
+            const Motion m = makeMotion(k, 2.0, X0, {0, 0, 0});
+            const ApparentMesh out = sliceWorld(alwaysExisting(mesh, m, 0), {vk, 7.0, {1, 1, 1}});
+            ASSERT_EQ(out.positions.size(), mesh.positions.size());
+            for (size_t i = 0; i < mesh.positions.size(); ++i)
+                EXPECT_NEAR(norm(out.positions[i] - (mesh.positions[i] + X0)), 0, 1e-13 * 40) << i;
+            EXPECT_EQ(out.triangles, mesh.triangles);
+        }
+    }
+    for (double b : {0.5, 0.99, 3.0}) {  // the instant model does not care about light speed
+        const Vec3 v{0, b, 0};
+        const Motion m = makeMotion(Kinematics::Galilean, 2.0, X0, v);
+        const double t_c = 7.0;
+        const ApparentMesh out = sliceWorld(alwaysExisting(mesh, m, 0), {ViewKind::Hyperplane, t_c, {}});
+        for (size_t i = 0; i < mesh.positions.size(); ++i) {
+            EXPECT_NEAR(norm(out.positions[i] - (mesh.positions[i] + X0 + v * (t_c - 2.0))), 0, 1e-13 * 40) << i;
+            EXPECT_EQ(out.emission_times[i], t_c);
+        }
+    }
+}
+
+// A closed 2-manifold that exists throughout gives a closed 2-manifold of the same genus, with
+// one output vertex per input vertex (no cracks, no duplicates), checked with CGAL.
+TEST(Slice, ClosedManifoldStaysClosedWithSameGenus) {
+    struct Case { RestMesh mesh; long genus; };
+    const Case cases[] = {{testmesh::icosphere(2, 2.0), 0}, {testmesh::torus(16, 10, 3.0, 1.0), 1}};
+    for (const Case& c : cases) {
+        const apparent::Topology in = apparent::analyzeTopology(c.mesh.positions, c.mesh.triangles);
+        ASSERT_TRUE(in.closed);
+        ASSERT_EQ(in.genus, c.genus);
+        for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+            const Motion m = makeMotion(k, 0, {-4, 1, -12}, {0.9, 0, 0.1});
+            const ApparentMesh out = sliceWorld(alwaysExisting(c.mesh, m, 0), {ViewKind::PastCone, 3.0, {}});
+            const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
+            EXPECT_TRUE(t.closed);
+            EXPECT_EQ(t.genus, c.genus);
+            EXPECT_EQ(t.vertices, in.vertices);
+            EXPECT_EQ(t.components, 1u);
+        }
+    }
+}
+
+// An object that begins existing inside the frames: on the frame where the cone crosses its
+// start, the surface is clipped and open. The clip points lie on the cap tau = tau_a: in the
+// Galilean model at one lab time (t0 + tau_a), in the Lorentz model on the tilted simultaneity
+// t = t0 + g (tau_a + v.q), which spreads the clip's emission times.
+TEST(Slice, ExistenceStartClipsAlongTheTiltedCap) {
+    const RestMesh mesh = testmesh::icosphere(3, 2.0);
+    const double tau_a = 0.0;
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        const Motion m = makeMotion(k, 0.0, {-1, 0, -20}, {0.8, 0, 0});
+        const World4D w = extrude(mesh, m, tau_a, 1e4, true, false);
+        // The frame whose cone meets the object's origin at its start: t_c = 0 + |X0 - C|.
+        const ViewSurface view{ViewKind::PastCone, norm(m.origin), {}};
+        const ApparentMesh out = sliceWorld(w, view);
+        EXPECT_GT(out.clipped_triangles, 0u);
+        EXPECT_GT(out.triangles.size(), 0u);
+        EXPECT_LT(out.triangles.size(), mesh.triangles.size());
+        const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
+        EXPECT_TRUE(t.manifold);
+        EXPECT_FALSE(t.closed);
+        EXPECT_GE(t.boundary_loops, 1u);
+        double t_min = INFINITY, t_max = -INFINITY;
+        size_t clip_points = 0;
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const Vec3 y = out.positions[i];
+            const double t_e = out.emission_times[i];
+            EXPECT_NEAR(norm(y - view.apex), view.t_c - t_e, 1e-9 * 20);
+            const Vec3 q = restFromLab(m, y, t_e);
+            const double tau = properTimeAt(m, q, t_e);
+            EXPECT_GE(tau, tau_a - 1e-9);
+            if (std::fabs(tau - tau_a) < 1e-9) {
+                ++clip_points;
+                t_min = std::min(t_min, t_e);
+                t_max = std::max(t_max, t_e);
+                // The clip point is on the rest surface's edges (on the surface, to rounding).
+                EXPECT_LE(distanceToMesh(q, mesh), 1e-9);
+            }
+        }
+        EXPECT_GT(clip_points, 10u);
+        if (k == Kinematics::Galilean) {
+            EXPECT_NEAR(t_max - t_min, 0, 1e-12);  // a flat cap: one lab time
+        } else {
+            // Tilted: emission times spread by g b times the extent along v (up to 2 g b r).
+            EXPECT_GT(t_max - t_min, 0.5);
+        }
+    }
+}
+
+// Clip points are computed once per (edge, cap): triangles sharing an edge share its point, so
+// a clipped closed surface has no cracks: every interior edge is shared by exactly two faces.
+TEST(Slice, ClippedSurfaceHasNoCracks) {
+    const RestMesh mesh = testmesh::torus(24, 12, 3.0, 1.0);
+    const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -15}, {0.7, 0.3, 0});
+    const World4D w = extrude(mesh, m, 0.0, 2.0, true, true);
+    for (double t_c = 10; t_c <= 22; t_c += 0.25) {
+        const ApparentMesh out = sliceWorld(w, {ViewKind::PastCone, t_c, {}});
+        if (out.triangles.empty()) continue;
+        const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
+        EXPECT_TRUE(t.manifold) << "t_c " << t_c;
+        if (out.clipped_triangles == 0) EXPECT_TRUE(t.closed) << "t_c " << t_c;
+    }
+}
