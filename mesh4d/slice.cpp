@@ -1,5 +1,7 @@
 #include "slice.h"
 
+#include <cmath>
+
 #include "robust.h"
 
 namespace mesh4d {
@@ -46,7 +48,12 @@ struct FrameBuilder {
         if (vertex_out[i] == kUnset) {
             const Motion& m = world.motion;
             const double one_minus_b2 = oneMinusSquare(m.beta);
-            vertex_out[i] = emit(cutWorldline(view, world.events[2 * i], m.velocity, one_minus_b2).event);
+            // Anchor the worldline at the cap event nearer in time to the frame: the shorter the
+            // extrapolation v (t_c - t_anchor), the smaller its absolute rounding.
+            const Event& ea = world.events[2 * i];
+            const Event& eb = world.events[2 * i + 1];
+            const Event& anchor = std::fabs(view.t_c - ea.t) <= std::fabs(view.t_c - eb.t) ? ea : eb;
+            vertex_out[i] = emit(cutWorldline(view, anchor, m.velocity, one_minus_b2).event);
         }
         return vertex_out[i];
     }

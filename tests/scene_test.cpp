@@ -39,6 +39,8 @@ struct BadScene {
     const char* expected;  // a substring of the one-line message
 };
 
+void PrintTo(const BadScene& b, std::ostream* os) { *os << b.file << " -> " << b.expected; }
+
 class SceneErrors : public ::testing::TestWithParam<BadScene> {};
 
 TEST_P(SceneErrors, NameFileFieldAndProblem) {

@@ -204,3 +204,20 @@ TEST(Slice, ClippedSurfaceHasNoCracks) {
         if (out.clipped_triangles == 0) EXPECT_TRUE(t.closed) << "t_c " << t_c;
     }
 }
+
+// The contracted model (hyperplane t = t_c, Lorentz): each vertex is where the boosted object is
+// at t_c, X0 + v (t_c - t0) + q - (1 - 1/g)(q.u) u; a rod along the motion measures L / gamma.
+TEST(Slice, ContractedModelIsTheMeasuredShape) {
+    const double b = 0.866, L = 2.0;
+    RestMesh rod;
+    rod.positions = {{0, 0, 0}, {L, 0, 0}, {0, 0.01, 0}};
+    rod.triangles = {{0, 1, 2}};
+    const Motion m = makeMotion(Kinematics::Lorentz, 1.0, {-3, 0, -18}, {b, 0, 0});
+    const double t_c = 4.0;
+    const ApparentMesh out = sliceWorld(extrude(rod, m, -10, 10, false, false), {ViewKind::Hyperplane, t_c, {}});
+    ASSERT_EQ(out.positions.size(), 3u);
+    const double gamma = 1 / std::sqrt((1 - b) * (1 + b));
+    EXPECT_NEAR(norm(out.positions[1] - out.positions[0]), L / gamma, 1e-12);
+    EXPECT_NEAR(out.positions[0].x, -3 + b * (t_c - 1.0), 1e-12);
+    for (double t_e : out.emission_times) EXPECT_EQ(t_e, t_c);
+}

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# One-command set-up for apparent on Debian 12 (README "Set up").
+#   scripts/setup.sh demo   install packages, build, render the default scene into out/
+#   scripts/setup.sh test   install packages (and the npm validators), build, run the whole test suite
+#   scripts/setup.sh build  install packages and build only
+# Environment: BUILD_DIR (default build), JOBS (default: number of cores), SKIP_APT=1 to skip apt-get.
+set -euo pipefail
+
+mode=${1:-demo}
+case "$mode" in demo|test|build) ;; *) echo "usage: $0 demo|test|build" >&2; exit 2 ;; esac
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+build_dir=${BUILD_DIR:-build}
+jobs=${JOBS:-$(nproc)}
+
+# Step: Debian packages (../shared/notes/dependencies.md section 1). assimp-testmodels holds real
+# third-party meshes for import tests; nodejs/npm run the Khronos glTF-Validator.
+packages=(build-essential cmake pkg-config
+  libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
+  libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels)
+if [ "$mode" = test ]; then
+  command -v node >/dev/null 2>&1 || packages+=(nodejs)
+  command -v npm >/dev/null 2>&1 || packages+=(npm)
+fi
+if [ "${SKIP_APT:-0}" != 1 ]; then
+  missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo=sudo
+    echo "== installing ${missing[*]}"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  fi
+fi
+
+# Step: npm validators for the test suite (versions pinned in package-lock.json).
+if [ "$mode" = test ]; then
+  echo "== npm packages"
+  npm ci --no-audit --no-fund --loglevel=error
+fi
+
+# Step: build.
+echo "== building in $build_dir"
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$build_dir" -j "$jobs"
+
+case "$mode" in
+  demo)
+    echo "== rendering data/scenes/flanges.json into out/"
+    "$build_dir/apparent" render data/scenes/flanges.json --out out --model all --format glb,ply
+    ;;
+  test)
+    echo "== running the test suite"
+    cd "$build_dir"
+    ctest --output-on-failure -j "$jobs"
+    ;;
+esac
