@@ -1,7 +1,8 @@
-// What the exporters receive: one frame of apparent geometry, all objects merged. Exporters make
-// no geometric decisions; they convert and write.
+// What the exporters receive: one frame of apparent geometry, one mesh per scene object, plus
+// what the sequence is. Exporters make no geometric decisions; they convert and write.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -10,9 +11,27 @@
 namespace apparent {
 
 struct ExportFrame {
-    long long index = 0;          // global frame number (file names use it)
-    double t_c = 0;               // camera time of the frame
-    mesh4d::ApparentMesh mesh;    // positions in lab coordinates, emission times, triangles
+    long long index = 0;                        // global frame number (file names use it)
+    double t_c = 0;                             // camera time of the frame
+    std::vector<mesh4d::ApparentMesh> objects;  // one per scene object, in scene order
+
+    size_t triangleCount() const {
+        size_t n = 0;
+        for (const auto& o : objects) n += o.triangles.size();
+        return n;
+    }
+};
+
+struct ExportObject {
+    std::string name;
+    std::array<double, 4> base_color{0.8, 0.8, 0.8, 1.0};  // linear RGBA
+};
+
+struct ExportCamera {
+    mesh4d::Vec3 position{0, 0, 0};
+    mesh4d::Vec3 look_at{0, 0, -1};
+    mesh4d::Vec3 up{0, 1, 0};
+    double fov_deg = 60;  // vertical field of view
 };
 
 struct SequenceInfo {
@@ -20,6 +39,11 @@ struct SequenceInfo {
     double tolerance = 0;         // requested tolerance (light-seconds)
     double fps = 1;
     std::string scene_path;
+    std::vector<ExportObject> objects;  // parallel to ExportFrame::objects
+    ExportCamera camera;
 };
+
+// All objects of a frame in one mesh (PLY and OBJ hold every object in one file).
+mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame);
 
 }  // namespace apparent

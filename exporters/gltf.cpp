@@ -4,20 +4,34 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 
+#include <draco/compression/decode.h>
+#include <draco/compression/expert_encode.h>
+#include <draco/mesh/mesh.h>
 #include <tiny_gltf.h>
 
 #include "exporters/atomic_file.h"
+#include "mesh4d/normals.h"
 
 namespace apparent {
 
 namespace {
 
+using mesh4d::Vec3;
+
+// One primitive's data as it goes into the file: float32 positions relative to the frame origin.
+struct PrimitiveData {
+    std::vector<float> positions, normals, emission;
+    std::vector<uint32_t> indices;
+    size_t vertexCount() const { return emission.size(); }
+};
+
 class GlbBuilder {
 public:
     tinygltf::Model model;
 
-    GlbBuilder() {
+    explicit GlbBuilder(const GlbOptions& options) : options_(options) {
         model.asset.version = "2.0";
         model.asset.generator = "apparent";
         model.buffers.emplace_back();  // buffer 0 without uri: the GLB BIN chunk
@@ -50,86 +64,249 @@ public:
         return int(model.accessors.size()) - 1;
     }
 
-    // Adds frame k's mesh; returns the mesh index, or -1 for an empty frame.
-    int addFrameMesh(const ExportFrame& f, double origin[3], double* max_err) {
-        const auto& m = f.mesh;
-        if (m.triangles.empty()) return -1;
-        // Step: local origin at the bounding-box centre, so float32 offsets are as small as possible.
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (const auto& p : m.positions)
-            for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
-        for (int c = 0; c < 3; ++c) origin[c] = 0.5 * (lo[c] + hi[c]);
-
-        // Step: float32 positions relative to the origin, with accessor bounds from the floats.
-        std::vector<float> pos(3 * m.positions.size());
-        std::vector<double> pmin(3, INFINITY), pmax(3, -INFINITY);
-        for (size_t i = 0; i < m.positions.size(); ++i) {
-            for (int c = 0; c < 3; ++c) {
-                const double rel = m.positions[i][c] - origin[c];
-                const float fv = float(rel);
-                pos[3 * i + c] = fv;
-                pmin[c] = std::min(pmin[c], double(fv));
-                pmax[c] = std::max(pmax[c], double(fv));
-                *max_err = std::max(*max_err, std::fabs(double(fv) - rel));
-            }
-        }
-        std::vector<float> emission(m.emission_times.begin(), m.emission_times.end());
-        std::vector<uint32_t> idx;
-        idx.reserve(3 * m.triangles.size());
-        for (const auto& t : m.triangles) idx.insert(idx.end(), t.begin(), t.end());
-
-        const int pos_acc = addAccessor(addView(pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, m.positions.size(), pmin, pmax);
-        const int em_acc = addAccessor(addView(emission.data(), emission.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, emission.size());
-        const int idx_acc = addAccessor(addView(idx.data(), idx.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-                                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, idx.size());
+    // A plain (uncompressed) primitive.
+    tinygltf::Primitive plainPrimitive(const PrimitiveData& d) {
         tinygltf::Primitive prim;
-        prim.attributes["POSITION"] = pos_acc;
-        prim.attributes["_EMISSION_TIME"] = em_acc;
-        prim.indices = idx_acc;
+        std::vector<double> lo, hi;
+        bounds(d.positions, &lo, &hi);
+        prim.attributes["POSITION"] = addAccessor(addView(d.positions.data(), d.positions.size() * 4, kArray),
+                                                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount(), lo, hi);
+        prim.attributes["NORMAL"] = addAccessor(addView(d.normals.data(), d.normals.size() * 4, kArray),
+                                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount());
+        prim.attributes["_EMISSION_TIME"] = addAccessor(addView(d.emission.data(), d.emission.size() * 4, kArray),
+                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
+                                                        d.vertexCount());
+        prim.indices = addAccessor(addView(d.indices.data(), d.indices.size() * 4, kElements),
+                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, d.indices.size());
         prim.mode = TINYGLTF_MODE_TRIANGLES;
-        prim.material = 0;
-        tinygltf::Mesh mesh;
-        mesh.name = "frame_" + std::to_string(f.index);
-        mesh.primitives.push_back(prim);
-        model.meshes.push_back(mesh);
-        return int(model.meshes.size()) - 1;
+        return prim;
+    }
+
+    // A KHR_draco_mesh_compression primitive; returns false with a message when Draco fails.
+    // `quantization_error` receives the position error bound: half a step of the quantization
+    // grid, which spans the largest extent of the primitive's positions in 2^bits - 1 steps.
+    bool dracoPrimitive(const PrimitiveData& d, tinygltf::Primitive* prim, double* quantization_error,
+                        std::string* error) {
+        // Step: build the Draco mesh with identity point mapping.
+        draco::Mesh dm;
+        const size_t nv = d.vertexCount();
+        dm.set_num_points(uint32_t(nv));
+        auto addAttribute = [&](draco::GeometryAttribute::Type type, int components, const float* values) {
+            draco::GeometryAttribute ga;
+            ga.Init(type, nullptr, components, draco::DT_FLOAT32, false, 4 * components, 0);
+            const int id = dm.AddAttribute(ga, /*identity_mapping=*/true, uint32_t(nv));
+            for (size_t i = 0; i < nv; ++i)
+                dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(uint32_t(i)), values + components * i);
+            return id;
+        };
+        const int pos = addAttribute(draco::GeometryAttribute::POSITION, 3, d.positions.data());
+        const int nrm = addAttribute(draco::GeometryAttribute::NORMAL, 3, d.normals.data());
+        const int emt = addAttribute(draco::GeometryAttribute::GENERIC, 1, d.emission.data());
+        for (size_t f = 0; f < d.indices.size(); f += 3)
+            dm.AddFace({draco::PointIndex(d.indices[f]), draco::PointIndex(d.indices[f + 1]),
+                        draco::PointIndex(d.indices[f + 2])});
+
+        // Step: encode; the emission time stays unquantized (lossless).
+        draco::ExpertEncoder enc(dm);
+        enc.SetAttributeQuantization(pos, options_.position_bits);
+        enc.SetAttributeQuantization(nrm, options_.normal_bits);
+        enc.SetSpeedOptions(5, 5);
+        enc.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
+        draco::EncoderBuffer buf;
+        const draco::Status st = enc.EncodeToBuffer(&buf);
+        if (!st.ok()) {
+            *error = "Draco encoding failed: " + st.error_msg_string();
+            return false;
+        }
+        std::vector<double> lo, hi;
+        bounds(d.positions, &lo, &hi);
+        double extent = 0;
+        for (int c = 0; c < 3; ++c) extent = std::max(extent, hi[c] - lo[c]);
+        *quantization_error = 0.5 * extent / double((1u << options_.position_bits) - 1);
+
+        // Step: decode it again; the accessors must describe what a reader will get.
+        draco::DecoderBuffer db;
+        db.Init(buf.data(), buf.size());
+        draco::Decoder dec;
+        auto decoded = dec.DecodeMeshFromBuffer(&db);
+        if (!decoded.ok()) {
+            *error = "Draco could not decode its own output: " + decoded.status().error_msg_string();
+            return false;
+        }
+        const std::unique_ptr<draco::Mesh> back = std::move(decoded).value();
+        const draco::PointAttribute* bpos = back->GetAttributeByUniqueId(dm.attribute(pos)->unique_id());
+        std::vector<double> dlo(3, INFINITY), dhi(3, -INFINITY);
+        for (draco::PointIndex p(0); p < back->num_points(); ++p) {
+            float v[3];
+            bpos->GetMappedValue(p, v);
+            for (int c = 0; c < 3; ++c) { dlo[c] = std::min(dlo[c], double(v[c])); dhi[c] = std::max(dhi[c], double(v[c])); }
+        }
+        const size_t n_points = back->num_points();
+        prim->attributes["POSITION"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points, dlo, dhi);
+        prim->attributes["NORMAL"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
+        prim->attributes["_EMISSION_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
+        prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                    size_t(back->num_faces()) * 3);
+        prim->mode = TINYGLTF_MODE_TRIANGLES;
+        const int view = addView(buf.data(), buf.size(), 0);
+        tinygltf::Value::Object attrs{
+            {"POSITION", tinygltf::Value(int(dm.attribute(pos)->unique_id()))},
+            {"NORMAL", tinygltf::Value(int(dm.attribute(nrm)->unique_id()))},
+            {"_EMISSION_TIME", tinygltf::Value(int(dm.attribute(emt)->unique_id()))}};
+        prim->extensions["KHR_draco_mesh_compression"] = tinygltf::Value(
+            tinygltf::Value::Object{{"bufferView", tinygltf::Value(view)}, {"attributes", tinygltf::Value(attrs)}});
+        return true;
+    }
+
+private:
+    static constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
+    static constexpr int kElements = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
+    GlbOptions options_;
+
+    static void bounds(const std::vector<float>& xyz, std::vector<double>* lo, std::vector<double>* hi) {
+        lo->assign(3, INFINITY);
+        hi->assign(3, -INFINITY);
+        for (size_t i = 0; i < xyz.size(); ++i) {
+            (*lo)[i % 3] = std::min((*lo)[i % 3], double(xyz[i]));
+            (*hi)[i % 3] = std::max((*hi)[i % 3], double(xyz[i]));
+        }
     }
 };
 
+// Float32 data of one object's mesh relative to `origin`; tracks the largest rounding.
+PrimitiveData toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double* max_err) {
+    PrimitiveData d;
+    const std::vector<Vec3> normals = mesh4d::vertexNormals(m);
+    d.positions.reserve(3 * m.positions.size());
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            const double rel = m.positions[i][c] - origin[c];
+            const float fv = float(rel);
+            d.positions.push_back(fv);
+            *max_err = std::max(*max_err, std::fabs(double(fv) - rel));
+            d.normals.push_back(float(normals[i][c]));
+        }
+    }
+    d.emission.assign(m.emission_times.begin(), m.emission_times.end());
+    for (const auto& t : m.triangles) d.indices.insert(d.indices.end(), t.begin(), t.end());
+    return d;
+}
+
+// Rotation quaternion (x, y, z, w) of the camera node: glTF cameras look down local -Z with +Y
+// up, so the node's axes are right = f x up, up' = right x f, back = -f.
+std::vector<double> cameraRotation(const ExportCamera& cam) {
+    const Vec3 f = (cam.look_at - cam.position) / mesh4d::norm(cam.look_at - cam.position);
+    const Vec3 r = mesh4d::cross(f, cam.up) / mesh4d::norm(mesh4d::cross(f, cam.up));
+    const Vec3 u = mesh4d::cross(r, f);
+    const Vec3 b = -f;
+    // Matrix columns r, u, b; standard matrix-to-quaternion conversion choosing the largest term.
+    const double m00 = r.x, m01 = u.x, m02 = b.x, m10 = r.y, m11 = u.y, m12 = b.y, m20 = r.z, m21 = u.z, m22 = b.z;
+    const double trace = m00 + m11 + m22;
+    double x, y, z, w;
+    if (trace > 0) {
+        const double s = 0.5 / std::sqrt(trace + 1.0);
+        w = 0.25 / s; x = (m21 - m12) * s; y = (m02 - m20) * s; z = (m10 - m01) * s;
+    } else if (m00 > m11 && m00 > m22) {
+        const double s = 2.0 * std::sqrt(1.0 + m00 - m11 - m22);
+        w = (m21 - m12) / s; x = 0.25 * s; y = (m01 + m10) / s; z = (m02 + m20) / s;
+    } else if (m11 > m22) {
+        const double s = 2.0 * std::sqrt(1.0 + m11 - m00 - m22);
+        w = (m02 - m20) / s; x = (m01 + m10) / s; y = 0.25 * s; z = (m12 + m21) / s;
+    } else {
+        const double s = 2.0 * std::sqrt(1.0 + m22 - m00 - m11);
+        w = (m10 - m01) / s; x = (m02 + m20) / s; y = (m12 + m21) / s; z = 0.25 * s;
+    }
+    const double len = std::sqrt(x * x + y * y + z * z + w * w);
+    return {x / len, y / len, z / len, w / len};
+}
+
 tinygltf::Value number(double v) { return tinygltf::Value(v); }
 
-}  // namespace
+// Builds the whole glTF model of the sequence into `b.model`; fills the error statistics.
+bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
+                const GlbOptions& options, GlbBuilder& b, GlbStats& local, std::string* error) {
 
-bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
-                      GlbStats* stats, std::string* error) {
-    if (frames.empty()) {
-        *error = path + ": no frames to write";
-        return false;
+    // Step: one material per object.
+    for (const ExportObject& o : info.objects) {
+        tinygltf::Material mat;
+        mat.name = o.name;
+        mat.pbrMetallicRoughness.baseColorFactor = {o.base_color[0], o.base_color[1], o.base_color[2], o.base_color[3]};
+        mat.pbrMetallicRoughness.metallicFactor = 0.0;
+        mat.pbrMetallicRoughness.roughnessFactor = 0.8;
+        mat.doubleSided = true;  // thin shells such as the flanges are seen from both sides
+        b.model.materials.push_back(mat);
     }
-    GlbBuilder b;
-    tinygltf::Material mat;
-    mat.name = "apparent";
-    mat.pbrMetallicRoughness.baseColorFactor = {0.8, 0.55, 0.2, 1.0};
-    mat.pbrMetallicRoughness.metallicFactor = 0.0;
-    mat.doubleSided = true;  // thin shells such as the flanges are seen from both sides
-    b.model.materials.push_back(mat);
 
-    // Step: one node per frame, visible only in its own time slot.
+    // Step: the camera node (node 0).
     tinygltf::Scene scene;
     scene.name = info.model;
-    const size_t n = frames.size();
-    double max_err = 0;
-    for (size_t k = 0; k < n; ++k) {
+    {
+        tinygltf::Camera cam;
+        cam.type = "perspective";
+        cam.perspective.yfov = info.camera.fov_deg * 3.14159265358979323846 / 180.0;
+        // Clip planes in light-seconds: 1e-3 of, and 10 times, the farthest apparent point's
+        // distance (tinygltf always writes zfar, and the validator requires zfar > znear).
+        double far = 0;
+        for (const auto& f : frames)
+            for (const auto& o : f.objects)
+                for (const auto& p : o.positions) far = std::max(far, mesh4d::norm(p - info.camera.position));
+        far = far > 0 ? far : 1.0;
+        cam.perspective.znear = 1e-3 * far;
+        cam.perspective.zfar = 10 * far;
+        b.model.cameras.push_back(cam);
         tinygltf::Node node;
-        node.name = "frame_" + std::to_string(frames[k].index);
-        double origin[3] = {0, 0, 0};
-        node.mesh = b.addFrameMesh(frames[k], origin, &max_err);
-        if (node.mesh >= 0) node.translation = {origin[0], origin[1], origin[2]};
+        node.name = "camera";
+        node.camera = 0;
+        node.translation = {info.camera.position.x, info.camera.position.y, info.camera.position.z};
+        node.rotation = cameraRotation(info.camera);
+        b.model.nodes.push_back(node);
+        scene.nodes.push_back(0);
+    }
+
+    // Step: one node per frame (node 1 + k), visible only in its own time slot.
+    const size_t n = frames.size();
+    for (size_t k = 0; k < n; ++k) {
+        const ExportFrame& f = frames[k];
+        tinygltf::Node node;
+        node.name = "frame_" + std::string(std::max(0, 5 - int(std::to_string(f.index).size())), '0') +
+                    std::to_string(f.index);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (const auto& o : f.objects)
+            for (const auto& p : o.positions)
+                for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+        if (f.triangleCount() > 0) {
+            const double origin[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+            for (int c = 0; c < 3; ++c) local.max_extent = std::max(local.max_extent, hi[c] - lo[c]);
+            tinygltf::Mesh mesh;
+            mesh.name = node.name;
+            for (size_t o = 0; o < f.objects.size(); ++o) {
+                if (f.objects[o].triangles.empty()) continue;
+                const PrimitiveData d = toPrimitive(f.objects[o], origin, &local.max_float_error);
+                tinygltf::Primitive prim;
+                if (options.draco) {
+                    double qerr = 0;
+                    if (!b.dracoPrimitive(d, &prim, &qerr, error)) {
+                        *error = path + ": " + node.name + ": " + *error;
+                        return false;
+                    }
+                    local.max_quantization_error = std::max(local.max_quantization_error, qerr);
+                } else {
+                    prim = b.plainPrimitive(d);
+                }
+                prim.material = o < info.objects.size() ? int(o) : -1;
+                mesh.primitives.push_back(prim);
+            }
+            b.model.meshes.push_back(mesh);
+            node.mesh = int(b.model.meshes.size()) - 1;
+            node.translation = {origin[0], origin[1], origin[2]};
+        }
         node.scale = {k == 0 ? 1.0 : 0.0, k == 0 ? 1.0 : 0.0, k == 0 ? 1.0 : 0.0};
         b.model.nodes.push_back(node);
-        scene.nodes.push_back(int(k));
+        scene.nodes.push_back(int(b.model.nodes.size()) - 1);
+    }
+    if (options.draco) {
+        b.model.extensionsUsed.push_back("KHR_draco_mesh_compression");
+        b.model.extensionsRequired.push_back("KHR_draco_mesh_compression");
     }
 
     // Step: STEP scale channels, at most 3 keys each so the file grows linearly with the frame
@@ -159,40 +336,69 @@ bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& f
         anim.samplers.push_back(s);
         tinygltf::AnimationChannel c;
         c.sampler = int(k);
-        c.target_node = int(k);
+        c.target_node = int(1 + k);
         c.target_path = "scale";
         anim.channels.push_back(c);
     }
     b.model.animations.push_back(anim);
 
     // Step: scene extras: what was computed, in which units, at which camera times.
-    tinygltf::Value::Array frame_times;
+    tinygltf::Value::Array frame_times, object_names;
     for (const auto& f : frames) frame_times.push_back(number(f.t_c));
+    for (const auto& o : info.objects) object_names.push_back(tinygltf::Value(o.name));
     tinygltf::Value::Object extras{{"model", tinygltf::Value(info.model)},
                                    {"tolerance", number(info.tolerance)},
                                    {"units", tinygltf::Value(std::string("light-seconds, seconds, c = 1"))},
                                    {"fps", number(info.fps)},
-                                   {"first_frame", tinygltf::Value(int(frames.front().index))},
+                                   {"first_frame", number(double(frames.front().index))},
                                    {"frame_times", tinygltf::Value(frame_times)},
+                                   {"objects", tinygltf::Value(object_names)},
                                    {"scene_file", tinygltf::Value(info.scene_path)}};
     scene.extras = tinygltf::Value(extras);
     b.model.scenes.push_back(scene);
     b.model.defaultScene = 0;
 
+    return true;
+}
+
+}  // namespace
+
+bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
+                      const GlbOptions& options, GlbStats* stats, std::string* error) {
+    if (frames.empty()) {
+        *error = path + ": no frames to write";
+        return false;
+    }
+    GlbBuilder b(options);
+    GlbStats local;
+    if (!buildModel(path, frames, info, options, b, local, error)) return false;
+
     // Step: write through a temporary file.
-    AtomicOutput out(path);
     tinygltf::TinyGLTF writer;
+    AtomicOutput out(path);
     if (!writer.WriteGltfSceneToFile(&b.model, out.tempPath(), /*embedImages=*/true, /*embedBuffers=*/true,
                                      /*prettyPrint=*/false, /*writeBinary=*/true)) {
         *error = path + ": tinygltf could not write the file";
         return false;
     }
-    if (stats) {
-        std::error_code ec;
-        stats->bytes = size_t(std::filesystem::file_size(out.tempPath(), ec));
-        stats->max_position_error = max_err;
+    std::error_code ec;
+    local.bytes = size_t(std::filesystem::file_size(out.tempPath(), ec));
+    if (!out.commit(error)) return false;
+
+    // Step: with Draco, the size the same sequence has without it, serialized in memory.
+    if (options.draco) {
+        GlbOptions plain_options = options;
+        plain_options.draco = false;
+        GlbBuilder plain(plain_options);
+        GlbStats ignored;
+        if (buildModel(path, frames, info, plain_options, plain, ignored, error)) {
+            std::ostringstream os;
+            if (writer.WriteGltfSceneToStream(&plain.model, os, /*prettyPrint=*/false, /*writeBinary=*/true))
+                local.bytes_without_draco = os.str().size();
+        }
     }
-    return out.commit(error);
+    if (stats) *stats = local;
+    return true;
 }
 
 }  // namespace apparent

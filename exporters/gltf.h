@@ -1,13 +1,21 @@
 // One animated binary glTF (.glb) per model, holding every frame of the sequence.
 //
-// Layout (glTF 2.0): node k carries mesh k (frame k, all objects merged) and its translation is
-// the frame's local origin (the centre of its bounding box, as JSON doubles); POSITION is float32
-// relative to that origin, so scenes far from the world origin keep their precision. A per-vertex
-// float attribute _EMISSION_TIME holds the lab time the light left each point. One animation with
-// STEP-interpolated scale channels shows exactly frame k's node during [k/fps, (k+1)/fps): n + 1
-// keys, the last one closing the final frame (../shared/notes/dependencies.md section 4). A frame
-// with nothing visible gets a node without a mesh (glTF forbids empty accessors).
-// Scene extras record the model, tolerance, units and the camera time of every frame.
+// Layout (glTF 2.0):
+// - node 0 "camera": a perspective camera placed and aimed like the scene camera;
+// - node 1 + k "frame_NNNNN": mesh k, frame k, one primitive per visible object with that
+//   object's material; its translation is the frame's local origin (the centre of its bounding
+//   box, as JSON doubles) and POSITION is float32 relative to it, so scenes far from the world
+//   origin keep their precision. Each primitive has NORMAL (area-weighted) and a float
+//   _EMISSION_TIME (the lab time the light left the point). A frame with nothing visible gets a
+//   node without a mesh (glTF forbids empty accessors).
+// - one animation "frames" of STEP scale channels: node k is visible (scale 1) during
+//   [k/fps, (k+1)/fps) and hidden (scale 0) otherwise; the last frame stays visible at the final
+//   key n/fps, which closes the sequence (../shared/notes/dependencies.md section 4).
+// - scene extras: model, tolerance, units, fps, first_frame, frame_times, objects, scene_file.
+// With Draco (KHR_draco_mesh_compression, required), every primitive's attributes and indices
+// are Edgebreaker-coded; POSITION is quantized to `position_bits` over the primitive's largest
+// extent, NORMAL to `normal_bits`, and _EMISSION_TIME kept lossless. Accessor counts and bounds
+// are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
 #pragma once
 
 #include <string>
@@ -17,12 +25,21 @@
 
 namespace apparent {
 
+struct GlbOptions {
+    bool draco = false;
+    int position_bits = 14;  // Draco position quantization, 1..30
+    int normal_bits = 10;    // Draco normal quantization, 1..30
+};
+
 struct GlbStats {
-    size_t bytes = 0;
-    double max_position_error = 0;  // largest |float32 - double| over all exported positions, light-seconds
+    size_t bytes = 0;                 // size of the written file
+    size_t bytes_without_draco = 0;   // with Draco: size of the same file without it (0 otherwise)
+    double max_float_error = 0;       // largest |float32 - double| over exported positions, light-seconds
+    double max_quantization_error = 0;  // Draco: largest position quantization error bound, light-seconds
+    double max_extent = 0;            // largest frame extent, light-seconds (to judge the errors above)
 };
 
 bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
-                      GlbStats* stats, std::string* error);
+                      const GlbOptions& options, GlbStats* stats, std::string* error);
 
 }  // namespace apparent

@@ -2,8 +2,20 @@
 
 namespace apparent {
 
+mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame) {
+    mesh4d::ApparentMesh all;
+    for (const auto& part : frame.objects) {
+        const uint32_t base = uint32_t(all.positions.size());
+        all.positions.insert(all.positions.end(), part.positions.begin(), part.positions.end());
+        all.emission_times.insert(all.emission_times.end(), part.emission_times.begin(), part.emission_times.end());
+        for (const auto& t : part.triangles) all.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+        all.clipped_triangles += part.clipped_triangles;
+    }
+    return all;
+}
+
 OpenMesh::VPropHandleT<double> toOpenMesh(const ExportFrame& frame, FrameTriMesh* om) {
-    const auto& m = frame.mesh;
+    const mesh4d::ApparentMesh m = mergeObjects(frame);
     OpenMesh::VPropHandleT<double> quality;
     om->add_property(quality, "quality");
     om->property(quality).set_persistent(true);

@@ -1,5 +1,6 @@
 #include "pipeline/render.h"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -76,18 +77,37 @@ private:
     double last_ = -1;
 };
 
-void appendMesh(const mesh4d::ApparentMesh& part, mesh4d::ApparentMesh* all) {
-    const uint32_t base = uint32_t(all->positions.size());
-    all->positions.insert(all->positions.end(), part.positions.begin(), part.positions.end());
-    all->emission_times.insert(all->emission_times.end(), part.emission_times.begin(), part.emission_times.end());
-    for (const auto& t : part.triangles) all->triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-    all->clipped_triangles += part.clipped_triangles;
-}
-
 std::string frameFileName(long long k, const char* ext) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "frame_%05lld.%s", k, ext);
     return buf;
+}
+
+// Distinct base colours for objects without their own (linear RGB, roughly equal lightness).
+constexpr std::array<std::array<double, 4>, 6> kPalette = {{{0.85, 0.45, 0.10, 1.0},
+                                                            {0.10, 0.45, 0.85, 1.0},
+                                                            {0.55, 0.55, 0.55, 1.0},
+                                                            {0.20, 0.70, 0.25, 1.0},
+                                                            {0.75, 0.20, 0.60, 1.0},
+                                                            {0.85, 0.75, 0.15, 1.0}}};
+
+SequenceInfo sequenceInfo(const Scene& scene, const std::vector<PreparedObject>& objects, const std::string& model) {
+    SequenceInfo info;
+    info.model = model;
+    info.tolerance = scene.tolerance;
+    info.fps = scene.frames.fps;
+    info.scene_path = scene.path;
+    for (size_t i = 0; i < objects.size(); ++i) {
+        ExportObject o;
+        o.name = objects[i].spec.name;
+        o.base_color = objects[i].has_color ? objects[i].color : kPalette[i % kPalette.size()];
+        info.objects.push_back(o);
+    }
+    info.camera.position = scene.camera.position;
+    info.camera.look_at = scene.camera.look_at;
+    info.camera.up = scene.camera.up;
+    info.camera.fov_deg = scene.camera.fov_deg;
+    return info;
 }
 
 }  // namespace
@@ -231,8 +251,8 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
             frame.index = k;
             frame.t_c = frameTime(scene.frames, k);
             const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-            for (const auto& w : worlds) appendMesh(mesh4d::sliceWorld(w, view), &frame.mesh);
-            max_triangles = std::max(max_triangles, frame.mesh.triangles.size());
+            for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view));
+            max_triangles = std::max(max_triangles, frame.triangleCount());
             std::string error;
             if (settings.write_ply &&
                 !writePly((std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string(), frame, &error)) {
@@ -251,23 +271,32 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         // Step: the animated sequence.
         std::string summary;
         if (settings.write_glb) {
-            SequenceInfo info;
-            info.model = name;
-            info.tolerance = scene.tolerance;
-            info.fps = scene.frames.fps;
-            info.scene_path = scene.path;
+            const SequenceInfo info = sequenceInfo(scene, objects, name);
             GlbStats stats;
             std::string error;
             const std::string glb = (std::filesystem::path(settings.out_dir) / (name + ".glb")).string();
-            if (!writeAnimatedGlb(glb, frames, info, &stats, &error)) {
+            if (!writeAnimatedGlb(glb, frames, info, settings.glb, &stats, &error)) {
                 err << "error: " << error << "\n";
                 return kExitOutputError;
             }
-            summary = ", " + glb + " (" + humanBytes(stats.bytes) + ")";
-            if (settings.verbose) {
-                std::ostringstream os;
-                os << "; float32 position error <= " << std::setprecision(3) << stats.max_position_error << " ls";
-                summary += os.str();
+            summary = ", " + glb + " (" + humanBytes(stats.bytes);
+            if (settings.glb.draco) summary += " with Draco, " + humanBytes(stats.bytes_without_draco) + " without";
+            summary += ")";
+            std::ostringstream os;
+            os << std::setprecision(3);
+            if (settings.verbose) os << "; float32 position error <= " << stats.max_float_error << " ls";
+            if (settings.glb.draco && settings.verbose)
+                os << "; Draco " << settings.glb.position_bits << "-bit position error <= " << stats.max_quantization_error
+                   << " ls";
+            summary += os.str();
+            // Warn when Draco's quantization is coarser than the accuracy asked for (gltfpack warns
+            // the same way about position bits).
+            if (settings.glb.draco && stats.max_quantization_error > scene.tolerance && !settings.quiet) {
+                std::ostringstream w;
+                w << std::setprecision(3) << "warning: " << glb << ": Draco position error up to "
+                  << stats.max_quantization_error << " ls exceeds the tolerance " << scene.tolerance
+                  << " ls; consider more bits (--draco-bits " << std::min(30, settings.glb.position_bits + 2) << ")\n";
+                err << w.str();
             }
         }
         if (!settings.quiet)

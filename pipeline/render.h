@@ -3,10 +3,12 @@
 // usage, 3 output could not be written.
 #pragma once
 
+#include <array>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
+#include "exporters/gltf.h"
 #include "pipeline/obj_reader.h"
 #include "pipeline/scene.h"
 
@@ -24,6 +26,7 @@ struct RenderSettings {
     bool write_glb = true;
     bool write_ply = false;
     bool write_obj = false;
+    GlbOptions glb;                    // --draco, --draco-bits
     bool has_tolerance = false;        // --tolerance given: overrides the scene's
     double tolerance = 1e-3;
     long long frame_from = 0;          // --frames A:B, global frame numbers, B exclusive
@@ -38,6 +41,8 @@ struct RenderSettings {
 struct PreparedObject {
     ObjectSpec spec;
     mesh4d::RestMesh rest;
+    bool has_color = false;            // the mesh file gave a base colour
+    std::array<double, 4> color{1, 1, 1, 1};
 };
 
 // Loads every object's mesh and applies rotation and scale. Messages of counted warnings go to `log`.

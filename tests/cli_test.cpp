@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstring>
 #include <sstream>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -152,16 +153,23 @@ TEST(Cli, GlbHoldsEveryFrameAsAStepAnimation) {
     tinygltf::TinyGLTF loader;
     std::string err, warn;
     ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir / "relativistic.glb").string())) << err;
-    ASSERT_EQ(model.nodes.size(), 5u);
+    ASSERT_EQ(model.nodes.size(), 6u);  // the camera, then one node per frame
+    EXPECT_EQ(model.nodes[0].name, "camera");
+    EXPECT_EQ(model.nodes[0].camera, 0);
     ASSERT_EQ(model.animations.size(), 1u);
     ASSERT_EQ(model.animations[0].channels.size(), 5u);
     for (size_t k = 0; k < 5; ++k) {
         const auto& ch = model.animations[0].channels[k];
-        EXPECT_EQ(ch.target_node, int(k));
+        EXPECT_EQ(ch.target_node, int(k + 1));
         EXPECT_EQ(ch.target_path, "scale");
         EXPECT_EQ(model.animations[0].samplers[ch.sampler].interpolation, "STEP");
-        ASSERT_GE(model.nodes[k].mesh, 0);
-        EXPECT_EQ(model.nodes[k].translation.size(), 3u);
+        const auto& node = model.nodes[k + 1];
+        EXPECT_EQ(node.name, "frame_0000" + std::to_string(k));
+        ASSERT_GE(node.mesh, 0);
+        EXPECT_EQ(node.translation.size(), 3u);
+        const auto& prim = model.meshes[node.mesh].primitives.at(0);
+        for (const char* attr : {"POSITION", "NORMAL", "_EMISSION_TIME"}) EXPECT_TRUE(prim.attributes.count(attr)) << attr;
+        EXPECT_EQ(prim.material, 0);
     }
     const auto& extras = model.scenes[0].extras;
     ASSERT_TRUE(extras.Has("frame_times"));
@@ -226,4 +234,60 @@ TEST(Cli, DefaultSceneRendersInEveryModel) {
     for (const char* m : {"instant", "finite", "relativistic", "contracted"})
         EXPECT_TRUE(fs::exists(dir / (std::string(m) + ".glb"))) << m;
     EXPECT_NE(r.out.find("relativistic: 10 frames"), std::string::npos) << r.out;
+}
+
+// Draco: the file is smaller, reloads through tinygltf's Draco decoder, and every decoded
+// position is within the quantization bound of a position of the plain export (Draco reorders
+// points, so each decoded point is matched to the nearest original of the same primitive).
+TEST(Cli, DracoRoundTripWithinQuantizationBound) {
+    TempDir plain_dir, draco_dir;
+    const std::string scene = source("data/scenes/flanges.json");
+    ASSERT_EQ(apparentRun({"render", scene, "--out", plain_dir.str(), "--frames", "90:110", "--quiet"}).code, 0);
+    const CommandResult r = apparentRun({"render", scene, "--out", draco_dir.str(), "--frames", "90:110", "--draco",
+                                         "--draco-bits", "12"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("with Draco"), std::string::npos) << r.out;
+
+    auto load = [](const fs::path& p, tinygltf::Model* m) {
+        tinygltf::TinyGLTF loader;
+        std::string err, warn;
+        return loader.LoadBinaryFromFile(m, &err, &warn, p.string());
+    };
+    tinygltf::Model plain, draco;
+    ASSERT_TRUE(load(plain_dir / "relativistic.glb", &plain));
+    ASSERT_TRUE(load(draco_dir / "relativistic.glb", &draco));
+    ASSERT_EQ(draco.extensionsRequired, std::vector<std::string>{"KHR_draco_mesh_compression"});
+    ASSERT_EQ(plain.meshes.size(), draco.meshes.size());
+    auto positions = [](const tinygltf::Model& m, const tinygltf::Primitive& p) {
+        const auto& acc = m.accessors[p.attributes.at("POSITION")];
+        const auto& view = m.bufferViews[acc.bufferView];
+        const uint8_t* base = m.buffers[view.buffer].data.data() + view.byteOffset + acc.byteOffset;
+        const size_t stride = acc.ByteStride(view);
+        std::vector<std::array<float, 3>> out(acc.count);
+        for (size_t i = 0; i < acc.count; ++i) std::memcpy(out[i].data(), base + i * stride, 12);
+        return out;
+    };
+    double worst_ratio = 0;
+    for (size_t mi = 0; mi < plain.meshes.size(); ++mi) {
+        ASSERT_EQ(plain.meshes[mi].primitives.size(), draco.meshes[mi].primitives.size());
+        for (size_t pi = 0; pi < plain.meshes[mi].primitives.size(); ++pi) {
+            const auto a = positions(plain, plain.meshes[mi].primitives[pi]);
+            const auto b = positions(draco, draco.meshes[mi].primitives[pi]);
+            // The bound: half a step of a 12-bit grid over the primitive's largest extent.
+            float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (const auto& p : a)
+                for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+            const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+            const double bound = 0.5 * extent / 4095.0 * std::sqrt(3.0) + 1e-6;
+            for (const auto& q : b) {
+                double best = INFINITY;
+                for (const auto& p : a)
+                    best = std::min(best, std::sqrt(std::pow(double(p[0] - q[0]), 2) + std::pow(double(p[1] - q[1]), 2) +
+                                                    std::pow(double(p[2] - q[2]), 2)));
+                EXPECT_LE(best, bound) << "mesh " << mi << " primitive " << pi;
+                worst_ratio = std::max(worst_ratio, best / bound);
+            }
+        }
+    }
+    EXPECT_GT(worst_ratio, 0.0);  // quantization did happen: the test can see an error
 }

@@ -21,14 +21,14 @@ async function main(files) {
   for (const f of files) {
     const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(f)), {
       uri: path.basename(f),
-      maxIssues: 100,
+      maxIssues: 0,  // unlimited: a truncated list could hide errors behind Draco's infos
       externalResourceFunction: (uri) =>
         fs.promises.readFile(path.resolve(path.dirname(f), decodeURIComponent(uri))),
     });
     const i = report.issues;
     console.log(`${f}: ${i.numErrors} errors, ${i.numWarnings} warnings, ${i.numInfos} infos, ` +
                 `${i.numHints} hints (glTF-Validator ${validator.version()}; ` +
-                `${report.info.animationCount} animations, ${report.info.totalVertexCount} vertices)`);
+                (report.info ? `${report.info.animationCount} animations, ${report.info.totalVertexCount} vertices)` : 'no info)'));
     for (const m of i.messages) {
       if (m.severity <= 1) console.log(`  ${m.severity === 0 ? 'ERROR' : 'WARNING'} ${m.code} ${m.pointer || ''}: ${m.message}`);
     }
