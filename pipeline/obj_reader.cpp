@@ -100,15 +100,6 @@ Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* sc
 
 }  // namespace
 
-std::vector<std::string> MeshWarnings::lines() const {
-    std::vector<std::string> out;
-    if (polygons_triangulated) out.push_back(std::to_string(polygons_triangulated) + " polygons triangulated");
-    if (degenerate_dropped) out.push_back(std::to_string(degenerate_dropped) + " degenerate triangles dropped");
-    if (nonmanifold_split)
-        out.push_back(std::to_string(nonmanifold_split) + " non-manifold faces given their own vertices");
-    return out;
-}
-
 Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
     // Step: scan for what the library would drop silently.
     ScanResult scan;

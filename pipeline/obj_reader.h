@@ -13,21 +13,10 @@
 #include <vector>
 
 #include "mesh4d/extrude.h"
+#include "pipeline/mesh_input.h"
 #include "pipeline/status.h"
 
 namespace apparent {
-
-struct MeshWarnings {
-    size_t polygons_triangulated = 0;   // faces with more than 3 vertices
-    size_t degenerate_dropped = 0;      // faces with a repeated index or zero area
-    size_t nonmanifold_split = 0;       // faces OpenMesh had to give their own vertices
-    std::vector<std::string> lines() const;  // human-readable, one per non-zero count
-};
-
-struct MeshLimits {
-    size_t max_vertices = 50'000'000;
-    size_t max_faces = 50'000'000;
-};
 
 // Reads an OBJ file into a rest-frame triangle mesh (no transform applied).
 Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings);

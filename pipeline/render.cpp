@@ -114,20 +114,22 @@ SequenceInfo sequenceInfo(const Scene& scene, const std::vector<PreparedObject>&
 
 Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<PreparedObject>* objects,
                       std::ostream& log, bool quiet) {
-    std::map<std::string, mesh4d::RestMesh> cache;  // one read per mesh file
+    std::map<std::string, LoadedMesh> cache;  // one read per mesh file
     for (const ObjectSpec& spec : scene.objects) {
         auto it = cache.find(spec.mesh_path);
         if (it == cache.end()) {
-            mesh4d::RestMesh mesh;
+            LoadedMesh mesh;
             MeshWarnings warnings;
-            if (Status s = readObj(spec.mesh_path, limits, &mesh, &warnings); !s.ok) return s;
+            if (Status s = readMesh(spec.mesh_path, limits, &mesh, &warnings); !s.ok) return s;
             if (!quiet)
                 for (const std::string& w : warnings.lines()) log << "warning: " << spec.mesh_path << ": " << w << "\n";
             it = cache.emplace(spec.mesh_path, std::move(mesh)).first;
         }
         PreparedObject obj;
         obj.spec = spec;
-        obj.rest = it->second;
+        obj.rest = it->second.mesh;
+        obj.has_color = it->second.has_color;
+        obj.color = it->second.color;
         for (Vec3& p : obj.rest.positions)
             p = rotateXYZ({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z}, spec.rotation_deg);
         // A negative scale determinant mirrors the mesh: flip triangles to keep outward orientation.

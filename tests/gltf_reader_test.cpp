@@ -1,0 +1,219 @@
+// glTF import through tinygltf: real third-party files (the Khronos samples in ../shared and the
+// glTF files of Debian's assimp-testmodels) import or are refused with a reason, never crash;
+// expected counts come from the files' own documentation (SOURCES.md) and accessor bounds.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/mesh_input.h"
+
+using namespace apparent;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string fixture(const std::string& name) { return std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/gltf/" + name; }
+const fs::path kSamples = fs::path(APPARENT_SOURCE_DIR) / "../shared/data/gltf-samples";
+const fs::path kAssimp = "/usr/share/assimp/models/glTF2";
+
+Status load(const std::string& path, LoadedMesh* m, MeshWarnings* w = nullptr) {
+    MeshWarnings local;
+    return readMesh(path, {}, m, w ? w : &local);
+}
+
+}  // namespace
+
+// Triangle counts from ../shared/data/gltf-samples/SOURCES.md ("drawn in default scene").
+TEST(GltfReader, KhronosSamplesGiveTheirDocumentedTriangleCounts) {
+    ASSERT_TRUE(fs::exists(kSamples)) << kSamples;
+    const std::pair<const char*, size_t> expected[] = {
+        {"Box.gltf", 12}, {"BoxVertexColors.gltf", 12}, {"AnimatedTriangle.gltf", 1}, {"Cameras.gltf", 2},
+        {"SimpleMeshes.gltf", 2}, {"TriangleWithoutIndices.gltf", 1}, {"Triangle.gltf", 1},
+        {"SimpleSparseAccessor.gltf", 12}, {"SimpleMorph.gltf", 1}, {"MultipleScenes.gltf", 2},
+        {"BoxAnimated.gltf", 254}};
+    for (const auto& [file, triangles] : expected) {
+        LoadedMesh m;
+        const Status st = load((kSamples / file).string(), &m);
+        ASSERT_TRUE(st.ok) << st.message;
+        EXPECT_EQ(m.mesh.triangles.size(), triangles) << file;
+    }
+}
+
+// The sparse sample substitutes three positions; the accessor's declared min/max (written by the
+// file's author) describe the substituted data, and the loaded bounds must match them.
+TEST(GltfReader, SparseAccessorSubstitutionsAreApplied) {
+    const std::string path = (kSamples / "SimpleSparseAccessor.gltf").string();
+    std::ifstream in(path);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    const auto& acc = j["accessors"][j["meshes"][0]["primitives"][0]["attributes"]["POSITION"].get<int>()];
+    ASSERT_TRUE(acc.contains("sparse"));
+    LoadedMesh m;
+    ASSERT_TRUE(load(path, &m).ok);
+    for (int c = 0; c < 3; ++c) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (const auto& p : m.mesh.positions) { lo = std::min(lo, p[c]); hi = std::max(hi, p[c]); }
+        EXPECT_NEAR(lo, acc["min"][c].get<double>(), 1e-6) << c;
+        EXPECT_NEAR(hi, acc["max"][c].get<double>(), 1e-6) << c;
+    }
+}
+
+// Every .gltf/.glb of the samples and of assimp-testmodels (many deliberately broken) imports or
+// is refused with a one-line reason naming the file; none crashes. Known-broken ones must fail.
+TEST(GltfReader, EveryThirdPartyFileImportsOrIsRefusedClearly) {
+    ASSERT_TRUE(fs::exists(kAssimp)) << "install Debian's assimp-testmodels (scripts/setup.sh does)";
+    std::vector<fs::path> files;
+    for (const auto& dir : {kSamples, kAssimp})
+        for (const auto& e : fs::recursive_directory_iterator(dir))
+            if (e.path().extension() == ".gltf" || e.path().extension() == ".glb") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    ASSERT_GE(files.size(), 50u);
+    size_t loaded = 0, refused = 0;
+    for (const auto& f : files) {
+        LoadedMesh m;
+        const Status st = load(f.string(), &m);
+        if (st.ok) {
+            ++loaded;
+            EXPECT_FALSE(m.mesh.triangles.empty()) << f;
+            for (const auto& p : m.mesh.positions) ASSERT_TRUE(mesh4d::isFinite(p)) << f;
+        } else {
+            ++refused;
+            EXPECT_EQ(st.message.rfind(f.string(), 0), 0u) << st.message;
+            EXPECT_EQ(st.message.find('\n'), std::string::npos) << st.message;
+        }
+    }
+    std::printf("glTF corpus: %zu files, %zu imported, %zu refused\n", files.size(), loaded, refused);
+    const std::pair<const char*, const char*> broken[] = {
+        {"IndexOutOfRange/IndexOutOfRange.gltf", "index 255 out of range (24 vertices)"},
+        {"IndexOutOfRange/AllIndicesOutOfRange.gltf", "out of range"},
+        {"RecursiveNodes/RecursiveNodes.gltf", "cycle"},
+        {"MissingBin/BoxTextured.gltf", "File not found"},
+        {"BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "is not finite"},
+        {"IncorrectVertexArrays/Cube.gltf", "not a multiple of 3"},
+    };
+    for (const auto& [file, reason] : broken) {
+        LoadedMesh m;
+        const Status st = load((kAssimp / file).string(), &m);
+        EXPECT_FALSE(st.ok) << file;
+        EXPECT_NE(st.message.find(reason), std::string::npos) << st.message;
+    }
+}
+
+// Strips and fans are triangulated (n - 2 triangles for n indices), points and lines skipped;
+// both are counted. Modes per file are read from the files themselves.
+TEST(GltfReader, PrimitiveModes) {
+    const fs::path dir = kAssimp / "glTF-Asset-Generator/Mesh_PrimitiveMode";
+    int strips_or_fans = 0, lines_or_points = 0;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        if (e.path().extension() != ".gltf") continue;
+        std::ifstream in(e.path());
+        const nlohmann::json j = nlohmann::json::parse(in);
+        const int mode = j["meshes"][0]["primitives"][0].value("mode", 4);
+        LoadedMesh m;
+        MeshWarnings w;
+        const Status st = load(e.path().string(), &m, &w);
+        if (mode <= 3) {
+            EXPECT_FALSE(st.ok) << e.path();
+            EXPECT_EQ(w.points_lines_skipped, 1u) << e.path();
+            ++lines_or_points;
+        } else {
+            ASSERT_TRUE(st.ok) << st.message;
+            if (mode != 4) {
+                EXPECT_EQ(w.strips_fans_triangulated, 1u) << e.path();
+                ++strips_or_fans;
+            }
+        }
+    }
+    EXPECT_GT(strips_or_fans, 0);
+    EXPECT_GT(lines_or_points, 0);
+}
+
+// Debian's package has 2CylinderEngine plain (.glb) and Draco-compressed (.gltf): both import,
+// with the same triangle count and bounding boxes equal to Draco's quantization.
+TEST(GltfReader, DracoPrimitivesDecodeLikeThePlainFile) {
+    LoadedMesh plain, draco;
+    ASSERT_TRUE(load((kAssimp / "2CylinderEngine-glTF-Binary/2CylinderEngine.glb").string(), &plain).ok);
+    const Status st = load((kAssimp / "draco/2CylinderEngine.gltf").string(), &draco);
+    ASSERT_TRUE(st.ok) << st.message;
+    // Draco's encoder drops degenerate faces that the plain file keeps and that survive our
+    // exact collinearity test (near-zero area): allow 0.1 % of the count.
+    const double nt = double(plain.mesh.triangles.size());
+    EXPECT_NEAR(double(draco.mesh.triangles.size()), nt, 1e-3 * nt);
+    double extent = 0;
+    for (int c = 0; c < 3; ++c) {
+        double plo = INFINITY, phi = -INFINITY, dlo = INFINITY, dhi = -INFINITY;
+        for (const auto& p : plain.mesh.positions) { plo = std::min(plo, p[c]); phi = std::max(phi, p[c]); }
+        for (const auto& p : draco.mesh.positions) { dlo = std::min(dlo, p[c]); dhi = std::max(dhi, p[c]); }
+        extent = std::max(extent, phi - plo);
+        EXPECT_NEAR(dlo, plo, 1e-3 * (phi - plo)) << c;
+        EXPECT_NEAR(dhi, phi, 1e-3 * (phi - plo)) << c;
+    }
+    EXPECT_GT(extent, 0);
+}
+
+TEST(GltfReader, NodeTransformsAndNodeSelection) {
+    LoadedMesh m;
+    ASSERT_TRUE(load(fixture("triangle.gltf"), &m).ok);
+    ASSERT_EQ(m.mesh.positions.size(), 3u);
+    EXPECT_EQ(m.mesh.positions[1], (mesh4d::Vec3{11, 0, 0}));  // node translation applied
+
+    ASSERT_TRUE(load(fixture("two_nodes.gltf"), &m).ok);
+    EXPECT_EQ(m.mesh.triangles.size(), 2u);
+    EXPECT_EQ(m.mesh.positions[1], (mesh4d::Vec3{96, 0, 0}));   // root (100) + left (-5) + 1
+    EXPECT_EQ(m.mesh.positions[4], (mesh4d::Vec3{104, 0, 0}));  // root + right (5) - 1 (mirrored)
+    // The mirrored copy keeps an outward winding: its normal points the same way (+z).
+    auto normalZ = [&](const std::array<uint32_t, 3>& t) {
+        return mesh4d::cross(m.mesh.positions[t[1]] - m.mesh.positions[t[0]], m.mesh.positions[t[2]] - m.mesh.positions[t[0]]).z;
+    };
+    EXPECT_GT(normalZ(m.mesh.triangles[0]), 0);
+    EXPECT_GT(normalZ(m.mesh.triangles[1]), 0);
+
+    // "#right": that node's subtree in its own frame, without its or its ancestors' transforms.
+    ASSERT_TRUE(load(fixture("two_nodes.gltf") + "#right", &m).ok);
+    EXPECT_EQ(m.mesh.triangles.size(), 1u);
+    EXPECT_EQ(m.mesh.positions[1], (mesh4d::Vec3{1, 0, 0}));
+    const Status st = load(fixture("two_nodes.gltf") + "#nobody", &m);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("no node named 'nobody'"), std::string::npos) << st.message;
+}
+
+TEST(GltfReader, HostileFilesAreRefusedWithTheField) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"escape_parent.gltf", "buffers[0].uri: '../../x.bin' leaves the glTF file's folder (refused)"},
+        {"escape_absolute.gltf", "buffers[0].uri: '/etc/hostname' is not a relative path"},
+        {"missing_bin.gltf", "File not found"},
+        {"accessor_overflow.gltf", "accessors[0]: count 1000 with byteOffset 0 reaches past bufferViews[0]"},
+        {"absurd_count.gltf", "accessors[0]"},
+        {"int_position.gltf", "accessors[0].componentType: POSITION must be FLOAT, got UNSIGNED_SHORT"},
+        {"view_overflow.gltf", "bufferViews[0]"},
+        {"draco_bad_view.gltf", "KHR_draco_mesh_compression.bufferView: 99 out of range"},
+    };
+    for (const auto& [file, expected] : cases) {
+        LoadedMesh m;
+        const Status st = load(fixture(file), &m);
+        EXPECT_FALSE(st.ok) << file;
+        EXPECT_NE(st.message.find(expected), std::string::npos) << file << ": " << st.message;
+        EXPECT_NE(st.message.find(file), std::string::npos) << st.message;
+    }
+}
+
+// Every truncated prefix of a real .glb either loads or fails with a message; none crashes.
+TEST(GltfReader, TruncatedGlbPrefixesNeverCrash) {
+    const fs::path src = kAssimp / "BoxTextured-glTF-Binary/BoxTextured.glb";
+    std::ifstream in(src, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    ASSERT_GT(bytes.size(), 100u);
+    const fs::path dir = fs::temp_directory_path() / ("apparent_glb_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string path = (dir / "prefix.glb").string();
+    for (size_t n = 0; n < bytes.size(); n += std::max<size_t>(1, bytes.size() / 300)) {
+        std::ofstream(path, std::ios::binary) << bytes.substr(0, n);
+        LoadedMesh m;
+        const Status st = load(path, &m);
+        EXPECT_FALSE(st.ok) << n;  // a strict prefix is never a valid GLB (its length field says more)
+        EXPECT_FALSE(st.message.empty());
+    }
+    fs::remove_all(dir);
+}
