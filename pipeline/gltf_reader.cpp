@@ -6,12 +6,14 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <algorithm>
 #include <set>
 
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "pipeline/mesh_check.h"
+#include "pipeline/scene_json.h"
 
 namespace apparent {
 
@@ -487,24 +489,19 @@ private:
     }
 };
 
-}  // namespace
 
-Status readGltf(const std::string& path_and_node, const MeshLimits& limits, LoadedMesh* out, MeshWarnings* warnings) {
-    const auto hash = path_and_node.find('#');
-    const std::string path = path_and_node.substr(0, hash);
-    const std::string node_name = hash == std::string::npos ? "" : path_and_node.substr(hash + 1);
-    *out = LoadedMesh{};
-
+// Reads, checks and parses a glTF file into `model` (tinygltf), file access confined.
+Status loadModel(const std::string& path, const MeshLimits& limits, tinygltf::Model* model, MeshWarnings* warnings) {
     // Step: read the file ourselves (size-limited) and check what tinygltf would not.
     std::error_code ec;
     const auto size = fs::file_size(path, ec);
-    if (ec) return Status::failure(path + ": cannot open mesh file");
+    if (ec) return Status::failure(path + ": cannot open file");
     if (size > limits.max_file_bytes) return Status::failure(path + ": larger than the limit of " + std::to_string(limits.max_file_bytes) + " bytes");
     std::vector<unsigned char> bytes(size_t(size), 0);
     {
         std::ifstream in(path, std::ios::binary);
         if (!in || (size && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size))))
-            return Status::failure(path + ": cannot read mesh file");
+            return Status::failure(path + ": cannot read file");
     }
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     std::string json_text, problem;
@@ -519,15 +516,126 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&confinedExists, &confinedExpand, &confinedRead, &refuseWrite, &conf});
     loader.SetImageLoader(&skipImage, nullptr);
-    tinygltf::Model model;
     std::string err, warn;
     const std::string base_dir = conf.root.string();
-    const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base_dir)
-                           : loader.LoadASCIIFromString(&model, &err, &warn, json_text.c_str(), unsigned(json_text.size()), base_dir);
+    const bool ok = binary ? loader.LoadBinaryFromMemory(model, &err, &warn, bytes.data(), unsigned(bytes.size()), base_dir)
+                           : loader.LoadASCIIFromString(model, &err, &warn, json_text.c_str(), unsigned(json_text.size()), base_dir);
     if (!conf.violation.empty())
         return Status::failure(path + ": buffers: URI '" + conf.violation + "' is outside the glTF file's folder (refused)");
     if (!ok) return Status::failure(path + ": tinygltf: " + (err.empty() ? std::string("could not load the file") : firstLine(err)));
     if (!warn.empty()) warnings->other.push_back("tinygltf: " + firstLine(warn));
+    return Status::success();
+}
+
+nlohmann::json toJson(const tinygltf::Value& v) {
+    switch (v.Type()) {
+        case tinygltf::BOOL_TYPE: return v.Get<bool>();
+        case tinygltf::INT_TYPE: return v.Get<int>();
+        case tinygltf::REAL_TYPE: return v.Get<double>();
+        case tinygltf::STRING_TYPE: return v.Get<std::string>();
+        case tinygltf::ARRAY_TYPE: {
+            nlohmann::json a = nlohmann::json::array();
+            for (size_t i = 0; i < v.ArrayLen(); ++i) a.push_back(toJson(v.Get(int(i))));
+            return a;
+        }
+        case tinygltf::OBJECT_TYPE: {
+            nlohmann::json o = nlohmann::json::object();
+            for (const auto& key : v.Keys()) o[key] = toJson(v.Get(key));
+            return o;
+        }
+        default: return nullptr;
+    }
+}
+
+}  // namespace
+
+Status loadGltfScene(const std::string& path, Scene* scene) {
+    *scene = Scene{};
+    scene->path = path;
+    tinygltf::Model model;
+    MeshWarnings warnings;
+    if (Status s = loadModel(path, MeshLimits{}, &model, &warnings); !s.ok) return s;
+    if (model.scenes.empty()) return Status::failure(path + ": scenes: none (a scene file needs a scene whose nodes carry extras)");
+    const size_t si = model.defaultScene >= 0 && size_t(model.defaultScene) < model.scenes.size() ? size_t(model.defaultScene) : 0;
+
+    // Step: scene-level extras give frames, model and tolerance.
+    nlohmann::json root = nlohmann::json::object();
+    SceneJsonPaths paths;
+    paths.top = "scenes[" + std::to_string(si) + "].extras";
+    const nlohmann::json sx = toJson(model.scenes[si].extras);
+    if (sx.is_object())
+        for (const char* key : {"frames", "model", "tolerance"})
+            if (sx.contains(key)) root[key] = sx[key];
+
+    // Step: walk the node tree; nodes whose extras carry object fields become objects, the first
+    // camera node becomes the camera.
+    const std::string file = fs::path(path).filename().string();
+    nlohmann::json objects = nlohmann::json::array();
+    std::set<std::string> names;
+    std::string problem;
+    std::function<bool(int, const Affine&, int, std::vector<int>&)> visit =
+        [&](int n, const Affine& parent, int owner, std::vector<int>& stack) -> bool {
+        const std::string where = "nodes[" + std::to_string(n) + "]";
+        if (n < 0 || size_t(n) >= model.nodes.size()) { problem = "nodes: index " + std::to_string(n) + " out of range"; return false; }
+        if (std::find(stack.begin(), stack.end(), n) != stack.end()) { problem = where + ": the node hierarchy has a cycle"; return false; }
+        const tinygltf::Node& node = model.nodes[size_t(n)];
+        const Affine world = parent * localTransform(node);
+        stack.push_back(n);
+        if (node.camera >= 0 && !root.contains("camera") && size_t(node.camera) < model.cameras.size()) {
+            // glTF cameras look down local -Z with +Y up.
+            const Vec3 pos = world.apply({0, 0, 0});
+            const Vec3 ahead = world.apply({0, 0, -1}) - pos, up = world.apply({0, 1, 0}) - pos;
+            const Vec3 look = pos + ahead / mesh4d::norm(ahead);
+            const auto& cam = model.cameras[size_t(node.camera)];
+            root["camera"] = {{"position", {pos.x, pos.y, pos.z}}, {"look_at", {look.x, look.y, look.z}},
+                              {"up", {up.x, up.y, up.z}}};
+            if (cam.type == "perspective") root["camera"]["fov_deg"] = cam.perspective.yfov * 180.0 / 3.14159265358979323846;
+            paths.camera = where;
+        }
+        const nlohmann::json ex = toJson(node.extras);
+        const bool is_object = ex.is_object() && (ex.contains("velocity") || ex.contains("t0") || ex.contains("exists"));
+        if (is_object) {
+            if (owner >= 0) { problem = where + ": is inside object nodes[" + std::to_string(owner) + "] (objects cannot nest)"; return false; }
+            if (node.name.empty() || node.name.find('#') != std::string::npos) { problem = where + ".name: an object node needs a name without '#'"; return false; }
+            if (!names.insert(node.name).second) { problem = where + ".name: '" + node.name + "' names two object nodes"; return false; }
+            nlohmann::json obj = nlohmann::json::object();
+            // Known object fields are taken from the extras; other custom properties are ignored.
+            for (const char* key : {"t0", "velocity", "exists", "rotation_deg", "scale"})
+                if (ex.contains(key)) obj[key] = ex[key];
+            obj["name"] = node.name;
+            obj["mesh"] = file + "#" + node.name;
+            const Vec3 pos = world.apply({0, 0, 0});
+            obj["position"] = {pos.x, pos.y, pos.z};
+            objects.push_back(obj);
+            paths.objects.push_back(where + ".extras");
+            std::array<double, 9> linear{};
+            for (int c = 0; c < 3; ++c)
+                for (int r = 0; r < 3; ++r) linear[size_t(c * 3 + r)] = world.m[c * 4 + r];
+            paths.linear.push_back(linear);
+            owner = n;
+        }
+        for (int child : node.children)
+            if (!visit(child, world, owner, stack)) return false;
+        stack.pop_back();
+        return true;
+    };
+    for (int r : model.scenes[si].nodes) {
+        std::vector<int> stack;
+        if (!visit(r, Affine{}, -1, stack)) return Status::failure(path + ": " + problem);
+    }
+    if (objects.empty())
+        return Status::failure(path + ": nodes: no node carries object extras (velocity, t0 or exists) in scene " + std::to_string(si));
+    root["objects"] = objects;
+    return parseScene(root, path, paths, scene);
+}
+
+Status readGltf(const std::string& path_and_node, const MeshLimits& limits, LoadedMesh* out, MeshWarnings* warnings) {
+    const auto hash = path_and_node.find('#');
+    const std::string path = path_and_node.substr(0, hash);
+    const std::string node_name = hash == std::string::npos ? "" : path_and_node.substr(hash + 1);
+    *out = LoadedMesh{};
+    tinygltf::Model model;
+    if (Status s = loadModel(path, limits, &model, warnings); !s.ok) return s;
 
     // Step: choose the roots: one named node, the default scene, the first scene, or every root node.
     Reader reader(path, model, limits, out, warnings);

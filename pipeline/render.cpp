@@ -130,10 +130,16 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
         obj.rest = it->second.mesh;
         obj.has_color = it->second.has_color;
         obj.color = it->second.color;
-        for (Vec3& p : obj.rest.positions)
-            p = rotateXYZ({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z}, spec.rotation_deg);
-        // A negative scale determinant mirrors the mesh: flip triangles to keep outward orientation.
-        if (spec.scale.x * spec.scale.y * spec.scale.z < 0)
+        const auto& L = spec.linear;  // column-major
+        for (Vec3& p : obj.rest.positions) {
+            const Vec3 r = rotateXYZ({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z}, spec.rotation_deg);
+            p = {L[0] * r.x + L[3] * r.y + L[6] * r.z, L[1] * r.x + L[4] * r.y + L[7] * r.z,
+                 L[2] * r.x + L[5] * r.y + L[8] * r.z};
+        }
+        // A mirroring map (negative determinant) flips the winding: flip triangles back.
+        const double det_linear = L[0] * (L[4] * L[8] - L[7] * L[5]) - L[3] * (L[1] * L[8] - L[7] * L[2]) +
+                                  L[6] * (L[1] * L[5] - L[4] * L[2]);
+        if (spec.scale.x * spec.scale.y * spec.scale.z * det_linear < 0)
             for (auto& t : obj.rest.triangles) std::swap(t[1], t[2]);
         objects->push_back(std::move(obj));
     }

@@ -1,5 +1,9 @@
 #include "pipeline/scene.h"
 
+#include "pipeline/gltf_reader.h"
+#include "pipeline/scene_json.h"
+
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -112,6 +116,18 @@ private:
     Status* status_;
 };
 
+}  // namespace
+
+bool isGltfPath(const std::string& path) {
+    const auto dot = path.find_last_of('.');
+    if (dot == std::string::npos) return false;
+    std::string ext = path.substr(dot);
+    for (char& c : ext) c = char(std::tolower((unsigned char)c));
+    return ext == ".gltf" || ext == ".glb";
+}
+
+namespace {
+
 std::string formatNumber(double v) {
     std::ostringstream os;
     os.precision(17);
@@ -167,10 +183,13 @@ void readObject(FieldReader& r, const json& j, const std::string& path, const st
 }  // namespace
 
 Status loadScene(const std::string& path, Scene* scene) {
-    *scene = Scene{};
-    scene->path = path;
+    if (isGltfPath(path)) return loadGltfScene(path, scene);
     std::ifstream in(path, std::ios::binary);
-    if (!in) return Status::failure(path + ": cannot open scene file");
+    if (!in) {
+        *scene = Scene{};
+        scene->path = path;
+        return Status::failure(path + ": cannot open scene file");
+    }
     json root;
     try {
         root = json::parse(in, nullptr, true, /*ignore_comments=*/true);
@@ -181,66 +200,78 @@ Status loadScene(const std::string& path, Scene* scene) {
         const auto at = what.find("line ");
         return Status::failure(path + ": invalid JSON at " + (at == std::string::npos ? what : what.substr(at)));
     }
+    return parseScene(root, path, SceneJsonPaths{}, scene);
+}
+
+Status parseScene(const json& root, const std::string& path, const SceneJsonPaths& paths, Scene* scene) {
+    *scene = Scene{};
+    scene->path = path;
     Status status;
     FieldReader r(path, &status);
+    const std::string top = paths.top;
+    auto at = [&](const std::string& key) { return FieldReader::join(top, key); };
     if (!root.is_object()) {
-        r.fail("(top level)", "expected a JSON object, got " + FieldReader::typeName(root));
+        r.fail(top.empty() ? "(top level)" : top, "expected a JSON object, got " + FieldReader::typeName(root));
         return status;
     }
-    r.checkKeys(root, "", {"camera", "frames", "model", "tolerance", "objects"});
+    r.checkKeys(root, top, {"camera", "frames", "model", "tolerance", "objects"});
     const std::filesystem::path folder = std::filesystem::path(path).parent_path();
 
     // Step: camera.
-    if (const json* cam = nullptr; r.object(root, "camera", "", &cam)) {
-        r.checkKeys(*cam, "camera", {"position", "look_at", "up", "fov_deg"});
-        r.vec3(*cam, "position", "camera", &scene->camera.position);
-        r.vec3(*cam, "look_at", "camera", &scene->camera.look_at);
-        r.vec3(*cam, "up", "camera", &scene->camera.up);
-        r.number(*cam, "fov_deg", "camera", &scene->camera.fov_deg);
+    if (const json* cam = nullptr; r.object(root, "camera", top, &cam)) {
+        const std::string cp = paths.camera.empty() ? at("camera") : paths.camera;
+        r.checkKeys(*cam, cp, {"position", "look_at", "up", "fov_deg"});
+        r.vec3(*cam, "position", cp, &scene->camera.position);
+        r.vec3(*cam, "look_at", cp, &scene->camera.look_at);
+        r.vec3(*cam, "up", cp, &scene->camera.up);
+        r.number(*cam, "fov_deg", cp, &scene->camera.fov_deg);
         const CameraSpec& c = scene->camera;
         const Vec3 dir = c.look_at - c.position;
-        if (!r.failed() && !(mesh4d::norm(dir) > 0)) r.fail("camera.look_at", "must differ from camera.position");
+        if (!r.failed() && !(mesh4d::norm(dir) > 0)) r.fail(cp + ".look_at", "must differ from camera.position");
         if (!r.failed() && !(mesh4d::norm(mesh4d::cross(dir, c.up)) > 0))
-            r.fail("camera.up", "must be non-zero and not parallel to the view direction");
-        if (!r.failed() && !(c.fov_deg > 0 && c.fov_deg < 180)) r.fail("camera.fov_deg", "must be in (0, 180)");
+            r.fail(cp + ".up", "must be non-zero and not parallel to the view direction");
+        if (!r.failed() && !(c.fov_deg > 0 && c.fov_deg < 180)) r.fail(cp + ".fov_deg", "must be in (0, 180)");
     }
 
     // Step: frames.
-    if (const json* fr = nullptr; r.object(root, "frames", "", &fr)) {
-        r.checkKeys(*fr, "frames", {"start", "end", "fps"});
-        r.number(*fr, "start", "frames", &scene->frames.start);
-        r.number(*fr, "end", "frames", &scene->frames.end);
-        r.number(*fr, "fps", "frames", &scene->frames.fps);
-        if (!r.failed() && !(scene->frames.fps > 0)) r.fail("frames.fps", "must be > 0");
+    if (const json* fr = nullptr; r.object(root, "frames", top, &fr)) {
+        const std::string fp = at("frames");
+        r.checkKeys(*fr, fp, {"start", "end", "fps"});
+        r.number(*fr, "start", fp, &scene->frames.start);
+        r.number(*fr, "end", fp, &scene->frames.end);
+        r.number(*fr, "fps", fp, &scene->frames.fps);
+        if (!r.failed() && !(scene->frames.fps > 0)) r.fail(fp + ".fps", "must be > 0");
         if (!r.failed() && !(scene->frames.end > scene->frames.start))
-            r.fail("frames.end", "must be greater than frames.start (" + formatNumber(scene->frames.start) + ")");
+            r.fail(fp + ".end", "must be greater than frames.start (" + formatNumber(scene->frames.start) + ")");
     }
 
     // Step: model and tolerance.
     if (root.contains("model")) {
         std::string name;
-        r.string(root, "model", "", &name);
+        r.string(root, "model", top, &name);
         if (!r.failed() && !parseModel(name, &scene->model))
-            r.fail("model", "unknown model '" + name + "' (instant, finite, relativistic, contracted)");
+            r.fail(at("model"), "unknown model '" + name + "' (instant, finite, relativistic, contracted)");
     }
-    r.number(root, "tolerance", "", &scene->tolerance);
-    if (!r.failed() && !(scene->tolerance > 0)) r.fail("tolerance", "must be > 0 (light-seconds)");
+    r.number(root, "tolerance", top, &scene->tolerance);
+    if (!r.failed() && !(scene->tolerance > 0)) r.fail(at("tolerance"), "must be > 0 (light-seconds)");
 
     // Step: objects.
     auto objs = root.find("objects");
     if (objs == root.end()) {
-        r.fail("objects", "missing (a list of moving objects)");
+        r.fail(at("objects"), "missing (a list of moving objects)");
     } else if (!objs->is_array()) {
-        r.fail("objects", "expected an array, got " + FieldReader::typeName(*objs));
+        r.fail(at("objects"), "expected an array, got " + FieldReader::typeName(*objs));
     } else if (objs->empty()) {
-        r.fail("objects", "empty: the scene has nothing to show");
+        r.fail(at("objects"), "empty: the scene has nothing to show");
     } else {
         for (size_t i = 0; i < objs->size() && !r.failed(); ++i) {
-            const std::string p = "objects[" + std::to_string(i) + "]";
+            const std::string p = i < paths.objects.size() ? paths.objects[i] : "objects[" + std::to_string(i) + "]";
             if (!(*objs)[i].is_object()) { r.fail(p, "expected an object"); break; }
             ObjectSpec obj;
             obj.name = "object" + std::to_string(i);
             readObject(r, (*objs)[i], p, folder, &obj);
+            obj.field_path = p;
+            if (i < paths.linear.size()) obj.linear = paths.linear[i];
             scene->objects.push_back(obj);
         }
     }
@@ -252,7 +283,7 @@ Status checkSceneForModel(const Scene& scene, Model model) {
     for (size_t i = 0; i < scene.objects.size(); ++i) {
         const double b = mesh4d::norm(scene.objects[i].velocity);
         if (!(b < 1)) {
-            return Status::failure(scene.path + ": objects[" + std::to_string(i) + "].velocity: |velocity| = " +
+            return Status::failure(scene.path + ": " + scene.objects[i].field_path + ".velocity: |velocity| = " +
                                    formatNumber(b) + " must be < 1 (the speed of light) for model " +
                                    modelName(model));
         }

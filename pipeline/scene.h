@@ -2,6 +2,7 @@
 // format"). Units: light-seconds and seconds, c = 1, velocities as fractions of c.
 #pragma once
 
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@ struct FrameSpec {
 
 struct ObjectSpec {
     std::string name;
+    std::string field_path = "objects[0]";  // where the object is defined, for messages
     std::string mesh_path;             // resolved against the scene file's folder
     mesh4d::Vec3 position;             // lab position of the mesh origin at lab time t0
     double t0 = 0;
@@ -41,6 +43,9 @@ struct ObjectSpec {
     // and contracted models, lab time since t0 for the instant and finite models.
     double exists_from = -std::numeric_limits<double>::infinity();
     double exists_to = std::numeric_limits<double>::infinity();
+    // A further linear map of the rest mesh, applied after scale and rotation (column-major 3x3):
+    // the world rotation and scale of a glTF node that carries the object (identity otherwise).
+    std::array<double, 9> linear{1, 0, 0, 0, 1, 0, 0, 0, 1};
 };
 
 struct Scene {
@@ -56,7 +61,10 @@ struct Scene {
 // days); raise it with --max-frames.
 constexpr long long kDefaultMaxFrames = 100000;
 
-// Reads and validates a scene file. On failure the message names the file, the field (a JSON
+// True for a .gltf or .glb path: a scene authored in glTF (README "Scenes in glTF").
+bool isGltfPath(const std::string& path);
+
+// Reads and validates a scene file, JSON or glTF (dispatching on the extension). On failure the message names the file, the field (a JSON
 // path such as objects[1].velocity) and the problem with the valid range.
 Status loadScene(const std::string& path, Scene* scene);
 

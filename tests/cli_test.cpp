@@ -291,3 +291,21 @@ TEST(Cli, DracoRoundTripWithinQuantizationBound) {
     }
     EXPECT_GT(worst_ratio, 0.0);  // quantization did happen: the test can see an error
 }
+
+// `apparent render scene.gltf` needs no JSON: the glTF twin of the default scene gives
+// byte-identical per-frame output.
+TEST(Cli, GltfSceneRendersLikeItsJsonTwin) {
+    TempDir a, b;
+    ASSERT_EQ(apparentRun({"render", source("data/scenes/flanges.json"), "--out", a.str(), "--format", "ply",
+                           "--frames", "90:110", "--quiet"}).code, 0);
+    ASSERT_EQ(apparentRun({"render", source("data/scenes/flanges.gltf"), "--out", b.str(), "--format", "ply",
+                           "--frames", "90:110", "--quiet"}).code, 0);
+    for (int k = 90; k < 110; ++k) {
+        char name[64];
+        std::snprintf(name, sizeof name, "relativistic/frame_%05d.ply", k);
+        std::ifstream fa(a / name, std::ios::binary), fb(b / name, std::ios::binary);
+        const std::string da((std::istreambuf_iterator<char>(fa)), {}), db((std::istreambuf_iterator<char>(fb)), {});
+        ASSERT_FALSE(da.empty()) << name;
+        EXPECT_EQ(da, db) << name;
+    }
+}

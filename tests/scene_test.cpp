@@ -73,3 +73,38 @@ TEST(Scene, SuperluminalIsAllowedOnlyInTheInstantModel) {
     EXPECT_TRUE(checkSceneForModel(s, Model::Instant).ok);
     for (Model m : {Model::Finite, Model::Relativistic, Model::Contracted}) EXPECT_FALSE(checkSceneForModel(s, m).ok);
 }
+
+// A scene authored in glTF (node and scene extras, a camera node) loads into the same scene as
+// its JSON twin; the two files are written independently (data/scenes/make_flanges_gltf.py).
+TEST(Scene, GltfSceneMatchesItsJsonTwin) {
+    Scene js, gs;
+    ASSERT_TRUE(loadScene(std::string(APPARENT_SOURCE_DIR) + "/data/scenes/flanges.json", &js).ok);
+    const Status st = loadScene(std::string(APPARENT_SOURCE_DIR) + "/data/scenes/flanges.gltf", &gs);
+    ASSERT_TRUE(st.ok) << st.message;
+    ASSERT_EQ(gs.objects.size(), js.objects.size());
+    EXPECT_EQ(gs.model, js.model);
+    EXPECT_EQ(frameCount(gs.frames), frameCount(js.frames));
+    EXPECT_NEAR(gs.camera.fov_deg, js.camera.fov_deg, 1e-9);
+    for (size_t i = 0; i < js.objects.size(); ++i) {
+        EXPECT_EQ(gs.objects[i].name, js.objects[i].name);
+        EXPECT_EQ(gs.objects[i].position, js.objects[i].position);
+        EXPECT_EQ(gs.objects[i].velocity, js.objects[i].velocity);
+        EXPECT_EQ(gs.objects[i].t0, js.objects[i].t0);
+        EXPECT_NE(gs.objects[i].mesh_path.find("flanges.gltf#" + js.objects[i].name), std::string::npos);
+    }
+}
+
+TEST(Scene, GltfSceneErrorsNameTheNode) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"scene_superluminal.gltf", "nodes[1].extras.velocity: |velocity| = 1.5 must be < 1"},
+        {"scene_no_objects.gltf", "no node carries object extras"},
+        {"scene_duplicate_names.gltf", "nodes[2].name: 'flange-a' names two object nodes"},
+    };
+    for (const auto& [file, expected] : cases) {
+        Scene s;
+        Status st = loadScene(std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/gltf/" + file, &s);
+        if (st.ok) st = checkSceneForModel(s, Model::Relativistic);
+        ASSERT_FALSE(st.ok) << file;
+        EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+    }
+}

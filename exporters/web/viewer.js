@@ -293,7 +293,8 @@ function updateLabels() {
     m.sub.textContent = `${shown}${camT}`;
     m.label.title = `${m.url}\n${m.cameraNote || ''}${zoom !== 1 ? `\nzoom ${zoom.toFixed(2)}×` : ''}`;
   }
-  timeEl.textContent = `t = ${time.toFixed(3)} s / ${maxDuration.toFixed(3)} s`;
+  timeEl.textContent = `t = ${time.toFixed(3)} s / ${maxDuration.toFixed(3)} s` +
+    (zoom !== 1 ? ` · zoom ${zoom.toFixed(2)}×` : '');
   slider.value = String(time);
 }
 
@@ -433,13 +434,19 @@ function info() {
   }]));
 }
 
+function errText(e) {
+  if (e instanceof Error) return e.message;
+  if (e && typeof e === 'object') return String(e.error || e.message || JSON.stringify(e));
+  return String(e);
+}
+
 const ready = (async () => {
   if (!models.length) throw new Error('no models given (?models=a,b,c)');
   render();   // empty viewports while loading
   const results = await Promise.allSettled(models.map(loadModel));
   const failed = results.map((r, i) => [r, models[i]]).filter(([r]) => r.status === 'rejected');
   for (const [r, m] of failed) {
-    m.sub.textContent = `failed: ${r.reason?.message || r.reason}`;
+    m.sub.textContent = `failed: ${errText(r.reason)}`;
   }
   setupDefaultCameras();
   if (!aspectParam) aspect = models.find((m) => m.fileAspect)?.fileAspect || DEFAULT_ASPECT;
@@ -452,7 +459,7 @@ const ready = (async () => {
   setPlaying(playing);
   requestAnimationFrame(tick);
   if (failed.length) {
-    const msg = failed.map(([r, m]) => `${m.name}: ${r.reason?.message || r.reason} (${m.url})`).join('\n');
+    const msg = failed.map(([r, m]) => `${m.name}: ${errText(r.reason)} (${m.url})`).join('\n');
     setStatus(`could not load:\n${msg}`, true);
     throw new Error(`could not load ${msg}`);
   }

@@ -10,9 +10,13 @@ function readGlb(file) {
   const buf = fs.readFileSync(file);
   if (buf.length < 20 || buf.readUInt32LE(0) !== 0x46546c67) throw new Error(`${file}: not a GLB file`);
   if (buf.readUInt32LE(4) !== 2) throw new Error(`${file}: GLB version ${buf.readUInt32LE(4)}, expected 2`);
+  if (buf.readUInt32LE(8) !== buf.length) {
+    throw new Error(`${file}: GLB header says ${buf.readUInt32LE(8)} bytes, file has ${buf.length} (truncated?)`);
+  }
   let off = 12, json = null, bin = null;
   while (off + 8 <= buf.length) {
     const len = buf.readUInt32LE(off), type = buf.readUInt32LE(off + 4);
+    if (off + 8 + len > buf.length) throw new Error(`${file}: chunk at byte ${off} runs past the end of the file`);
     const body = buf.subarray(off + 8, off + 8 + len);
     if (type === 0x4e4f534a) json = JSON.parse(body.toString('utf8'));
     else if (type === 0x004e4942) bin = body;

@@ -110,7 +110,12 @@ async function main() {
   const files = {};
   console.log(`viewer_test: OUTDIR ${opts.outdir}`);
   for (const m of opts.models) {
-    const d = describe(path.join(opts.outdir, `${m}.glb`));
+    let d;
+    try {
+      d = describe(path.join(opts.outdir, `${m}.glb`));
+    } catch (e) {
+      throw new Error(`cannot read ${path.join(opts.outdir, m + '.glb')}: ${e.message}`);
+    }
     files[m] = d;
     // frames per second: scene extras, else (e.g. after draco_transcoder, which drops extras) frames / duration
     d.fps = Number(d.extras.fps) > 0 ? Number(d.extras.fps) : d.duration > 0 ? d.frames.length / d.duration : NaN;
@@ -168,7 +173,7 @@ async function main() {
     const viewerUrl = `${url}/exporters/web/?dir=/out&models=${opts.models.join(',')}&paused=1&t=0`;
     console.log(`  browser: ${await ctx.browser()?.version() ?? 'chromium'}; opening ${viewerUrl}`);
     await page.goto(viewerUrl, { waitUntil: 'load', timeout: 20000 });
-    await page.waitForFunction(() => window.apparentViewer && window.apparentViewer.ready, null, { timeout: 20000 });
+    await page.waitForFunction(() => !!window.apparentViewer, null, { timeout: 20000 });
     const info = await page.evaluate(() => Promise.race([
       window.apparentViewer.ready,
       new Promise((_, rej) => setTimeout(() => rej(new Error('apparentViewer.ready timed out after 30 s')), 30000)),
@@ -197,7 +202,7 @@ async function main() {
     let ks = opts.frames || [0, 50, 100, nMin - 1];
     ks = [...new Set(ks.filter((k) => k < nMin))].sort((a, b) => a - b);
     const times = [];
-    for (const k of ks) times.push({ label: `frame ${k}`, k });
+    for (const k of ks) times.push({ label: `frame #${k}`, k });
     times.push({ label: 't = 0', t: 0, k: 0 });
     for (const m of opts.models) {
       // the last frame must stay visible at t = duration (LoopRepeat would wrap to frame 0 here)
