@@ -173,10 +173,14 @@ private:
     }
 };
 
-// Float32 data of one object's mesh relative to `origin`; tracks the largest rounding.
-PrimitiveData toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double* max_err) {
+// Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
+// are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
+constexpr double kCreaseDeg = 30.0;
+PrimitiveData toPrimitive(const mesh4d::ApparentMesh& input, const double origin[3], double* max_err) {
     PrimitiveData d;
-    const std::vector<Vec3> normals = mesh4d::vertexNormals(m);
+    const mesh4d::CreasedMesh creased = mesh4d::creaseSplit(input, kCreaseDeg);
+    const mesh4d::ApparentMesh& m = creased.mesh;
+    const std::vector<Vec3>& normals = creased.normals;
     d.positions.reserve(3 * m.positions.size());
     for (size_t i = 0; i < m.positions.size(); ++i) {
         for (int c = 0; c < 3; ++c) {

@@ -1,6 +1,15 @@
 #include "normals.h"
 
+#include <cmath>
+
 namespace mesh4d {
+
+namespace {
+Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
+    const double len = norm(v);
+    return len > 0 ? v / len : fallback;
+}
+}  // namespace
 
 std::vector<Vec3> vertexNormals(const ApparentMesh& mesh) {
     std::vector<Vec3> n(mesh.positions.size(), Vec3{0, 0, 0});
@@ -9,11 +18,57 @@ std::vector<Vec3> vertexNormals(const ApparentMesh& mesh) {
         const Vec3 area2 = cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
         for (uint32_t v : t) n[v] += area2;
     }
-    for (Vec3& v : n) {
-        const double len = norm(v);
-        v = len > 0 ? v / len : Vec3{0, 0, 1};
-    }
+    for (Vec3& v : n) v = unitOr(v, {0, 0, 1});
     return n;
+}
+
+CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
+    const double cos_crease = std::cos(crease_deg * 3.14159265358979323846 / 180.0);
+    const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();
+
+    // Step: face area vectors and unit normals; faces around each vertex (CSR layout).
+    std::vector<Vec3> area(nf), unit(nf);
+    std::vector<uint32_t> start(nv + 1, 0), faces(3 * nf);
+    for (size_t f = 0; f < nf; ++f) {
+        const auto& t = mesh.triangles[f];
+        area[f] = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
+        unit[f] = unitOr(area[f], {0, 0, 0});
+        for (uint32_t v : t) ++start[v + 1];
+    }
+    for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (size_t f = 0; f < nf; ++f)
+        for (uint32_t v : mesh.triangles[f]) faces[fill[v]++] = uint32_t(f);
+
+    // Step: one normal per corner from the faces within the crease angle; corners of a vertex
+    // with bit-identical normals share one output vertex.
+    CreasedMesh out;
+    std::vector<std::vector<uint32_t>> copies(nv);  // output vertices made for each input vertex
+    out.mesh.triangles.resize(nf);
+    for (size_t f = 0; f < nf; ++f) {
+        for (int c = 0; c < 3; ++c) {
+            const uint32_t v = mesh.triangles[f][c];
+            Vec3 sum{0, 0, 0};
+            for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
+                const uint32_t g = faces[k];
+                if (g == f || dot(unit[g], unit[f]) >= cos_crease) sum += area[g];
+            }
+            const Vec3 n = unitOr(sum, unitOr(area[f], {0, 0, 1}));
+            uint32_t id = UINT32_MAX;
+            for (uint32_t o : copies[v])
+                if (out.normals[o] == n) id = o;
+            if (id == UINT32_MAX) {
+                id = uint32_t(out.mesh.positions.size());
+                out.mesh.positions.push_back(mesh.positions[v]);
+                out.mesh.emission_times.push_back(mesh.emission_times[v]);
+                out.normals.push_back(n);
+                copies[v].push_back(id);
+            }
+            out.mesh.triangles[f][c] = id;
+        }
+    }
+    out.mesh.clipped_triangles = mesh.clipped_triangles;
+    return out;
 }
 
 }  // namespace mesh4d

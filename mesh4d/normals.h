@@ -1,9 +1,12 @@
 // Per-vertex normals of an apparent mesh, for shading in viewers.
 //
-// Each vertex gets the normalised sum of the cross products of its triangles' edges, which is
-// the area-weighted average of the face normals (geometry-central's "area-weighted" vertex
-// normal). The apparent surface is oriented like the input (the cut keeps triangle orientation).
-// A vertex whose triangles all have zero area gets (0, 0, 1) rather than NaN: glTF requires unit normals.
+// vertexNormals: each vertex gets the normalised sum of its triangles' edge cross products, the
+// area-weighted average of the face normals. creaseSplit: the same average taken only over the
+// faces around a vertex whose normals are within `crease_deg` of the corner's own face, with the
+// vertex duplicated where corners disagree, so that sharp folds (the flange's 90-degree edge)
+// shade flat on each side while curved apparent surfaces stay smooth. The apparent surface is
+// oriented like the input (the cut keeps triangle orientation). A vertex whose triangles all have
+// zero area gets +z rather than NaN: glTF requires unit normals.
 #pragma once
 
 #include <vector>
@@ -12,7 +15,15 @@
 
 namespace mesh4d {
 
-// Returns one unit normal per position (or +z where undefined).
+// Returns one unit normal per position.
 std::vector<Vec3> vertexNormals(const ApparentMesh& mesh);
+
+struct CreasedMesh {
+    ApparentMesh mesh;             // positions and emission times copied per split vertex
+    std::vector<Vec3> normals;     // one unit normal per vertex of `mesh`
+};
+
+// Splits vertices along edges sharper than crease_deg (0 < crease_deg <= 180).
+CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg);
 
 }  // namespace mesh4d

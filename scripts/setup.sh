@@ -20,6 +20,7 @@ packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels)
 if [ "$mode" = test ]; then
+  packages+=(chromium)  # three.js viewer test (tests/web), headless
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi

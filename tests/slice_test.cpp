@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include "mesh4d/normals.h"
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
 #include "pipeline/mesh_check.h"
@@ -220,4 +221,29 @@ TEST(Slice, ContractedModelIsTheMeasuredShape) {
     EXPECT_NEAR(norm(out.positions[1] - out.positions[0]), L / gamma, 1e-12);
     EXPECT_NEAR(out.positions[0].x, -3 + b * (t_c - 1.0), 1e-12);
     for (double t_e : out.emission_times) EXPECT_EQ(t_e, t_c);
+}
+
+// Crease splitting (for shading): the flange's 90-degree fold splits its two shared vertices,
+// a finely tessellated sphere stays in one piece, and every normal is a unit vector.
+TEST(Normals, CreaseSplitKeepsCurvesSmoothAndFoldsSharp) {
+    ApparentMesh flange;
+    flange.positions = {{0, -2, 0}, {0, 2, 0}, {2, -2, 0}, {2, 2, 0}, {0, -2, -2}, {0, 2, -2}};
+    flange.emission_times.assign(6, 0.0);
+    flange.triangles = {{0, 2, 3}, {0, 3, 1}, {0, 1, 5}, {0, 5, 4}};
+    const CreasedMesh f = creaseSplit(flange, 30);
+    EXPECT_EQ(f.mesh.positions.size(), 8u);  // the two fold vertices doubled
+    for (size_t i = 0; i < f.normals.size(); ++i) {
+        EXPECT_NEAR(norm(f.normals[i]), 1.0, 1e-15);
+        // Each normal is one plate's normal exactly: +z or -x.
+        EXPECT_TRUE(f.normals[i] == (Vec3{0, 0, 1}) || f.normals[i] == (Vec3{-1, 0, 0})) << i;
+    }
+    const RestMesh s = testmesh::icosphere(3, 1.0);
+    ApparentMesh sphere;
+    sphere.positions = s.positions;
+    sphere.emission_times.assign(s.positions.size(), 0.0);
+    sphere.triangles = s.triangles;
+    const CreasedMesh c = creaseSplit(sphere, 30);
+    EXPECT_EQ(c.mesh.positions.size(), s.positions.size());
+    for (size_t i = 0; i < c.normals.size(); ++i)
+        EXPECT_GT(dot(c.normals[i], c.mesh.positions[i]), 0.99);  // close to the radial direction
 }
