@@ -20,7 +20,8 @@ packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels)
 if [ "$mode" = test ]; then
-  packages+=(chromium)  # three.js viewer test (tests/web), headless
+  packages+=(chromium)            # three.js viewer test (tests/web), headless
+  packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi

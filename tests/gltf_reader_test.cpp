@@ -170,6 +170,11 @@ TEST(GltfReader, NodeTransformsAndNodeSelection) {
     EXPECT_GT(normalZ(m.mesh.triangles[0]), 0);
     EXPECT_GT(normalZ(m.mesh.triangles[1]), 0);
 
+    // Interleaved POSITION/NORMAL (byteStride 24): positions read from every 24th byte.
+    ASSERT_TRUE(load(fixture("interleaved.gltf"), &m).ok);
+    ASSERT_EQ(m.mesh.positions.size(), 3u);
+    EXPECT_EQ(m.mesh.positions[2], (mesh4d::Vec3{10, 1, 0}));
+
     // "#right": that node's subtree in its own frame, without its or its ancestors' transforms.
     ASSERT_TRUE(load(fixture("two_nodes.gltf") + "#right", &m).ok);
     EXPECT_EQ(m.mesh.triangles.size(), 1u);
