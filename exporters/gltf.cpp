@@ -354,7 +354,7 @@ bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames,
                                    {"tolerance", number(info.tolerance)},
                                    {"units", tinygltf::Value(std::string("light-seconds, seconds, c = 1"))},
                                    {"fps", number(info.fps)},
-                                   {"first_frame", number(double(frames.front().index))},
+                                   {"first_frame", tinygltf::Value(int(frames.front().index))},
                                    {"frame_times", tinygltf::Value(frame_times)},
                                    {"objects", tinygltf::Value(object_names)},
                                    {"scene_file", tinygltf::Value(info.scene_path)}};

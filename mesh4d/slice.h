@@ -14,7 +14,23 @@
 // genus, with exactly one output vertex per input vertex. Which side of a cap a vertex falls on is
 // decided by the sign of viewSide at the cap event, once per vertex; zero counts as inside.
 // Straight edges between exact vertices leave an error that grows with triangle size, speed and
-// nearness (DESIGN.md section 6); bounding it is the tessellation's job, not this file's.
+// nearness (DESIGN.md section 6). With a tolerance T > 0 the cut is refined where the surface
+// departs from the chord, and nowhere else (see "Refinement" in slice.cpp):
+//   - each mesh edge is split, once per frame and keyed by its id, into the fewest equal
+//     parameter segments whose exact midpoints lie within T/4 of the chord; both triangles of the
+//     edge use the same points, so watertight input stays watertight (no T-junctions);
+//   - a triangle whose edges need no split and whose exact centroid lies within T/4 of its plane is
+//     kept whole; otherwise its parameter domain gets a regular interior grid of level N, joined
+//     to the edge points by a constrained Delaunay triangulation (tessellate.h), and N doubles until
+//     every output edge's exact midpoint lies within T/4 of the chord.
+// Why that bounds the error: on an output triangle with exact corners, the difference e(p) between
+// the exact map F and the linear interpolant L is, to second order, a quadratic vanishing at the
+// corners, e = sum over edges c_ij l_i l_j; its edge-midpoint values are c_ij / 4 and
+// |e| <= (|c_01| + |c_12| + |c_20|) / 4 <= 3 T / 4 everywhere on the triangle. |F(p) - L(p)| bounds
+// both one-sided Hausdorff distances (each output point L(p) has the exact point F(p), and back),
+// so the two-sided distance is <= 3T/4 plus third-order terms, which the remaining T/4 covers once
+// the mesh resolves the curvature. The test suite measures the true error on samples of every
+// output triangle. Triangles cut by a real cap are clipped in vertex mode (clip curves are chords).
 #pragma once
 
 #include <array>
@@ -31,12 +47,28 @@ struct ApparentMesh {
     // in input order, then the clip points of this frame.
     std::vector<Vec3> positions;
     std::vector<double> emission_times;   // lab time each point emitted the light seen at t_c
+    std::vector<Vec3> rest_points;        // the rest-frame point each apparent point is the image of
     std::vector<std::array<uint32_t, 3>> triangles;  // orientation of the input triangles kept
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame
+    size_t refined_triangles = 0;         // input triangles split by the tolerance
+    size_t limited_triangles = 0;         // input triangles that reached max_segments first
+};
+
+struct SliceSettings {
+    // Two-sided distance bound to the exact apparent surface, light-seconds; 0 is vertex mode
+    // (exact vertices, straight edges: what real-time engines do). 0 is the safe default.
+    double tolerance = 0;
+    // Most segments per input edge, and most interior grid levels per input triangle; a triangle
+    // that would need more is counted in ApparentMesh::limited_triangles and keeps this level.
+    int max_segments = 256;
 };
 
 // Cuts `world` with `view`. Precondition: world.motion.beta < 1 when view.kind == PastCone.
 // The result is empty when no part of the history meets the view surface.
-ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view);
+ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
+
+// The exact apparent point of rest point `q` (any point of the object's rest frame): the crossing of
+// its worldline with the view surface. Used by tests and tools to measure the error of a mesh.
+Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q);
 
 }  // namespace mesh4d

@@ -61,8 +61,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "instant|finite|relativistic|contracted|all, or a comma list (default: the scene's model)");
     render_cmd->add_option("--format", format_text, "Comma list of glb, ply, obj")->capture_default_str();
     render_cmd->add_option("--tolerance", tolerance_text,
-                           "Accuracy target in light-seconds (overrides the scene's; accepted and recorded, "
-                           "vertex mode: exact vertices joined by straight edges)");
+                           "Largest distance between output and exact apparent surface, light-seconds (overrides "
+                           "the scene's), or 'vertex': exact vertices joined by straight edges, no refinement");
     render_cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
     render_cmd->add_flag("--draco", rs.glb.draco, "Compress every frame mesh of the .glb with KHR_draco_mesh_compression");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
@@ -120,12 +120,16 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!rs.write_glb && !rs.write_ply && !rs.write_obj) return usage("--format: no format given (glb, ply, obj)");
     }
     if (!tolerance_text.empty()) {
-        try {
-            size_t used = 0;
-            rs.tolerance = std::stod(tolerance_text, &used);
-            if (used != tolerance_text.size() || !(rs.tolerance > 0) || !std::isfinite(rs.tolerance)) throw 0;
-        } catch (...) {
-            return usage("--tolerance: '" + tolerance_text + "' is not a positive number of light-seconds");
+        if (tolerance_text == "vertex") {
+            rs.tolerance = 0;
+        } else {
+            try {
+                size_t used = 0;
+                rs.tolerance = std::stod(tolerance_text, &used);
+                if (used != tolerance_text.size() || !(rs.tolerance > 0) || !std::isfinite(rs.tolerance)) throw 0;
+            } catch (...) {
+                return usage("--tolerance: '" + tolerance_text + "' is neither a positive number of light-seconds nor 'vertex'");
+            }
         }
         rs.has_tolerance = true;
     }

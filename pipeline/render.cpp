@@ -250,17 +250,20 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
             }
         }
 
-        // Step: per frame, cut every world with the view surface, then export.
+        // Step: per frame, cut every world with the view surface (refined to the tolerance), then export.
+        mesh4d::SliceSettings slice_settings;
+        slice_settings.tolerance = scene.tolerance;
         std::vector<ExportFrame> frames;
         Progress progress(err, !settings.quiet, name, last_excl - first);
-        size_t max_triangles = 0;
+        size_t max_triangles = 0, limited = 0;
         for (long long k = first; k < last_excl; ++k) {
             ExportFrame frame;
             frame.index = k;
             frame.t_c = frameTime(scene.frames, k);
             const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-            for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view));
+            for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view, slice_settings));
             max_triangles = std::max(max_triangles, frame.triangleCount());
+            for (const auto& o : frame.objects) limited += o.limited_triangles;
             std::string error;
             if (settings.write_ply &&
                 !writePly((std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string(), frame, &error)) {
@@ -299,7 +302,8 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
             summary += os.str();
             // Warn when Draco's quantization is coarser than the accuracy asked for (gltfpack warns
             // the same way about position bits).
-            if (settings.glb.draco && stats.max_quantization_error > scene.tolerance && !settings.quiet) {
+            if (settings.glb.draco && scene.tolerance > 0 && stats.max_quantization_error > scene.tolerance &&
+                !settings.quiet) {
                 std::ostringstream w;
                 w << std::setprecision(3) << "warning: " << glb << ": Draco position error up to "
                   << stats.max_quantization_error << " ls exceeds the tolerance " << scene.tolerance
@@ -307,6 +311,10 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                 err << w.str();
             }
         }
+        if (limited > 0 && !settings.quiet)
+            err << "warning: " << name << ": " << limited << " triangle-frames reached the refinement limit of "
+                << slice_settings.max_segments << " segments; the tolerance " << scene.tolerance
+                << " ls is not met there (a coarser tolerance or a finer input mesh helps)\n";
         if (!settings.quiet)
             log << name << ": " << (last_excl - first) << " frames, up to " << max_triangles << " triangles"
                 << summary << "\n";

@@ -252,8 +252,14 @@ Status parseScene(const json& root, const std::string& path, const SceneJsonPath
         if (!r.failed() && !parseModel(name, &scene->model))
             r.fail(at("model"), "unknown model '" + name + "' (instant, finite, relativistic, contracted)");
     }
-    r.number(root, "tolerance", top, &scene->tolerance);
-    if (!r.failed() && !(scene->tolerance > 0)) r.fail(at("tolerance"), "must be > 0 (light-seconds)");
+    // tolerance: light-seconds > 0, or "vertex" (0 inside: exact vertices, straight edges).
+    if (auto tol = root.find("tolerance"); tol != root.end() && tol->is_string()) {
+        if (tol->get<std::string>() != "vertex") r.fail(at("tolerance"), "expected a number > 0 or \"vertex\"");
+        else scene->tolerance = 0;
+    } else {
+        r.number(root, "tolerance", top, &scene->tolerance);
+        if (!r.failed() && !(scene->tolerance > 0)) r.fail(at("tolerance"), "must be > 0 (light-seconds) or \"vertex\"");
+    }
 
     // Step: objects.
     auto objs = root.find("objects");

@@ -53,7 +53,7 @@ struct Scene {
     CameraSpec camera;
     FrameSpec frames;
     Model model = Model::Relativistic;
-    double tolerance = 1e-3;
+    double tolerance = 1e-3;          // light-seconds; 0 = vertex mode
     std::vector<ObjectSpec> objects;
 };
 

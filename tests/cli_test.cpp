@@ -122,7 +122,7 @@ TEST(Cli, OutputLayoutAndFrameNumbers) {
 TEST(Cli, PlyCarriesEmissionTimeAsQuality) {
     TempDir dir;
     ASSERT_EQ(apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(), "--format", "ply",
-                           "--quiet"}).code, 0);
+                           "--tolerance", "vertex", "--quiet"}).code, 0);
     const fs::path ply = dir / "relativistic/frame_00001.ply";
     std::ifstream head(ply, std::ios::binary);
     std::string header((std::istreambuf_iterator<char>(head)), {});
@@ -208,7 +208,7 @@ TEST(Cli, BadInputExitsTwoAndWritesNothing) {
 TEST(Cli, ExistenceWindowGivesClippedFrames) {
     TempDir dir;
     ASSERT_EQ(apparentRun({"render", source("data/fixtures/scene_exists_window.json"), "--out", dir.str(), "--format",
-                           "ply", "--quiet"}).code, 0);
+                           "ply", "--tolerance", "vertex", "--quiet"}).code, 0);
     int empty = 0, full = 0, partial = 0;
     for (int k = 0; k < 120; ++k) {
         char name[64];
