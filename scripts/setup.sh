@@ -22,6 +22,7 @@ packages=(build-essential cmake pkg-config
 if [ "$mode" = test ]; then
   packages+=(chromium)            # three.js viewer test (tests/web), headless
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
+  packages+=(blender python3-numpy)  # Blender imports the .glb (tests/blender); its importer needs numpy
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi
