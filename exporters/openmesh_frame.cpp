@@ -9,6 +9,7 @@ mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame) {
         all.positions.insert(all.positions.end(), part.positions.begin(), part.positions.end());
         all.emission_times.insert(all.emission_times.end(), part.emission_times.begin(), part.emission_times.end());
         for (const auto& t : part.triangles) all.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+        all.rest_points.insert(all.rest_points.end(), part.rest_points.begin(), part.rest_points.end());
         all.clipped_triangles += part.clipped_triangles;
     }
     return all;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "robust.h"
 #include "tessellate.h"
@@ -16,9 +15,14 @@ enum class Side : uint8_t { NotYet, Inside, Gone };
 
 constexpr uint32_t kUnset = 0xffffffffu;
 
-// Refinement (see slice.h): each output chord's exact midpoint must lie within this fraction of
-// the tolerance, so that the three midpoints of a triangle sum to at most 3/4 of it.
+// Refinement (see slice.h): each inner output chord's exact midpoint must lie within this
+// fraction of the tolerance, and each segment of a split mesh edge within half of it. A triangle
+// of the ring next to an edge spans a whole edge segment, so its inner chords are about as long
+// as that segment: the stricter edge limit leaves them room to pass at the inner limit instead of
+// forcing an ever finer interior grid. Any output triangle's three midpoints then sum to at most
+// 3/4 of the tolerance (at most 5/8 next to an edge).
 constexpr double kMidpointShare = 0.25;
+constexpr double kEdgeMidpointShare = 0.125;
 
 struct FrameBuilder {
     const World4D& world;
@@ -35,6 +39,11 @@ struct FrameBuilder {
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), one_minus_b2(oneMinusSquare(w.motion.beta)) {}
+
+    void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
+        out.triangles.push_back(t);
+        out.source_triangles.push_back(uint32_t(f));
+    }
 
     uint32_t emit(const Event& e, const Vec3& rest) {
         out.positions.push_back(e.x);
@@ -110,7 +119,7 @@ struct FrameBuilder {
         const Edge& e = world.edges[edge];
         const uint32_t v[3] = {e.lo, e.hi, e.hi};
         const int cap = anchorCap(e.lo);
-        const double limit = kMidpointShare * settings.tolerance;
+        const double limit = kEdgeMidpointShare * settings.tolerance;
         const Vec3 y0 = out.positions[vertexPoint(e.lo)], y1 = out.positions[vertexPoint(e.hi)];
         auto at = [&](double s) {
             const double l[3] = {1 - s, s, 0};
@@ -156,75 +165,63 @@ struct FrameBuilder {
         const double third[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
         const double centroid_dev = norm(surfaceAt(v, third, cap).x - (y[0] + y[1] + y[2]) / 3.0);
         if (n[0] == 1 && n[1] == 1 && n[2] == 1 && centroid_dev <= limit) {
-            out.triangles.push_back({corner[0], corner[1], corner[2]});
+            addOutput(f, {corner[0], corner[1], corner[2]});
             return;
         }
         ++out.refined_triangles;
 
-        // Boundary of the parameter domain (0,0), (M,0), (0,M), counter-clockwise from corner 0,
-        // with the output id of each boundary point; edge c runs from corner c to corner c + 1.
-        int level = int(std::ceil(std::sqrt(std::max(centroid_dev, 1e-300) / limit)));
-        level = std::max<int>(level, int(std::max({n[0], n[1], n[2]})));
+        // The domain is triangulated with each edge's own points and an interior grid of level
+        // `level` (tessellate.h); the level grows until every inner chord passes.
+        uint32_t level = uint32_t(std::ceil(std::sqrt(std::max(centroid_dev, 1e-300) / limit)));
+        level = std::max({level, n[0], n[1], n[2], 3u});
         for (;;) {
-            level = std::min(level, settings.max_segments);
-            // M: a common multiple of every segment count, so every lattice point is an integer.
-            double M = double(level);
-            for (int c = 0; c < 3; ++c) M = double(std::lcm((long long)M, (long long)n[c]));
-            const double corners[3][2] = {{0, 0}, {M, 0}, {0, M}};
-            std::vector<std::array<double, 2>> boundary, interior;
-            std::vector<uint32_t> ids;
-            std::vector<std::array<double, 3>> bary;  // barycentrics of every domain point
+            level = std::min<uint32_t>(level, uint32_t(std::max(settings.max_segments, 3)));
+            const DomainTriangulation dom = triangulateDomain(n, level);
+
+            // Step: output ids of the boundary points (corners and shared edge points) and exact
+            // points for the interior lattice.
+            std::vector<uint32_t> ids(dom.points.size());
             for (int c = 0; c < 3; ++c) {
-                boundary.push_back({corners[c][0], corners[c][1]});
-                ids.push_back(corner[c]);
                 const uint32_t edge = world.triangle_edges[f][c];
                 const bool forward = v[c] == world.edges[edge].lo;  // edge points run lo -> hi
-                const uint32_t segs = n[c];
-                for (uint32_t i = 1; i < segs; ++i) {
-                    const uint32_t k = forward ? i : segs - i;  // index along this triangle's edge
-                    const double step = M / segs;
-                    const double* a = corners[c];
-                    const double* b = corners[(c + 1) % 3];
-                    // Integer lattice point i steps from a towards b.
-                    boundary.push_back({a[0] + (b[0] - a[0]) / M * step * i, a[1] + (b[1] - a[1]) / M * step * i});
-                    ids.push_back(edge_points[edge_first[edge] + (k - 1)]);
-                }
+                ids[boundaryIndex(n, c, 0)] = corner[c];
+                for (uint32_t k = 1; k < n[c]; ++k)
+                    ids[boundaryIndex(n, c, k)] = edge_points[edge_first[edge] + (forward ? k : n[c] - k) - 1];
             }
-            for (int i = 1; i < level; ++i)
-                for (int j = 1; i + j < level; ++j) interior.push_back({M / level * i, M / level * j});
-            const std::vector<std::array<uint32_t, 3>> local = triangulateDomain(boundary, interior);
-
-            // Step: exact points for the interior grid; then check every output chord.
             const size_t first_interior = out.positions.size();
-            for (const auto& p : interior) {
-                const double l[3] = {1 - (p[0] + p[1]) / M, p[0] / M, p[1] / M};
-                ids.push_back(emit(surfaceAt(v, l, cap), restAt(v, l)));
+            for (size_t p = dom.boundary_count; p < dom.points.size(); ++p) {
+                const double l[3] = {1 - dom.points[p][0] - dom.points[p][1], dom.points[p][0], dom.points[p][1]};
+                ids[p] = emit(surfaceAt(v, l, cap), restAt(v, l));
             }
-            std::vector<std::array<double, 2>> param(boundary);
-            param.insert(param.end(), interior.begin(), interior.end());
+
+            // Step: check every chord that is not a boundary segment (those passed refineEdge).
+            auto isBoundarySegment = [&](uint32_t a, uint32_t b) {
+                const size_t nb = dom.boundary_count;
+                return a < nb && b < nb && ((a + 1) % nb == b || (b + 1) % nb == a);
+            };
             double worst = 0;
-            for (const auto& t : local) {
+            for (const auto& t : dom.triangles) {
                 for (int c = 0; c < 3; ++c) {
                     const uint32_t a = t[c], b = t[(c + 1) % 3];
-                    if (a < boundary.size() && b < boundary.size() && (std::max(a, b) - std::min(a, b) == 1 ||
-                                                                      std::max(a, b) - std::min(a, b) == boundary.size() - 1))
-                        continue;  // a boundary segment: checked by refineEdge
-                    const double px = 0.5 * (param[a][0] + param[b][0]), py = 0.5 * (param[a][1] + param[b][1]);
-                    const double l[3] = {1 - (px + py) / M, px / M, py / M};
+                    if (a > b || isBoundarySegment(a, b)) continue;  // each interior chord once
+                    const double pu = 0.5 * (dom.points[a][0] + dom.points[b][0]);
+                    const double pv = 0.5 * (dom.points[a][1] + dom.points[b][1]);
+                    const double l[3] = {1 - pu - pv, pu, pv};
                     const Vec3 mid = (out.positions[ids[a]] + out.positions[ids[b]]) * 0.5;
-                    worst = std::max(worst, norm(surfaceAt(v, l, cap).x - mid));
+                    const double dv = norm(surfaceAt(v, l, cap).x - mid);
+                    worst = std::max(worst, dv);
                 }
             }
-            if (worst <= limit || level >= settings.max_segments) {
+            if (worst <= limit || level >= uint32_t(settings.max_segments)) {
                 if (worst > limit) ++out.limited_triangles;
-                for (const auto& t : local) out.triangles.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
+                for (const auto& t : dom.triangles) addOutput(f, {ids[t[0]], ids[t[1]], ids[t[2]]});
                 return;
             }
             // Too coarse: drop this attempt's interior points and refine the grid.
             out.positions.resize(first_interior);
             out.emission_times.resize(first_interior);
             out.rest_points.resize(first_interior);
-            level = std::max(level + 1, int(std::ceil(level * std::sqrt(worst / limit))));
+            level = std::max(level + 1, uint32_t(std::ceil(level * std::sqrt(worst / limit))));
         }
     }
 
@@ -234,7 +231,7 @@ struct FrameBuilder {
         const Side s0 = side[tri[0]], s1 = side[tri[1]], s2 = side[tri[2]];
         if (s0 == Side::Inside && s1 == Side::Inside && s2 == Side::Inside) {
             if (settings.tolerance > 0) refineTriangle(f);
-            else out.triangles.push_back({vertexPoint(tri[0]), vertexPoint(tri[1]), vertexPoint(tri[2])});
+            else addOutput(f, {vertexPoint(tri[0]), vertexPoint(tri[1]), vertexPoint(tri[2])});
             return;
         }
         if (s0 == s1 && s1 == s2) return;  // wholly before or after existence
@@ -259,7 +256,7 @@ struct FrameBuilder {
             }
         }
         // Fan over the clipped polygon, convex in the triangle's parameter domain.
-        for (int k = 1; k + 1 < n; ++k) out.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+        for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
     }
 };
 

@@ -17,16 +17,17 @@
 // nearness (DESIGN.md section 6). With a tolerance T > 0 the cut is refined where the surface
 // departs from the chord, and nowhere else (see "Refinement" in slice.cpp):
 //   - each mesh edge is split, once per frame and keyed by its id, into the fewest equal
-//     parameter segments whose exact midpoints lie within T/4 of the chord; both triangles of the
+//     parameter segments whose exact midpoints lie within T/8 of the chord; both triangles of the
 //     edge use the same points, so watertight input stays watertight (no T-junctions);
 //   - a triangle whose edges need no split and whose exact centroid lies within T/4 of its plane is
-//     kept whole; otherwise its parameter domain gets a regular interior grid of level N, joined
-//     to the edge points by a constrained Delaunay triangulation (tessellate.h), and N doubles until
-//     every output edge's exact midpoint lies within T/4 of the chord.
+//     kept whole; otherwise its parameter domain gets a regular interior grid of level N, zipped
+//     to the edge points (tessellate.h), and N grows until every output edge's exact midpoint
+//     lies within T/4 of the chord.
 // Why that bounds the error: on an output triangle with exact corners, the difference e(p) between
 // the exact map F and the linear interpolant L is, to second order, a quadratic vanishing at the
 // corners, e = sum over edges c_ij l_i l_j; its edge-midpoint values are c_ij / 4 and
-// |e| <= (|c_01| + |c_12| + |c_20|) / 4 <= 3 T / 4 everywhere on the triangle. |F(p) - L(p)| bounds
+// |e| <= (|c_01| + |c_12| + |c_20|) / 4 <= 3 T / 4 everywhere on the triangle (each midpoint
+// deviates at most T/4, T/8 on edge segments). |F(p) - L(p)| bounds
 // both one-sided Hausdorff distances (each output point L(p) has the exact point F(p), and back),
 // so the two-sided distance is <= 3T/4 plus third-order terms, which the remaining T/4 covers once
 // the mesh resolves the curvature. The test suite measures the true error on samples of every
@@ -49,6 +50,7 @@ struct ApparentMesh {
     std::vector<double> emission_times;   // lab time each point emitted the light seen at t_c
     std::vector<Vec3> rest_points;        // the rest-frame point each apparent point is the image of
     std::vector<std::array<uint32_t, 3>> triangles;  // orientation of the input triangles kept
+    std::vector<uint32_t> source_triangles;  // the input triangle each output triangle lies on
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame
     size_t refined_triangles = 0;         // input triangles split by the tolerance
     size_t limited_triangles = 0;         // input triangles that reached max_segments first

@@ -10,77 +10,17 @@
 
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
+#include "mesh4d/tessellate.h"
 #include "pipeline/mesh_check.h"
+#include "error_measure.h"
 #include "test_meshes.h"
 
 using namespace mesh4d;
 
 namespace {
 
-// The rest-space point with barycentrics w on output triangle t, and the output point there.
-struct Sample {
-    Vec3 rest, out;
-};
-Sample sampleOutput(const ApparentMesh& m, const std::array<uint32_t, 3>& t, const double w[3]) {
-    Sample s{{0, 0, 0}, {0, 0, 0}};
-    for (int k = 0; k < 3; ++k) {
-        s.rest += m.rest_points[t[k]] * w[k];
-        s.out += m.positions[t[k]] * w[k];
-    }
-    return s;
-}
-
-// Barycentric sample points: vertices, edge midpoints, the centroid and interior points.
-const double kSamples[][3] = {{1, 0, 0},   {0, 1, 0},       {0, 0, 1},       {0.5, 0.5, 0},   {0, 0.5, 0.5},
-                              {0.5, 0, 0.5}, {1. / 3, 1. / 3, 1. / 3}, {0.6, 0.2, 0.2}, {0.2, 0.6, 0.2}, {0.2, 0.2, 0.6},
-                              {0.25, 0.75, 0}, {0.75, 0, 0.25}};
-
-// Output -> exact: largest |L(p) - F(p)| over samples of every output triangle.
-double outputToExact(const World4D& w, const ViewSurface& view, const ApparentMesh& m) {
-    double worst = 0;
-    for (const auto& t : m.triangles)
-        for (const auto& b : kSamples) {
-            const Sample s = sampleOutput(m, t, b);
-            worst = std::max(worst, norm(exactApparentPoint(w, view, s.rest).x - s.out));
-        }
-    return worst;
-}
-
-// Exact -> output: for points sampled on every input triangle, the distance from the exact point
-// to the output triangle whose rest-space image contains it (the output tiles the rest surface),
-// at the same rest point.
-double exactToOutput(const World4D& w, const ViewSurface& view, const ApparentMesh& m, int grid) {
-    double worst = 0;
-    for (const auto& it : w.mesh.triangles) {
-        const Vec3 a = w.mesh.positions[it[0]], b = w.mesh.positions[it[1]], c = w.mesh.positions[it[2]];
-        const Vec3 n = cross(b - a, c - a);
-        auto bary = [&](const Vec3& p, const Vec3& p0, const Vec3& p1, const Vec3& p2, double out[3]) {
-            const double area = dot(cross(p1 - p0, p2 - p0), n);
-            out[0] = dot(cross(p1 - p, p2 - p), n) / area;
-            out[1] = dot(cross(p2 - p, p0 - p), n) / area;
-            out[2] = dot(cross(p0 - p, p1 - p), n) / area;
-        };
-        for (int i = 0; i <= grid; ++i)
-            for (int j = 0; i + j <= grid; ++j) {
-                const double l1 = double(i) / grid, l2 = double(j) / grid;
-                const Vec3 q = a * (1 - l1 - l2) + b * l1 + c * l2;
-                const Vec3 exact = exactApparentPoint(w, view, q).x;
-                double best = INFINITY;
-                for (const auto& t : m.triangles) {
-                    double l[3];
-                    bary(q, m.rest_points[t[0]], m.rest_points[t[1]], m.rest_points[t[2]], l);
-                    // Outside this output triangle, or not on this input triangle's plane.
-                    if (std::min({l[0], l[1], l[2]}) < -1e-9) continue;
-                    const Vec3 rest = m.rest_points[t[0]] * l[0] + m.rest_points[t[1]] * l[1] + m.rest_points[t[2]] * l[2];
-                    if (norm(rest - q) > 1e-9) continue;
-                    const Vec3 out = m.positions[t[0]] * l[0] + m.positions[t[1]] * l[1] + m.positions[t[2]] * l[2];
-                    best = std::min(best, norm(exact - out));
-                }
-                worst = std::max(worst, best);
-            }
-    }
-    return worst;
-}
+using errmeasure::exactToOutput;
+using errmeasure::outputToExact;
 
 double restSize(const RestMesh& m) {
     Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
@@ -248,4 +188,29 @@ TEST(Tessellate, PenroseOutlineOfARelativisticSphereIsACircle) {
         EXPECT_GT(finite, 30 * rel) << "T = " << tolerance;
     }
     std::printf("; finite 0.9c: %.3f\n", finite);
+}
+
+// The domain pattern itself: any mix of edge segment counts and interior level tiles the
+// parameter triangle (areas add to 1/2) with counter-clockwise triangles only, and the boundary
+// points are exactly each edge's equal subdivision.
+TEST(Tessellate, DomainPatternTilesTheTriangle) {
+    for (uint32_t n0 = 1; n0 <= 7; n0 += 3)
+        for (uint32_t n1 = 1; n1 <= 9; n1 += 4)
+            for (uint32_t n2 = 1; n2 <= 5; n2 += 2)
+                for (uint32_t level : {3u, 4u, 9u, 20u}) {
+                    const uint32_t n[3] = {n0, n1, n2};
+                    const DomainTriangulation d = triangulateDomain(n, level);
+                    double area = 0;
+                    for (const auto& t : d.triangles) {
+                        const auto &a = d.points[t[0]], &b = d.points[t[1]], &c = d.points[t[2]];
+                        const double A = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+                        EXPECT_GT(A, 0) << n0 << " " << n1 << " " << n2 << " N " << level;
+                        area += A;
+                    }
+                    EXPECT_NEAR(area, 0.5, 1e-12) << n0 << " " << n1 << " " << n2 << " N " << level;
+                    EXPECT_EQ(d.boundary_count, size_t(n0 + n1 + n2));
+                    const auto& p = d.points[boundaryIndex(n, 1, 1)];  // first point of edge 1
+                    EXPECT_DOUBLE_EQ(p[1], 1.0 / n1);
+                    EXPECT_DOUBLE_EQ(p[0] + p[1], 1.0);
+                }
 }

@@ -1,0 +1,74 @@
+// Measured distance between an apparent mesh and the exact apparent surface, both directions,
+// shared by the tests and the accuracy benchmark. The exact surface is evaluated point by point
+// with the closed form (exactApparentPoint), independently of how the mesh was refined.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "mesh4d/slice.h"
+
+namespace errmeasure {
+
+using mesh4d::ApparentMesh;
+using mesh4d::Vec3;
+
+// Barycentric sample points: vertices, edge midpoints, the centroid and interior points.
+inline const double kSamples[12][3] = {{1, 0, 0},     {0, 1, 0},   {0, 0, 1},   {0.5, 0.5, 0},
+                                       {0, 0.5, 0.5}, {0.5, 0, 0.5}, {1. / 3, 1. / 3, 1. / 3}, {0.6, 0.2, 0.2},
+                                       {0.2, 0.6, 0.2}, {0.2, 0.2, 0.6}, {0.25, 0.75, 0}, {0.75, 0, 0.25}};
+
+// Output -> exact: the largest |L(p) - F(p)| over samples of every output triangle, where L is the
+// mesh (linear on each triangle) and F the exact image of the same rest point. Bounds the
+// distance from every sampled output point to the exact surface.
+inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m) {
+    double worst = 0;
+    for (const auto& t : m.triangles)
+        for (const auto& b : kSamples) {
+            Vec3 rest{0, 0, 0}, out{0, 0, 0};
+            for (int k = 0; k < 3; ++k) {
+                rest += m.rest_points[t[k]] * b[k];
+                out += m.positions[t[k]] * b[k];
+            }
+            worst = std::max(worst, mesh4d::norm(mesh4d::exactApparentPoint(w, view, rest).x - out));
+        }
+    return worst;
+}
+
+// Exact -> output: for points on a barycentric grid of every input triangle, the distance from
+// the exact point to the output point at the same rest point (found in the output triangles that
+// lie on that input triangle). Bounds the distance from every sampled exact point to the mesh.
+inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m,
+                            int grid) {
+    std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
+    for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
+    double worst = 0;
+    for (size_t f = 0; f < w.mesh.triangles.size(); ++f) {
+        const auto& it = w.mesh.triangles[f];
+        const Vec3 a = w.mesh.positions[it[0]], b = w.mesh.positions[it[1]], c = w.mesh.positions[it[2]];
+        const Vec3 n = mesh4d::cross(b - a, c - a);
+        for (int i = 0; i <= grid; ++i)
+            for (int j = 0; i + j <= grid; ++j) {
+                const double l1 = double(i) / grid, l2 = double(j) / grid;
+                const Vec3 q = a * (1 - l1 - l2) + b * l1 + c * l2;
+                const Vec3 exact = mesh4d::exactApparentPoint(w, view, q).x;
+                double best = INFINITY;
+                for (size_t t : by_source[f]) {
+                    const auto& ot = m.triangles[t];
+                    const Vec3 p0 = m.rest_points[ot[0]], p1 = m.rest_points[ot[1]], p2 = m.rest_points[ot[2]];
+                    const double area = mesh4d::dot(mesh4d::cross(p1 - p0, p2 - p0), n);
+                    if (area == 0) continue;
+                    const double l[3] = {mesh4d::dot(mesh4d::cross(p1 - q, p2 - q), n) / area,
+                                         mesh4d::dot(mesh4d::cross(p2 - q, p0 - q), n) / area,
+                                         mesh4d::dot(mesh4d::cross(p0 - q, p1 - q), n) / area};
+                    if (std::min({l[0], l[1], l[2]}) < -1e-9) continue;
+                    const Vec3 out = m.positions[ot[0]] * l[0] + m.positions[ot[1]] * l[1] + m.positions[ot[2]] * l[2];
+                    best = std::min(best, mesh4d::norm(exact - out));
+                }
+                worst = std::max(worst, best);
+            }
+    }
+    return worst;
+}
+
+}  // namespace errmeasure
