@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "robust.h"
 #include "tessellate.h"
@@ -33,9 +34,13 @@ struct FrameBuilder {
     std::vector<Side> side;
     std::vector<uint32_t> vertex_out;     // rest vertex -> output vertex
     std::vector<uint32_t> crossing_out;   // 2 * edge + cap -> output vertex
-    // Refinement of each edge: its segment count (0 = not yet decided) and the output ids of its
-    // interior points from lo to hi, at edge_first[e] .. edge_first[e] + segments - 2.
-    std::vector<uint32_t> edge_segments, edge_first, edge_points;
+    // Refinement of each edge: its segment count (0 = not yet decided), and the events and output
+    // ids (made on first use) of its inner points from lo to hi, at edge_first[e] .. + segments - 2.
+    std::vector<uint32_t> edge_segments, edge_first, edge_ids;
+    std::vector<Event> edge_events;
+    // Cap crossings on segments of refined mesh edges, keyed by (edge, segment, cap).
+    std::map<std::pair<uint64_t, uint64_t>, uint32_t> sub_crossings;
+    uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being refined
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), one_minus_b2(oneMinusSquare(w.motion.beta)) {}
@@ -112,15 +117,28 @@ struct FrameBuilder {
         return slot;
     }
 
+    // The exact image of vertex i, without emitting it.
+    Event vertexEvent(uint32_t i) const {
+        return cutWorldline(view, world.events[2 * i + anchorCap(i)], world.motion.velocity, one_minus_b2).event;
+    }
+
+    // Which side of the real caps a rest point falls on, from its events on both caps.
+    Side sideOf(const Event& on_a, const Event& on_b) const {
+        if (world.cap_a_real && viewSide(view, on_a) < 0) return Side::NotYet;
+        if (world.cap_b_real && viewSide(view, on_b) > 0) return Side::Gone;
+        return Side::Inside;
+    }
+
     // Step (refinement): split edge `edge` into the fewest equal parameter segments whose exact
-    // midpoints lie within T/4 of their chords; computed once per frame, from lo to hi.
+    // midpoints lie within T/8 of their chords; decided once per frame, from lo to hi, from the
+    // edge alone. The inner points' events are kept; output vertices are made on first use.
     void refineEdge(uint32_t edge) {
         if (edge_segments[edge] != 0) return;
         const Edge& e = world.edges[edge];
         const uint32_t v[3] = {e.lo, e.hi, e.hi};
         const int cap = anchorCap(e.lo);
         const double limit = kEdgeMidpointShare * settings.tolerance;
-        const Vec3 y0 = out.positions[vertexPoint(e.lo)], y1 = out.positions[vertexPoint(e.hi)];
+        const Vec3 y0 = vertexEvent(e.lo).x, y1 = vertexEvent(e.hi).x;
         auto at = [&](double s) {
             const double l[3] = {1 - s, s, 0};
             return surfaceAt(v, l, cap);
@@ -142,33 +160,125 @@ struct FrameBuilder {
             n = std::max(n + 1, int(std::ceil(n * std::sqrt(worst / limit))));
         }
         edge_segments[edge] = uint32_t(n);
-        edge_first[edge] = uint32_t(edge_points.size());
+        edge_first[edge] = uint32_t(edge_events.size());
         for (int i = 1; i < n; ++i) {
-            const double s = double(i) / n;
-            edge_points.push_back(emit(pts[size_t(i)], world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s));
+            edge_events.push_back(pts[size_t(i)]);
+            edge_ids.push_back(kUnset);
         }
     }
 
-    // Step (refinement): one whole triangle to the tolerance.
-    void refineTriangle(size_t f) {
+    // Output vertex of inner point k (1 .. n-1, counted from lo) of a refined edge.
+    uint32_t edgePoint(uint32_t edge, uint32_t k) {
+        uint32_t& id = edge_ids[edge_first[edge] + k - 1];
+        if (id == kUnset) {
+            const Edge& e = world.edges[edge];
+            const double s = double(k) / edge_segments[edge];
+            id = emit(edge_events[edge_first[edge] + k - 1], world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s);
+        }
+        return id;
+    }
+
+    // A point of a refined triangle's domain: a corner (vertex id), a refined edge's point (edge,
+    // index from lo), or an interior lattice point (barycentrics on the triangle's vertices).
+    struct DomainPoint {
+        enum Kind : uint8_t { Corner, EdgePoint, Interior } kind = Interior;
+        uint32_t a = 0, k = 0;
+        double l[3] = {0, 0, 0};
+        Side side = Side::Inside;
+        uint32_t id = kUnset;
+    };
+
+    // The event of a domain point on cap `cap`; edge points are parametrised from lo, as refineEdge does.
+    Event capEvent(const DomainPoint& p, const uint32_t v[3], int cap) const {
+        if (p.kind == DomainPoint::Corner) return world.events[2 * p.a + cap];
+        if (p.kind == DomainPoint::EdgePoint) {
+            const Edge& e = world.edges[p.a];
+            return lerp(world.events[2 * e.lo + cap], world.events[2 * e.hi + cap], double(p.k) / edge_segments[p.a]);
+        }
+        Event r{0, {0, 0, 0}};
+        for (int c = 0; c < 3; ++c) {
+            const Event& e = world.events[2 * v[c] + cap];
+            r.t += p.l[c] * e.t;
+            r.x += e.x * p.l[c];
+        }
+        return r;
+    }
+
+    Vec3 restOf(const DomainPoint& p, const uint32_t v[3]) const {
+        if (p.kind == DomainPoint::Corner) return world.mesh.positions[p.a];
+        if (p.kind == DomainPoint::EdgePoint) {
+            const Edge& e = world.edges[p.a];
+            const double s = double(p.k) / edge_segments[p.a];
+            return world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s;
+        }
+        return restAt(v, p.l);
+    }
+
+    // The crossing of the domain segment p -> q with cap `cap`. A segment of a mesh edge is keyed by
+    // (edge, segment, cap) and parametrised from lo, so the triangle on the other side of the edge
+    // makes the same point; other segments are keyed within the triangle.
+    uint32_t subCrossing(const DomainPoint& p, const DomainPoint& q, uint32_t pi, uint32_t qi, const uint32_t v[3], int cap,
+                         std::map<std::pair<uint64_t, uint64_t>, uint32_t>& local) {
+        uint32_t edge = kUnset, kp = 0, kq = 0;
+        auto onEdge = [&](const DomainPoint& d, uint32_t e, uint32_t* k) {
+            if (d.kind == DomainPoint::EdgePoint && d.a == e) { *k = d.k; return true; }
+            if (d.kind == DomainPoint::Corner && d.a == world.edges[e].lo) { *k = 0; return true; }
+            if (d.kind == DomainPoint::Corner && d.a == world.edges[e].hi) { *k = edge_segments[e]; return true; }
+            return false;
+        };
+        const uint32_t candidate = p.kind == DomainPoint::EdgePoint ? p.a : (q.kind == DomainPoint::EdgePoint ? q.a : kUnset);
+        if (candidate != kUnset && onEdge(p, candidate, &kp) && onEdge(q, candidate, &kq) &&
+            (kp + 1 == kq || kq + 1 == kp))
+            edge = candidate;
+        if (edge == kUnset && p.kind == DomainPoint::Corner && q.kind == DomainPoint::Corner) {
+            // A whole unsplit mesh edge: the vertex-mode crossing, keyed by the edge.
+            for (int c = 0; c < 3; ++c) {
+                const Edge& e = world.edges[cur_edges[c]];
+                if ((e.lo == p.a && e.hi == q.a) || (e.lo == q.a && e.hi == p.a)) return crossingPoint(cur_edges[c], cap);
+            }
+        }
+        std::pair<uint64_t, uint64_t> key;
+        const DomainPoint *first = &p, *second = &q;
+        if (edge != kUnset) {
+            key = {uint64_t(edge) << 1 | 1u, (uint64_t(std::min(kp, kq)) << 1) | uint64_t(cap)};
+            if (kq < kp) std::swap(first, second);
+            auto it = sub_crossings.find(key);
+            if (it != sub_crossings.end()) return it->second;
+        } else {
+            key = {(uint64_t(std::min(pi, qi)) << 32) | std::max(pi, qi), uint64_t(cap)};
+            if (qi < pi) std::swap(first, second);
+            auto it = local.find(key);
+            if (it != local.end()) return it->second;
+        }
+        const Event e0 = capEvent(*first, v, cap), e1 = capEvent(*second, v, cap);
+        const double s = cutSegment(view, e0, e1);
+        const uint32_t id = emit(lerp(e0, e1, s), restOf(*first, v) * (1 - s) + restOf(*second, v) * s);
+        (edge != kUnset ? sub_crossings : local)[key] = id;
+        return id;
+    }
+
+    // Step (refinement): one triangle to the tolerance; `clipped` when a real cap cuts it.
+    void refineTriangle(size_t f, bool clipped) {
         const auto& tri = world.mesh.triangles[f];
         const uint32_t v[3] = {tri[0], tri[1], tri[2]};
-        const uint32_t corner[3] = {vertexPoint(v[0]), vertexPoint(v[1]), vertexPoint(v[2])};
         uint32_t n[3];
         for (int c = 0; c < 3; ++c) {
-            refineEdge(world.triangle_edges[f][c]);
-            n[c] = edge_segments[world.triangle_edges[f][c]];
+            cur_edges[c] = world.triangle_edges[f][c];
+            refineEdge(cur_edges[c]);
+            n[c] = edge_segments[cur_edges[c]];
         }
         const double limit = kMidpointShare * settings.tolerance;
         const int cap = anchorCap(v[0]);
-        const Vec3 y[3] = {out.positions[corner[0]], out.positions[corner[1]], out.positions[corner[2]]};
+        const Vec3 y[3] = {vertexEvent(v[0]).x, vertexEvent(v[1]).x, vertexEvent(v[2]).x};
         const double third[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
         const double centroid_dev = norm(surfaceAt(v, third, cap).x - (y[0] + y[1] + y[2]) / 3.0);
         if (n[0] == 1 && n[1] == 1 && n[2] == 1 && centroid_dev <= limit) {
-            addOutput(f, {corner[0], corner[1], corner[2]});
+            if (clipped) clipWhole(f);
+            else addOutput(f, {vertexPoint(v[0]), vertexPoint(v[1]), vertexPoint(v[2])});
             return;
         }
         ++out.refined_triangles;
+        const bool caps = world.cap_a_real || world.cap_b_real;
 
         // The domain is triangulated with each edge's own points and an interior grid of level
         // `level` (tessellate.h); the level grows until every inner chord passes.
@@ -178,23 +288,40 @@ struct FrameBuilder {
             level = std::min<uint32_t>(level, uint32_t(std::max(settings.max_segments, 3)));
             const DomainTriangulation dom = triangulateDomain(n, level);
 
-            // Step: output ids of the boundary points (corners and shared edge points) and exact
-            // points for the interior lattice.
-            std::vector<uint32_t> ids(dom.points.size());
+            // Step: describe every domain point and decide its side; visible boundary points get
+            // their (shared) output vertices now, so that a retry below drops interior points only.
+            std::vector<DomainPoint> dp(dom.points.size());
             for (int c = 0; c < 3; ++c) {
-                const uint32_t edge = world.triangle_edges[f][c];
+                const uint32_t edge = cur_edges[c];
                 const bool forward = v[c] == world.edges[edge].lo;  // edge points run lo -> hi
-                ids[boundaryIndex(n, c, 0)] = corner[c];
-                for (uint32_t k = 1; k < n[c]; ++k)
-                    ids[boundaryIndex(n, c, k)] = edge_points[edge_first[edge] + (forward ? k : n[c] - k) - 1];
+                DomainPoint& corner = dp[boundaryIndex(n, c, 0)];
+                corner.kind = DomainPoint::Corner;
+                corner.a = v[c];
+                corner.side = side[v[c]];
+                for (uint32_t k = 1; k < n[c]; ++k) {
+                    DomainPoint& d = dp[boundaryIndex(n, c, k)];
+                    d.kind = DomainPoint::EdgePoint;
+                    d.a = edge;
+                    d.k = forward ? k : n[c] - k;
+                }
+            }
+            for (size_t p = dom.boundary_count; p < dom.points.size(); ++p) {
+                dp[p].l[0] = 1 - dom.points[p][0] - dom.points[p][1];
+                dp[p].l[1] = dom.points[p][0];
+                dp[p].l[2] = dom.points[p][1];
+            }
+            for (auto& d : dp)
+                if (d.kind != DomainPoint::Corner && caps) d.side = sideOf(capEvent(d, v, 0), capEvent(d, v, 1));
+            for (auto& d : dp) {
+                if (d.side != Side::Inside) continue;
+                if (d.kind == DomainPoint::Corner) d.id = vertexPoint(d.a);
+                else if (d.kind == DomainPoint::EdgePoint) d.id = edgePoint(d.a, d.k);
             }
             const size_t first_interior = out.positions.size();
-            for (size_t p = dom.boundary_count; p < dom.points.size(); ++p) {
-                const double l[3] = {1 - dom.points[p][0] - dom.points[p][1], dom.points[p][0], dom.points[p][1]};
-                ids[p] = emit(surfaceAt(v, l, cap), restAt(v, l));
-            }
+            for (auto& d : dp)
+                if (d.kind == DomainPoint::Interior && d.side == Side::Inside) d.id = emit(surfaceAt(v, d.l, cap), restAt(v, d.l));
 
-            // Step: check every chord that is not a boundary segment (those passed refineEdge).
+            // Step: check every visible chord that is not a boundary segment (those passed refineEdge).
             auto isBoundarySegment = [&](uint32_t a, uint32_t b) {
                 const size_t nb = dom.boundary_count;
                 return a < nb && b < nb && ((a + 1) % nb == b || (b + 1) % nb == a);
@@ -203,18 +330,18 @@ struct FrameBuilder {
             for (const auto& t : dom.triangles) {
                 for (int c = 0; c < 3; ++c) {
                     const uint32_t a = t[c], b = t[(c + 1) % 3];
-                    if (a > b || isBoundarySegment(a, b)) continue;  // each interior chord once
+                    if (a > b || isBoundarySegment(a, b) || dp[a].side != Side::Inside || dp[b].side != Side::Inside)
+                        continue;  // each inner chord once
                     const double pu = 0.5 * (dom.points[a][0] + dom.points[b][0]);
                     const double pv = 0.5 * (dom.points[a][1] + dom.points[b][1]);
                     const double l[3] = {1 - pu - pv, pu, pv};
-                    const Vec3 mid = (out.positions[ids[a]] + out.positions[ids[b]]) * 0.5;
-                    const double dv = norm(surfaceAt(v, l, cap).x - mid);
-                    worst = std::max(worst, dv);
+                    const Vec3 mid = (out.positions[dp[a].id] + out.positions[dp[b].id]) * 0.5;
+                    worst = std::max(worst, norm(surfaceAt(v, l, cap).x - mid));
                 }
             }
             if (worst <= limit || level >= uint32_t(settings.max_segments)) {
                 if (worst > limit) ++out.limited_triangles;
-                for (const auto& t : dom.triangles) addOutput(f, {ids[t[0]], ids[t[1]], ids[t[2]]});
+                emitDomain(f, dom, dp, v);
                 return;
             }
             // Too coarse: drop this attempt's interior points and refine the grid.
@@ -225,17 +352,40 @@ struct FrameBuilder {
         }
     }
 
-    // Step: one triangle: refined, whole, or clipped to the span (Sutherland-Hodgman over the caps).
-    void addTriangle(size_t f) {
-        const auto& tri = world.mesh.triangles[f];
-        const Side s0 = side[tri[0]], s1 = side[tri[1]], s2 = side[tri[2]];
-        if (s0 == Side::Inside && s1 == Side::Inside && s2 == Side::Inside) {
-            if (settings.tolerance > 0) refineTriangle(f);
-            else addOutput(f, {vertexPoint(tri[0]), vertexPoint(tri[1]), vertexPoint(tri[2])});
-            return;
+    // Step: the domain's triangles; those a real cap cuts are clipped at exact cap crossings.
+    void emitDomain(size_t f, const DomainTriangulation& dom, const std::vector<DomainPoint>& dp, const uint32_t v[3]) {
+        std::map<std::pair<uint64_t, uint64_t>, uint32_t> local;
+        for (const auto& t : dom.triangles) {
+            const Side s[3] = {dp[t[0]].side, dp[t[1]].side, dp[t[2]].side};
+            if (s[0] == Side::Inside && s[1] == Side::Inside && s[2] == Side::Inside) {
+                addOutput(f, {dp[t[0]].id, dp[t[1]].id, dp[t[2]].id});
+                continue;
+            }
+            if (s[0] == s[1] && s[1] == s[2]) continue;
+            uint32_t polygon[6];
+            int n = 0;
+            for (int c = 0; c < 3; ++c) {
+                const uint32_t pi = t[c], qi = t[(c + 1) % 3];
+                const Side si = s[c], sj = s[(c + 1) % 3];
+                if (si == Side::Inside) polygon[n++] = dp[pi].id;
+                if (si == sj) continue;
+                const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
+                const bool cross_b = si == Side::Gone || sj == Side::Gone;
+                const bool a_first = si == Side::NotYet || sj == Side::Gone;
+                if (cross_a && cross_b) {
+                    polygon[n++] = subCrossing(dp[pi], dp[qi], pi, qi, v, a_first ? 0 : 1, local);
+                    polygon[n++] = subCrossing(dp[pi], dp[qi], pi, qi, v, a_first ? 1 : 0, local);
+                } else {
+                    polygon[n++] = subCrossing(dp[pi], dp[qi], pi, qi, v, cross_a ? 0 : 1, local);
+                }
+            }
+            for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
         }
-        if (s0 == s1 && s1 == s2) return;  // wholly before or after existence
-        ++out.clipped_triangles;
+    }
+
+    // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).
+    void clipWhole(size_t f) {
+        const auto& tri = world.mesh.triangles[f];
         uint32_t polygon[6];  // a triangle clipped by a slab has at most 5 corners
         int n = 0;
         for (int c = 0; c < 3; ++c) {
@@ -257,6 +407,18 @@ struct FrameBuilder {
         }
         // Fan over the clipped polygon, convex in the triangle's parameter domain.
         for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
+    }
+
+    // Step: one triangle: whole, refined, or clipped to the span.
+    void addTriangle(size_t f) {
+        const auto& tri = world.mesh.triangles[f];
+        const Side s0 = side[tri[0]], s1 = side[tri[1]], s2 = side[tri[2]];
+        const bool inside = s0 == Side::Inside && s1 == Side::Inside && s2 == Side::Inside;
+        if (!inside && s0 == s1 && s1 == s2) return;  // wholly before or after existence
+        if (!inside) ++out.clipped_triangles;
+        if (settings.tolerance > 0) refineTriangle(f, !inside);
+        else if (inside) addOutput(f, {vertexPoint(tri[0]), vertexPoint(tri[1]), vertexPoint(tri[2])});
+        else clipWhole(f);
     }
 };
 

@@ -31,7 +31,11 @@
 // both one-sided Hausdorff distances (each output point L(p) has the exact point F(p), and back),
 // so the two-sided distance is <= 3T/4 plus third-order terms, which the remaining T/4 covers once
 // the mesh resolves the curvature. The test suite measures the true error on samples of every
-// output triangle. Triangles cut by a real cap are clipped in vertex mode (clip curves are chords).
+// output triangle. A refined triangle cut by a real cap is refined the same way, then each small
+// triangle is clipped at the exact cap crossings of its edges (keyed by mesh edge and segment,
+// so neighbours share them): the clip curve is a polyline whose vertices lie exactly on the
+// tilted cap and on the cone; inside chords are checked as above, the clip chords themselves are
+// measured by the tests, not bounded.
 #pragma once
 
 #include <array>

@@ -214,3 +214,35 @@ TEST(Tessellate, DomainPatternTilesTheTriangle) {
                     EXPECT_DOUBLE_EQ(p[0] + p[1], 1.0);
                 }
 }
+
+// Objects that begin or end existing inside the frames, refined: the clipped surface stays a
+// crack-free manifold (clip points shared along refined edges), every point of it is within T of
+// the exact surface, and its boundary points lie on the tilted caps (proper time tau_a or tau_b).
+TEST(Tessellate, ClippedSurfacesAreRefinedToo) {
+    const RestMesh torus = testmesh::torus(16, 8, 3.0, 1.0);
+    const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -12}, {0.8, 0.2, 0});
+    const double tau_a = 0.0, tau_b = 3.0;
+    const World4D w = extrude(torus, m, tau_a, tau_b, true, true);
+    SliceSettings s;
+    s.tolerance = 1e-3;
+    size_t clipped_frames = 0;
+    for (double t_c = 6; t_c <= 22; t_c += 0.5) {
+        const ViewSurface view{ViewKind::PastCone, t_c, {}};
+        const ApparentMesh out = sliceWorld(w, view, s);
+        if (out.triangles.empty()) continue;
+        const apparent::Topology topo = apparent::analyzeTopology(out.positions, out.triangles);
+        EXPECT_TRUE(topo.manifold) << "t_c " << t_c;
+        if (out.clipped_triangles == 0) continue;
+        ++clipped_frames;
+        EXPECT_GT(out.refined_triangles, 0u) << "t_c " << t_c;
+        EXPECT_FALSE(topo.closed) << "t_c " << t_c;
+        EXPECT_LE(outputToExact(w, view, out), s.tolerance) << "t_c " << t_c;
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const double tau = properTimeAt(m, out.rest_points[i], out.emission_times[i]);
+            EXPECT_GE(tau, tau_a - 1e-9) << "t_c " << t_c;
+            EXPECT_LE(tau, tau_b + 1e-9) << "t_c " << t_c;
+            EXPECT_NEAR(norm(out.positions[i] - view.apex), view.t_c - out.emission_times[i], 1e-9 * 20);
+        }
+    }
+    EXPECT_GT(clipped_frames, 3u);
+}
