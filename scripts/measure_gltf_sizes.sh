@@ -21,21 +21,24 @@ cat > "$tmp/duck.json" <<'JSON'
                  "velocity": [0.9, 0, 0], "scale": 1.2 } ] }
 JSON
 
-row() {  # name scene
-  local name=$1 scene=$2
-  "$build/apparent" render "$scene" --out "$tmp/$name-plain" --model relativistic --quiet
-  "$build/apparent" render "$scene" --out "$tmp/$name-draco" --model relativistic --draco --quiet
+row() {  # name scene tolerance
+  local name=$1 scene=$2 tol=$3
+  "$build/apparent" render "$scene" --out "$tmp/$name-plain" --model relativistic --tolerance "$tol" --quiet
+  "$build/apparent" render "$scene" --out "$tmp/$name-draco" --model relativistic --tolerance "$tol" --draco --quiet
   local plain draco verdict tris
   plain=$(stat -c %s "$tmp/$name-plain/relativistic.glb")
   draco=$(stat -c %s "$tmp/$name-draco/relativistic.glb")
   verdict=$(cd "$root" && node tests/validators/validate_gltf.js "$tmp/$name-plain/relativistic.glb" "$tmp/$name-draco/relativistic.glb" | \
             sed -E 's/.*: ([0-9]+ errors, [0-9]+ warnings).*/\1/' | paste -sd ';' -)
-  tris=$("$build/apparent" render "$scene" --out "$tmp/$name-count" --model relativistic --format glb 2>&1 | \
+  tris=$("$build/apparent" render "$scene" --out "$tmp/$name-count" --model relativistic --tolerance "$tol" 2>&1 | \
          grep -o "up to [0-9]* triangles")
-  printf '| %s | %s | %d | %d | %.1f x | %s |\n' "$name" "$tris" "$plain" "$draco" \
+  rm -rf "$tmp/$name-plain" "$tmp/$name-draco" "$tmp/$name-count"
+  printf '| %s | %s | %s | %d | %d | %.1f x | %s |\n' "$name" "$tol" "$tris" "$plain" "$draco" \
     "$(echo "$plain / $draco" | bc -l)" "$verdict"
 }
-echo "| sequence (200 frames, relativistic) | per frame | .glb bytes | with --draco (14 bits) | ratio | glTF-Validator (plain; Draco) |"
-echo "|---|---|---|---|---|---|"
-row flanges "$root/data/scenes/flanges.json"
-row duck "$tmp/duck.json"
+echo "| sequence (200 frames, relativistic) | tolerance (ls) | per frame | .glb bytes | with --draco (14 bits) | ratio | glTF-Validator (plain; Draco) |"
+echo "|---|---|---|---|---|---|---|"
+row flanges "$root/data/scenes/flanges.json" vertex
+row flanges "$root/data/scenes/flanges.json" 0.01
+row duck "$tmp/duck.json" vertex
+row duck "$tmp/duck.json" 0.01
