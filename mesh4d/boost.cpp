@@ -11,10 +11,33 @@ Motion makeMotion(Kinematics kinematics, double t0, const Vec3& origin, const Ve
     m.origin = origin;
     m.velocity = velocity;
     m.beta = norm(velocity);
+    m.one_minus_beta2 = oneMinusSquare(m.beta);
     if (kinematics == Kinematics::Lorentz) {
-        m.inv_gamma2 = oneMinusSquare(m.beta);
+        m.inv_gamma2 = m.one_minus_beta2;
         m.gamma = 1.0 / std::sqrt(m.inv_gamma2);
     }
+    return m;
+}
+
+Motion makeMotionFromGamma(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& direction, double gamma) {
+    // b = sqrt((g - 1)(g + 1)) / g: no cancellation for g near 1 either.
+    const double beta = std::sqrt((gamma - 1.0) * (gamma + 1.0)) / gamma;
+    Motion m = makeMotion(kinematics, t0, origin, direction * beta);
+    m.beta = beta;
+    m.one_minus_beta2 = 1.0 / (gamma * gamma);
+    if (kinematics == Kinematics::Lorentz) {
+        m.gamma = gamma;
+        m.inv_gamma2 = m.one_minus_beta2;
+    }
+    return m;
+}
+
+Motion makeMotionFromRapidity(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& direction,
+                              double rapidity) {
+    const double gamma = std::cosh(rapidity);
+    Motion m = makeMotionFromGamma(kinematics, t0, origin, direction, gamma);
+    m.beta = std::tanh(rapidity);  // more accurate than from gamma for small rapidities
+    m.velocity = direction * m.beta;
     return m;
 }
 
@@ -39,12 +62,15 @@ double properTimeAt(const Motion& m, const Vec3& q, double t) {
     return (t - m.t0) / m.gamma - dot(m.velocity, q);
 }
 
-Vec3 labPositionAt(const Motion& m, const Vec3& q, double t) {
-    const Vec3 moved = m.origin + m.velocity * (t - m.t0) + q;
-    if (m.kinematics == Kinematics::Galilean) return moved;
+Vec3 shapeOffset(const Motion& m, const Vec3& q) {
+    if (m.kinematics == Kinematics::Galilean) return q;
     // (1 - 1/g)(q.u)u = (q.v)v * (1 - 1/g)/b^2, and (1 - 1/g)/b^2 = (g - 1)/(g b^2) = g/(g + 1).
     const double g = m.gamma;
-    return moved - alongVelocityScaled(m, q, g / (g + 1.0));
+    return q - alongVelocityScaled(m, q, g / (g + 1.0));
+}
+
+Vec3 labPositionAt(const Motion& m, const Vec3& q, double t) {
+    return m.origin + m.velocity * (t - m.t0) + shapeOffset(m, q);
 }
 
 Vec3 restFromLab(const Motion& m, const Vec3& x, double t) {

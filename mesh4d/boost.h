@@ -24,7 +24,10 @@ struct Motion {
     Vec3 velocity;        // lab velocity v, |v| < 1 for Lorentz
     double beta = 0;      // |v|
     double gamma = 1;     // 1/sqrt(1 - b^2) (Lorentz), 1 (Galilean)
-    double inv_gamma2 = 1;  // 1 - b^2 without cancellation (Lorentz), 1 (Galilean)
+    double inv_gamma2 = 1;  // 1/g^2 = 1 - b^2 without cancellation (Lorentz), 1 (Galilean)
+    // 1 - b^2 for the light-delay quadratic, in both kinematics; exact when the speed was given
+    // as gamma or rapidity (makeMotionExact), else (1 - b)(1 + b) of the rounded |v|.
+    double one_minus_beta2 = 1;
 };
 
 // Builds a Motion. Precondition: |velocity| < 1 when kinematics == Lorentz (callers validate).
@@ -36,9 +39,21 @@ Event labFromRest(const Motion& m, double tau, const Vec3& q);
 // Proper time of rest-frame point q at lab time t (the inverse of labFromRest's time equation).
 double properTimeAt(const Motion& m, const Vec3& q, double t);
 
+// Builds a Motion from a unit direction and a speed stated without rounding 1 - b^2: one of
+// gamma (>= 1) or rapidity (>= 0). b = tanh(rapidity) = sqrt((g - 1)(g + 1)) / g, and
+// 1 - b^2 = 1 / g^2 exactly as stated, so gamma = 1e7 (b = 1 - 5e-15) keeps full precision where
+// a velocity written as three doubles could not. Precondition: |direction| = 1.
+Motion makeMotionFromGamma(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& direction, double gamma);
+Motion makeMotionFromRapidity(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& direction,
+                              double rapidity);
+
 // Where rest-frame point q is at lab time t: X0 + v (t - t0) + q - (1 - 1/g)(q.u) u (Lorentz),
 // X0 + v (t - t0) + q (Galilean). At a fixed lab time the shape is contracted by 1/g along u.
 Vec3 labPositionAt(const Motion& m, const Vec3& q, double t);
+
+// labPositionAt(m, q, t) minus X0 + v (t - t0): q itself (Galilean) or q contracted by 1/g along
+// u (Lorentz). Affine pieces kept apart so callers can add the large terms last.
+Vec3 shapeOffset(const Motion& m, const Vec3& q);
 
 // The rest-frame point q whose worldline passes through lab position x at lab time t
 // (the inverse of labPositionAt in q).

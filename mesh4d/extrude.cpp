@@ -60,12 +60,10 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
 
 ProperTimeSpan spanSeen(const RestMesh& mesh, const Motion& motion, const ViewSurface& first, const ViewSurface& last) {
     ProperTimeSpan span{INFINITY, -INFINITY};
-    const double one_minus_b2 = oneMinusSquare(motion.beta);
+    const Vec3 base_first = nowBase(first, motion), base_last = nowBase(last, motion);
     for (const Vec3& q : mesh.positions) {
-        // Any event on q's worldline anchors it; tau = 0 is the natural one.
-        const Event anchor = labFromRest(motion, 0.0, q);
-        const double t_first = cutWorldline(first, anchor, motion.velocity, one_minus_b2).event.t;
-        const double t_last = cutWorldline(last, anchor, motion.velocity, one_minus_b2).event.t;
+        const double t_first = cutRestWorldline(first, motion, base_first, q).t;
+        const double t_last = cutRestWorldline(last, motion, base_last, q).t;
         span.lo = std::min(span.lo, properTimeAt(motion, q, t_first));
         span.hi = std::max(span.hi, properTimeAt(motion, q, t_last));
     }

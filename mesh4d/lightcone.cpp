@@ -37,6 +37,17 @@ WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Ve
     return cut;
 }
 
+Vec3 nowBase(const ViewSurface& view, const Motion& m) {
+    return (m.origin - view.apex) + m.velocity * (view.t_c - m.t0);
+}
+
+Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q) {
+    const Vec3 e = now_base + shapeOffset(m, q);
+    if (view.kind == ViewKind::Hyperplane) return {view.t_c, view.apex + e};
+    const double d = retardedDelay(e, m.velocity, m.one_minus_beta2);
+    return {view.t_c - d, view.apex + (e - m.velocity * d)};
+}
+
 // Bisection on the side function; h changes sign on [0, 1] by precondition. 64 halvings reach
 // the spacing of doubles in [0, 1] near any root away from 0.
 static double bisectSide(const ViewSurface& view, const Event& p0, const Event& p1) {

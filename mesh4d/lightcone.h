@@ -20,6 +20,7 @@
 // Reference: Black et al., Am. J. Phys. 2007, section III.B; DESIGN.md sections 5 and 6.
 #pragma once
 
+#include "boost.h"
 #include "event.h"
 
 namespace mesh4d {
@@ -46,6 +47,14 @@ struct WorldlineCut {
 // The crossing of the worldline through `anchor` with velocity v (|v| < 1) and the view surface.
 // one_minus_b2 = 1 - |v|^2 computed without cancellation by the caller.
 WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Vec3& v, double one_minus_b2);
+
+// The crossing of the worldline of rest point q (an object moving with `m`) with the view surface,
+// from where the point is at t_c relative to the camera: e = (X0 - C) + v (t_c - t0) + shape(q),
+// the large terms summed first and once (DESIGN.md section 5's e). Anchoring at an event far
+// from t_c instead would make e a difference of large numbers, whose rounding the light delay
+// then multiplies by up to 2 gamma^2. `now_base` = (X0 - C) + v (t_c - t0), computed once a frame.
+Vec3 nowBase(const ViewSurface& view, const Motion& m);
+Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q);
 
 // The parameter s in [0, 1] where the segment p0 -> p1 crosses the view surface.
 // Precondition: viewSide(p0) and viewSide(p1) have opposite signs or one is zero; the segment is

@@ -30,6 +30,7 @@ struct FrameBuilder {
     const ViewSurface& view;
     const SliceSettings& settings;
     const double one_minus_b2;
+    const Vec3 now_base;  // (X0 - C) + v (t_c - t0): where the object's origin is now, from the camera
     ApparentMesh out;
     std::vector<Side> side;
     std::vector<uint32_t> vertex_out;     // rest vertex -> output vertex
@@ -43,7 +44,7 @@ struct FrameBuilder {
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being refined
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
-        : world(w), view(v), settings(s), one_minus_b2(oneMinusSquare(w.motion.beta)) {}
+        : world(w), view(v), settings(s), one_minus_b2(w.motion.one_minus_beta2), now_base(nowBase(v, w.motion)) {}
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
         out.triangles.push_back(t);
@@ -57,21 +58,9 @@ struct FrameBuilder {
         return uint32_t(out.positions.size() - 1);
     }
 
-    // The cap whose events anchor worldlines near vertex i: the one nearer in time to the frame,
-    // so that the extrapolation v (t_c - t_anchor) and its absolute rounding stay small.
-    int anchorCap(uint32_t i) const {
-        return std::fabs(view.t_c - world.events[2 * i].t) <= std::fabs(view.t_c - world.events[2 * i + 1].t) ? 0 : 1;
-    }
-
     // The exact cut of the worldline of the rest point with barycentrics `l` on vertices `v`.
-    Event surfaceAt(const uint32_t v[3], const double l[3], int cap) const {
-        Event anchor{0, {0, 0, 0}};
-        for (int k = 0; k < 3; ++k) {
-            const Event& e = world.events[2 * v[k] + cap];
-            anchor.t += l[k] * e.t;
-            anchor.x += e.x * l[k];
-        }
-        return cutWorldline(view, anchor, world.motion.velocity, one_minus_b2).event;
+    Event surfaceAt(const uint32_t v[3], const double l[3]) const {
+        return cutRestWorldline(view, world.motion, now_base, restAt(v, l));
     }
 
     Vec3 restAt(const uint32_t v[3], const double l[3]) const {
@@ -95,9 +84,7 @@ struct FrameBuilder {
 
     uint32_t vertexPoint(uint32_t i) {
         if (vertex_out[i] == kUnset) {
-            const Event& anchor = world.events[2 * i + anchorCap(i)];
-            vertex_out[i] = emit(cutWorldline(view, anchor, world.motion.velocity, one_minus_b2).event,
-                                 world.mesh.positions[i]);
+            vertex_out[i] = emit(vertexEvent(i), world.mesh.positions[i]);
         }
         return vertex_out[i];
     }
@@ -118,9 +105,7 @@ struct FrameBuilder {
     }
 
     // The exact image of vertex i, without emitting it.
-    Event vertexEvent(uint32_t i) const {
-        return cutWorldline(view, world.events[2 * i + anchorCap(i)], world.motion.velocity, one_minus_b2).event;
-    }
+    Event vertexEvent(uint32_t i) const { return cutRestWorldline(view, world.motion, now_base, world.mesh.positions[i]); }
 
     // Which side of the real caps a rest point falls on, from its events on both caps.
     Side sideOf(const Event& on_a, const Event& on_b) const {
@@ -136,12 +121,11 @@ struct FrameBuilder {
         if (edge_segments[edge] != 0) return;
         const Edge& e = world.edges[edge];
         const uint32_t v[3] = {e.lo, e.hi, e.hi};
-        const int cap = anchorCap(e.lo);
         const double limit = kEdgeMidpointShare * settings.tolerance;
         const Vec3 y0 = vertexEvent(e.lo).x, y1 = vertexEvent(e.hi).x;
         auto at = [&](double s) {
             const double l[3] = {1 - s, s, 0};
-            return surfaceAt(v, l, cap);
+            return surfaceAt(v, l);
         };
         // First guess from the whole edge's midpoint deviation: chord error shrinks as 1/n^2.
         const double dev1 = norm(at(0.5).x - (y0 + y1) * 0.5);
@@ -268,10 +252,9 @@ struct FrameBuilder {
             n[c] = edge_segments[cur_edges[c]];
         }
         const double limit = kMidpointShare * settings.tolerance;
-        const int cap = anchorCap(v[0]);
         const Vec3 y[3] = {vertexEvent(v[0]).x, vertexEvent(v[1]).x, vertexEvent(v[2]).x};
         const double third[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
-        const double centroid_dev = norm(surfaceAt(v, third, cap).x - (y[0] + y[1] + y[2]) / 3.0);
+        const double centroid_dev = norm(surfaceAt(v, third).x - (y[0] + y[1] + y[2]) / 3.0);
         if (n[0] == 1 && n[1] == 1 && n[2] == 1 && centroid_dev <= limit) {
             if (clipped) clipWhole(f);
             else addOutput(f, {vertexPoint(v[0]), vertexPoint(v[1]), vertexPoint(v[2])});
@@ -319,7 +302,7 @@ struct FrameBuilder {
             }
             const size_t first_interior = out.positions.size();
             for (auto& d : dp)
-                if (d.kind == DomainPoint::Interior && d.side == Side::Inside) d.id = emit(surfaceAt(v, d.l, cap), restAt(v, d.l));
+                if (d.kind == DomainPoint::Interior && d.side == Side::Inside) d.id = emit(surfaceAt(v, d.l), restAt(v, d.l));
 
             // Step: check every visible chord that is not a boundary segment (those passed refineEdge).
             auto isBoundarySegment = [&](uint32_t a, uint32_t b) {
@@ -336,7 +319,7 @@ struct FrameBuilder {
                     const double pv = 0.5 * (dom.points[a][1] + dom.points[b][1]);
                     const double l[3] = {1 - pu - pv, pu, pv};
                     const Vec3 mid = (out.positions[dp[a].id] + out.positions[dp[b].id]) * 0.5;
-                    worst = std::max(worst, norm(surfaceAt(v, l, cap).x - mid));
+                    worst = std::max(worst, norm(surfaceAt(v, l).x - mid));
                 }
             }
             if (worst <= limit || level >= uint32_t(settings.max_segments)) {
@@ -438,8 +421,7 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
 }
 
 Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q) {
-    const Event anchor = labFromRest(world.motion, 0.0, q);
-    return cutWorldline(view, anchor, world.motion.velocity, oneMinusSquare(world.motion.beta)).event;
+    return cutRestWorldline(view, world.motion, nowBase(view, world.motion), q);
 }
 
 }  // namespace mesh4d

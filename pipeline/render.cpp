@@ -158,7 +158,11 @@ mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame) {
     const ObjectSpec& s = object.spec;
-    const mesh4d::Motion motion = mesh4d::makeMotion(kinematicsOf(model), s.t0, s.position, s.velocity);
+    const mesh4d::Kinematics kin = kinematicsOf(model);
+    const mesh4d::Motion motion =
+        s.speed == ObjectSpec::Speed::Gamma      ? mesh4d::makeMotionFromGamma(kin, s.t0, s.position, s.direction, s.gamma)
+        : s.speed == ObjectSpec::Speed::Rapidity ? mesh4d::makeMotionFromRapidity(kin, s.t0, s.position, s.direction, s.rapidity)
+                                                 : mesh4d::makeMotion(kin, s.t0, s.position, s.velocity);
     // Step: the proper-time span the requested frames can see, padded by the object's own light
     // crossing time so that rounding in the vertex crossings never reaches an artificial cap.
     const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(object.rest, motion, viewForFrame(scene, model, first_frame),

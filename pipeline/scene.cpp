@@ -137,7 +137,8 @@ std::string formatNumber(double v) {
 
 void readObject(FieldReader& r, const json& j, const std::string& path, const std::filesystem::path& folder,
                 ObjectSpec* obj) {
-    r.checkKeys(j, path, {"name", "mesh", "position", "t0", "velocity", "rotation_deg", "scale", "exists"});
+    r.checkKeys(j, path, {"name", "mesh", "position", "t0", "velocity", "direction", "gamma", "rapidity",
+                          "rotation_deg", "scale", "exists"});
     r.string(j, "name", path, &obj->name);
     std::string mesh;
     if (!j.contains("mesh")) r.fail(path + ".mesh", "missing (the path of an OBJ file)");
@@ -151,6 +152,33 @@ void readObject(FieldReader& r, const json& j, const std::string& path, const st
     r.vec3(j, "position", path, &obj->position);
     r.number(j, "t0", path, &obj->t0);
     r.vec3(j, "velocity", path, &obj->velocity);
+    // Step: an exactly stated speed, as a unit direction with gamma or rapidity.
+    const bool has_dir = j.contains("direction"), has_gamma = j.contains("gamma"), has_rap = j.contains("rapidity");
+    if (!r.failed() && (has_dir || has_gamma || has_rap)) {
+        if (j.contains("velocity")) {
+            r.fail(path + ".velocity", "give either velocity or direction with gamma or rapidity, not both");
+        } else if (!has_dir || has_gamma == has_rap) {
+            r.fail(path + (has_dir ? ".gamma" : ".direction"), "an exact speed needs direction and exactly one of gamma, rapidity");
+        } else {
+            Vec3 d;
+            r.vec3(j, "direction", path, &d);
+            if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(path + ".direction", "must be non-zero");
+            if (!r.failed()) obj->direction = d / mesh4d::norm(d);
+            if (has_gamma) {
+                r.number(j, "gamma", path, &obj->gamma);
+                if (!r.failed() && !(obj->gamma >= 1)) r.fail(path + ".gamma", "must be >= 1");
+                obj->speed = ObjectSpec::Speed::Gamma;
+                obj->rapidity = std::acosh(obj->gamma);
+            } else {
+                r.number(j, "rapidity", path, &obj->rapidity);
+                if (!r.failed() && !(obj->rapidity >= 0 && obj->rapidity <= 700))
+                    r.fail(path + ".rapidity", "must be in [0, 700] (gamma overflows beyond)");
+                obj->speed = ObjectSpec::Speed::Rapidity;
+                obj->gamma = std::cosh(obj->rapidity);
+            }
+            if (!r.failed()) obj->velocity = obj->direction * std::tanh(obj->rapidity);
+        }
+    }
     r.vec3(j, "rotation_deg", path, &obj->rotation_deg);
     if (auto it = j.find("scale"); it != j.end()) {
         if (it->is_array()) {
@@ -287,6 +315,7 @@ Status parseScene(const json& root, const std::string& path, const SceneJsonPath
 Status checkSceneForModel(const Scene& scene, Model model) {
     if (model == Model::Instant) return Status::success();
     for (size_t i = 0; i < scene.objects.size(); ++i) {
+        if (scene.objects[i].speed != ObjectSpec::Speed::Velocity) continue;  // b < 1 by construction
         const double b = mesh4d::norm(scene.objects[i].velocity);
         if (!(b < 1)) {
             return Status::failure(scene.path + ": " + scene.objects[i].field_path + ".velocity: |velocity| = " +

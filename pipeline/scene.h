@@ -36,7 +36,11 @@ struct ObjectSpec {
     std::string mesh_path;             // resolved against the scene file's folder
     mesh4d::Vec3 position;             // lab position of the mesh origin at lab time t0
     double t0 = 0;
-    mesh4d::Vec3 velocity;             // lab frame, units of c
+    mesh4d::Vec3 velocity;             // lab frame, units of c (derived when gamma/rapidity is given)
+    // The speed may instead be stated exactly: a unit `direction` with `gamma` or `rapidity`.
+    enum class Speed { Velocity, Gamma, Rapidity } speed = Speed::Velocity;
+    mesh4d::Vec3 direction;            // unit vector (with Speed::Gamma or Speed::Rapidity)
+    double gamma = 1, rapidity = 0;
     mesh4d::Vec3 rotation_deg;         // rest-frame rotation, degrees, applied X then Y then Z
     mesh4d::Vec3 scale{1, 1, 1};       // rest-frame scale, applied before the rotation
     // Interval of existence on the object's own clock (0 at t0): proper time for the relativistic

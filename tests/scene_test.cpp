@@ -2,6 +2,8 @@
 // naming the file, the field and the problem.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "pipeline/scene.h"
 
 using namespace apparent;
@@ -107,4 +109,30 @@ TEST(Scene, GltfSceneErrorsNameTheNode) {
         ASSERT_FALSE(st.ok) << file;
         EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
     }
+}
+
+// Speeds stated exactly: direction with gamma or rapidity; velocity is derived, and mixing the
+// two forms is refused.
+TEST(Scene, ExactSpeedAsGammaOrRapidity) {
+    const std::string dir = ::testing::TempDir();
+    auto write = [&](const std::string& name, const std::string& text) {
+        std::ofstream(dir + name) << text;
+        return dir + name;
+    };
+    std::ofstream(dir + "tetra.obj") << "v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\nf 1 2 4\nf 1 3 2\nf 1 4 3\nf 2 3 4\n";
+    Scene s;
+    ASSERT_TRUE(loadScene(write("g.json", R"({"objects":[{"mesh":"tetra.obj","direction":[0,0,2],"gamma":1e7}]})"), &s).ok);
+    EXPECT_EQ(s.objects[0].speed, ObjectSpec::Speed::Gamma);
+    EXPECT_EQ(s.objects[0].direction, (mesh4d::Vec3{0, 0, 1}));
+    EXPECT_EQ(s.objects[0].gamma, 1e7);
+    EXPECT_TRUE(checkSceneForModel(s, Model::Relativistic).ok);  // b < 1 by construction
+    ASSERT_TRUE(loadScene(write("r.json", R"({"objects":[{"mesh":"tetra.obj","direction":[1,0,0],"rapidity":1.5}]})"), &s).ok);
+    EXPECT_NEAR(s.objects[0].velocity.x, std::tanh(1.5), 1e-15);
+    EXPECT_NEAR(s.objects[0].gamma, std::cosh(1.5), 1e-12);
+    Status st = loadScene(write("b.json", R"({"objects":[{"mesh":"tetra.obj","velocity":[0.5,0,0],"gamma":2}]})"), &s);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("either velocity or direction"), std::string::npos) << st.message;
+    st = loadScene(write("c.json", R"({"objects":[{"mesh":"tetra.obj","direction":[1,0,0],"gamma":0.5}]})"), &s);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("objects[0].gamma: must be >= 1"), std::string::npos) << st.message;
 }

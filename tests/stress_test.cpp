@@ -1,0 +1,120 @@
+// Numerical stress: speeds up to gamma = 1e7 (stated exactly as direction + gamma), sizes from
+// 1e-6 to 1e6 light-seconds and distances up to 1e9. Assertions: nothing non-finite anywhere,
+// every vertex on the past cone to a relative bound, closed input stays closed, and Lampa's rod
+// lengths where they can be computed in closed form.
+#include <gtest/gtest.h>
+
+#include "mesh4d/robust.h"
+#include "mesh4d/slice.h"
+#include "pipeline/mesh_check.h"
+#include "test_meshes.h"
+
+using namespace mesh4d;
+
+namespace {
+// The history over the span the view can see, padded by the object's size, as the pipeline
+// builds it (render.cpp): anchors stay near the emission events, whatever the delay.
+World4D extrudeSeen(const RestMesh& mesh, const Motion& m, const ViewSurface& view, double size) {
+    const ProperTimeSpan span = spanSeen(mesh, m, view, view);
+    const double pad = size + 1e-9 * std::max(std::fabs(span.lo), std::fabs(span.hi));
+    return extrude(mesh, m, span.lo - pad, span.hi + pad, false, false);
+}
+}  // namespace
+
+// Lampa's rod at extreme gamma, speed given exactly: 1 - b = 1 / (gamma^2 (1 + b)).
+// finite: L/(1-b) = L gamma^2 (1+b) approaching, L/(1+b) receding;
+// relativistic: L sqrt((1+b)/(1-b)) = L gamma (1+b) approaching, L / (gamma (1+b)) receding.
+TEST(Stress, RodLengthsAtExtremeGamma) {
+    const double L = 2.0;
+    const RestMesh rod = testmesh::rod(L, 1e-3);
+    for (double gamma : {10.0, 1e3, 1e5, 1e7}) {
+        const double b = std::sqrt((gamma - 1) * (gamma + 1)) / gamma;
+        for (int approach : {1, -1}) {
+            for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+                const Motion m = makeMotionFromGamma(k, 0.0, {0, 0, -100}, {0, 0, double(approach)}, gamma);
+                const ViewSurface view{ViewKind::PastCone, 0.0, {0, 0, 0}};
+                // The history reaches back to the emission: d ~ 100 gamma^2 (1 + b) when approaching.
+                const World4D w = extrudeSeen(rod, m, view, L);
+                const ApparentMesh out = sliceWorld(w, view);
+                ASSERT_EQ(out.positions.size(), 3u);
+                for (const auto& p : out.positions) ASSERT_TRUE(isFinite(p));
+                const double apparent = norm(out.positions[1] - out.positions[0]);
+                double expected;
+                if (k == Kinematics::Galilean) expected = approach > 0 ? L * gamma * gamma * (1 + b) : L / (1 + b);
+                else expected = approach > 0 ? L * gamma * (1 + b) : L / (gamma * (1 + b));
+                // Bound: the ends are ~100 gamma^2 away when approaching, so their difference
+                // carries ~1e-16 of that absolute rounding.
+                const double bound = 1e-12 + 4e-16 * 100 * gamma * gamma * (1 + b) / expected;
+                EXPECT_NEAR(apparent / expected, 1.0, bound)
+                    << "gamma " << gamma << (approach > 0 ? " approaching " : " receding ")
+                    << (k == Kinematics::Galilean ? "finite" : "relativistic");
+            }
+        }
+    }
+}
+
+// The sweep: speed x size x distance x direction of motion, vertex mode and refined.
+TEST(Stress, SweepStaysFiniteOnTheConeAndClosed) {
+    const RestMesh unit = testmesh::icosphere(1, 0.5);
+    struct Speed { const char* name; double gamma; };  // gamma 1 = at rest
+    const Speed speeds[] = {{"rest", 1.0}, {"0.5c", 1 / std::sqrt(0.75)}, {"gamma 1e3", 1e3}, {"gamma 1e7", 1e7}};
+    const Vec3 dirs[] = {{1, 0, 0}, {0, 0, 1}, {0, 0, -1}, Vec3{1, 1, 1} / std::sqrt(3.0)};
+    int cases = 0;
+    for (double size : {1e-6, 1.0, 1e6}) {
+        RestMesh mesh = unit;
+        for (auto& p : mesh.positions) p = p * size;
+        for (double distance_factor : {10.0, 1e3}) {
+            const double distance = std::min(size * distance_factor, 1e9);
+            for (const Speed& sp : speeds) {
+                for (const Vec3& dir : dirs) {
+                    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+                        const Motion m = makeMotionFromGamma(k, 0.0, {0, 0, -distance}, dir, sp.gamma);
+                        const ViewSurface view{ViewKind::PastCone, distance, {0, 0, 0}};
+                        const World4D w = extrudeSeen(mesh, m, view, size);
+                        for (double tol : {0.0, 1e-3 * size}) {
+                            if (tol > 0 && sp.gamma > 1e3) continue;  // refined output grows with gamma^2
+                            SliceSettings s;
+                            s.tolerance = tol;
+                            const ApparentMesh out = sliceWorld(w, view, s);
+                            ++cases;
+                            const std::string what = std::string(sp.name) + " size " + std::to_string(size) +
+                                                     " distance " + std::to_string(distance) + " tol " + std::to_string(tol);
+                            ASSERT_FALSE(out.triangles.empty()) << what;
+                            for (size_t i = 0; i < out.positions.size(); ++i) {
+                                ASSERT_TRUE(isFinite(out.positions[i]) && std::isfinite(out.emission_times[i])) << what;
+                                const double dist = norm(out.positions[i] - view.apex);
+                                const double delay = view.t_c - out.emission_times[i];
+                                // Relative to the delay, plus the rounding of the inputs' own scale
+                                // (|X0 - C| and |v (t_c - t0)| are both `distance` here, and their sum
+                                // cancels when the object is now at the camera).
+                                ASSERT_NEAR(dist, delay, 1e-12 * std::max(dist, delay) + 1e-15 * (distance + size)) << what;
+                            }
+                            if (tol == 0) {
+                                const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
+                                EXPECT_TRUE(t.closed) << what;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_EQ(cases, 3 * 2 * 4 * 2 * (4 + 3));
+}
+
+// An object whose history passes through the camera event: the vertex at the camera has zero
+// delay (d = 0 at e = 0), and nothing is NaN.
+TEST(Stress, ObjectThroughTheCamera) {
+    const RestMesh sphere = testmesh::icosphere(1, 1.0);
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        const Motion m = makeMotion(k, 0.0, {-5, 0, 0}, {0.9, 0, 0});
+        const World4D w = extrude(sphere, m, -100, 100, false, false);
+        for (double t_c = 4; t_c <= 8; t_c += 0.25) {
+            SliceSettings s;
+            s.tolerance = 1e-3;
+            const ApparentMesh out = sliceWorld(w, {ViewKind::PastCone, t_c, {0, 0, 0}}, s);
+            for (size_t i = 0; i < out.positions.size(); ++i)
+                ASSERT_TRUE(isFinite(out.positions[i]) && std::isfinite(out.emission_times[i])) << t_c;
+        }
+    }
+}
