@@ -407,7 +407,11 @@ struct FrameBuilder {
 
 }  // namespace
 
-ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings) {
+ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& requested) {
+    // Model only what the cut requires: on a hyperplane, or at rest, the map from the rest
+    // surface to the apparent one is affine, so straight edges are exact and nothing is refined.
+    SliceSettings settings = requested;
+    if (view.kind == ViewKind::Hyperplane || world.motion.beta == 0) settings.tolerance = 0;
     FrameBuilder b(world, view, settings);
     if (world.empty()) return std::move(b.out);
     b.classifyVertices();

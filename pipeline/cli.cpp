@@ -67,6 +67,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->add_flag("--draco", rs.glb.draco, "Compress every frame mesh of the .glb with KHR_draco_mesh_compression");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
         ->capture_default_str();
+    render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
+                           "output is byte-identical for any count")->capture_default_str();
     render_cmd->add_flag("--quiet,-q", rs.quiet, "No progress or summary");
     render_cmd->add_flag("--verbose,-v", rs.verbose, "Mesh topology and export precision");
     render_cmd->add_option("--max-frames", rs.max_frames, "Refuse scenes with more frames")->capture_default_str();
@@ -137,6 +139,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
+    if (rs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
     if (max_vertices <= 0 || max_faces <= 0 || rs.max_frames <= 0)
         return usage("--max-vertices, --max-faces and --max-frames must be positive");
     rs.limits.max_vertices = size_t(max_vertices);

@@ -12,6 +12,9 @@
 
 #include <unistd.h>
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include "exporters/gltf.h"
 #include "exporters/obj.h"
 #include "exporters/ply.h"
@@ -240,6 +243,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         return kExitOutputError;
     }
 
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     for (Model model : models) {
         const std::string name = modelName(model);
         // Step: build the static 4D world once per model.
@@ -260,27 +264,39 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         std::vector<ExportFrame> frames;
         Progress progress(err, !settings.quiet, name, last_excl - first);
         size_t max_triangles = 0, limited = 0;
-        for (long long k = first; k < last_excl; ++k) {
-            ExportFrame frame;
-            frame.index = k;
-            frame.t_c = frameTime(scene.frames, k);
-            const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-            for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view, slice_settings));
-            max_triangles = std::max(max_triangles, frame.triangleCount());
-            for (const auto& o : frame.objects) limited += o.limited_triangles;
-            std::string error;
-            if (settings.write_ply &&
-                !writePly((std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string(), frame, &error)) {
-                err << "error: " << error << "\n";
-                return kExitOutputError;
+        // Frames are independent given the static worlds: cut a batch in parallel (TBB), then
+        // export it in frame order, so files are byte-identical whatever the thread count.
+        const long long batch = std::max<long long>(1, 4 * (long long)arena.max_concurrency());
+        for (long long b0 = first; b0 < last_excl; b0 += batch) {
+            const long long b1 = std::min(last_excl, b0 + batch);
+            std::vector<ExportFrame> cut(size_t(b1 - b0));
+            arena.execute([&] {
+                tbb::parallel_for(b0, b1, [&](long long k) {
+                    ExportFrame& frame = cut[size_t(k - b0)];
+                    frame.index = k;
+                    frame.t_c = frameTime(scene.frames, k);
+                    const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
+                    for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view, slice_settings));
+                });
+            });
+            for (ExportFrame& frame : cut) {
+                const long long k = frame.index;
+                max_triangles = std::max(max_triangles, frame.triangleCount());
+                for (const auto& o : frame.objects) limited += o.limited_triangles;
+                std::string error;
+                if (settings.write_ply &&
+                    !writePly((std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string(), frame, &error)) {
+                    err << "error: " << error << "\n";
+                    return kExitOutputError;
+                }
+                if (settings.write_obj &&
+                    !writeObj((std::filesystem::path(frame_dir) / frameFileName(k, "obj")).string(), frame, &error)) {
+                    err << "error: " << error << "\n";
+                    return kExitOutputError;
+                }
+                if (settings.write_glb) frames.push_back(std::move(frame));
+                progress.update(k - first + 1);
             }
-            if (settings.write_obj &&
-                !writeObj((std::filesystem::path(frame_dir) / frameFileName(k, "obj")).string(), frame, &error)) {
-                err << "error: " << error << "\n";
-                return kExitOutputError;
-            }
-            if (settings.write_glb) frames.push_back(std::move(frame));
-            progress.update(k - first + 1);
         }
 
         // Step: the animated sequence.

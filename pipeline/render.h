@@ -31,6 +31,7 @@ struct RenderSettings {
     double tolerance = 1e-3;
     long long frame_from = 0;          // --frames A:B, global frame numbers, B exclusive
     long long frame_to = -1;           // -1: to the last frame of the scene
+    int threads = 0;                   // --threads; 0: all cores
     bool quiet = false;
     bool verbose = false;
     long long max_frames = kDefaultMaxFrames;

@@ -309,3 +309,21 @@ TEST(Cli, GltfSceneRendersLikeItsJsonTwin) {
         EXPECT_EQ(da, db) << name;
     }
 }
+
+// Frames run in parallel, yet the same input gives byte-identical files whatever the thread count.
+TEST(Cli, OutputIsIdenticalForAnyThreadCount) {
+    TempDir one, two;
+    for (const auto& [dir, threads] : {std::pair<const TempDir*, const char*>{&one, "1"}, {&two, "2"}})
+        ASSERT_EQ(apparentRun({"render", source("data/scenes/flanges.json"), "--out", dir->str(), "--frames", "90:110",
+                               "--model", "finite,relativistic", "--format", "glb,ply", "--threads", threads, "--quiet"})
+                      .code,
+                  0);
+    const auto files = listFiles(one / "");
+    ASSERT_EQ(files, listFiles(two / ""));
+    ASSERT_EQ(files.size(), 2u + 2u * 20u);
+    for (const auto& f : files) {
+        std::ifstream a(one / f, std::ios::binary), b(two / f, std::ios::binary);
+        const std::string da((std::istreambuf_iterator<char>(a)), {}), db((std::istreambuf_iterator<char>(b)), {});
+        EXPECT_EQ(da, db) << f;
+    }
+}
