@@ -28,6 +28,7 @@
 const fs = require('node:fs');
 const os = require('node:os');
 const path = require('node:path');
+const { launchHeadless } = require('../web/chromium.js');
 
 const REPO = path.resolve(__dirname, '..', '..');
 const t0 = Date.now();
@@ -170,13 +171,7 @@ async function main() {
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'apparent-model-viewer-'));
   let ctx = null;
   try {
-    ctx = await chromium.launchPersistentContext(profile, {
-      executablePath: opts.chromium, headless: true, viewport: { width: 660, height: 500 }, deviceScaleFactor: 1,
-      timeout: 30000,
-      args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-        '--disable-component-update', '--disable-sync', '--use-gl=angle', '--use-angle=swiftshader',
-        '--enable-unsafe-swiftshader'],
-    });
+    ctx = await launchHeadless(chromium, profile, opts.chromium, { width: 660, height: 500 });
     const page = ctx.pages()[0] || await ctx.newPage();
     const consoleMsgs = [];
     const external = [];

@@ -19,6 +19,7 @@
 const fs = require('node:fs');
 const os = require('node:os');
 const path = require('node:path');
+const { launchHeadless } = require('./chromium.js');
 
 const REPO = path.resolve(__dirname, '..', '..');
 const t0 = Date.now();
@@ -154,13 +155,7 @@ async function main() {
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'apparent-viewer-test-'));
   let ctx = null;
   try {
-    ctx = await chromium.launchPersistentContext(profile, {
-      executablePath: opts.chromium, headless: true, viewport: { width: 1440, height: 560 }, deviceScaleFactor: 1,
-      timeout: 30000,
-      args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-        '--disable-component-update', '--disable-sync', '--use-gl=angle', '--use-angle=swiftshader',
-        '--enable-unsafe-swiftshader'],
-    });
+    ctx = await launchHeadless(chromium, profile, opts.chromium, { width: 1440, height: 560 });
     const page = ctx.pages()[0] || await ctx.newPage();
     const consoleMsgs = [];
     page.on('console', (msg) => {
