@@ -25,6 +25,15 @@ constexpr uint32_t kUnset = 0xffffffffu;
 constexpr double kMidpointShare = 0.25;
 constexpr double kEdgeMidpointShare = 0.125;
 
+// Segment count or lattice level from a deviation ratio (chord error falls as 1/n^2): the ratio
+// is clamped in double before the conversion, so NaN, infinities and huge ratios give `cap`
+// instead of undefined behaviour.
+uint32_t levelFor(double current, double ratio, uint32_t cap) {
+    const double want = current * std::sqrt(ratio);
+    if (!(want < double(cap))) return cap;  // also NaN
+    return std::max<uint32_t>(1, uint32_t(std::ceil(want)));
+}
+
 struct FrameBuilder {
     const World4D& world;
     const ViewSurface& view;
@@ -42,6 +51,7 @@ struct FrameBuilder {
     // Cap crossings on segments of refined mesh edges, keyed by (edge, segment, cap).
     std::map<std::pair<uint64_t, uint64_t>, uint32_t> sub_crossings;
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being refined
+    size_t limited_edges = 0;           // edges that reached max_segments before the tolerance
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), one_minus_b2(w.motion.one_minus_beta2), now_base(nowBase(v, w.motion)) {}
@@ -129,7 +139,8 @@ struct FrameBuilder {
         };
         // First guess from the whole edge's midpoint deviation: chord error shrinks as 1/n^2.
         const double dev1 = norm(at(0.5).x - (y0 + y1) * 0.5);
-        int n = dev1 <= limit ? 1 : int(std::ceil(std::sqrt(dev1 / limit)));
+        const uint32_t cap_n = uint32_t(std::max(settings.max_segments, 1));
+        int n = dev1 <= limit ? 1 : int(levelFor(1.0, dev1 / limit, cap_n));
         std::vector<Event> pts;
         for (;;) {
             n = std::min(n, settings.max_segments);
@@ -140,8 +151,11 @@ struct FrameBuilder {
             double worst = 0;
             for (int i = 0; i < n; ++i)
                 worst = std::max(worst, norm(at((i + 0.5) / n).x - (pts[size_t(i)].x + pts[size_t(i) + 1].x) * 0.5));
-            if (worst <= limit || n >= settings.max_segments) break;
-            n = std::max(n + 1, int(std::ceil(n * std::sqrt(worst / limit))));
+            if (worst <= limit || n >= settings.max_segments || !(worst == worst)) {
+                if (!(worst <= limit)) ++limited_edges;
+                break;
+            }
+            n = std::max(n + 1, int(levelFor(n, worst / limit, cap_n)));
         }
         edge_segments[edge] = uint32_t(n);
         edge_first[edge] = uint32_t(edge_events.size());
@@ -265,10 +279,11 @@ struct FrameBuilder {
 
         // The domain is triangulated with each edge's own points and an interior grid of level
         // `level` (tessellate.h); the level grows until every inner chord passes.
-        uint32_t level = uint32_t(std::ceil(std::sqrt(std::max(centroid_dev, 1e-300) / limit)));
+        const uint32_t cap_level = uint32_t(std::max(settings.max_segments, 3));
+        uint32_t level = levelFor(1.0, centroid_dev / limit, cap_level);
         level = std::max({level, n[0], n[1], n[2], 3u});
         for (;;) {
-            level = std::min<uint32_t>(level, uint32_t(std::max(settings.max_segments, 3)));
+            level = std::min<uint32_t>(level, cap_level);
             const DomainTriangulation dom = triangulateDomain(n, level);
 
             // Step: describe every domain point and decide its side; visible boundary points get
@@ -322,8 +337,8 @@ struct FrameBuilder {
                     worst = std::max(worst, norm(surfaceAt(v, l).x - mid));
                 }
             }
-            if (worst <= limit || level >= uint32_t(settings.max_segments)) {
-                if (worst > limit) ++out.limited_triangles;
+            if (worst <= limit || level >= cap_level || !(worst == worst)) {
+                if (!(worst <= limit)) ++out.limited_triangles;
                 emitDomain(f, dom, dp, v);
                 return;
             }
@@ -331,7 +346,7 @@ struct FrameBuilder {
             out.positions.resize(first_interior);
             out.emission_times.resize(first_interior);
             out.rest_points.resize(first_interior);
-            level = std::max(level + 1, uint32_t(std::ceil(level * std::sqrt(worst / limit))));
+            level = std::max(level + 1, levelFor(level, worst / limit, cap_level));
         }
     }
 
@@ -421,6 +436,7 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
         b.edge_first.assign(world.edges.size(), 0);
     }
     for (size_t f = 0; f < world.mesh.triangles.size(); ++f) b.addTriangle(f);
+    b.out.limited_triangles += b.limited_edges;
     return std::move(b.out);
 }
 

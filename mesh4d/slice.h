@@ -57,15 +57,16 @@ struct ApparentMesh {
     std::vector<uint32_t> source_triangles;  // the input triangle each output triangle lies on
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame
     size_t refined_triangles = 0;         // input triangles split by the tolerance
-    size_t limited_triangles = 0;         // input triangles that reached max_segments first
+    size_t limited_triangles = 0;         // input triangles and edges that reached max_segments first
 };
 
 struct SliceSettings {
     // Two-sided distance bound to the exact apparent surface, light-seconds; 0 is vertex mode
     // (exact vertices, straight edges: what real-time engines do). 0 is the safe default.
     double tolerance = 0;
-    // Most segments per input edge, and most interior grid levels per input triangle; a triangle
-    // that would need more is counted in ApparentMesh::limited_triangles and keeps this level.
+    // Most segments per input edge, and most interior grid levels per input triangle (at least 3);
+    // an edge or triangle that would need more is counted in ApparentMesh::limited_triangles and
+    // keeps this level. Values below 1 count as 1.
     int max_segments = 256;
 };
 

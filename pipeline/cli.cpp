@@ -26,7 +26,7 @@ constexpr const char* kRenderFooter =
     "Outputs in DIR:\n"
     "  <model>.glb                      one animated glTF holding every frame (STEP scale channels)\n"
     "  <model>/frame_NNNNN.ply|.obj     per frame, all objects; PLY vertex 'quality' = emission time\n"
-    "Exit codes: 0 success, 2 bad usage or bad input, 3 output could not be written.";
+    "Exit codes: 0 success, 1 internal error, 2 bad usage or bad input, 3 output could not be written.";
 
 bool parseFrames(const std::string& text, long long* from, long long* to) {
     const auto colon = text.find(':');
@@ -144,7 +144,16 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return usage("--max-vertices, --max-faces and --max-frames must be positive");
     rs.limits.max_vertices = size_t(max_vertices);
     rs.limits.max_faces = size_t(max_faces);
-    return render(rs, out, err);
+    try {
+        return render(rs, out, err);
+    } catch (const std::bad_alloc&) {
+        err << "error: out of memory (raise no limit; try a coarser --tolerance or fewer frames)\n";
+        return kExitOutputError;
+    } catch (const std::exception& e) {
+        // A broken invariant, not bad input: say so plainly.
+        err << "error: internal: " << e.what() << "\n";
+        return 1;
+    }
 }
 
 }  // namespace apparent

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <set>
 
+#include <draco/compression/decode.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -19,8 +20,14 @@ namespace apparent {
 
 namespace fs = std::filesystem;
 using mesh4d::Vec3;
+using nlohmann::json;
 
 namespace {
+
+// A node graph is walked depth first from the roots; a node reached through several parents is
+// visited once per path, so both the depth and the total number of visits are bounded.
+constexpr size_t kMaxNodeDepth = 1000;
+constexpr size_t kMaxNodeVisits = 1'000'000;
 
 // Column-major 4x4 affine matrix, as glTF stores node matrices.
 struct Affine {
@@ -191,6 +198,67 @@ bool checkBufferUris(const nlohmann::json& j, std::string* problem) {
     return true;
 }
 
+// Standard base64 (RFC 4648), for data: URIs; returns false on a malformed string.
+bool decodeBase64(const std::string& in, std::vector<unsigned char>* out) {
+    auto value = [](char c) -> int {
+        if (c >= 'A' && c <= 'Z') return c - 'A';
+        if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+        if (c >= '0' && c <= '9') return c - '0' + 52;
+        if (c == '+') return 62;
+        if (c == '/') return 63;
+        return -1;
+    };
+    uint32_t acc = 0;
+    int bits = 0;
+    for (char c : in) {
+        if (c == '=') break;
+        const int v = value(c);
+        if (v < 0) return false;
+        acc = (acc << 6) | uint32_t(v);
+        bits += 6;
+        if (bits >= 8) {
+            bits -= 8;
+            out->push_back(static_cast<unsigned char>((acc >> bits) & 0xff));
+        }
+    }
+    return true;
+}
+
+// The bytes of buffers[index]: the GLB's BIN chunk, a data: URI, or a file inside `root`.
+bool bufferBytes(const nlohmann::json& j, size_t index, const std::vector<unsigned char>& glb, bool binary,
+                 const fs::path& root, size_t max_bytes, std::vector<unsigned char>* out) {
+    const auto& b = j["buffers"][index];
+    if (!b.is_object()) return false;
+    if (!b.contains("uri")) {
+        // GLB BIN chunk: after the JSON chunk, padded to 4 bytes (glTF 2.0 section 4.4.3).
+        if (!binary || index != 0 || glb.size() < 20) return false;
+        uint32_t json_len;
+        std::memcpy(&json_len, glb.data() + 12, 4);
+        const size_t at = 20 + size_t(json_len);
+        if (at + 8 > glb.size()) return false;
+        uint32_t bin_len, bin_type;
+        std::memcpy(&bin_len, glb.data() + at, 4);
+        std::memcpy(&bin_type, glb.data() + at + 4, 4);
+        if (bin_type != 0x004E4942u || at + 8 + size_t(bin_len) > glb.size()) return false;
+        out->assign(glb.begin() + long(at + 8), glb.begin() + long(at + 8 + bin_len));
+        return true;
+    }
+    if (!b["uri"].is_string()) return false;
+    const std::string uri = b["uri"].get<std::string>();
+    if (uri.rfind("data:", 0) == 0) {
+        const auto comma = uri.find(";base64,");
+        return comma != std::string::npos && decodeBase64(uri.substr(comma + 8), out);
+    }
+    // Relative file (checkBufferUris has refused escapes already).
+    std::error_code ec;
+    const fs::path p = root / uri;
+    const auto size = fs::file_size(p, ec);
+    if (ec || size > max_bytes) return false;
+    std::ifstream in(p, std::ios::binary);
+    out->resize(size_t(size));
+    return size == 0 || bool(in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size)));
+}
+
 // References tinygltf's Draco decoder follows without checking them, checked here.
 bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
     using nlohmann::json;
@@ -228,8 +296,10 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
                 return false;
             }
             const json& buffer = j["buffers"][size_t(buf)];
-            const double len = view.value("byteLength", 0.0), off = view.value("byteOffset", 0.0);
-            const double blen = buffer.is_object() ? buffer.value("byteLength", 0.0) : 0.0;
+            auto num = [](const json& o, const char* key) {  // a missing or non-number field counts as 0
+                return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
+            };
+            const double len = num(view, "byteLength"), off = num(view, "byteOffset"), blen = num(buffer, "byteLength");
             if (!(off >= 0 && len >= 0 && off + len <= blen)) {
                 *problem = "bufferViews[" + std::to_string(bv) + "]: byteOffset + byteLength exceeds buffers[" + std::to_string(buf) + "].byteLength";
                 return false;
@@ -258,6 +328,60 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
                 if (!it.value().is_number_integer() || it.value().get<long long>() < 0 ||
                     it.value().get<long long>() >= (long long)(*dr)["attributes"].size()) {
                     *problem = dwhere + ".attributes." + it.key() + ": Draco attribute id out of range";
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+// tinygltf 2.7 decodes Draco attributes into a 4-value stack array and dereferences the
+// attribute named by each id without checking (tiny_gltf.h, GetAttributeForAllPoints and
+// ParseDracoExtension): decode every Draco bufferView first and require each listed id to exist
+// with at most 4 components.
+bool checkDracoPayloads(const nlohmann::json& j, const std::vector<unsigned char>& file, bool binary,
+                        const fs::path& root, size_t max_bytes, std::string* problem) {
+    auto meshes = j.find("meshes");
+    if (meshes == j.end() || !meshes->is_array()) return true;
+    for (size_t m = 0; m < meshes->size(); ++m) {
+        const auto& mesh = (*meshes)[m];
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+            const auto& prim = mesh["primitives"][p];
+            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object()) continue;
+            auto dr = prim["extensions"].find("KHR_draco_mesh_compression");
+            if (dr == prim["extensions"].end()) continue;
+            const std::string where = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) +
+                                      "].extensions.KHR_draco_mesh_compression";
+            // checkDracoReferences has validated the indices and ranges used here.
+            const auto& view = j["bufferViews"][(*dr)["bufferView"].get<size_t>()];
+            const size_t buffer = view["buffer"].get<size_t>();
+            std::vector<unsigned char> bytes;
+            if (!bufferBytes(j, buffer, file, binary, root, max_bytes, &bytes)) continue;  // tinygltf reports it
+            const size_t off = view.contains("byteOffset") && view["byteOffset"].is_number() ? view["byteOffset"].get<size_t>() : 0;
+            const size_t len = view.contains("byteLength") && view["byteLength"].is_number() ? view["byteLength"].get<size_t>() : 0;
+            if (off > bytes.size() || len > bytes.size() - off) {
+                *problem = where + ".bufferView: reaches past buffers[" + std::to_string(buffer) + "] (" + std::to_string(bytes.size()) + " bytes)";
+                return false;
+            }
+            draco::DecoderBuffer db;
+            db.Init(reinterpret_cast<const char*>(bytes.data() + off), len);
+            draco::Decoder decoder;
+            auto decoded = decoder.DecodeMeshFromBuffer(&db);
+            if (!decoded.ok()) {
+                *problem = where + ": Draco cannot decode the bufferView: " + decoded.status().error_msg_string();
+                return false;
+            }
+            const std::unique_ptr<draco::Mesh> dm = std::move(decoded).value();
+            for (auto it = (*dr)["attributes"].begin(); it != (*dr)["attributes"].end(); ++it) {
+                const draco::PointAttribute* a = dm->GetAttributeByUniqueId(uint32_t(it.value().get<long long>()));
+                if (!a) {
+                    *problem = where + ".attributes." + it.key() + ": Draco attribute id " + it.value().dump() + " is not in the payload";
+                    return false;
+                }
+                if (a->num_components() < 1 || a->num_components() > 4) {
+                    *problem = where + ".attributes." + it.key() + ": " + std::to_string(a->num_components()) + " components (glTF allows 1 to 4)";
                     return false;
                 }
             }
@@ -299,7 +423,10 @@ public:
             return fail("nodes", "index " + std::to_string(node) + " out of range (" + std::to_string(model_.nodes.size()) + " nodes)");
         for (int p : path)
             if (p == node) return fail("nodes[" + std::to_string(node) + "]", "the node hierarchy has a cycle");
-        if (path.size() > 1000) return fail("nodes[" + std::to_string(node) + "]", "node hierarchy deeper than 1000");
+        if (path.size() > kMaxNodeDepth)
+            return fail("nodes[" + std::to_string(node) + "]", "node hierarchy deeper than " + std::to_string(kMaxNodeDepth));
+        if (++visits_ > kMaxNodeVisits)
+            return fail("nodes", "more than " + std::to_string(kMaxNodeVisits) + " node visits (nodes shared by many parents)");
         const tinygltf::Node& n = model_.nodes[size_t(node)];
         const Affine world = apply_own_transform ? parent * localTransform(n) : parent;
         for (int i = 0; i < 16; ++i)
@@ -313,6 +440,7 @@ public:
     }
 
 private:
+    size_t visits_ = 0;
     std::string file_;
     const tinygltf::Model& model_;
     MeshLimits limits_;
@@ -336,8 +464,10 @@ private:
             a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
             return fail(aw + ".componentType", std::string("indices must be unsigned integers, got ") + componentName(a.componentType));
         if (a.count == 0) return fail(aw + ".count", "is 0");
-        if (a.count > std::max(limits_.max_vertices, 3 * limits_.max_faces))
-            return fail(aw + ".count", std::to_string(a.count) + " exceeds the limit (raise with --max-vertices / --max-faces)");
+        const size_t count_limit = integer ? 3 * limits_.max_faces : limits_.max_vertices;
+        if (a.count > count_limit)
+            return fail(aw + ".count", std::to_string(a.count) + " exceeds the limit of " + std::to_string(count_limit) +
+                                           (integer ? " (raise with --max-faces)" : " (raise with --max-vertices)"));
         const size_t elem = size_t(csize) * size_t(components);
         values->assign(a.count * size_t(components), 0.0);
 
@@ -509,10 +639,15 @@ Status loadModel(const std::string& path, const MeshLimits& limits, tinygltf::Mo
     nlohmann::json j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) return Status::failure(path + ": invalid JSON");
     if (!j.is_object()) return Status::failure(path + ": the glTF JSON is not an object");
-    if (!checkBufferUris(j, &problem) || !checkDracoReferences(j, &problem)) return Status::failure(path + ": " + problem);
+    std::error_code canon_ec;
+    const fs::path canonical = fs::weakly_canonical(fs::absolute(path, canon_ec), canon_ec);
+    if (canon_ec) return Status::failure(path + ": cannot resolve the path: " + canon_ec.message());
+    if (!checkBufferUris(j, &problem) || !checkDracoReferences(j, &problem) ||
+        !checkDracoPayloads(j, bytes, binary, canonical.parent_path(), limits.max_file_bytes, &problem))
+        return Status::failure(path + ": " + problem);
 
     // Step: parse with tinygltf, file access confined to the glTF file's folder.
-    Confinement conf{fs::weakly_canonical(fs::absolute(path)).parent_path(), limits.max_file_bytes, {}};
+    Confinement conf{canonical.parent_path(), limits.max_file_bytes, {}};
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&confinedExists, &confinedExpand, &confinedRead, &refuseWrite, &conf});
     loader.SetImageLoader(&skipImage, nullptr);
@@ -573,11 +708,14 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
     nlohmann::json objects = nlohmann::json::array();
     std::set<std::string> names;
     std::string problem;
+    size_t visits = 0;
     std::function<bool(int, const Affine&, int, std::vector<int>&)> visit =
         [&](int n, const Affine& parent, int owner, std::vector<int>& stack) -> bool {
         const std::string where = "nodes[" + std::to_string(n) + "]";
         if (n < 0 || size_t(n) >= model.nodes.size()) { problem = "nodes: index " + std::to_string(n) + " out of range"; return false; }
         if (std::find(stack.begin(), stack.end(), n) != stack.end()) { problem = where + ": the node hierarchy has a cycle"; return false; }
+        if (stack.size() > kMaxNodeDepth) { problem = where + ": node hierarchy deeper than " + std::to_string(kMaxNodeDepth); return false; }
+        if (++visits > kMaxNodeVisits) { problem = "nodes: more than " + std::to_string(kMaxNodeVisits) + " node visits (nodes shared by many parents)"; return false; }
         const tinygltf::Node& node = model.nodes[size_t(n)];
         const Affine world = parent * localTransform(node);
         stack.push_back(n);
@@ -630,7 +768,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
 }
 
 Status readGltf(const std::string& path_and_node, const MeshLimits& limits, LoadedMesh* out, MeshWarnings* warnings) {
-    const auto hash = path_and_node.find('#');
+    const auto hash = path_and_node.rfind('#');
     const std::string path = path_and_node.substr(0, hash);
     const std::string node_name = hash == std::string::npos ? "" : path_and_node.substr(hash + 1);
     *out = LoadedMesh{};

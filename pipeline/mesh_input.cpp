@@ -23,12 +23,19 @@ std::vector<std::string> MeshWarnings::lines() const {
 }
 
 Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* out, MeshWarnings* warnings) {
-    const std::string file = path.substr(0, path.find('#'));
+    // A node name follows the last '#' (names of object nodes cannot contain one; folders may).
+    const auto hash = path.rfind('#');
+    const std::string file = path.substr(0, hash);
     std::string ext = file.substr(file.find_last_of('.') == std::string::npos ? file.size() : file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".gltf" || ext == ".glb") return readGltf(path, limits, out, warnings);
-    if (path.find('#') != std::string::npos)
+    if (hash != std::string::npos) {
+        // No glTF before the '#': the '#' is part of an OBJ's own path.
+        std::string whole = path.substr(path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
+        for (char& c : whole) c = char(std::tolower((unsigned char)c));
+        if (whole == ".obj") return readObj(path, limits, &out->mesh, warnings);
         return Status::failure(path + ": '#NodeName' selects a node of a glTF file only");
+    }
     if (ext == ".obj") return readObj(path, limits, &out->mesh, warnings);
     return Status::failure(path + ": unknown mesh format '" + ext + "' (use .obj, .gltf or .glb)");
 }

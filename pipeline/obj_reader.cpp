@@ -35,7 +35,8 @@ bool parseFinite(const std::string& token, double* out) {
     errno = 0;
     char* end = nullptr;
     const double v = std::strtod(token.c_str(), &end);
-    if (end == token.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
+    // OpenMesh reads OBJ coordinates as float: larger magnitudes would be dropped by it silently.
+    if (end == token.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v) || std::fabs(v) > 3.0e38) return false;
     *out = v;
     return true;
 }
@@ -60,7 +61,7 @@ Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* sc
             double xyz[3];
             for (int i = 0; i < 3; ++i) {
                 if (!(ls >> tok) || !parseFinite(tok, &xyz[i]))
-                    return fail("v: expected 3 finite numbers, got '" + line + "'");
+                    return fail("v: expected 3 finite numbers within float range (|x| <= 3e38), got '" + line + "'");
             }
             if (++scan->vertices > limits.max_vertices)
                 return fail("v: more than " + std::to_string(limits.max_vertices) + " vertices (raise with --max-vertices)");

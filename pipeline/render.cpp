@@ -175,7 +175,11 @@ mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scen
         lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
         hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
     }
-    const double pad = mesh4d::norm(hi - lo) + 1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
+    // Interior points of a triangle can emit up to diag (1 + b) / (1 - b^2) = diag / (1 - b) later or
+    // earlier than its vertices (the crossing time's slope along the surface is at most 1/(1 - b)).
+    const double diag = mesh4d::norm(hi - lo);
+    const double pad = diag * (1 + motion.beta) / motion.one_minus_beta2 +
+                       1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
     const double open_a = seen.lo - pad, open_b = seen.hi + pad;
     // Step: clip the span to the object's existence; only those ends are real caps.
     const bool cap_a_real = s.exists_from > open_a;

@@ -166,13 +166,14 @@ void readObject(FieldReader& r, const json& j, const std::string& path, const st
             if (!r.failed()) obj->direction = d / mesh4d::norm(d);
             if (has_gamma) {
                 r.number(j, "gamma", path, &obj->gamma);
-                if (!r.failed() && !(obj->gamma >= 1)) r.fail(path + ".gamma", "must be >= 1");
+                // gamma^2 must stay finite with room to spare (1 - b^2 = 1/gamma^2).
+                if (!r.failed() && !(obj->gamma >= 1 && obj->gamma <= 1e15)) r.fail(path + ".gamma", "must be in [1, 1e15]");
                 obj->speed = ObjectSpec::Speed::Gamma;
                 obj->rapidity = std::acosh(obj->gamma);
             } else {
                 r.number(j, "rapidity", path, &obj->rapidity);
-                if (!r.failed() && !(obj->rapidity >= 0 && obj->rapidity <= 700))
-                    r.fail(path + ".rapidity", "must be in [0, 700] (gamma overflows beyond)");
+                if (!r.failed() && !(obj->rapidity >= 0 && obj->rapidity <= 35))
+                    r.fail(path + ".rapidity", "must be in [0, 35] (gamma up to about 8e14)");
                 obj->speed = ObjectSpec::Speed::Rapidity;
                 obj->gamma = std::cosh(obj->rapidity);
             }

@@ -327,3 +327,12 @@ TEST(Cli, OutputIsIdenticalForAnyThreadCount) {
         EXPECT_EQ(da, db) << f;
     }
 }
+
+// An absurdly fine tolerance stops at the refinement limit with a warning, not a crash.
+TEST(Cli, AbsurdToleranceHitsTheLimitWithAWarning) {
+    TempDir dir;
+    const CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(),
+                                         "--frames", "0:1", "--tolerance", "1e-20"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("reached the refinement limit"), std::string::npos) << r.err;
+}

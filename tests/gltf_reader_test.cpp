@@ -6,8 +6,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include <cstring>
+#include <functional>
+#include <sstream>
+
 #include <nlohmann/json.hpp>
 
+#include "pipeline/cli.h"
 #include "pipeline/mesh_input.h"
 
 using namespace apparent;
@@ -220,5 +225,52 @@ TEST(GltfReader, TruncatedGlbPrefixesNeverCrash) {
         EXPECT_FALSE(st.ok) << n;  // a strict prefix is never a valid GLB (its length field says more)
         EXPECT_FALSE(st.message.empty());
     }
+    fs::remove_all(dir);
+}
+
+namespace {
+// Rewrites a GLB's JSON chunk with `edit` and keeps its BIN chunk (glTF 2.0 section 4.4).
+std::string editGlbJson(const std::string& glb, const std::function<void(nlohmann::json&)>& edit) {
+    uint32_t json_len;
+    std::memcpy(&json_len, glb.data() + 12, 4);
+    nlohmann::json j = nlohmann::json::parse(glb.substr(20, json_len));
+    edit(j);
+    std::string text = j.dump();
+    while (text.size() % 4) text += ' ';
+    const std::string bin = glb.substr(20 + json_len);
+    std::string out(12, '\0');
+    const uint32_t header[3] = {0x46546C67u, 2u, uint32_t(12 + 8 + text.size() + bin.size())};
+    std::memcpy(out.data(), header, 12);
+    const uint32_t chunk[2] = {uint32_t(text.size()), 0x4E4F534Au};
+    out.append(reinterpret_cast<const char*>(chunk), 8);
+    return out + text + bin;
+}
+}  // namespace
+
+// tinygltf 2.7 dereferences the Draco attribute named by each id without checking it exists:
+// a file listing an id its payload lacks must be refused before tinygltf sees it.
+TEST(GltfReader, DracoAttributeIdMissingFromThePayloadIsRefused) {
+    const fs::path dir = fs::temp_directory_path() / ("apparent_draco_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string scene = std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/scene_tetra.json";
+    const char* argv[] = {"apparent", "render", scene.c_str(), "--out", dir.c_str(), "--draco", "--frames", "0:1",
+                          "--tolerance", "vertex", "--quiet"};
+    std::ostringstream o, e;
+    ASSERT_EQ(apparent::runCommandLine(11, argv, o, e), 0) << e.str();
+    std::ifstream in(dir / "relativistic.glb", std::ios::binary);
+    const std::string glb((std::istreambuf_iterator<char>(in)), {});
+    LoadedMesh m;
+    ASSERT_TRUE(load((dir / "relativistic.glb").string(), &m).ok);  // the unedited file loads
+    const std::string bad = editGlbJson(glb, [](nlohmann::json& j) {
+        auto& prim = j["meshes"][0]["primitives"][0];
+        // A fourth attribute whose Draco id (3) the payload (ids 0, 1, 2) does not have.
+        prim["attributes"]["TEXCOORD_0"] = prim["attributes"]["NORMAL"];
+        prim["extensions"]["KHR_draco_mesh_compression"]["attributes"]["TEXCOORD_0"] = 3;
+    });
+    std::ofstream(dir / "bad.glb", std::ios::binary) << bad;
+    const Status st = load((dir / "bad.glb").string(), &m);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("attributes.TEXCOORD_0: Draco attribute id 3 is not in the payload"), std::string::npos)
+        << st.message;
     fs::remove_all(dir);
 }

@@ -33,9 +33,9 @@ TEST(Render, ExtrudesOnlyTheSpanTheFramesSee) {
             }
         }
         // Frames 95..104 cover 0.9 s of camera time; emission times advance at most 1/(1 - b)
-        // times faster (the Doppler factor of an approaching source), and the span is padded by
-        // the flange's diagonal sqrt(2^2 + 4^2 + 2^2) at each end.
-        const double bound = 0.9 / (1 - 0.866) + 2 * std::sqrt(24.0);
+        // times faster (the Doppler factor of an approaching source), and the span is padded at
+        // each end by the flange's diagonal sqrt(2^2 + 4^2 + 2^2) over (1 - b) (render.cpp).
+        const double bound = (0.9 + 2 * std::sqrt(24.0)) / (1 - 0.866);
         EXPECT_LT(few.tau_b - few.tau_a, bound);
     }
 }
