@@ -259,6 +259,26 @@ bool bufferBytes(const nlohmann::json& j, size_t index, const std::vector<unsign
     return size == 0 || bool(in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size)));
 }
 
+// Calls fn(primitive, draco_extension, "meshes[m].primitives[p]") for every primitive with a
+// KHR_draco_mesh_compression object; stops and returns false as soon as fn does.
+template <class Fn>
+bool forEachDracoPrimitive(const nlohmann::json& j, Fn fn) {
+    auto meshes = j.find("meshes");
+    if (meshes == j.end() || !meshes->is_array()) return true;
+    for (size_t m = 0; m < meshes->size(); ++m) {
+        const nlohmann::json& mesh = (*meshes)[m];
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+            const nlohmann::json& prim = mesh["primitives"][p];
+            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object()) continue;
+            auto dr = prim["extensions"].find("KHR_draco_mesh_compression");
+            if (dr == prim["extensions"].end()) continue;
+            if (!fn(prim, *dr, "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]")) return false;
+        }
+    }
+    return true;
+}
+
 // References tinygltf's Draco decoder follows without checking them, checked here.
 bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
     using nlohmann::json;
@@ -267,73 +287,63 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
         return it != j.end() && it->is_array() ? it->size() : size_t(0);
     };
     const size_t n_views = arraySize("bufferViews"), n_buffers = arraySize("buffers"), n_accessors = arraySize("accessors");
-    auto meshes = j.find("meshes");
-    if (meshes == j.end() || !meshes->is_array()) return true;
-    for (size_t m = 0; m < meshes->size(); ++m) {
-        const json& mesh = (*meshes)[m];
-        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
-        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
-            const json& prim = mesh["primitives"][p];
-            const std::string where = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
-            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object()) continue;
-            auto dr = prim["extensions"].find("KHR_draco_mesh_compression");
-            if (dr == prim["extensions"].end()) continue;
-            const std::string dwhere = where + ".extensions.KHR_draco_mesh_compression";
-            if (!dr->is_object() || !dr->contains("bufferView") || !(*dr)["bufferView"].is_number_integer()) {
-                *problem = dwhere + ".bufferView: missing or not an integer";
+    return forEachDracoPrimitive(j, [&](const json& prim, const json& draco, const std::string& where) {
+        const json* dr = &draco;
+        const std::string dwhere = where + ".extensions.KHR_draco_mesh_compression";
+        if (!dr->is_object() || !dr->contains("bufferView") || !(*dr)["bufferView"].is_number_integer()) {
+            *problem = dwhere + ".bufferView: missing or not an integer";
+            return false;
+        }
+        const long long bv = (*dr)["bufferView"].get<long long>();
+        if (bv < 0 || size_t(bv) >= n_views) {
+            *problem = dwhere + ".bufferView: " + std::to_string(bv) + " out of range (" + std::to_string(n_views) + " bufferViews)";
+            return false;
+        }
+        const json& view = j["bufferViews"][size_t(bv)];
+        const long long buf = view.is_object() && view.contains("buffer") && view["buffer"].is_number_integer()
+                                  ? view["buffer"].get<long long>() : -1;
+        if (buf < 0 || size_t(buf) >= n_buffers) {
+            *problem = "bufferViews[" + std::to_string(bv) + "].buffer: out of range (" + std::to_string(n_buffers) + " buffers)";
+            return false;
+        }
+        const json& buffer = j["buffers"][size_t(buf)];
+        auto num = [](const json& o, const char* key) {  // a missing or non-number field counts as 0
+            return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
+        };
+        const double len = num(view, "byteLength"), off = num(view, "byteOffset"), blen = num(buffer, "byteLength");
+        if (!(off >= 0 && len >= 0 && off + len <= blen)) {
+            *problem = "bufferViews[" + std::to_string(bv) + "]: byteOffset + byteLength exceeds buffers[" + std::to_string(buf) + "].byteLength";
+            return false;
+        }
+        if (prim.contains("indices")) {
+            const auto& ind = prim["indices"];
+            if (!ind.is_number_integer() || ind.get<long long>() < 0 || size_t(ind.get<long long>()) >= n_accessors) {
+                *problem = where + ".indices: accessor out of range (" + std::to_string(n_accessors) + " accessors)";
                 return false;
-            }
-            const long long bv = (*dr)["bufferView"].get<long long>();
-            if (bv < 0 || size_t(bv) >= n_views) {
-                *problem = dwhere + ".bufferView: " + std::to_string(bv) + " out of range (" + std::to_string(n_views) + " bufferViews)";
-                return false;
-            }
-            const json& view = j["bufferViews"][size_t(bv)];
-            const long long buf = view.is_object() && view.contains("buffer") && view["buffer"].is_number_integer()
-                                      ? view["buffer"].get<long long>() : -1;
-            if (buf < 0 || size_t(buf) >= n_buffers) {
-                *problem = "bufferViews[" + std::to_string(bv) + "].buffer: out of range (" + std::to_string(n_buffers) + " buffers)";
-                return false;
-            }
-            const json& buffer = j["buffers"][size_t(buf)];
-            auto num = [](const json& o, const char* key) {  // a missing or non-number field counts as 0
-                return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
-            };
-            const double len = num(view, "byteLength"), off = num(view, "byteOffset"), blen = num(buffer, "byteLength");
-            if (!(off >= 0 && len >= 0 && off + len <= blen)) {
-                *problem = "bufferViews[" + std::to_string(bv) + "]: byteOffset + byteLength exceeds buffers[" + std::to_string(buf) + "].byteLength";
-                return false;
-            }
-            if (prim.contains("indices")) {
-                const auto& ind = prim["indices"];
-                if (!ind.is_number_integer() || ind.get<long long>() < 0 || size_t(ind.get<long long>()) >= n_accessors) {
-                    *problem = where + ".indices: accessor out of range (" + std::to_string(n_accessors) + " accessors)";
-                    return false;
-                }
-            }
-            if (!dr->contains("attributes") || !(*dr)["attributes"].is_object() || !prim.contains("attributes") ||
-                !prim["attributes"].is_object()) {
-                *problem = dwhere + ".attributes: missing";
-                return false;
-            }
-            for (auto it = (*dr)["attributes"].begin(); it != (*dr)["attributes"].end(); ++it) {
-                auto acc = prim["attributes"].find(it.key());
-                if (acc == prim["attributes"].end() || !acc->is_number_integer() || acc->get<long long>() < 0 ||
-                    size_t(acc->get<long long>()) >= n_accessors) {
-                    *problem = where + ".attributes." + it.key() + ": accessor missing or out of range";
-                    return false;
-                }
-                // Draco numbers attributes 0, 1, ... in the order they were added; an id past a
-                // small bound cannot name a decoded attribute, and tinygltf would dereference null.
-                if (!it.value().is_number_integer() || it.value().get<long long>() < 0 ||
-                    it.value().get<long long>() >= (long long)(*dr)["attributes"].size()) {
-                    *problem = dwhere + ".attributes." + it.key() + ": Draco attribute id out of range";
-                    return false;
-                }
             }
         }
-    }
-    return true;
+        if (!dr->contains("attributes") || !(*dr)["attributes"].is_object() || !prim.contains("attributes") ||
+            !prim["attributes"].is_object()) {
+            *problem = dwhere + ".attributes: missing";
+            return false;
+        }
+        for (auto it = (*dr)["attributes"].begin(); it != (*dr)["attributes"].end(); ++it) {
+            auto acc = prim["attributes"].find(it.key());
+            if (acc == prim["attributes"].end() || !acc->is_number_integer() || acc->get<long long>() < 0 ||
+                size_t(acc->get<long long>()) >= n_accessors) {
+                *problem = where + ".attributes." + it.key() + ": accessor missing or out of range";
+                return false;
+            }
+            // Draco numbers attributes 0, 1, ... in the order they were added; an id past a
+            // small bound cannot name a decoded attribute, and tinygltf would dereference null.
+            if (!it.value().is_number_integer() || it.value().get<long long>() < 0 ||
+                it.value().get<long long>() >= (long long)(*dr)["attributes"].size()) {
+                *problem = dwhere + ".attributes." + it.key() + ": Draco attribute id out of range";
+                return false;
+            }
+        }
+        return true;
+    });
 }
 
 // tinygltf 2.7 decodes Draco attributes into a 4-value stack array and dereferences the
@@ -342,52 +352,42 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
 // with at most 4 components.
 bool checkDracoPayloads(const nlohmann::json& j, const std::vector<unsigned char>& file, bool binary,
                         const fs::path& root, size_t max_bytes, std::string* problem) {
-    auto meshes = j.find("meshes");
-    if (meshes == j.end() || !meshes->is_array()) return true;
-    for (size_t m = 0; m < meshes->size(); ++m) {
-        const auto& mesh = (*meshes)[m];
-        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
-        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
-            const auto& prim = mesh["primitives"][p];
-            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object()) continue;
-            auto dr = prim["extensions"].find("KHR_draco_mesh_compression");
-            if (dr == prim["extensions"].end()) continue;
-            const std::string where = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) +
-                                      "].extensions.KHR_draco_mesh_compression";
-            // checkDracoReferences has validated the indices and ranges used here.
-            const auto& view = j["bufferViews"][(*dr)["bufferView"].get<size_t>()];
-            const size_t buffer = view["buffer"].get<size_t>();
-            std::vector<unsigned char> bytes;
-            if (!bufferBytes(j, buffer, file, binary, root, max_bytes, &bytes)) continue;  // tinygltf reports it
-            const size_t off = view.contains("byteOffset") && view["byteOffset"].is_number() ? view["byteOffset"].get<size_t>() : 0;
-            const size_t len = view.contains("byteLength") && view["byteLength"].is_number() ? view["byteLength"].get<size_t>() : 0;
-            if (off > bytes.size() || len > bytes.size() - off) {
-                *problem = where + ".bufferView: reaches past buffers[" + std::to_string(buffer) + "] (" + std::to_string(bytes.size()) + " bytes)";
+    return forEachDracoPrimitive(j, [&](const json&, const json& draco, const std::string& prim_where) {
+        const json* dr = &draco;
+        const std::string where = prim_where + ".extensions.KHR_draco_mesh_compression";
+        // checkDracoReferences has validated the indices and ranges used here.
+        const auto& view = j["bufferViews"][(*dr)["bufferView"].get<size_t>()];
+        const size_t buffer = view["buffer"].get<size_t>();
+        std::vector<unsigned char> bytes;
+        if (!bufferBytes(j, buffer, file, binary, root, max_bytes, &bytes)) return true;  // tinygltf reports it
+        const size_t off = view.contains("byteOffset") && view["byteOffset"].is_number() ? view["byteOffset"].get<size_t>() : 0;
+        const size_t len = view.contains("byteLength") && view["byteLength"].is_number() ? view["byteLength"].get<size_t>() : 0;
+        if (off > bytes.size() || len > bytes.size() - off) {
+            *problem = where + ".bufferView: reaches past buffers[" + std::to_string(buffer) + "] (" + std::to_string(bytes.size()) + " bytes)";
+            return false;
+        }
+        draco::DecoderBuffer db;
+        db.Init(reinterpret_cast<const char*>(bytes.data() + off), len);
+        draco::Decoder decoder;
+        auto decoded = decoder.DecodeMeshFromBuffer(&db);
+        if (!decoded.ok()) {
+            *problem = where + ": Draco cannot decode the bufferView: " + decoded.status().error_msg_string();
+            return false;
+        }
+        const std::unique_ptr<draco::Mesh> dm = std::move(decoded).value();
+        for (auto it = (*dr)["attributes"].begin(); it != (*dr)["attributes"].end(); ++it) {
+            const draco::PointAttribute* a = dm->GetAttributeByUniqueId(uint32_t(it.value().get<long long>()));
+            if (!a) {
+                *problem = where + ".attributes." + it.key() + ": Draco attribute id " + it.value().dump() + " is not in the payload";
                 return false;
             }
-            draco::DecoderBuffer db;
-            db.Init(reinterpret_cast<const char*>(bytes.data() + off), len);
-            draco::Decoder decoder;
-            auto decoded = decoder.DecodeMeshFromBuffer(&db);
-            if (!decoded.ok()) {
-                *problem = where + ": Draco cannot decode the bufferView: " + decoded.status().error_msg_string();
+            if (a->num_components() < 1 || a->num_components() > 4) {
+                *problem = where + ".attributes." + it.key() + ": " + std::to_string(a->num_components()) + " components (glTF allows 1 to 4)";
                 return false;
-            }
-            const std::unique_ptr<draco::Mesh> dm = std::move(decoded).value();
-            for (auto it = (*dr)["attributes"].begin(); it != (*dr)["attributes"].end(); ++it) {
-                const draco::PointAttribute* a = dm->GetAttributeByUniqueId(uint32_t(it.value().get<long long>()));
-                if (!a) {
-                    *problem = where + ".attributes." + it.key() + ": Draco attribute id " + it.value().dump() + " is not in the payload";
-                    return false;
-                }
-                if (a->num_components() < 1 || a->num_components() > 4) {
-                    *problem = where + ".attributes." + it.key() + ": " + std::to_string(a->num_components()) + " components (glTF allows 1 to 4)";
-                    return false;
-                }
             }
         }
-    }
-    return true;
+        return true;
+    });
 }
 
 const char* componentName(int c) {
