@@ -11,17 +11,6 @@ Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
 }
 }  // namespace
 
-std::vector<Vec3> vertexNormals(const ApparentMesh& mesh) {
-    std::vector<Vec3> n(mesh.positions.size(), Vec3{0, 0, 0});
-    for (const auto& t : mesh.triangles) {
-        const Vec3& a = mesh.positions[t[0]];
-        const Vec3 area2 = cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
-        for (uint32_t v : t) n[v] += area2;
-    }
-    for (Vec3& v : n) v = unitOr(v, {0, 0, 1});
-    return n;
-}
-
 CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
     const double cos_crease = std::cos(crease_deg * 3.14159265358979323846 / 180.0);
     const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();

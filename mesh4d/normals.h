@@ -1,8 +1,8 @@
 // Per-vertex normals of an apparent mesh, for shading in viewers.
 //
-// vertexNormals: each vertex gets the normalised sum of its triangles' edge cross products, the
-// area-weighted average of the face normals. creaseSplit: the same average taken only over the
-// faces around a vertex whose normals are within `crease_deg` of the corner's own face, with the
+// creaseSplit: each corner of a triangle gets the normalised sum of the edge cross products (the
+// area-weighted average of the face normals) of the faces around its vertex whose normals are
+// within `crease_deg` of the corner's own face, with the
 // vertex duplicated where corners disagree, so that sharp folds (the flange's 90-degree edge)
 // shade flat on each side while curved apparent surfaces stay smooth. The apparent surface is
 // oriented like the input (the cut keeps triangle orientation). A vertex whose triangles all have
@@ -14,9 +14,6 @@
 #include "slice.h"
 
 namespace mesh4d {
-
-// Returns one unit normal per position.
-std::vector<Vec3> vertexNormals(const ApparentMesh& mesh);
 
 struct CreasedMesh {
     ApparentMesh mesh;             // positions and emission times copied per split vertex

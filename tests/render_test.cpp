@@ -9,14 +9,19 @@ using namespace apparent;
 
 namespace {
 std::string source(const std::string& rel) { return std::string(APPARENT_SOURCE_DIR) + "/" + rel; }
+
+// Loads a shipped scene and its meshes, as `apparent render` does before the 4D stage.
+void loadPrepared(const std::string& rel, Scene* scene, std::vector<PreparedObject>* objects) {
+    ASSERT_TRUE(loadScene(source(rel), scene).ok);
+    std::ostringstream log;
+    ASSERT_TRUE(prepareObjects(*scene, {}, objects, log, true).ok);
+}
 }  // namespace
 
 TEST(Render, ExtrudesOnlyTheSpanTheFramesSee) {
     Scene scene;
-    ASSERT_TRUE(loadScene(source("data/scenes/flanges.json"), &scene).ok);
     std::vector<PreparedObject> objects;
-    std::ostringstream log;
-    ASSERT_TRUE(prepareObjects(scene, {}, &objects, log, true).ok);
+    ASSERT_NO_FATAL_FAILURE(loadPrepared("data/scenes/flanges.json", &scene, &objects));
     for (Model model : {Model::Finite, Model::Relativistic}) {
         const mesh4d::World4D all = buildWorld(objects[0], model, scene, 0, 199);
         const mesh4d::World4D few = buildWorld(objects[0], model, scene, 95, 104);
@@ -42,10 +47,8 @@ TEST(Render, ExtrudesOnlyTheSpanTheFramesSee) {
 
 TEST(Render, ExistenceEndsBecomeRealCaps) {
     Scene scene;
-    ASSERT_TRUE(loadScene(source("data/fixtures/scene_exists_window.json"), &scene).ok);
     std::vector<PreparedObject> objects;
-    std::ostringstream log;
-    ASSERT_TRUE(prepareObjects(scene, {}, &objects, log, true).ok);
+    ASSERT_NO_FATAL_FAILURE(loadPrepared("data/fixtures/scene_exists_window.json", &scene, &objects));
     const mesh4d::World4D w = buildWorld(objects[0], Model::Relativistic, scene, 0, frameCount(scene.frames) - 1);
     EXPECT_TRUE(w.cap_a_real);
     EXPECT_TRUE(w.cap_b_real);
