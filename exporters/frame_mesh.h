@@ -43,7 +43,8 @@ struct SequenceInfo {
     ExportCamera camera;
 };
 
-// All objects of a frame in one mesh (PLY and OBJ hold every object in one file).
+// All objects of a frame in one mesh with absolute lab positions and times (origin 0): PLY and
+// OBJ hold every object in one file.
 mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame);
 
 }  // namespace apparent

@@ -184,14 +184,16 @@ PrimitiveData toPrimitive(const mesh4d::ApparentMesh& input, const double origin
     d.positions.reserve(3 * m.positions.size());
     for (size_t i = 0; i < m.positions.size(); ++i) {
         for (int c = 0; c < 3; ++c) {
-            const double rel = m.positions[i][c] - origin[c];
+            // The object's own origin first: both large terms cancel before the small local one is added.
+            const double rel = (m.origin[c] - origin[c]) + m.positions[i][c];
             const float fv = float(rel);
             d.positions.push_back(fv);
             *max_err = std::max(*max_err, std::fabs(double(fv) - rel));
             d.normals.push_back(float(normals[i][c]));
         }
     }
-    d.emission.assign(m.emission_times.begin(), m.emission_times.end());
+    d.emission.reserve(m.emission_times.size());
+    for (size_t i = 0; i < m.emission_times.size(); ++i) d.emission.push_back(float(m.absoluteTime(i)));
     for (const auto& t : m.triangles) d.indices.insert(d.indices.end(), t.begin(), t.end());
     return d;
 }
@@ -253,7 +255,8 @@ bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames,
         double far = 0;
         for (const auto& f : frames)
             for (const auto& o : f.objects)
-                for (const auto& p : o.positions) far = std::max(far, mesh4d::norm(p - info.camera.position));
+                for (size_t i = 0; i < o.positions.size(); ++i)
+                    far = std::max(far, mesh4d::norm(o.absolutePosition(i) - info.camera.position));
         far = far > 0 ? far : 1.0;
         cam.perspective.znear = 1e-3 * far;
         cam.perspective.zfar = 10 * far;
@@ -276,8 +279,10 @@ bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames,
                     std::to_string(f.index);
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (const auto& o : f.objects)
-            for (const auto& p : o.positions)
+            for (size_t i = 0; i < o.positions.size(); ++i) {
+                const Vec3 p = o.absolutePosition(i);
                 for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+            }
         if (f.triangleCount() > 0) {
             const double origin[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
             for (int c = 0; c < 3; ++c) local.max_extent = std::max(local.max_extent, hi[c] - lo[c]);

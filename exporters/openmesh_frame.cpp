@@ -3,11 +3,13 @@
 namespace apparent {
 
 mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame) {
-    mesh4d::ApparentMesh all;
+    mesh4d::ApparentMesh all;  // absolute lab positions and times (origin 0)
     for (const auto& part : frame.objects) {
         const uint32_t base = uint32_t(all.positions.size());
-        all.positions.insert(all.positions.end(), part.positions.begin(), part.positions.end());
-        all.emission_times.insert(all.emission_times.end(), part.emission_times.begin(), part.emission_times.end());
+        for (size_t i = 0; i < part.positions.size(); ++i) {
+            all.positions.push_back(part.absolutePosition(i));
+            all.emission_times.push_back(part.absoluteTime(i));
+        }
         for (const auto& t : part.triangles) all.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
         all.rest_points.insert(all.rest_points.end(), part.rest_points.begin(), part.rest_points.end());
         all.clipped_triangles += part.clipped_triangles;

@@ -48,6 +48,36 @@ Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now
     return {view.t_c - d, view.apex + (e - m.velocity * d)};
 }
 
+ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m) {
+    ViewAnchor a;
+    const Vec3 E = nowBase(view, m);
+    if (view.kind == ViewKind::Hyperplane) {
+        a.cone = false;
+        a.y0 = E;
+        a.origin = view.apex + E;
+        a.time_origin = view.t_c;
+        return a;
+    }
+    const double ev = dot(E, m.velocity);
+    a.S = std::sqrt(ev * ev + m.one_minus_beta2 * norm2(E));
+    const double D = retardedDelay(E, m.velocity, m.one_minus_beta2);
+    a.y0 = E - m.velocity * D;
+    a.origin = view.apex + a.y0;
+    a.time_origin = view.t_c - D;
+    return a;
+}
+
+Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q) {
+    const Vec3 s = shapeOffset(m, q);
+    if (!anchor.cone) return {0, s};
+    const double K = 2 * dot(s, anchor.y0) + norm2(s);
+    const double B = anchor.S + dot(s, m.velocity);
+    const double disc = std::sqrt(std::max(0.0, B * B + m.one_minus_beta2 * K));
+    // The same-sign branch: no cancellation in the denominator (B >= 0) or the numerator.
+    const double delta = B >= 0 ? (K == 0 ? 0.0 : K / (B + disc)) : (disc - B) / m.one_minus_beta2;
+    return {-delta, s - m.velocity * delta};
+}
+
 // Bisection on the side function; h changes sign on [0, 1] by precondition. 64 halvings reach
 // the spacing of doubles in [0, 1] near any root away from 0.
 static double bisectSide(const ViewSurface& view, const Event& p0, const Event& p1) {

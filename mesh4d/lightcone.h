@@ -56,6 +56,27 @@ WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Ve
 Vec3 nowBase(const ViewSurface& view, const Motion& m);
 Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q);
 
+// Per-object origins (DESIGN.md section 5, "scale"): an object far from the camera (|e| ~ 1e9) but
+// small (|shape| ~ 1e-6) would lose its shape to the rounding of C + e - v d, and of e itself.
+// Instead the cut is anchored once per frame at the object's origin, d = D + delta, with
+//     D    the delay of the origin (e = E = now_base), S = sqrt((E.v)^2 + (1 - b^2)|E|^2),
+//     Y0 = E - v D  the apparent position of the origin relative to C,
+// and for rest point q with s = shape(q), subtracting the origin's quadratic from the point's:
+//     (1 - b^2) delta^2 + 2 B delta - K = 0,   B = S + s.v,   K = 2 s.Y0 + |s|^2,
+// whose physical root is delta = K / (B + sqrt(B^2 + (1 - b^2) K)) (B >= 0; otherwise the
+// conjugate form). The apparent point relative to the anchor is s - v delta, emitted delta before
+// the origin's emission: no term of the size of the distance enters the shape.
+struct ViewAnchor {
+    Vec3 origin;             // lab position the local coordinates are relative to: C + Y0
+    double time_origin = 0;  // lab time local emission times are relative to: t_c - D
+    Vec3 y0;                 // Y0 (cone) or E (hyperplane), relative to the camera
+    double S = 0;
+    bool cone = true;
+};
+ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m);
+// The cut of rest point q's worldline in the anchor's local coordinates: {-delta, s - v delta}.
+Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q);
+
 // The parameter s in [0, 1] where the segment p0 -> p1 crosses the view surface.
 // Precondition: viewSide(p0) and viewSide(p1) have opposite signs or one is zero; the segment is
 // spacelike or lies in a hyperplane of constant t. Returns the root of the exact quadratic

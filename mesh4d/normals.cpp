@@ -57,6 +57,8 @@ CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
         }
     }
     out.mesh.clipped_triangles = mesh.clipped_triangles;
+    out.mesh.origin = mesh.origin;
+    out.mesh.time_origin = mesh.time_origin;
     return out;
 }
 

@@ -38,8 +38,7 @@ struct FrameBuilder {
     const World4D& world;
     const ViewSurface& view;
     const SliceSettings& settings;
-    const double one_minus_b2;
-    const Vec3 now_base;  // (X0 - C) + v (t_c - t0): where the object's origin is now, from the camera
+    const ViewAnchor anchor;  // the frame's local coordinates (positions relative to the object's apparent origin)
     ApparentMesh out;
     std::vector<Side> side;
     std::vector<uint32_t> vertex_out;     // rest vertex -> output vertex
@@ -54,12 +53,18 @@ struct FrameBuilder {
     size_t limited_edges = 0;           // edges that reached max_segments before the tolerance
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
-        : world(w), view(v), settings(s), one_minus_b2(w.motion.one_minus_beta2), now_base(nowBase(v, w.motion)) {}
+        : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)) {
+        out.origin = anchor.origin;
+        out.time_origin = anchor.time_origin;
+    }
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
         out.triangles.push_back(t);
         out.source_triangles.push_back(uint32_t(f));
     }
+
+    // A lab event (a clip point made from the absolute 4D events) in local coordinates.
+    Event toLocal(const Event& e) const { return {e.t - anchor.time_origin, e.x - anchor.origin}; }
 
     uint32_t emit(const Event& e, const Vec3& rest) {
         out.positions.push_back(e.x);
@@ -68,9 +73,9 @@ struct FrameBuilder {
         return uint32_t(out.positions.size() - 1);
     }
 
-    // The exact cut of the worldline of the rest point with barycentrics `l` on vertices `v`.
+    // The exact cut (local coordinates) of the worldline of the rest point with barycentrics `l` on vertices `v`.
     Event surfaceAt(const uint32_t v[3], const double l[3]) const {
-        return cutRestWorldline(view, world.motion, now_base, restAt(v, l));
+        return cutRestLocal(anchor, world.motion, restAt(v, l));
     }
 
     Vec3 restAt(const uint32_t v[3], const double l[3]) const {
@@ -109,13 +114,13 @@ struct FrameBuilder {
             const Event& p1 = world.events[2 * e.hi + cap];
             const double s = cutSegment(view, p0, p1);
             const Vec3 rest = world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s;
-            slot = emit(lerp(p0, p1, s), rest);
+            slot = emit(toLocal(lerp(p0, p1, s)), rest);
         }
         return slot;
     }
 
-    // The exact image of vertex i, without emitting it.
-    Event vertexEvent(uint32_t i) const { return cutRestWorldline(view, world.motion, now_base, world.mesh.positions[i]); }
+    // The exact image of vertex i (local coordinates), without emitting it.
+    Event vertexEvent(uint32_t i) const { return cutRestLocal(anchor, world.motion, world.mesh.positions[i]); }
 
     // Which side of the real caps a rest point falls on, from its events on both caps.
     Side sideOf(const Event& on_a, const Event& on_b) const {
@@ -250,7 +255,7 @@ struct FrameBuilder {
         }
         const Event e0 = capEvent(*first, v, cap), e1 = capEvent(*second, v, cap);
         const double s = cutSegment(view, e0, e1);
-        const uint32_t id = emit(lerp(e0, e1, s), restOf(*first, v) * (1 - s) + restOf(*second, v) * s);
+        const uint32_t id = emit(toLocal(lerp(e0, e1, s)), restOf(*first, v) * (1 - s) + restOf(*second, v) * s);
         (edge != kUnset ? sub_crossings : local)[key] = id;
         return id;
     }
@@ -441,7 +446,13 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
 }
 
 Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q) {
-    return cutRestWorldline(view, world.motion, nowBase(view, world.motion), q);
+    const ViewAnchor anchor = viewAnchor(view, world.motion);
+    const Event local = cutRestLocal(anchor, world.motion, q);
+    return {anchor.time_origin + local.t, anchor.origin + local.x};
+}
+
+Event exactLocalPoint(const World4D& world, const ViewSurface& view, const Vec3& q) {
+    return cutRestLocal(viewAnchor(view, world.motion), world.motion, q);
 }
 
 }  // namespace mesh4d

@@ -48,16 +48,23 @@
 namespace mesh4d {
 
 struct ApparentMesh {
-    // Apparent points (lab frame, light-seconds): first the images of the visible input vertices
-    // in input order, then the clip points of this frame.
+    // Apparent points (lab frame, light-seconds) relative to `origin`: first the images of the
+    // visible input vertices in input order, then the clip points of this frame. The shape is
+    // computed relative to the object's own origin (lightcone.h, ViewAnchor), so it keeps its
+    // relative accuracy however far the object is from the camera; absolute = origin + local.
     std::vector<Vec3> positions;
-    std::vector<double> emission_times;   // lab time each point emitted the light seen at t_c
+    std::vector<double> emission_times;   // lab time each point emitted the light seen at t_c, minus time_origin
+    Vec3 origin{0, 0, 0};                 // lab point the positions are relative to
+    double time_origin = 0;               // lab time the emission times are relative to
     std::vector<Vec3> rest_points;        // the rest-frame point each apparent point is the image of
     std::vector<std::array<uint32_t, 3>> triangles;  // orientation of the input triangles kept
     std::vector<uint32_t> source_triangles;  // the input triangle each output triangle lies on
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame
     size_t refined_triangles = 0;         // input triangles split by the tolerance
     size_t limited_triangles = 0;         // input triangles and edges that reached max_segments first
+
+    Vec3 absolutePosition(size_t i) const { return origin + positions[i]; }
+    double absoluteTime(size_t i) const { return time_origin + emission_times[i]; }
 };
 
 struct SliceSettings {
@@ -77,5 +84,8 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
 // The exact apparent point of rest point `q` (any point of the object's rest frame): the crossing of
 // its worldline with the view surface. Used by tests and tools to measure the error of a mesh.
 Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q);
+// The same point in the local coordinates of sliceWorld's output for this world and view
+// (relative to ApparentMesh::origin and time_origin), computed the same way.
+Event exactLocalPoint(const World4D& world, const ViewSurface& view, const Vec3& q);
 
 }  // namespace mesh4d

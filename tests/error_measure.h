@@ -1,6 +1,6 @@
 // Measured distance between an apparent mesh and the exact apparent surface, both directions,
 // shared by the tests and the accuracy benchmark. The exact surface is evaluated point by point
-// with the closed form (exactApparentPoint), independently of how the mesh was refined.
+// with the closed form (exactLocalPoint, in the mesh's local coordinates), independently of how the mesh was refined.
 #pragma once
 
 #include <algorithm>
@@ -22,6 +22,7 @@ inline const double kSamples[12][3] = {{1, 0, 0},     {0, 1, 0},   {0, 0, 1},   
 // mesh (linear on each triangle) and F the exact image of the same rest point. Bounds the
 // distance from every sampled output point to the exact surface.
 inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m) {
+    const Vec3 shift = mesh4d::viewAnchor(view, w.motion).origin - m.origin;  // 0 for sliceWorld's own output
     double worst = 0;
     for (const auto& t : m.triangles)
         for (const auto& b : kSamples) {
@@ -30,7 +31,7 @@ inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface&
                 rest += m.rest_points[t[k]] * b[k];
                 out += m.positions[t[k]] * b[k];
             }
-            worst = std::max(worst, mesh4d::norm(mesh4d::exactApparentPoint(w, view, rest).x - out));
+            worst = std::max(worst, mesh4d::norm((shift + mesh4d::exactLocalPoint(w, view, rest).x) - out));
         }
     return worst;
 }
@@ -40,6 +41,7 @@ inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface&
 // lie on that input triangle). Bounds the distance from every sampled exact point to the mesh.
 inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m,
                             int grid) {
+    const Vec3 shift = mesh4d::viewAnchor(view, w.motion).origin - m.origin;  // 0 for sliceWorld's own output
     std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
     for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
     double worst = 0;
@@ -51,7 +53,7 @@ inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface&
             for (int j = 0; i + j <= grid; ++j) {
                 const double l1 = double(i) / grid, l2 = double(j) / grid;
                 const Vec3 q = a * (1 - l1 - l2) + b * l1 + c * l2;
-                const Vec3 exact = mesh4d::exactApparentPoint(w, view, q).x;
+                const Vec3 exact = shift + mesh4d::exactLocalPoint(w, view, q).x;
                 double best = INFINITY;
                 for (size_t t : by_source[f]) {
                     const auto& ot = m.triangles[t];

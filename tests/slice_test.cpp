@@ -54,7 +54,7 @@ TEST(Slice, OutputVerticesAreOnConeAndWorldtube) {
             const double beta = seed % 5 == 0 ? 0.999 : 0.95 * std::fabs(u(rng));
             const Motion m = makeMotion(k, u(rng), Vec3{u(rng), u(rng), u(rng)} * 40.0, dir * (beta / norm(dir)));
             const ViewSurface view{ViewKind::PastCone, 10 * u(rng), Vec3{u(rng), u(rng), u(rng)}};
-            const ApparentMesh out = sliceWorld(alwaysExisting(mesh, m, view.t_c), view);
+            const ApparentMesh out = testmesh::sliceAbsolute(alwaysExisting(mesh, m, view.t_c), view);
             ASSERT_EQ(out.positions.size(), mesh.positions.size());
             ASSERT_EQ(out.triangles.size(), mesh.triangles.size());
             for (size_t i = 0; i < out.positions.size(); ++i) {
@@ -81,7 +81,7 @@ TEST(Slice, RodOnTheLineOfSight) {
                 // The rod's near end is 100 light-seconds down the -z axis at t0 = 0.
                 const Motion m = makeMotion(k, 0.0, {0, 0, -100}, {0, 0, approach * b});
                 const ViewSurface view{ViewKind::PastCone, 0.0, {0, 0, 0}};
-                const ApparentMesh out = sliceWorld(alwaysExisting(rod, m, 0), view);
+                const ApparentMesh out = testmesh::sliceAbsolute(alwaysExisting(rod, m, 0), view);
                 ASSERT_EQ(out.triangles.size(), 1u);
                 // Output vertices follow the triangle's corners: 0 and 1 are the rod's ends.
                 const double apparent = norm(out.positions[1] - out.positions[0]);
@@ -104,7 +104,7 @@ TEST(Slice, RestIsIdentityAndInstantIsTranslation) {
     for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
         for (ViewKind vk : {ViewKind::PastCone, ViewKind::Hyperplane}) {
             const Motion m = makeMotion(k, 2.0, X0, {0, 0, 0});
-            const ApparentMesh out = sliceWorld(alwaysExisting(mesh, m, 0), {vk, 7.0, {1, 1, 1}});
+            const ApparentMesh out = testmesh::sliceAbsolute(alwaysExisting(mesh, m, 0), {vk, 7.0, {1, 1, 1}});
             ASSERT_EQ(out.positions.size(), mesh.positions.size());
             for (size_t i = 0; i < mesh.positions.size(); ++i)
                 EXPECT_NEAR(norm(out.positions[i] - (mesh.positions[i] + X0)), 0, 1e-13 * 40) << i;
@@ -115,7 +115,7 @@ TEST(Slice, RestIsIdentityAndInstantIsTranslation) {
         const Vec3 v{0, b, 0};
         const Motion m = makeMotion(Kinematics::Galilean, 2.0, X0, v);
         const double t_c = 7.0;
-        const ApparentMesh out = sliceWorld(alwaysExisting(mesh, m, 0), {ViewKind::Hyperplane, t_c, {}});
+        const ApparentMesh out = testmesh::sliceAbsolute(alwaysExisting(mesh, m, 0), {ViewKind::Hyperplane, t_c, {}});
         for (size_t i = 0; i < mesh.positions.size(); ++i) {
             EXPECT_NEAR(norm(out.positions[i] - (mesh.positions[i] + X0 + v * (t_c - 2.0))), 0, 1e-13 * 40) << i;
             EXPECT_EQ(out.emission_times[i], t_c);
@@ -134,7 +134,7 @@ TEST(Slice, ClosedManifoldStaysClosedWithSameGenus) {
         ASSERT_EQ(in.genus, c.genus);
         for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
             const Motion m = makeMotion(k, 0, {-4, 1, -12}, {0.9, 0, 0.1});
-            const ApparentMesh out = sliceWorld(alwaysExisting(c.mesh, m, 0), {ViewKind::PastCone, 3.0, {}});
+            const ApparentMesh out = testmesh::sliceAbsolute(alwaysExisting(c.mesh, m, 0), {ViewKind::PastCone, 3.0, {}});
             const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
             EXPECT_TRUE(t.closed);
             EXPECT_EQ(t.genus, c.genus);
@@ -156,7 +156,7 @@ TEST(Slice, ExistenceStartClipsAlongTheTiltedCap) {
         const World4D w = extrude(mesh, m, tau_a, 1e4, true, false);
         // The frame whose cone meets the object's origin at its start: t_c = 0 + |X0 - C|.
         const ViewSurface view{ViewKind::PastCone, norm(m.origin), {}};
-        const ApparentMesh out = sliceWorld(w, view);
+        const ApparentMesh out = testmesh::sliceAbsolute(w, view);
         EXPECT_GT(out.clipped_triangles, 0u);
         EXPECT_GT(out.triangles.size(), 0u);
         EXPECT_LT(out.triangles.size(), mesh.triangles.size());
@@ -198,7 +198,7 @@ TEST(Slice, ClippedSurfaceHasNoCracks) {
     const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -15}, {0.7, 0.3, 0});
     const World4D w = extrude(mesh, m, 0.0, 2.0, true, true);
     for (double t_c = 10; t_c <= 22; t_c += 0.25) {
-        const ApparentMesh out = sliceWorld(w, {ViewKind::PastCone, t_c, {}});
+        const ApparentMesh out = testmesh::sliceAbsolute(w, {ViewKind::PastCone, t_c, {}});
         if (out.triangles.empty()) continue;
         const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
         EXPECT_TRUE(t.manifold) << "t_c " << t_c;
@@ -215,7 +215,7 @@ TEST(Slice, ContractedModelIsTheMeasuredShape) {
     rod.triangles = {{0, 1, 2}};
     const Motion m = makeMotion(Kinematics::Lorentz, 1.0, {-3, 0, -18}, {b, 0, 0});
     const double t_c = 4.0;
-    const ApparentMesh out = sliceWorld(extrude(rod, m, -10, 10, false, false), {ViewKind::Hyperplane, t_c, {}});
+    const ApparentMesh out = testmesh::sliceAbsolute(extrude(rod, m, -10, 10, false, false), {ViewKind::Hyperplane, t_c, {}});
     ASSERT_EQ(out.positions.size(), 3u);
     const double gamma = 1 / std::sqrt((1 - b) * (1 + b));
     EXPECT_NEAR(norm(out.positions[1] - out.positions[0]), L / gamma, 1e-12);

@@ -82,8 +82,9 @@ TEST(Stress, SweepStaysFiniteOnTheConeAndClosed) {
                             ASSERT_FALSE(out.triangles.empty()) << what;
                             for (size_t i = 0; i < out.positions.size(); ++i) {
                                 ASSERT_TRUE(isFinite(out.positions[i]) && std::isfinite(out.emission_times[i])) << what;
-                                const double dist = norm(out.positions[i] - view.apex);
-                                const double delay = view.t_c - out.emission_times[i];
+                                // The local coordinates are relative to the object's apparent origin.
+                                const double dist = norm((out.origin - view.apex) + out.positions[i]);
+                                const double delay = (view.t_c - out.time_origin) - out.emission_times[i];
                                 // Relative to the delay, plus the rounding of the inputs' own scale
                                 // (|X0 - C| and |v (t_c - t0)| are both `distance` here, and their sum
                                 // cancels when the object is now at the camera).
@@ -117,4 +118,42 @@ TEST(Stress, ObjectThroughTheCamera) {
                 ASSERT_TRUE(isFinite(out.positions[i]) && std::isfinite(out.emission_times[i])) << t_c;
         }
     }
+}
+
+// Relative accuracy far from the camera (issue: sizes 1e-6..1e6 at distances up to 1e9): a rod on
+// the line of sight has the distance-independent apparent lengths of Lampa, L/(1-b) or L/(1+b)
+// (finite) and L sqrt((1+b)/(1-b)) or L sqrt((1-b)/(1+b)) (relativistic). The shape is computed
+// relative to the object's origin (lightcone.h, ViewAnchor), so it keeps ~1e-12 relative
+// accuracy where absolute doubles (ulp 1.2e-7 at 1e9) would leave nothing of a 1e-6 rod.
+TEST(Stress, SmallRodFarAwayKeepsItsShape) {
+    int cases = 0;
+    for (double L : {1e-6, 1e-3, 1.0}) {
+        const RestMesh rod = testmesh::rod(L, 1e-3 * L);
+        for (double distance : {1e3, 1e6, 1e9}) {
+            for (double b : {0.5, 0.9}) {
+                for (int approach : {1, -1}) {
+                    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+                        // The rod's origin is at -distance on the z axis now (t_c = distance, t0 = 0).
+                        const Motion m = makeMotion(k, 0.0, {0, 0, -distance - approach * b * distance},
+                                                    {0, 0, approach * b});
+                        const ViewSurface view{ViewKind::PastCone, distance, {0, 0, 0}};
+                        const World4D w = extrudeSeen(rod, m, view, L);
+                        const ApparentMesh out = sliceWorld(w, view);
+                        ASSERT_EQ(out.positions.size(), 3u);
+                        const double apparent = norm(out.positions[1] - out.positions[0]);
+                        double expected;
+                        if (k == Kinematics::Galilean) expected = approach > 0 ? L / (1 - b) : L / (1 + b);
+                        else expected = L * (approach > 0 ? std::sqrt((1 + b) / (1 - b)) : std::sqrt((1 - b) / (1 + b)));
+                        EXPECT_NEAR(apparent / expected, 1.0, 1e-11)
+                            << "L " << L << " distance " << distance << " b " << b << (approach > 0 ? " approaching" : " receding");
+                        // And it is where it should be: the origin's light delay d solves the cone equation.
+                        const double delay = view.t_c - out.time_origin;
+                        EXPECT_NEAR(norm(out.origin - view.apex) / delay, 1.0, 1e-14);
+                        ++cases;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_EQ(cases, 3 * 3 * 2 * 2 * 2);
 }

@@ -42,7 +42,7 @@ TEST(Tessellate, ErrorWithinToleranceBothDirections) {
         const Motion m = makeMotion(k, 0.0, {0, 0, -4}, {0.9, 0, 0});
         const World4D w = extrude(sphere, m, -100, 100, false, false);
         const ViewSurface view{ViewKind::PastCone, 4.0, {0, 0, 0}};
-        const ApparentMesh vertex_mode = sliceWorld(w, view);
+        const ApparentMesh vertex_mode = testmesh::sliceAbsolute(w, view);
         const double vertex_error = outputToExact(w, view, vertex_mode);
         EXPECT_GT(vertex_error, 1e-2 * size) << "the test must be able to fail: vertex mode is coarse here";
         // One face of the icosahedron (the one nearest the camera) carries the finest tolerances,
@@ -60,7 +60,7 @@ TEST(Tessellate, ErrorWithinToleranceBothDirections) {
             s.tolerance = rel * size;
             s.max_segments = 4096;
             const World4D& wt = rel >= 1e-4 ? w : w_face;
-            const ApparentMesh out = sliceWorld(wt, view, s);
+            const ApparentMesh out = testmesh::sliceAbsolute(wt, view, s);
             EXPECT_EQ(out.limited_triangles, 0u);
             const double forward = outputToExact(wt, view, out);
             EXPECT_LE(forward, s.tolerance) << "T = " << rel << " x size, " << out.triangles.size() << " triangles";
@@ -81,7 +81,7 @@ TEST(Tessellate, RefinesOnlyWhereTheSurfaceIsCurved) {
     auto count = [&](Kinematics k, ViewKind vk, double beta, double distance) {
         const Motion m = makeMotion(k, 0.0, {0, 0, -distance}, {beta, 0, 0});
         const World4D w = extrude(sphere, m, -1000, 1000, false, false);
-        return sliceWorld(w, {vk, distance, {0, 0, 0}}, s).triangles.size();
+        return testmesh::sliceAbsolute(w, {vk, distance, {0, 0, 0}}, s).triangles.size();
     };
     EXPECT_EQ(count(Kinematics::Lorentz, ViewKind::PastCone, 0.0, 10), sphere.triangles.size());
     EXPECT_EQ(count(Kinematics::Galilean, ViewKind::Hyperplane, 0.9, 10), sphere.triangles.size());
@@ -102,7 +102,7 @@ TEST(Tessellate, RefinedClosedMeshStaysWatertight) {
         const World4D w = extrude(torus, m, -100, 100, false, false);
         SliceSettings s;
         s.tolerance = 1e-3;
-        const ApparentMesh out = sliceWorld(w, {ViewKind::PastCone, 8.0, {}}, s);
+        const ApparentMesh out = testmesh::sliceAbsolute(w, {ViewKind::PastCone, 8.0, {}}, s);
         EXPECT_GT(out.refined_triangles, 0u);
         const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
         EXPECT_TRUE(t.closed);
@@ -176,7 +176,7 @@ TEST(Tessellate, PenroseOutlineOfARelativisticSphereIsACircle) {
         const World4D w = extrude(sphere, m, -100, 100, false, false);
         SliceSettings s;
         s.tolerance = tolerance;
-        return outlineNonCircularity(sliceWorld(w, {ViewKind::PastCone, 4.0, C}, s), C);
+        return outlineNonCircularity(testmesh::sliceAbsolute(w, {ViewKind::PastCone, 4.0, C}, s), C);
     };
     const double rest = outline(Kinematics::Lorentz, 0.0, 0);
     const double finite = outline(Kinematics::Galilean, 0.9, 1e-4);
@@ -228,7 +228,7 @@ TEST(Tessellate, ClippedSurfacesAreRefinedToo) {
     size_t clipped_frames = 0;
     for (double t_c = 6; t_c <= 22; t_c += 0.5) {
         const ViewSurface view{ViewKind::PastCone, t_c, {}};
-        const ApparentMesh out = sliceWorld(w, view, s);
+        const ApparentMesh out = testmesh::sliceAbsolute(w, view, s);
         if (out.triangles.empty()) continue;
         const apparent::Topology topo = apparent::analyzeTopology(out.positions, out.triangles);
         EXPECT_TRUE(topo.manifold) << "t_c " << t_c;

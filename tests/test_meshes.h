@@ -5,6 +5,7 @@
 #include <map>
 
 #include "mesh4d/extrude.h"
+#include "mesh4d/slice.h"
 
 namespace testmesh {
 
@@ -67,6 +68,21 @@ inline RestMesh rod(double L, double width) {
     RestMesh m;
     m.positions = {{0, 0, 0}, {0, 0, -L}, {width, 0, -L}};
     m.triangles = {{0, 1, 2}};
+    return m;
+}
+
+// sliceWorld's output with absolute lab positions and emission times (origin 0), for tests that
+// compare with lab-frame closed forms. Fine for scenes near the origin; the stress tests use the
+// local coordinates instead.
+inline mesh4d::ApparentMesh sliceAbsolute(const mesh4d::World4D& w, const mesh4d::ViewSurface& view,
+                                          const mesh4d::SliceSettings& s = {}) {
+    mesh4d::ApparentMesh m = mesh4d::sliceWorld(w, view, s);
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+        m.positions[i] = m.absolutePosition(i);
+        m.emission_times[i] = m.absoluteTime(i);
+    }
+    m.origin = {0, 0, 0};
+    m.time_origin = 0;
     return m;
 }
 
