@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "exact_side.h"
 #include "robust.h"
 
 namespace mesh4d {
@@ -82,11 +83,11 @@ Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q) {
 // the spacing of doubles in [0, 1] near any root away from 0.
 static double bisectSide(const ViewSurface& view, const Event& p0, const Event& p1) {
     double lo = 0, hi = 1;
-    const bool lo_positive = viewSide(view, p0) > 0;
+    const bool lo_positive = viewSideSign(view, p0) > 0;
     for (int it = 0; it < 64; ++it) {
         const double mid = 0.5 * (lo + hi);
         if (mid <= lo || mid >= hi) break;
-        const bool mid_positive = viewSide(view, lerp(p0, p1, mid)) > 0;
+        const bool mid_positive = viewSideSign(view, lerp(p0, p1, mid)) > 0;
         if (mid_positive == lo_positive) lo = mid; else hi = mid;
     }
     return 0.5 * (lo + hi);
@@ -95,8 +96,8 @@ static double bisectSide(const ViewSurface& view, const Event& p0, const Event& 
 double cutSegment(const ViewSurface& view, const Event& p0, const Event& p1) {
     // Step 1: the two end values decide the trivial cases.
     const double h0 = viewSide(view, p0), h1 = viewSide(view, p1);
-    if (h0 == 0) return 0;
-    if (h1 == 0) return 1;
+    if (viewSideSign(view, p0) == 0) return 0;
+    if (viewSideSign(view, p1) == 0) return 1;
     if (view.kind == ViewKind::Hyperplane) return std::clamp(h0 / (h0 - h1), 0.0, 1.0);
 
     // Step 2: the cone. Relative to the camera, dt(s) = A + s B and dx(s) = P + s Q; the cone

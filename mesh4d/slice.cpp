@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "exact_side.h"
 #include "robust.h"
 #include "tessellate.h"
 
@@ -88,8 +89,8 @@ struct FrameBuilder {
         side.assign(nv, Side::Inside);
         vertex_out.assign(nv, kUnset);
         for (size_t i = 0; i < nv; ++i) {
-            if (world.cap_a_real && viewSide(view, world.events[2 * i]) < 0) side[i] = Side::NotYet;
-            else if (world.cap_b_real && viewSide(view, world.events[2 * i + 1]) > 0) side[i] = Side::Gone;
+            if (world.cap_a_real && viewSideSign(view, world.events[2 * i]) < 0) side[i] = Side::NotYet;
+            else if (world.cap_b_real && viewSideSign(view, world.events[2 * i + 1]) > 0) side[i] = Side::Gone;
         }
         // Visible vertices first, in input order: when nothing is clipped or refined, output
         // vertex i is the image of input vertex i (unreferenced input vertices aside).
@@ -124,8 +125,8 @@ struct FrameBuilder {
 
     // Which side of the real caps a rest point falls on, from its events on both caps.
     Side sideOf(const Event& on_a, const Event& on_b) const {
-        if (world.cap_a_real && viewSide(view, on_a) < 0) return Side::NotYet;
-        if (world.cap_b_real && viewSide(view, on_b) > 0) return Side::Gone;
+        if (world.cap_a_real && viewSideSign(view, on_a) < 0) return Side::NotYet;
+        if (world.cap_b_real && viewSideSign(view, on_b) > 0) return Side::Gone;
         return Side::Inside;
     }
 

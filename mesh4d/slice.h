@@ -12,7 +12,8 @@
 //     keyed by the edge's global id, so neighbouring triangles share them bit for bit.
 // A closed 2-manifold that exists throughout therefore gives a closed 2-manifold of the same
 // genus, with exactly one output vertex per input vertex. Which side of a cap a vertex falls on is
-// decided by the sign of viewSide at the cap event, once per vertex; zero counts as inside.
+// decided by the exact sign of viewSide at the cap event (exact_side.h), once per vertex; zero
+// counts as inside.
 // Straight edges between exact vertices leave an error that grows with triangle size, speed and
 // nearness (DESIGN.md section 6). With a tolerance T > 0 the cut is refined where the surface
 // departs from the chord, and nowhere else (see "Refinement" in slice.cpp):

@@ -8,6 +8,7 @@ extern "C" {
 }
 
 #include "mesh4d/boost.h"
+#include "mesh4d/exact_side.h"
 #include "mesh4d/lightcone.h"
 #include "mesh4d/robust.h"
 
@@ -122,4 +123,63 @@ TEST(Lightcone, SegmentCrossingIsOnTheCone) {
     EXPECT_NEAR(viewSide(view, e), 0, 1e-13);
     const ViewSurface plane{ViewKind::Hyperplane, -10.0, {}};
     EXPECT_NEAR(lerp(q0, q1, cutSegment(plane, q0, q1)).t, -10.0, 1e-14);
+}
+
+// The side of the cone, decided exactly. An event a hair outside the cone far away: in doubles
+// |x|^2 = a^2 + b^2 rounds to a^2, so the float side function says "on the cone" (0), while the
+// event is outside (h < 0). The exact sign says so, through the exact fallback.
+TEST(ExactSide, DecidesWhereDoublesCannot) {
+    const ViewSurface view{ViewKind::PastCone, 0.0, {0, 0, 0}};
+    const double a = 1e8, b = 1e-5;
+    const Event e{-a, {a, b, 0}};
+    EXPECT_EQ(viewSide(view, e), 0.0);  // the rounding this test is about
+    const long long before = exactSideFallbacks();
+    EXPECT_EQ(viewSideSign(view, e), -1);
+    EXPECT_EQ(exactSideFallbacks(), before + 1);
+    EXPECT_EQ(viewSideSign(view, Event{-a - 1e-7, {a, 0, 0}}), 1);  // inside by 1e-7 (ulp of a is 1.5e-8)
+    // Exactly on the cone, and at the apex.
+    EXPECT_EQ(viewSideSign(view, Event{-5, {3, 4, 0}}), 0);
+    EXPECT_EQ(viewSideSign(view, Event{-a, {a, 0, 0}}), 0);
+    EXPECT_EQ(viewSideSign(view, Event{0, {0, 0, 0}}), 0);
+    EXPECT_EQ(viewSideSign(view, Event{0, {0, 1e-300, 0}}), -1);  // at the camera time, elsewhere
+    EXPECT_EQ(viewSideSign(view, Event{1e-300, {0, 0, 0}}), -1);   // in the future of the apex
+    // The hyperplane: the sign of one subtraction.
+    const ViewSurface plane{ViewKind::Hyperplane, 1.0, {}};
+    EXPECT_EQ(viewSideSign(plane, Event{1.0, {5, 5, 5}}), 0);
+    EXPECT_EQ(viewSideSign(plane, Event{std::nextafter(1.0, 2.0), {}}), -1);
+}
+
+// Against an independent exact evaluation: events on integer lattices (times 2^-20, offset by a
+// camera far from the origin) within one unit of the cone, where dt^2 - |dx|^2 is computed
+// exactly in 64-bit integers.
+TEST(ExactSide, AgreesWithIntegerArithmeticNearTheCone) {
+    std::mt19937_64 rng(7);
+    std::uniform_int_distribution<int64_t> coord(-(1 << 20), 1 << 20), jitter(-2, 2);
+    const double unit = std::ldexp(1.0, -20);
+    const Vec3 apex{12345678.0, -7654321.0, 1e6};
+    const double t_c = 98765432.0;
+    const ViewSurface view{ViewKind::PastCone, t_c, apex};
+    int zeros = 0, negatives = 0, positives = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const int64_t dx = coord(rng), dy = coord(rng), dz = coord(rng);
+        const int64_t r2 = dx * dx + dy * dy + dz * dz;
+        int64_t dt = int64_t(std::llround(std::sqrt(double(r2)))) + jitter(rng);
+        if (i % 4 == 0) {  // exact cone points: a Pythagorean case along an axis
+            dt = std::llabs(dx);
+        }
+        const int64_t ry2 = i % 4 == 0 ? dx * dx : r2;
+        const Vec3 off = i % 4 == 0 ? Vec3{double(dx), 0, 0} : Vec3{double(dx), double(dy), double(dz)};
+        const Event e{t_c - double(dt) * unit, apex + off * unit};
+        // The event's coordinates are exact (integers times 2^-20 below 2^53 in magnitude).
+        ASSERT_EQ((e.x.x - apex.x) / unit, off.x);
+        ASSERT_EQ((t_c - e.t) / unit, double(dt));
+        const int expected = dt < 0 ? -1 : (dt == 0 ? (ry2 == 0 ? 0 : -1) : (dt * dt > ry2) - (dt * dt < ry2));
+        ASSERT_EQ(viewSideSign(view, e), expected) << i;
+        zeros += expected == 0;
+        negatives += expected < 0;
+        positives += expected > 0;
+    }
+    EXPECT_GT(zeros, 1000);
+    EXPECT_GT(negatives, 1000);
+    EXPECT_GT(positives, 1000);
 }
