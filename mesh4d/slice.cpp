@@ -60,6 +60,9 @@ struct FrameBuilder {
     }
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
+        // A clip point that fell on a visible corner is that corner (see crossingPoint): the
+        // triangle has no area then and is not emitted.
+        if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) return;
         out.triangles.push_back(t);
         out.source_triangles.push_back(uint32_t(f));
     }
@@ -114,6 +117,10 @@ struct FrameBuilder {
             const Event& p0 = world.events[2 * e.lo + cap];
             const Event& p1 = world.events[2 * e.hi + cap];
             const double s = cutSegment(view, p0, p1);
+            // The cap passes exactly through a visible end (a frame at the instant the object
+            // begins or ends): the clip point is that vertex, not a copy of it.
+            if (s == 0 && side[e.lo] == Side::Inside) return slot = vertexPoint(e.lo);
+            if (s == 1 && side[e.hi] == Side::Inside) return slot = vertexPoint(e.hi);
             const Vec3 rest = world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s;
             slot = emit(toLocal(lerp(p0, p1, s)), rest);
         }
@@ -256,7 +263,10 @@ struct FrameBuilder {
         }
         const Event e0 = capEvent(*first, v, cap), e1 = capEvent(*second, v, cap);
         const double s = cutSegment(view, e0, e1);
-        const uint32_t id = emit(toLocal(lerp(e0, e1, s)), restOf(*first, v) * (1 - s) + restOf(*second, v) * s);
+        uint32_t id;
+        if (s == 0 && first->side == Side::Inside && first->id != kUnset) id = first->id;  // as in crossingPoint
+        else if (s == 1 && second->side == Side::Inside && second->id != kUnset) id = second->id;
+        else id = emit(toLocal(lerp(e0, e1, s)), restOf(*first, v) * (1 - s) + restOf(*second, v) * s);
         (edge != kUnset ? sub_crossings : local)[key] = id;
         return id;
     }

@@ -272,6 +272,17 @@ Status parseScene(const json& root, const std::string& path, const SceneJsonPath
         if (!r.failed() && !(scene->frames.fps > 0)) r.fail(fp + ".fps", "must be > 0");
         if (!r.failed() && !(scene->frames.end > scene->frames.start))
             r.fail(fp + ".end", "must be greater than frames.start (" + formatNumber(scene->frames.start) + ")");
+        // Very high frame rates late in time: each frame time start + k / fps is a double, so the
+        // frame spacing must stay well above the spacing of doubles there, or frames would
+        // collapse onto the same time (or be unevenly spaced). Ask for 1/1024 of a frame.
+        if (!r.failed()) {
+            const double t_max = std::max(std::fabs(scene->frames.start), std::fabs(scene->frames.end));
+            const double ulp = std::nextafter(t_max, INFINITY) - t_max;
+            if (!(1.0 / scene->frames.fps >= 1024 * ulp))
+                r.fail(fp + ".fps", formatNumber(scene->frames.fps) + " frames per second near time " + formatNumber(t_max) +
+                                        " s are closer than doubles resolve there (" + formatNumber(ulp) +
+                                        " s); shift frames.start and the objects' t0 towards 0");
+        }
     }
 
     // Step: model and tolerance.

@@ -1,0 +1,223 @@
+// Geometry at the edges (issue: numerical stability): the view grazing a face, a frame at the
+// exact instant an object begins or ends existing, an object that exists for a tiny proper time,
+// nearly degenerate triangles, and very high and very low frame rates.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "mesh4d/robust.h"
+#include "mesh4d/slice.h"
+#include "pipeline/mesh_check.h"
+#include "pipeline/scene.h"
+#include "test_meshes.h"
+
+using namespace mesh4d;
+
+namespace {
+
+// Every output point finite and on the view surface (lab time from the local coordinates).
+void expectOnTheCone(const ApparentMesh& out, const ViewSurface& view, double rel, const std::string& what) {
+    for (size_t i = 0; i < out.positions.size(); ++i) {
+        ASSERT_TRUE(isFinite(out.positions[i]) && std::isfinite(out.emission_times[i])) << what;
+        const double dist = norm((out.origin - view.apex) + out.positions[i]);
+        const double delay = (view.t_c - out.time_origin) - out.emission_times[i];
+        ASSERT_NEAR(dist, delay, rel * std::max(1.0, delay)) << what << " point " << i;
+    }
+    for (const auto& t : out.triangles) {
+        ASSERT_TRUE(t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) << what;
+        for (uint32_t k : t) ASSERT_LT(k, out.positions.size()) << what;
+    }
+}
+
+RestMesh square(double half) {
+    RestMesh m;
+    m.positions = {{-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}};
+    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    return m;
+}
+
+}  // namespace
+
+// A face seen exactly edge-on: the square lies in the plane y = 0, which holds the camera, so
+// every line of sight to it grazes it. Its image stays in that plane, finite, in vertex mode and
+// refined, while it passes at 0.9c.
+TEST(Extremes, FaceSeenEdgeOn) {
+    const RestMesh sq = square(1.0);
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        const Motion m = makeMotion(k, 0.0, {-10, 0, -10}, {0.9, 0, 0});
+        const World4D w = extrude(sq, m, -200, 200, false, false);
+        for (double t_c = 0; t_c <= 30; t_c += 2.5) {
+            for (double tol : {0.0, 1e-2}) {
+                SliceSettings s;
+                s.tolerance = tol;
+                const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
+                const ApparentMesh out = sliceWorld(w, view, s);
+                const std::string what = "t_c " + std::to_string(t_c) + " tol " + std::to_string(tol);
+                expectOnTheCone(out, view, 1e-13, what);
+                EXPECT_EQ(out.limited_triangles, 0u) << what;
+                EXPECT_FALSE(out.triangles.empty()) << what;
+                for (size_t i = 0; i < out.positions.size(); ++i) EXPECT_EQ(out.absolutePosition(i).y, 0.0) << what;
+            }
+        }
+    }
+}
+
+// The cone grazing an edge: an edge on a line through the camera (its points are all seen along
+// one line of sight), with the object approaching along that line at extreme speed.
+TEST(Extremes, EdgeOnTheLineOfSight) {
+    RestMesh tri;
+    tri.positions = {{0, 0, 0}, {0, 0, -2}, {0.5, 0, -1}};
+    tri.triangles = {{0, 1, 2}};
+    for (double gamma : {2.0, 1e3, 1e7}) {
+        const Motion m = makeMotionFromGamma(Kinematics::Lorentz, 0.0, {0, 0, -50}, {0, 0, 1}, gamma);
+        const World4D w = extrude(tri, m, -1e17, 1e3, false, false);
+        const ViewSurface view{ViewKind::PastCone, 0.0, {0, 0, 0}};
+        const ApparentMesh out = sliceWorld(w, view);
+        expectOnTheCone(out, view, 1e-12, "gamma " + std::to_string(gamma));
+        ASSERT_EQ(out.positions.size(), 3u);
+        // Both ends of the edge stay on the z axis, stretched by gamma (1 + b) (Lampa, approaching).
+        EXPECT_EQ(out.absolutePosition(0).x, 0.0);
+        EXPECT_EQ(out.absolutePosition(1).x, 0.0);
+        const double b = std::sqrt((gamma - 1) * (gamma + 1)) / gamma;
+        EXPECT_NEAR(norm(out.positions[1] - out.positions[0]) / (2 * gamma * (1 + b)), 1.0, 1e-12) << gamma;
+    }
+}
+
+// A frame at the exact instant the object begins existing: the one vertex whose light leaves at
+// that instant is on the cone exactly (the exact sign says 0: inside); the clip points on its
+// edges coincide with it and are it, so no zero-area triangle or duplicate point is emitted.
+// Then the frames just after, and the frame at the instant the object ends.
+TEST(Extremes, FrameAtTheExactStartAndEndOfExistence) {
+    RestMesh tet;
+    tet.positions = {{0, 0, 0}, {1, 0, -1}, {-1, 0, -1}, {0, 1, -1}};
+    tet.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    // At rest at z = -5 (vertex 0 at distance exactly 5), existing for lab times [0, 10].
+    const Motion m = makeMotion(Kinematics::Galilean, 0.0, {0, 0, -5}, {0, 0, 0});
+    const World4D w = extrude(tet, m, 0.0, 10.0, true, true);
+    {
+        const ViewSurface view{ViewKind::PastCone, 5.0, {0, 0, 0}};
+        const ApparentMesh out = sliceWorld(w, view);
+        expectOnTheCone(out, view, 1e-15, "at the start");
+        EXPECT_EQ(out.positions.size(), 1u);  // vertex 0 alone; everything else not yet
+        EXPECT_TRUE(out.triangles.empty());
+    }
+    for (double dt : {1e-12, 1e-6, 0.5}) {
+        const ViewSurface view{ViewKind::PastCone, 5.0 + dt, {0, 0, 0}};
+        const ApparentMesh out = sliceWorld(w, view);
+        expectOnTheCone(out, view, 1e-15, "just after the start");
+        EXPECT_EQ(out.triangles.size(), 3u) << dt;  // the three faces at vertex 0, clipped
+        const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
+        EXPECT_TRUE(t.manifold) << dt;
+    }
+    {
+        // The frame in which vertex 0's last light arrives: 15; the farther vertices still show.
+        const ViewSurface view{ViewKind::PastCone, 15.0, {0, 0, 0}};
+        const ApparentMesh out = sliceWorld(w, view);
+        expectOnTheCone(out, view, 1e-15, "at the end");
+        EXPECT_EQ(out.triangles.size(), 4u);
+    }
+    // The instant model at its start: the hyperplane t = 0 holds the whole cap: all of it shows.
+    const Motion mi = makeMotion(Kinematics::Galilean, 0.0, {0, 0, -5}, {0.5, 0, 0});
+    const World4D wi = extrude(tet, mi, 0.0, 10.0, true, true);
+    const ApparentMesh at_start = sliceWorld(wi, {ViewKind::Hyperplane, 0.0, {}});
+    EXPECT_EQ(at_start.triangles.size(), 4u);
+    EXPECT_TRUE(sliceWorld(wi, {ViewKind::Hyperplane, std::nextafter(0.0, -1.0), {}}).triangles.empty());
+    EXPECT_EQ(sliceWorld(wi, {ViewKind::Hyperplane, 10.0, {}}).triangles.size(), 4u);
+    EXPECT_TRUE(sliceWorld(wi, {ViewKind::Hyperplane, std::nextafter(10.0, 11.0), {}}).triangles.empty());
+}
+
+// An object that exists for a proper time of 1e-9 s while passing at 0.9c: each frame shows the
+// thin band of its surface whose light left in that instant. Every point is on the cone and
+// within rounding of the existence interval (its proper time from the inverse map).
+TEST(Extremes, TinyLifetime) {
+    const RestMesh sphere = testmesh::icosphere(2, 1.0);
+    const double life = 1e-9;
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        const Motion m = makeMotion(k, 0.0, {-1, 0, -10}, {0.9, 0, 0});
+        const World4D w = extrude(sphere, m, 0.0, life, true, true);
+        int shown = 0;
+        for (double t_c = 8; t_c <= 12; t_c += 0.05) {
+            for (double tol : {0.0, 1e-3}) {
+                SliceSettings s;
+                s.tolerance = tol;
+                const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
+                const ApparentMesh out = sliceWorld(w, view, s);
+                expectOnTheCone(out, view, 1e-13, "t_c " + std::to_string(t_c));
+                for (size_t i = 0; i < out.positions.size(); ++i) {
+                    const double t = out.absoluteTime(i);
+                    const Vec3 q = restFromLab(m, out.absolutePosition(i), t);
+                    const double tau = properTimeAt(m, q, t);
+                    ASSERT_GE(tau, -1e-13) << t_c;
+                    ASSERT_LE(tau, life + 1e-13) << t_c;
+                }
+                if (!out.triangles.empty()) {
+                    ++shown;
+                    const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
+                    EXPECT_TRUE(t.manifold) << t_c;
+                }
+            }
+        }
+        EXPECT_GT(shown, 10);
+    }
+}
+
+// Nearly degenerate triangles (a sliver 1e-12 wide, 1 long) moving at gamma 1e3: finite output
+// on the cone, refinement terminates.
+TEST(Extremes, NearlyDegenerateTriangles) {
+    RestMesh sliver;
+    sliver.positions = {{0, 0, 0}, {1, 0, 0}, {0.5, 1e-12, 0}, {0.5, 0, 1e-12}};
+    sliver.triangles = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+    for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+        const Motion m = makeMotionFromGamma(k, 0.0, {-3, 0, -5}, Vec3{1, 0, 1} / std::sqrt(2.0), 1e3);
+        const World4D w = extrude(sliver, m, -1e9, 1e9, false, false);
+        for (double tol : {0.0, 1e-3}) {
+            SliceSettings s;
+            s.tolerance = tol;
+            const ViewSurface view{ViewKind::PastCone, 0.0, {0, 0, 0}};
+            const ApparentMesh out = sliceWorld(w, view, s);
+            expectOnTheCone(out, view, 1e-12, "sliver");
+            EXPECT_FALSE(out.triangles.empty());
+        }
+    }
+}
+
+namespace {
+std::string writeScene(const std::string& name, const std::string& frames) {
+    const auto dir = std::filesystem::temp_directory_path() / "apparent_extremes";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    const auto path = dir / (name + ".json");
+    std::ofstream(path) << R"({"camera": {"position": [0, 0, 0]}, "frames": )" << frames
+                        << R"(, "model": "relativistic", "objects": [{"mesh": "tri.obj", "position": [0, 0, -5]}]})";
+    return path.string();
+}
+}  // namespace
+
+// Very high and very low frame rates: a trillion frames per second over a nanosecond, one frame
+// per ten days; and a rate the doubles cannot resolve at that time, refused on frames.fps.
+TEST(Extremes, FrameRates) {
+    apparent::Scene scene;
+    const apparent::Status fast = apparent::loadScene(writeScene("fast", R"({"start": 0, "end": 1e-9, "fps": 1e12})"), &scene);
+    ASSERT_TRUE(fast.ok) << fast.message;
+    EXPECT_EQ(apparent::frameCount(scene.frames), 1000);
+    for (long long k = 1; k < 1000; ++k)
+        ASSERT_NEAR(apparent::frameTime(scene.frames, k) - apparent::frameTime(scene.frames, k - 1), 1e-12, 1e-24);
+    ASSERT_TRUE(apparent::loadScene(writeScene("slow", R"({"start": 0, "end": 1e7, "fps": 1.1574074074074074e-6})"), &scene).ok);
+    EXPECT_EQ(apparent::frameCount(scene.frames), 12);  // every 864000 s (10 days) from 0 to 1e7 s
+    const apparent::Status late =
+        apparent::loadScene(writeScene("late", R"({"start": 1e9, "end": 1.0000001e9, "fps": 1e9})"), &scene);
+    ASSERT_FALSE(late.ok);
+    EXPECT_NE(late.message.find("frames.fps"), std::string::npos) << late.message;
+    EXPECT_NE(late.message.find("closer than doubles resolve"), std::string::npos) << late.message;
+
+    // A motion sampled at 1e12 fps: an object at 0.5c moves 5e-13 ls per frame, and the apparent
+    // shift per frame (b / (1 - b) of the frame time head-on: 1e-12) is resolved. (1e-2 ls from
+    // the camera, where doubles resolve 3.5e-18 ls.)
+    const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -1e-2}, {0, 0, 0.5});
+    const World4D w = extrude(testmesh::rod(1e-4, 1e-5), m, -1, 1, false, false);
+    const ViewSurface v0{ViewKind::PastCone, 0.0, {0, 0, 0}}, v1{ViewKind::PastCone, 1e-12, {0, 0, 0}};
+    const ApparentMesh a0 = sliceWorld(w, v0), a1 = sliceWorld(w, v1);
+    const double shift = a1.absolutePosition(0).z - a0.absolutePosition(0).z;
+    EXPECT_NEAR(shift / (0.5e-12 / (1 - 0.5)), 1.0, 1e-4);
+}
