@@ -8,6 +8,13 @@
 
 namespace mesh4d {
 
+void EventBox::add(const Event& e) {
+    t_lo = std::min(t_lo, e.t);
+    t_hi = std::max(t_hi, e.t);
+    lo = {std::min(lo.x, e.x.x), std::min(lo.y, e.x.y), std::min(lo.z, e.x.z)};
+    hi = {std::max(hi.x, e.x.x), std::max(hi.y, e.x.y), std::max(hi.z, e.x.z)};
+}
+
 World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
                 bool cap_a_real, bool cap_b_real) {
     World4D world;
@@ -54,6 +61,17 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         world.tets.push_back({ia, ja, ka, kb});
         world.tets.push_back({ia, ja, jb, kb});
         world.tets.push_back({ia, ib, jb, kb});
+    }
+
+    // Runs of triangles with the 4D boxes of their cap events, for the per-frame cull.
+    for (uint32_t f0 = 0; f0 < mesh.triangles.size(); f0 += kChunkTriangles) {
+        TriangleChunk c;
+        c.first = f0;
+        c.last = uint32_t(std::min<size_t>(mesh.triangles.size(), size_t(f0) + kChunkTriangles));
+        for (uint32_t f = c.first; f < c.last; ++f)
+            for (uint32_t v : mesh.triangles[f])
+                for (int cap = 0; cap < 2; ++cap) c.cap[cap].add(world.events[2 * v + cap]);
+        world.chunks.push_back(c);
     }
     return world;
 }

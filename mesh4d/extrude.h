@@ -18,6 +18,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -38,6 +39,22 @@ struct Edge {
     uint32_t lo = 0, hi = 0;
 };
 
+// The 4D bounding box of a set of events.
+struct EventBox {
+    double t_lo = INFINITY, t_hi = -INFINITY;
+    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    void add(const Event& e);
+};
+
+// A run of consecutive triangles with the boxes of their vertices' events on each cap: the
+// bounding level of the per-frame cull (slice.h). Meshes from scanners and modellers keep
+// neighbouring triangles near each other in the file, so runs are spatially compact.
+struct TriangleChunk {
+    uint32_t first = 0, last = 0;  // triangles [first, last)
+    EventBox cap[2];               // events of the run's vertices on cap a and cap b
+};
+constexpr uint32_t kChunkTriangles = 256;
+
 struct World4D {
     Motion motion;
     RestMesh mesh;
@@ -49,6 +66,7 @@ struct World4D {
     std::vector<Edge> edges;                    // unique undirected edges of the mesh
     std::vector<std::array<uint32_t, 3>> triangle_edges;  // edge of (v0,v1), (v1,v2), (v2,v0)
     std::vector<uint8_t> vertex_used;           // 1 where a triangle references the rest vertex
+    std::vector<TriangleChunk> chunks;          // runs of kChunkTriangles triangles, in order
     bool empty() const { return mesh.triangles.empty() || !(tau_a < tau_b); }
 };
 

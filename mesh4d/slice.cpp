@@ -87,12 +87,22 @@ struct FrameBuilder {
     }
 
     // Step: classify every vertex against the real caps, and cut the worldlines of the rest.
-    void classifyVertices() {
+    // With `live` (one flag per chunk), only the vertices of live chunks are looked at.
+    void classifyVertices(const std::vector<uint8_t>* live) {
         const size_t nv = world.mesh.positions.size();
         side.assign(nv, Side::Inside);
         vertex_out.assign(nv, kUnset);
+        std::vector<uint8_t> needed;
+        if (live) {
+            needed.assign(nv, 0);
+            for (size_t c = 0; c < world.chunks.size(); ++c)
+                if ((*live)[c])
+                    for (uint32_t f = world.chunks[c].first; f < world.chunks[c].last; ++f)
+                        for (uint32_t v : world.mesh.triangles[f]) needed[v] = 1;
+        }
         for (size_t i = 0; i < nv; ++i) {
-            if (world.cap_a_real && viewSideSign(view, world.events[2 * i]) < 0) side[i] = Side::NotYet;
+            if (live && !needed[i]) side[i] = Side::NotYet;  // only culled triangles use it
+            else if (world.cap_a_real && viewSideSign(view, world.events[2 * i]) < 0) side[i] = Side::NotYet;
             else if (world.cap_b_real && viewSideSign(view, world.events[2 * i + 1]) > 0) side[i] = Side::Gone;
         }
         // Visible vertices first, in input order: when nothing is clipped or refined, output
@@ -436,6 +446,42 @@ struct FrameBuilder {
     }
 };
 
+// The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
+// may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box) and
+// at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms remain.
+// The margin covers the rounding of these bounds (a few ulps of the largest term).
+bool chunkMayShow(const World4D& world, const ViewSurface& view, const TriangleChunk& c) {
+    const bool cone = view.kind == ViewKind::PastCone;
+    auto distances = [&](const EventBox& b, double* nearest, double* farthest) {
+        double in[3], out[3];
+        for (int k = 0; k < 3; ++k) {
+            const double p = view.apex[k], lo = b.lo[k], hi = b.hi[k];
+            in[k] = p < lo ? lo - p : (p > hi ? p - hi : 0.0);
+            out[k] = std::max(std::fabs(p - lo), std::fabs(p - hi));
+        }
+        *nearest = norm(Vec3{in[0], in[1], in[2]});
+        *farthest = norm(Vec3{out[0], out[1], out[2]});
+    };
+    auto margin = [&](const EventBox& b) {
+        const double scale = std::fabs(view.t_c) + std::max(std::fabs(b.t_lo), std::fabs(b.t_hi)) + norm(view.apex) +
+                             std::max(norm(b.lo), norm(b.hi));
+        return 1e-12 * scale;
+    };
+    if (world.cap_a_real) {
+        const EventBox& a = c.cap[0];
+        double nearest = 0, farthest = 0;
+        if (cone) distances(a, &nearest, &farthest);
+        if ((view.t_c - a.t_lo) - nearest < -margin(a)) return false;  // none has begun existing
+    }
+    if (world.cap_b_real) {
+        const EventBox& b = c.cap[1];
+        double nearest = 0, farthest = 0;
+        if (cone) distances(b, &nearest, &farthest);
+        if ((view.t_c - b.t_hi) - farthest > margin(b)) return false;  // all have ended existing
+    }
+    return true;
+}
+
 }  // namespace
 
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& requested) {
@@ -445,13 +491,32 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     if (view.kind == ViewKind::Hyperplane || world.motion.beta == 0) settings.tolerance = 0;
     FrameBuilder b(world, view, settings);
     if (world.empty()) return std::move(b.out);
-    b.classifyVertices();
+    // Step: the cull. Only real caps hide anything; without them every worldline meets the view.
+    std::vector<uint8_t> live;
+    const bool culling = settings.cull && (world.cap_a_real || world.cap_b_real) && !world.chunks.empty();
+    if (culling) {
+        live.resize(world.chunks.size());
+        bool any = false;
+        for (size_t c = 0; c < world.chunks.size(); ++c) {
+            live[c] = chunkMayShow(world, view, world.chunks[c]);
+            any |= live[c] != 0;
+            if (!live[c]) b.out.culled_triangles += world.chunks[c].last - world.chunks[c].first;
+        }
+        if (!any) return std::move(b.out);
+    }
+    b.classifyVertices(culling ? &live : nullptr);
     b.crossing_out.assign(2 * world.edges.size(), kUnset);
     if (settings.tolerance > 0) {
         b.edge_segments.assign(world.edges.size(), 0);
         b.edge_first.assign(world.edges.size(), 0);
     }
-    for (size_t f = 0; f < world.mesh.triangles.size(); ++f) b.addTriangle(f);
+    if (culling) {
+        for (size_t c = 0; c < world.chunks.size(); ++c)
+            if (live[c])
+                for (uint32_t f = world.chunks[c].first; f < world.chunks[c].last; ++f) b.addTriangle(f);
+    } else {
+        for (size_t f = 0; f < world.mesh.triangles.size(); ++f) b.addTriangle(f);
+    }
     b.out.limited_triangles += b.limited_edges;
     return std::move(b.out);
 }

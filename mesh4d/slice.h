@@ -63,6 +63,7 @@ struct ApparentMesh {
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame
     size_t refined_triangles = 0;         // input triangles split by the tolerance
     size_t limited_triangles = 0;         // input triangles and edges that reached max_segments first
+    size_t culled_triangles = 0;          // input triangles skipped by the 4D-box cull (SliceSettings::cull)
 
     Vec3 absolutePosition(size_t i) const { return origin + positions[i]; }
     double absoluteTime(size_t i) const { return time_origin + emission_times[i]; }
@@ -76,6 +77,11 @@ struct SliceSettings {
     // an edge or triangle that would need more is counted in ApparentMesh::limited_triangles and
     // keeps this level. Values below 1 count as 1.
     int max_segments = 256;
+    // Skip runs of triangles (World4D::chunks) whose cap events all lie on one side of the view
+    // surface: before a real cap a (not yet existing) or after a real cap b (gone), decided from
+    // the runs' 4D boxes with a margin above rounding, so a skipped run never holds a visible
+    // point. Off only to measure what it saves (benchmarks/performance_bench.cpp).
+    bool cull = true;
 };
 
 // Cuts `world` with `view`. Precondition: world.motion.beta < 1 when view.kind == PastCone.
