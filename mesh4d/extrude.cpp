@@ -63,6 +63,9 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         world.tets.push_back({ia, ib, jb, kb});
     }
 
+    for (size_t i = 0; i < nv; ++i)
+        if (world.vertex_used[i]) world.shape_radius = std::max(world.shape_radius, norm(mesh.positions[i]));
+
     // Runs of triangles with the 4D boxes of their cap events, for the per-frame cull.
     for (uint32_t f0 = 0; f0 < mesh.triangles.size(); f0 += kChunkTriangles) {
         TriangleChunk c;

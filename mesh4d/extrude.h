@@ -67,6 +67,7 @@ struct World4D {
     std::vector<std::array<uint32_t, 3>> triangle_edges;  // edge of (v0,v1), (v1,v2), (v2,v0)
     std::vector<uint8_t> vertex_used;           // 1 where a triangle references the rest vertex
     std::vector<TriangleChunk> chunks;          // runs of kChunkTriangles triangles, in order
+    double shape_radius = 0;                    // max |q| over the used rest vertices
     bool empty() const { return mesh.triangles.empty() || !(tau_a < tau_b); }
 };
 

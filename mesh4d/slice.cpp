@@ -527,6 +527,14 @@ Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Ve
     return {anchor.time_origin + local.t, anchor.origin + local.x};
 }
 
+BoundingSphere apparentBound(const World4D& world, const ViewSurface& view) {
+    const ViewAnchor anchor = viewAnchor(view, world.motion);
+    const double b = world.motion.beta;
+    const double stretch = view.kind == ViewKind::PastCone ? (1 + b) / world.motion.one_minus_beta2 : 1.0;
+    // A relative 1e-9 more for the rounding of the points themselves.
+    return {anchor.origin, world.shape_radius * stretch * (1 + 1e-9)};
+}
+
 Event exactLocalPoint(const World4D& world, const ViewSurface& view, const Vec3& q) {
     return cutRestLocal(viewAnchor(view, world.motion), world.motion, q);
 }

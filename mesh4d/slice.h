@@ -88,6 +88,17 @@ struct SliceSettings {
 // The result is empty when no part of the history meets the view surface.
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
 
+// A sphere that holds every apparent point of `world` in `view`: centred on the apparent position
+// of the object's origin, radius R / (1 - b) on the cone (R = World4D::shape_radius: the shape
+// offset never lengthens q; the light delay changes by at most |delta e| / (1 - b) between two
+// points, so each point lies within |s| + b |s| / (1 - b) of the origin's image) and R on the
+// hyperplane. For view culling (pipeline/render.cpp, --cull-view).
+struct BoundingSphere {
+    Vec3 center;
+    double radius = 0;
+};
+BoundingSphere apparentBound(const World4D& world, const ViewSurface& view);
+
 // The exact apparent point of rest point `q` (any point of the object's rest frame): the crossing of
 // its worldline with the view surface. Used by tests and tools to measure the error of a mesh.
 Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q);

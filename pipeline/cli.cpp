@@ -69,6 +69,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         ->capture_default_str();
     render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
                            "output is byte-identical for any count")->capture_default_str();
+    render_cmd->add_flag("--cull-view", rs.cull_view,
+                         "Leave objects wholly outside the camera's view empty in that frame (faster; "
+                         "the files then show only what the camera sees)");
     render_cmd->add_flag("--quiet,-q", rs.quiet, "No progress or summary");
     render_cmd->add_flag("--verbose,-v", rs.verbose, "Mesh topology and export precision");
     render_cmd->add_option("--max-frames", rs.max_frames, "Refuse scenes with more frames")->capture_default_str();

@@ -149,6 +149,19 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
     return Status::success();
 }
 
+bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound) {
+    const Vec3 d = bound.center - camera.position;
+    const double dist = mesh4d::norm(d);
+    if (!(dist > bound.radius)) return true;  // the camera is inside the sphere (or NaN: keep it)
+    const Vec3 f = camera.look_at - camera.position;
+    const double cos_angle = std::clamp(mesh4d::dot(d, f) / (dist * mesh4d::norm(f)), -1.0, 1.0);
+    const double angle = std::acos(cos_angle);                  // centre off the view axis
+    const double angular_radius = std::asin(bound.radius / dist);
+    const double half_fov = 0.5 * camera.fov_deg * M_PI / 180.0;
+    const double half_diagonal = std::atan(std::tan(half_fov) * std::sqrt(1 + kCullAspect * kCullAspect));
+    return angle - angular_radius <= half_diagonal;
+}
+
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
     mesh4d::ViewSurface view;
     view.kind = (model == Model::Finite || model == Model::Relativistic) ? mesh4d::ViewKind::PastCone
@@ -280,7 +293,14 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                     frame.index = k;
                     frame.t_c = frameTime(scene.frames, k);
                     const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-                    for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view, slice_settings));
+                    for (const auto& w : worlds) {
+                        // --cull-view: an object wholly outside the camera's view is left empty.
+                        if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(w, view))) {
+                            frame.objects.emplace_back();
+                            continue;
+                        }
+                        frame.objects.push_back(mesh4d::sliceWorld(w, view, slice_settings));
+                    }
                 });
             });
             for (ExportFrame& frame : cut) {

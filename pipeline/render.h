@@ -32,6 +32,7 @@ struct RenderSettings {
     long long frame_from = 0;          // --frames A:B, global frame numbers, B exclusive
     long long frame_to = -1;           // -1: to the last frame of the scene
     int threads = 0;                   // --threads; 0: all cores
+    bool cull_view = false;            // --cull-view: leave objects outside the camera's view empty
     bool quiet = false;
     bool verbose = false;
     long long max_frames = kDefaultMaxFrames;
@@ -54,6 +55,12 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
 // [first_frame, last_frame] can see, clipped to the object's existence.
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame);
+
+// View culling (--cull-view): whether a sphere may show in the camera's view, a circular cone
+// around the view axis whose half-angle reaches the corners of a kCullAspect:1 frame with the
+// camera's vertical field of view (wider than any common screen, so viewers never miss a part).
+constexpr double kCullAspect = 2.4;
+bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound);
 
 // The view surface of global frame k for `model`.
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k);

@@ -267,3 +267,32 @@ TEST(Extremes, CullSkipsOnlyWhatCannotShow) {
         EXPECT_GT(frames_shown, 10) << int(c.view);
     }
 }
+
+// The bounding sphere of the apparent shape (for view culling) holds every output point, at
+// speeds up to gamma 1e3 and from every direction, in both cuts.
+TEST(Extremes, ApparentBoundHoldsTheShape) {
+    const RestMesh sphere = testmesh::icosphere(2, 1.0);
+    RestMesh shifted = sphere;  // origin off the mesh: the bound is about the origin, not the centre
+    for (auto& p : shifted.positions) p = p + Vec3{2, 0, 0};
+    int checked = 0;
+    for (const RestMesh* mesh : {&sphere, static_cast<const RestMesh*>(&shifted)})
+        for (double gamma : {1.0, 2.0, 1e3})
+            for (const Vec3& dir : {Vec3{1, 0, 0}, Vec3{0, 0, 1}, Vec3{0, 0, -1}})
+                for (Kinematics k : {Kinematics::Galilean, Kinematics::Lorentz}) {
+                    const Motion m = makeMotionFromGamma(k, 0.0, {0, 0, -10}, dir, gamma);
+                    const World4D w = extrude(*mesh, m, -1e9, 1e9, false, false);
+                    for (ViewKind kind : {ViewKind::PastCone, ViewKind::Hyperplane}) {
+                        const ViewSurface view{kind, 0.0, {0, 0, 0}};
+                        const ApparentMesh out = sliceWorld(w, view);
+                        const BoundingSphere bound = apparentBound(w, view);
+                        double reach = 0;
+                        for (size_t i = 0; i < out.positions.size(); ++i)
+                            reach = std::max(reach, norm(out.absolutePosition(i) - bound.center));
+                        EXPECT_LE(reach, bound.radius) << gamma;
+                        EXPECT_GT(reach, 0.0);
+                        EXPECT_TRUE(std::isfinite(bound.radius));
+                        ++checked;
+                    }
+                }
+    EXPECT_EQ(checked, 2 * 3 * 3 * 2 * 2);
+}
