@@ -63,8 +63,13 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         world.tets.push_back({ia, ib, jb, kb});
     }
 
-    for (size_t i = 0; i < nv; ++i)
+    world.simple = true;
+    for (size_t i = 0; i < nv; ++i) {
         if (world.vertex_used[i]) world.shape_radius = std::max(world.shape_radius, norm(mesh.positions[i]));
+        else world.simple = false;
+    }
+    for (const auto& t : mesh.triangles)
+        if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) world.simple = false;
 
     // Runs of triangles with the 4D boxes of their cap events, for the per-frame cull.
     for (uint32_t f0 = 0; f0 < mesh.triangles.size(); f0 += kChunkTriangles) {

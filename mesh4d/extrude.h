@@ -68,6 +68,7 @@ struct World4D {
     std::vector<uint8_t> vertex_used;           // 1 where a triangle references the rest vertex
     std::vector<TriangleChunk> chunks;          // runs of kChunkTriangles triangles, in order
     double shape_radius = 0;                    // max |q| over the used rest vertices
+    bool simple = false;  // every vertex used and no triangle repeats an index (the vertex-mode fast path)
     bool empty() const { return mesh.triangles.empty() || !(tau_a < tau_b); }
 };
 

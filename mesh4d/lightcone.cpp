@@ -68,8 +68,8 @@ ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m) {
     return a;
 }
 
-Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q) {
-    const Vec3 s = shapeOffset(m, q);
+namespace {
+inline Event cutLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& s) {
     if (!anchor.cone) return {0, s};
     const double K = 2 * dot(s, anchor.y0) + norm2(s);
     const double B = anchor.S + dot(s, m.velocity);
@@ -77,6 +77,28 @@ Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q) {
     // The same-sign branch: no cancellation in the denominator (B >= 0) or the numerator.
     const double delta = B >= 0 ? (K == 0 ? 0.0 : K / (B + disc)) : (disc - B) / m.one_minus_beta2;
     return {-delta, s - m.velocity * delta};
+}
+}  // namespace
+
+Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q) {
+    return cutLocal(anchor, m, shapeOffset(m, q));
+}
+
+void cutRestLocalBatch(const ViewAnchor& anchor, const Motion& m, const Vec3* q, size_t n, Vec3* positions,
+                       double* times) {
+    // shapeOffset inlined: q itself (Galilean, or at rest), or contracted along u by 1/gamma.
+    const bool contract = m.kinematics == Kinematics::Lorentz && m.beta > 0;
+    const Vec3 u = contract ? m.velocity / m.beta : Vec3{0, 0, 0};
+    for (size_t i = 0; i < n; ++i) {
+        Vec3 s = q[i];
+        if (contract) {
+            const double along = dot(s, u);
+            s = (s - u * along) + u * (along / m.gamma);
+        }
+        const Event e = cutLocal(anchor, m, s);
+        positions[i] = e.x;
+        times[i] = e.t;
+    }
 }
 
 // Bisection on the side function; h changes sign on [0, 1] by precondition. 64 halvings reach

@@ -76,6 +76,9 @@ struct ViewAnchor {
 ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m);
 // The cut of rest point q's worldline in the anchor's local coordinates: {-delta, s - v delta}.
 Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q);
+// The same for n points at once (the vertex-mode fast path): bit-identical to n calls.
+void cutRestLocalBatch(const ViewAnchor& anchor, const Motion& m, const Vec3* q, size_t n, Vec3* positions,
+                       double* times);
 
 // The parameter s in [0, 1] where the segment p0 -> p1 crosses the view surface.
 // Precondition: viewSide(p0) and viewSide(p1) have opposite signs or one is zero; the segment is

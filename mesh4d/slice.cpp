@@ -491,6 +491,21 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     if (view.kind == ViewKind::Hyperplane || world.motion.beta == 0) settings.tolerance = 0;
     FrameBuilder b(world, view, settings);
     if (world.empty()) return std::move(b.out);
+    // Step: the fast path of vertex mode when nothing is clipped: output vertex i is the image of
+    // input vertex i and the triangles are the input's (the same result as below, made in one pass).
+    if (settings.tolerance == 0 && !world.cap_a_real && !world.cap_b_real && world.simple) {
+        const size_t nv = world.mesh.positions.size(), nt = world.mesh.triangles.size();
+        ApparentMesh& out = b.out;
+        out.positions.resize(nv);
+        out.emission_times.resize(nv);
+        cutRestLocalBatch(b.anchor, world.motion, world.mesh.positions.data(), nv, out.positions.data(),
+                          out.emission_times.data());
+        out.rest_points = world.mesh.positions;
+        out.triangles = world.mesh.triangles;
+        out.source_triangles.resize(nt);
+        for (size_t f = 0; f < nt; ++f) out.source_triangles[f] = uint32_t(f);
+        return std::move(b.out);
+    }
     // Step: the cull. Only real caps hide anything; without them every worldline meets the view.
     std::vector<uint8_t> live;
     const bool culling = settings.cull && (world.cap_a_real || world.cap_b_real) && !world.chunks.empty();
@@ -504,6 +519,11 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
         }
         if (!any) return std::move(b.out);
     }
+    b.out.positions.reserve(world.mesh.positions.size());
+    b.out.emission_times.reserve(world.mesh.positions.size());
+    b.out.rest_points.reserve(world.mesh.positions.size());
+    b.out.triangles.reserve(world.mesh.triangles.size());
+    b.out.source_triangles.reserve(world.mesh.triangles.size());
     b.classifyVertices(culling ? &live : nullptr);
     b.crossing_out.assign(2 * world.edges.size(), kUnset);
     if (settings.tolerance > 0) {
