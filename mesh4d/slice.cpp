@@ -139,6 +139,10 @@ struct FrameBuilder {
 
     // The exact image of vertex i (local coordinates), without emitting it.
     Event vertexEvent(uint32_t i) const { return cutRestLocal(anchor, world.motion, world.mesh.positions[i]); }
+    // Its position: the emitted one when the vertex is visible (the same value, computed once).
+    Vec3 vertexImage(uint32_t i) const {
+        return vertex_out[i] != kUnset ? out.positions[vertex_out[i]] : vertexEvent(i).x;
+    }
 
     // Which side of the real caps a rest point falls on, from its events on both caps.
     Side sideOf(const Event& on_a, const Event& on_b) const {
@@ -155,7 +159,7 @@ struct FrameBuilder {
         const Edge& e = world.edges[edge];
         const uint32_t v[3] = {e.lo, e.hi, e.hi};
         const double limit = kEdgeMidpointShare * settings.tolerance;
-        const Vec3 y0 = vertexEvent(e.lo).x, y1 = vertexEvent(e.hi).x;
+        const Vec3 y0 = vertexImage(e.lo), y1 = vertexImage(e.hi);
         auto at = [&](double s) {
             const double l[3] = {1 - s, s, 0};
             return surfaceAt(v, l);
@@ -292,7 +296,7 @@ struct FrameBuilder {
             n[c] = edge_segments[cur_edges[c]];
         }
         const double limit = kMidpointShare * settings.tolerance;
-        const Vec3 y[3] = {vertexEvent(v[0]).x, vertexEvent(v[1]).x, vertexEvent(v[2]).x};
+        const Vec3 y[3] = {vertexImage(v[0]), vertexImage(v[1]), vertexImage(v[2])};
         const double third[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
         const double centroid_dev = norm(surfaceAt(v, third).x - (y[0] + y[1] + y[2]) / 3.0);
         if (n[0] == 1 && n[1] == 1 && n[2] == 1 && centroid_dev <= limit) {
