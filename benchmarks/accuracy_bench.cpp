@@ -33,7 +33,9 @@ const BenchScene& flanges() {
         apparent::loadScene(std::string(APPARENT_SOURCE_DIR) + "/data/scenes/flanges.json", &scene);
         std::vector<apparent::PreparedObject> objects;
         std::ostringstream log;
-        apparent::prepareObjects(scene, {}, &objects, log, true);
+        apparent::MeshLimits limits;
+        limits.allow_outside = true;  // the shipped scene reads ../meshes, whatever the working folder
+        apparent::prepareObjects(scene, limits, &objects, log, true);
         for (const auto& o : objects) b.worlds.push_back(apparent::buildWorld(o, apparent::Model::Relativistic, scene, 0, 199));
         b.view = apparent::viewForFrame(scene, apparent::Model::Relativistic, 100);
         b.size = std::sqrt(24.0);

@@ -20,11 +20,23 @@ public:
     const std::string& finalPath() const { return final_; }
     // Renames the temporary file into place. Returns false (and keeps errno's message in `error`) on failure.
     bool commit(std::string* error);
+    // Writes `bytes` to the temporary file, checking every write, fsync and close (a full disk or a
+    // file size limit fails here, not later), then commits. Returns false with a message on failure;
+    // the temporary file is then removed and the previous final file, if any, is untouched.
+    bool commitBytes(const std::string& bytes, std::string* error);
 
 private:
     std::string final_;
     std::string temp_;
     bool committed_ = false;
+    int slot_ = -1;  // entry in the registry of temporary files the interrupt handler removes
 };
+
+// Installs handlers for SIGINT and SIGTERM (SIGINT only when it is not ignored) that remove every
+// temporary file of a live AtomicOutput, print one line and exit with 128 + the signal number
+// (130, 143). Files already renamed into place are complete and stay. SIGXFSZ is ignored, so a
+// file size limit fails the write (exit 3) instead of killing the process. SIGKILL cannot be caught:
+// it can leave one temporary file per writer, named ".NAME.tmp-PID.EXT", never a truncated final file.
+void installInterruptCleanup();
 
 }  // namespace apparent

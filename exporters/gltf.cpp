@@ -2,17 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstring>
+#include <memory>
 #include <filesystem>
 #include <sstream>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
 #include <draco/mesh/mesh.h>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "exporters/atomic_file.h"
 #include "mesh4d/normals.h"
+
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace apparent {
 
@@ -27,26 +33,55 @@ struct PrimitiveData {
     size_t vertexCount() const { return emission.size(); }
 };
 
+// Writes all of `n` bytes to `fd`, retrying short writes; errno's message on failure.
+bool writeAll(int fd, const void* data, size_t n, std::string* error) {
+    const char* p = static_cast<const char*>(data);
+    while (n > 0) {
+        const ssize_t w = ::write(fd, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            *error = std::strerror(w < 0 ? errno : EIO);
+            return false;
+        }
+        p += w;
+        n -= size_t(w);
+    }
+    return true;
+}
+
+// Where the BIN chunk goes while frames arrive: a spill file (so memory does not grow with the
+// frame count), or nowhere (counting only, for the size without Draco).
+struct BinSink {
+    int fd = -1;        // -1: count only
+    size_t size = 0;
+    std::string error;  // the first write error
+    void write(const void* data, size_t n) {
+        if (fd >= 0 && error.empty() && !writeAll(fd, data, n, &error)) error = "cannot write: " + error;
+        size += n;
+    }
+};
+
 class GlbBuilder {
 public:
     tinygltf::Model model;
 
-    explicit GlbBuilder(const GlbOptions& options) : options_(options) {
+    GlbBuilder(const GlbOptions& options, BinSink* sink) : options_(options), sink_(sink) {
         model.asset.version = "2.0";
         model.asset.generator = "apparent";
-        model.buffers.emplace_back();  // buffer 0 without uri: the GLB BIN chunk
+        model.buffers.emplace_back();  // buffer 0 without uri: the GLB BIN chunk (data in the sink)
     }
 
+    size_t sinkSize() const { return sink_->size; }
+
     int addView(const void* data, size_t n, int target) {
-        auto& b = model.buffers[0].data;
-        while (b.size() % 4) b.push_back(0);  // accessors need 4-byte alignment for float/uint32
+        static const char zeros[4] = {0, 0, 0, 0};
+        if (sink_->size % 4) sink_->write(zeros, 4 - sink_->size % 4);  // 4-byte alignment for float/uint32
         tinygltf::BufferView v;
         v.buffer = 0;
-        v.byteOffset = b.size();
+        v.byteOffset = sink_->size;
         v.byteLength = n;
         v.target = target;
-        const auto* p = static_cast<const uint8_t*>(data);
-        b.insert(b.end(), p, p + n);
+        sink_->write(data, n);
         model.bufferViews.push_back(v);
         return int(model.bufferViews.size()) - 1;
     }
@@ -162,6 +197,7 @@ private:
     static constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
     static constexpr int kElements = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
     GlbOptions options_;
+    BinSink* sink_;
 
     static void bounds(const std::vector<float>& xyz, std::vector<double>* lo, std::vector<double>* hi) {
         lo->assign(3, INFINITY);
@@ -228,10 +264,12 @@ std::vector<double> cameraRotation(const ExportCamera& cam) {
 
 tinygltf::Value number(double v) { return tinygltf::Value(v); }
 
-// Builds the whole glTF model of the sequence into `b.model`; fills the error statistics.
-bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
-                const GlbOptions& options, GlbBuilder& b, GlbStats& local, std::string* error) {
-
+// The glTF model of a sequence, built frame by frame: JSON-side objects in `model`, binary data
+// streamed to the sink. Two run side by side with Draco: the real one and a plain one that only
+// counts, for the size without Draco.
+struct SequenceModel {
+    SequenceModel(const SequenceInfo& info_, const GlbOptions& options, BinSink* sink) : info(info_), b(options, sink) {
+        tinygltf::Model& model = b.model;
     // Step: one material per object.
     for (const ExportObject& o : info.objects) {
         tinygltf::Material mat;
@@ -240,67 +278,50 @@ bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames,
         mat.pbrMetallicRoughness.metallicFactor = 0.0;
         mat.pbrMetallicRoughness.roughnessFactor = 0.8;
         mat.doubleSided = true;  // thin shells such as the flanges are seen from both sides
-        b.model.materials.push_back(mat);
+        if (o.base_color[3] < 1) mat.alphaMode = "BLEND";  // e.g. a mirror, to show the reflections behind it
+        model.materials.push_back(mat);
     }
 
-    // Step: the camera node (node 0).
-    tinygltf::Scene scene;
-    scene.name = info.model;
-    {
+        // Step: the camera node (node 0); its clip planes are set in finish().
+        scene.name = info.model;
         tinygltf::Camera cam;
         cam.type = "perspective";
         cam.perspective.yfov = info.camera.fov_deg * 3.14159265358979323846 / 180.0;
-        // Clip planes in light-seconds: 1e-3 of, and 10 times, the farthest apparent point's
-        // distance (tinygltf always writes zfar, and the validator requires zfar > znear).
-        double far = 0;
-        for (const auto& f : frames)
-            for (const auto& o : f.objects)
-                for (size_t i = 0; i < o.positions.size(); ++i)
-                    far = std::max(far, mesh4d::norm(o.absolutePosition(i) - info.camera.position));
-        far = far > 0 ? far : 1.0;
-        cam.perspective.znear = 1e-3 * far;
-        cam.perspective.zfar = 10 * far;
-        b.model.cameras.push_back(cam);
+        model.cameras.push_back(cam);
         tinygltf::Node node;
         node.name = "camera";
         node.camera = 0;
         node.translation = {info.camera.position.x, info.camera.position.y, info.camera.position.z};
         node.rotation = cameraRotation(info.camera);
-        b.model.nodes.push_back(node);
+        model.nodes.push_back(node);
         scene.nodes.push_back(0);
+        if (options.draco) {
+            model.extensionsUsed.push_back("KHR_draco_mesh_compression");
+            model.extensionsRequired.push_back("KHR_draco_mesh_compression");
+        }
     }
 
-    // Step: one node per frame (node 1 + k), visible only in its own time slot.
-    const size_t n = frames.size();
-    for (size_t k = 0; k < n; ++k) {
-        const ExportFrame& f = frames[k];
+    // Step: frame k's node (node 1 + k), given each object's primitive data (empty: not shown).
+    bool addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3], bool draco,
+                  GlbStats* stats, std::string* error) {
         tinygltf::Node node;
         node.name = "frame_" + std::string(std::max(0, 5 - int(std::to_string(f.index).size())), '0') +
                     std::to_string(f.index);
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (const auto& o : f.objects)
-            for (size_t i = 0; i < o.positions.size(); ++i) {
-                const Vec3 p = o.absolutePosition(i);
-                for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
-            }
         if (f.triangleCount() > 0) {
-            const double origin[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-            for (int c = 0; c < 3; ++c) local.max_extent = std::max(local.max_extent, hi[c] - lo[c]);
             tinygltf::Mesh mesh;
             mesh.name = node.name;
             for (size_t o = 0; o < f.objects.size(); ++o) {
                 if (f.objects[o].triangles.empty()) continue;
-                const PrimitiveData d = toPrimitive(f.objects[o], origin, &local.max_float_error);
                 tinygltf::Primitive prim;
-                if (options.draco) {
+                if (draco) {
                     double qerr = 0;
-                    if (!b.dracoPrimitive(d, &prim, &qerr, error)) {
-                        *error = path + ": " + node.name + ": " + *error;
+                    if (!b.dracoPrimitive(data[o], &prim, &qerr, error)) {
+                        *error = node.name + ": " + *error;
                         return false;
                     }
-                    local.max_quantization_error = std::max(local.max_quantization_error, qerr);
+                    stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
                 } else {
-                    prim = b.plainPrimitive(d);
+                    prim = b.plainPrimitive(data[o]);
                 }
                 prim.material = o < info.objects.size() ? int(o) : -1;
                 mesh.primitives.push_back(prim);
@@ -309,105 +330,242 @@ bool buildModel(const std::string& path, const std::vector<ExportFrame>& frames,
             node.mesh = int(b.model.meshes.size()) - 1;
             node.translation = {origin[0], origin[1], origin[2]};
         }
-        node.scale = {k == 0 ? 1.0 : 0.0, k == 0 ? 1.0 : 0.0, k == 0 ? 1.0 : 0.0};
+        const double s = frames == 0 ? 1.0 : 0.0;
+        node.scale = {s, s, s};
         b.model.nodes.push_back(node);
         scene.nodes.push_back(int(b.model.nodes.size()) - 1);
-    }
-    if (options.draco) {
-        b.model.extensionsUsed.push_back("KHR_draco_mesh_compression");
-        b.model.extensionsRequired.push_back("KHR_draco_mesh_compression");
+        frame_times.push_back(tinygltf::Value(f.t_c));
+        if (frames == 0) first_frame = f.index;
+        ++frames;
+        return true;
     }
 
-    // Step: STEP scale channels, at most 3 keys each so the file grows linearly with the frame
-    // count: scale 0 until k/fps, 1 during frame k, 0 from (k+1)/fps on. The last frame keeps
-    // scale 1 at the final key n/fps, which closes the sequence so that it lasts 1/fps too
-    // (with one key per frame the last frame would have zero length).
-    tinygltf::Animation anim;
-    anim.name = "frames";
-    for (size_t k = 0; k < n; ++k) {
-        std::vector<float> times, scales;
-        auto key = [&](size_t i, float s) {
-            times.push_back(float(double(i) / info.fps));
-            scales.insert(scales.end(), {s, s, s});
-        };
-        if (k > 0) key(0, 0.0f);
-        key(k, 1.0f);
-        key(k + 1, k + 1 == n ? 1.0f : 0.0f);
-        const int in_acc = b.addAccessor(b.addView(times.data(), times.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                         TINYGLTF_TYPE_SCALAR, times.size(), {double(times.front())},
-                                         {double(times.back())});
-        const int out_acc = b.addAccessor(b.addView(scales.data(), scales.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                          TINYGLTF_TYPE_VEC3, times.size());
-        tinygltf::AnimationSampler s;
-        s.input = in_acc;
-        s.output = out_acc;
-        s.interpolation = "STEP";
-        anim.samplers.push_back(s);
-        tinygltf::AnimationChannel c;
-        c.sampler = int(k);
-        c.target_node = int(1 + k);
-        c.target_path = "scale";
-        anim.channels.push_back(c);
+    // Step: what needs the whole sequence: the camera's clip planes, the animation (at most 3 keys
+    // per channel), the scene extras. Returns the JSON chunk's text.
+    std::string finish(double far) {
+        tinygltf::Model& model = b.model;
+        // Clip planes in light-seconds: 1e-3 of, and 10 times, the farthest apparent point's
+        // distance (tinygltf always writes zfar, and the validator requires zfar > znear).
+        far = far > 0 ? far : 1.0;
+        model.cameras[0].perspective.znear = 1e-3 * far;
+        model.cameras[0].perspective.zfar = 10 * far;
+
+        // STEP scale channels, at most 3 keys each so the file grows linearly with the frame
+        // count: scale 0 until k/fps, 1 during frame k, 0 from (k+1)/fps on. The last frame keeps
+        // scale 1 at the final key n/fps, which closes the sequence so that it lasts 1/fps too
+        // (with one key per frame the last frame would have zero length).
+        const size_t n = frames;
+        tinygltf::Animation anim;
+        anim.name = "frames";
+        for (size_t k = 0; k < n; ++k) {
+            std::vector<float> times, scales;
+            auto key = [&](size_t i, float v) {
+                times.push_back(float(double(i) / info.fps));
+                scales.insert(scales.end(), {v, v, v});
+            };
+            if (k > 0) key(0, 0.0f);
+            key(k, 1.0f);
+            key(k + 1, k + 1 == n ? 1.0f : 0.0f);
+            const int in_acc = b.addAccessor(b.addView(times.data(), times.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                             TINYGLTF_TYPE_SCALAR, times.size(), {double(times.front())},
+                                             {double(times.back())});
+            const int out_acc = b.addAccessor(b.addView(scales.data(), scales.size() * 4, 0),
+                                              TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, times.size());
+            tinygltf::AnimationSampler sampler;
+            sampler.input = in_acc;
+            sampler.output = out_acc;
+            sampler.interpolation = "STEP";
+            anim.samplers.push_back(sampler);
+            tinygltf::AnimationChannel c;
+            c.sampler = int(k);
+            c.target_node = int(1 + k);
+            c.target_path = "scale";
+            anim.channels.push_back(c);
+        }
+        model.animations.push_back(anim);
+
+        // Scene extras: what was computed, in which units, at which camera times.
+        tinygltf::Value::Array object_names;
+        for (const auto& o : info.objects) object_names.push_back(tinygltf::Value(o.name));
+        tinygltf::Value::Object extras{{"model", tinygltf::Value(info.model)},
+                                       {"tolerance", number(info.tolerance)},
+                                       {"units", tinygltf::Value(std::string("light-seconds, seconds, c = 1"))},
+                                       {"fps", number(info.fps)},
+                                       {"first_frame", tinygltf::Value(int(first_frame))},
+                                       {"frame_times", tinygltf::Value(frame_times)},
+                                       {"objects", tinygltf::Value(object_names)},
+                                       {"scene_file", tinygltf::Value(info.scene_path)}};
+        scene.extras = tinygltf::Value(extras);
+        model.scenes.push_back(scene);
+        model.defaultScene = 0;
+
+        // The JSON by tinygltf (a GLB with an empty BIN chunk), with buffer 0's byteLength set to
+        // the streamed size: the only field tinygltf cannot know.
+        tinygltf::TinyGLTF writer;
+        std::ostringstream glb;
+        writer.WriteGltfSceneToStream(&model, glb, /*prettyPrint=*/false, /*writeBinary=*/true);
+        const std::string bytes = glb.str();
+        uint32_t json_len = 0;
+        std::memcpy(&json_len, bytes.data() + 12, 4);
+        nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_len));
+        j["buffers"][0]["byteLength"] = b.sinkSize();
+        return j.dump();
     }
-    b.model.animations.push_back(anim);
 
-    // Step: scene extras: what was computed, in which units, at which camera times.
-    tinygltf::Value::Array frame_times, object_names;
-    for (const auto& f : frames) frame_times.push_back(number(f.t_c));
-    for (const auto& o : info.objects) object_names.push_back(tinygltf::Value(o.name));
-    tinygltf::Value::Object extras{{"model", tinygltf::Value(info.model)},
-                                   {"tolerance", number(info.tolerance)},
-                                   {"units", tinygltf::Value(std::string("light-seconds, seconds, c = 1"))},
-                                   {"fps", number(info.fps)},
-                                   {"first_frame", tinygltf::Value(int(frames.front().index))},
-                                   {"frame_times", tinygltf::Value(frame_times)},
-                                   {"objects", tinygltf::Value(object_names)},
-                                   {"scene_file", tinygltf::Value(info.scene_path)}};
-    scene.extras = tinygltf::Value(extras);
-    b.model.scenes.push_back(scene);
-    b.model.defaultScene = 0;
+    const SequenceInfo& info;
+    GlbBuilder b;
+    tinygltf::Scene scene;
+    tinygltf::Value::Array frame_times;
+    long long first_frame = 0;
+    size_t frames = 0;
+};
 
-    return true;
-}
+size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
 
 }  // namespace
 
-bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
-                      const GlbOptions& options, GlbStats* stats, std::string* error) {
-    if (frames.empty()) {
-        *error = path + ": no frames to write";
-        return false;
-    }
-    GlbBuilder b(options);
-    GlbStats local;
-    if (!buildModel(path, frames, info, options, b, local, error)) return false;
-
-    // Step: write through a temporary file.
-    tinygltf::TinyGLTF writer;
-    AtomicOutput out(path);
-    if (!writer.WriteGltfSceneToFile(&b.model, out.tempPath(), /*embedImages=*/true, /*embedBuffers=*/true,
-                                     /*prettyPrint=*/false, /*writeBinary=*/true)) {
-        *error = path + ": tinygltf could not write the file";
-        return false;
-    }
-    std::error_code ec;
-    local.bytes = size_t(std::filesystem::file_size(out.tempPath(), ec));
-    if (!out.commit(error)) return false;
-
-    // Step: with Draco, the size the same sequence has without it, serialized in memory.
-    if (options.draco) {
-        GlbOptions plain_options = options;
-        plain_options.draco = false;
-        GlbBuilder plain(plain_options);
-        GlbStats ignored;
-        if (buildModel(path, frames, info, plain_options, plain, ignored, error)) {
-            std::ostringstream os;
-            if (writer.WriteGltfSceneToStream(&plain.model, os, /*prettyPrint=*/false, /*writeBinary=*/true))
-                local.bytes_without_draco = os.str().size();
+struct GlbSequenceWriter::Impl {
+    Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
+        : path(p), info(i), options(o), spill(p + ".bin"), model(info, options, &sink) {
+        sink.fd = ::open(spill.tempPath().c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+        if (sink.fd < 0) sink.error = std::string("cannot create ") + spill.tempPath() + ": " + std::strerror(errno);
+        if (options.draco) {
+            GlbOptions plain_options = options;
+            plain_options.draco = false;
+            plain = std::make_unique<SequenceModel>(info, plain_options, &count_only);
         }
     }
-    if (stats) *stats = local;
+    ~Impl() {
+        if (sink.fd >= 0) ::close(sink.fd);
+    }
+
+    std::string path;
+    SequenceInfo info;
+    GlbOptions options;
+    AtomicOutput spill;  // never committed: removed when done (or on an interrupt)
+    BinSink sink, count_only;
+    SequenceModel model;
+    std::unique_ptr<SequenceModel> plain;  // with Draco: the same sequence without it, counted
+    GlbStats stats;
+    double far = 0;
+};
+
+GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options)
+    : impl_(std::make_unique<Impl>(path, info, options)) {}
+
+GlbSequenceWriter::~GlbSequenceWriter() = default;
+
+bool GlbSequenceWriter::add(const ExportFrame& f, std::string* error) {
+    Impl& m = *impl_;
+    // Step: the frame's origin (the centre of its bounding box) and the far distance.
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const auto& o : f.objects)
+        for (size_t i = 0; i < o.positions.size(); ++i) {
+            const Vec3 p = o.absolutePosition(i);
+            m.far = std::max(m.far, mesh4d::norm(p - m.info.camera.position));
+            for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+        }
+    const double origin[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+    std::vector<PrimitiveData> data(f.objects.size());
+    if (f.triangleCount() > 0) {
+        for (int c = 0; c < 3; ++c) m.stats.max_extent = std::max(m.stats.max_extent, hi[c] - lo[c]);
+        for (size_t o = 0; o < f.objects.size(); ++o)
+            if (!f.objects[o].triangles.empty()) data[o] = toPrimitive(f.objects[o], origin, &m.stats.max_float_error);
+    }
+    // Step: into the model (binary data to the spill file), and into the counted plain twin.
+    if (!m.model.addFrame(f, data, origin, m.options.draco, &m.stats, error)) {
+        *error = m.path + ": " + *error;
+        return false;
+    }
+    GlbStats ignored;
+    if (m.plain && !m.plain->addFrame(f, data, origin, false, &ignored, error)) {
+        *error = m.path + ": " + *error;
+        return false;
+    }
+    if (!m.sink.error.empty()) {
+        *error = m.spill.tempPath() + ": " + m.sink.error;
+        return false;
+    }
     return true;
+}
+
+bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
+    Impl& m = *impl_;
+    if (m.model.frames == 0) {
+        *error = m.path + ": no frames to write";
+        return false;
+    }
+    const std::string json = m.model.finish(m.far);
+    if (!m.sink.error.empty()) {
+        *error = m.spill.tempPath() + ": " + m.sink.error;
+        return false;
+    }
+    const size_t bin = m.sink.size;
+    const uint64_t total = 12 + 8 + padded4(json.size()) + 8 + padded4(bin);
+    if (m.plain) {
+        const std::string plain_json = m.plain->finish(m.far);
+        m.stats.bytes_without_draco = 12 + 8 + padded4(plain_json.size()) + 8 + padded4(m.count_only.size);
+    }
+    if (total > 0xffffffffull) {
+        *error = m.path + ": " + std::to_string(total) +
+                 " bytes, more than a .glb can hold (4 GiB); render fewer frames at once (--frames) or add --draco";
+        return false;
+    }
+
+    // Step: header, JSON chunk, BIN chunk copied from the spill file; through a temporary name,
+    // every write checked and synced before the rename.
+    AtomicOutput out(m.path);
+    const int fd = ::open(out.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        *error = m.path + ": cannot create " + out.tempPath() + ": " + std::strerror(errno);
+        return false;
+    }
+    auto put32 = [](std::string* s, uint32_t v) {
+        for (int i = 0; i < 4; ++i) s->push_back(char((v >> (8 * i)) & 0xff));  // little-endian
+    };
+    std::string head = "glTF";
+    put32(&head, 2);
+    put32(&head, uint32_t(total));
+    put32(&head, uint32_t(padded4(json.size())));
+    put32(&head, 0x4E4F534A);  // JSON
+    head += json;
+    head.append(padded4(json.size()) - json.size(), ' ');
+    put32(&head, uint32_t(padded4(bin)));
+    put32(&head, 0x004E4942);  // BIN
+    std::string werr;
+    bool ok = writeAll(fd, head.data(), head.size(), &werr);
+    std::vector<char> chunk(size_t(1) << 20);
+    for (size_t off = 0; ok && off < bin;) {
+        const ssize_t r = ::pread(m.sink.fd, chunk.data(), std::min(chunk.size(), bin - off), off_t(off));
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) {
+            werr = std::string("cannot read back ") + m.spill.tempPath() + ": " + std::strerror(r < 0 ? errno : EIO);
+            ok = false;
+            break;
+        }
+        ok = writeAll(fd, chunk.data(), size_t(r), &werr);
+        off += size_t(r);
+    }
+    static const char zeros[4] = {0, 0, 0, 0};
+    if (ok) ok = writeAll(fd, zeros, padded4(bin) - bin, &werr);
+    if (ok && ::fsync(fd) != 0) { werr = std::strerror(errno); ok = false; }
+    if (::close(fd) != 0 && ok) { werr = std::strerror(errno); ok = false; }
+    if (!ok) {
+        *error = m.path + ": cannot write: " + werr;
+        return false;
+    }
+    if (!out.commit(error)) return false;
+    m.stats.bytes = size_t(total);
+    if (stats) *stats = m.stats;
+    return true;
+}
+
+bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
+                      const GlbOptions& options, GlbStats* stats, std::string* error) {
+    GlbSequenceWriter writer(path, info, options);
+    for (const ExportFrame& f : frames)
+        if (!writer.add(f, error)) return false;
+    return writer.finish(stats, error);
 }
 
 }  // namespace apparent

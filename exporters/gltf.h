@@ -18,6 +18,7 @@
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,28 @@ struct GlbStats {
     double max_extent = 0;            // largest frame extent, light-seconds (to judge the errors above)
 };
 
+// The .glb of a sequence written as frames arrive: each frame's binary data goes at once to a
+// spill file next to the output (".NAME.glb.tmp-PID.bin", removed when done), only the JSON-side
+// description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
+// under a temporary name and renames it into place. Memory does not grow with the frame data;
+// the disk briefly holds the binary data twice.
+class GlbSequenceWriter {
+public:
+    GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options);
+    ~GlbSequenceWriter();
+    GlbSequenceWriter(const GlbSequenceWriter&) = delete;
+    GlbSequenceWriter& operator=(const GlbSequenceWriter&) = delete;
+    // Frames in order; false with a message naming the file on failure.
+    bool add(const ExportFrame& frame, std::string* error);
+    // Writes the file; a .glb cannot exceed 4 GiB (refused with a message).
+    bool finish(GlbStats* stats, std::string* error);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// All frames at once (the same file as GlbSequenceWriter fed `frames`).
 bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,
                       const GlbOptions& options, GlbStats* stats, std::string* error);
 

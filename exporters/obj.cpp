@@ -1,5 +1,7 @@
 #include "exporters/obj.h"
 
+#include <sstream>
+
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
@@ -14,11 +16,12 @@ bool writeObj(const std::string& path, const ExportFrame& frame, std::string* er
     omlog().disable();
     AtomicOutput out(path);
     // 17 significant digits: a double survives the text round trip exactly.
-    if (!OpenMesh::IO::write_mesh(om, out.tempPath(), OpenMesh::IO::Options(), 17)) {
+    std::ostringstream os;  // in memory, then written with every error checked (see ply.cpp)
+    if (!OpenMesh::IO::write_mesh(om, os, ".obj", OpenMesh::IO::Options(), 17)) {
         *error = path + ": OpenMesh could not write the OBJ file";
         return false;
     }
-    return out.commit(error);
+    return out.commitBytes(os.str(), error);
 }
 
 }  // namespace apparent

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pipeline/raytrace.h"
 #include "pipeline/render.h"
 
 namespace apparent {
@@ -44,6 +45,22 @@ bool parseFrames(const std::string& text, long long* from, long long* to) {
     return *from >= 0 && (*to < 0 || *to > *from);
 }
 
+// "WxH" with 1 <= W, H <= 16384.
+bool parseSize(const std::string& text, int* width, int* height) {
+    const auto x = text.find('x');
+    if (x == std::string::npos) return false;
+    try {
+        size_t used_w = 0, used_h = 0;
+        const long w = std::stol(text.substr(0, x), &used_w), h = std::stol(text.substr(x + 1), &used_h);
+        if (used_w != x || used_h != text.size() - x - 1 || w < 1 || h < 1 || w > 16384 || h > 16384) return false;
+        *width = int(w);
+        *height = int(h);
+        return true;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
 }  // namespace
 
 int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -77,7 +94,42 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->add_option("--max-frames", rs.max_frames, "Refuse scenes with more frames")->capture_default_str();
     render_cmd->add_option("--max-vertices", max_vertices, "Refuse meshes with more vertices")->capture_default_str();
     render_cmd->add_option("--max-faces", max_faces, "Refuse meshes with more faces")->capture_default_str();
+    long long max_file_bytes = (long long)rs.limits.max_file_bytes;
+    render_cmd->add_option("--max-file-bytes", max_file_bytes, "Refuse mesh files (and glTF buffers) larger than this")
+        ->capture_default_str();
+    render_cmd->add_option("--max-output-bytes", rs.max_output_bytes,
+                           "Stop with exit code 3 before the outputs would exceed this many bytes in all")
+        ->capture_default_str();
+    render_cmd->add_flag("--allow-outside", rs.limits.allow_outside,
+                         "Let scene mesh paths leave the scene's folder and the working folder");
     render_cmd->footer(kRenderFooter);
+
+    // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
+    RaytraceSettings ts;
+    std::string trace_model_text, trace_size_text, trace_frames_text;
+    CLI::App* raytrace_cmd = app.add_subcommand("raytrace", "Ray-trace the 4D histories into PNG frames DIR/<model>/frame_NNNNN.png");
+    raytrace_cmd->add_option("scene", ts.scene_path, "Scene file (JSON or glTF)")->required();
+    raytrace_cmd->add_option("--out", ts.out_dir, "Output folder (created if missing)")->capture_default_str();
+    raytrace_cmd->add_option("--model", trace_model_text, "instant|finite|relativistic|contracted|all, or a comma list");
+    raytrace_cmd->add_option("--size", trace_size_text, "Image size WxH (default 480x270)");
+    raytrace_cmd->add_option("--frames", trace_frames_text, "A:B traces global frames A..B-1");
+    raytrace_cmd->add_option("--threads", ts.threads, "Worker threads (0: all cores)")->capture_default_str();
+    raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary");
+    raytrace_cmd->add_flag("--allow-outside", ts.limits.allow_outside,
+                           "Let scene mesh paths leave the scene's folder and the working folder");
+    FigureSettings fs;
+    std::string figure_size_text;
+    CLI::App* figure_cmd = app.add_subcommand(
+        "figure", "The paper's comparison sheet: rows instant, finite, relativistic; columns sequential frames");
+    figure_cmd->add_option("scene", fs.scene_path, "Scene file (JSON or glTF)")->required();
+    figure_cmd->add_option("--out", fs.out_path, "Output PNG")->capture_default_str();
+    figure_cmd->add_option("--columns", fs.columns, "Frames per row, evenly spaced, first and last included")
+        ->capture_default_str();
+    figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
+    figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
+    figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary");
+    figure_cmd->add_flag("--allow-outside", fs.limits.allow_outside,
+                         "Let scene mesh paths leave the scene's folder and the working folder");
 
     try {
         app.parse(argc, argv);
@@ -95,13 +147,35 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         err << "error: " << e.what() << "\n" << "Run 'apparent --help' or 'apparent render --help'.\n";
         return kExitBadInput;
     }
-    if (!render_cmd->parsed()) return kExitBadInput;
-
     // Step: turn the option strings into settings, one clear line per problem.
     auto usage = [&](const std::string& msg) {
         err << "error: " << msg << "\n";
         return kExitBadInput;
     };
+    if (raytrace_cmd->parsed()) {
+        std::stringstream ss(trace_model_text);
+        std::string item;
+        while (!trace_model_text.empty() && std::getline(ss, item, ',')) {
+            Model m;
+            if (item == "all") ts.all_models = true;
+            else if (parseModel(item, &m)) ts.models.push_back(m);
+            else return usage("--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)");
+        }
+        if (!trace_size_text.empty() && !parseSize(trace_size_text, &ts.width, &ts.height))
+            return usage("--size: '" + trace_size_text + "' is not WxH with W and H in 1..16384");
+        if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.frame_from, &ts.frame_to))
+            return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
+        if (ts.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        return raytrace(ts, out, err);
+    }
+    if (figure_cmd->parsed()) {
+        if (!figure_size_text.empty() && !parseSize(figure_size_text, &fs.width, &fs.height))
+            return usage("--size: '" + figure_size_text + "' is not WxH with W and H in 1..16384");
+        if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
+        if (fs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        return figure(fs, out, err);
+    }
+    if (!render_cmd->parsed()) return kExitBadInput;
     if (!model_text.empty()) {
         std::stringstream ss(model_text);
         std::string item;
@@ -143,10 +217,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
     if (rs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
-    if (max_vertices <= 0 || max_faces <= 0 || rs.max_frames <= 0)
-        return usage("--max-vertices, --max-faces and --max-frames must be positive");
+    if (max_vertices <= 0 || max_faces <= 0 || rs.max_frames <= 0 || max_file_bytes <= 0 || rs.max_output_bytes <= 0)
+        return usage("--max-vertices, --max-faces, --max-frames, --max-file-bytes and --max-output-bytes must be positive");
     rs.limits.max_vertices = size_t(max_vertices);
     rs.limits.max_faces = size_t(max_faces);
+    rs.limits.max_file_bytes = size_t(max_file_bytes);
     try {
         return render(rs, out, err);
     } catch (const std::bad_alloc&) {

@@ -114,7 +114,7 @@ bool confinedRead(std::vector<unsigned char>* out, std::string* err, const std::
         return false;
     }
     if (size > c->max_bytes) {
-        if (err) *err += filepath + " is larger than the limit of " + std::to_string(c->max_bytes) + " bytes\n";
+        if (err) *err += filepath + " is larger than the limit of " + std::to_string(c->max_bytes) + " bytes (raise with --max-file-bytes)\n";
         return false;
     }
     std::ifstream in(p, std::ios::binary);
@@ -626,7 +626,8 @@ Status loadModel(const std::string& path, const MeshLimits& limits, tinygltf::Mo
     std::error_code ec;
     const auto size = fs::file_size(path, ec);
     if (ec) return Status::failure(path + ": cannot open file");
-    if (size > limits.max_file_bytes) return Status::failure(path + ": larger than the limit of " + std::to_string(limits.max_file_bytes) + " bytes");
+    if (size > limits.max_file_bytes)
+        return Status::failure(path + ": larger than the limit of " + std::to_string(limits.max_file_bytes) + " bytes (raise with --max-file-bytes)");
     std::vector<unsigned char> bytes(size_t(size), 0);
     {
         std::ifstream in(path, std::ios::binary);
@@ -699,7 +700,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
     paths.top = "scenes[" + std::to_string(si) + "].extras";
     const nlohmann::json sx = toJson(model.scenes[si].extras);
     if (sx.is_object())
-        for (const char* key : {"frames", "model", "tolerance"})
+        for (const char* key : {"frames", "model", "tolerance", "light"})
             if (sx.contains(key)) root[key] = sx[key];
 
     // Step: walk the node tree; nodes whose extras carry object fields become objects, the first
@@ -728,6 +729,8 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
             root["camera"] = {{"position", {pos.x, pos.y, pos.z}}, {"look_at", {look.x, look.y, look.z}},
                               {"up", {up.x, up.y, up.z}}};
             if (cam.type == "perspective") root["camera"]["fov_deg"] = cam.perspective.yfov * 180.0 / 3.14159265358979323846;
+            if (const nlohmann::json cx = toJson(node.extras); cx.is_object() && cx.contains("instant_delay"))
+                root["camera"]["instant_delay"] = cx["instant_delay"];
             paths.camera = where;
         }
         const nlohmann::json ex = toJson(node.extras);
@@ -738,7 +741,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
             if (!names.insert(node.name).second) { problem = where + ".name: '" + node.name + "' names two object nodes"; return false; }
             nlohmann::json obj = nlohmann::json::object();
             // Known object fields are taken from the extras; other custom properties are ignored.
-            for (const char* key : {"t0", "velocity", "exists", "rotation_deg", "scale"})
+            for (const char* key : {"t0", "velocity", "exists", "rotation_deg", "scale", "mirror"})
                 if (ex.contains(key)) obj[key] = ex[key];
             obj["name"] = node.name;
             obj["mesh"] = file + "#" + node.name;

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 
 #include "pipeline/gltf_reader.h"
 #include "pipeline/obj_reader.h"
+#include "pipeline/ply_reader.h"
 
 namespace apparent {
 
@@ -37,7 +39,43 @@ Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* o
         return Status::failure(path + ": '#NodeName' selects a node of a glTF file only");
     }
     if (ext == ".obj") return readObj(path, limits, &out->mesh, warnings);
-    return Status::failure(path + ": unknown mesh format '" + ext + "' (use .obj, .gltf or .glb)");
+    if (ext == ".ply") return readPly(path, limits, &out->mesh, warnings);
+    return Status::failure(path + ": unknown mesh format '" + ext + "' (use .obj, .ply, .gltf or .glb)");
+}
+
+namespace {
+
+// True when `p` is `root` or below it, both already canonical (compared component by component).
+bool isWithin(const std::filesystem::path& p, const std::filesystem::path& root) {
+    auto pi = p.begin();
+    for (auto ri = root.begin(); ri != root.end(); ++ri, ++pi) {
+        if (ri->empty()) continue;  // a trailing separator
+        if (pi == p.end() || *pi != *ri) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+Status checkMeshInside(const std::string& scene_path, const std::string& field, const std::string& mesh_text,
+                       const std::string& mesh_path) {
+    namespace fs = std::filesystem;
+    // A glTF node selector "file.glb#Node" names the file before the '#'.
+    std::string file = mesh_path;
+    if (const auto hash = mesh_path.rfind('#'); hash != std::string::npos) {
+        std::string ext = mesh_path.substr(0, hash);
+        ext = ext.substr(std::min(ext.size(), ext.find_last_of('.') == std::string::npos ? ext.size() : ext.find_last_of('.')));
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        if (ext == ".gltf" || ext == ".glb") file = mesh_path.substr(0, hash);
+    }
+    std::error_code ec;
+    const fs::path scene_folder = fs::path(scene_path).parent_path();
+    const fs::path mesh = fs::weakly_canonical(fs::absolute(file, ec), ec);
+    const fs::path folder = fs::weakly_canonical(fs::absolute(scene_folder.empty() ? fs::path(".") : scene_folder, ec), ec);
+    const fs::path cwd = fs::weakly_canonical(fs::current_path(ec), ec);
+    if (!ec && (isWithin(mesh, folder) || isWithin(mesh, cwd))) return Status::success();
+    return Status::failure(scene_path + ": " + field + ": \"" + mesh_text +
+                           "\" is outside the scene's folder and the working folder (allow with --allow-outside)");
 }
 
 }  // namespace apparent

@@ -24,6 +24,10 @@ struct MeshLimits {
     size_t max_vertices = 50'000'000;
     size_t max_faces = 50'000'000;
     size_t max_file_bytes = size_t(2) << 30;  // any one file a mesh reads (glTF buffers included)
+    // Scene mesh paths must resolve (".." and symlinks followed) inside the scene file's folder or
+    // the current working folder, unless this is set (--allow-outside). glTF buffer URIs stay
+    // confined to the glTF file's folder either way.
+    bool allow_outside = false;
 };
 
 struct LoadedMesh {
@@ -32,8 +36,16 @@ struct LoadedMesh {
     std::array<double, 4> color{1, 1, 1, 1};
 };
 
-// Reads an OBJ (.obj), glTF (.gltf) or binary glTF (.glb) file; a glTF path may end in
+// Reads an OBJ (.obj), PLY (.ply), glTF (.gltf) or binary glTF (.glb) file; a glTF path may end in
 // "#NodeName" to read only that node's subtree. Dispatches on the extension.
 Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* out, MeshWarnings* warnings);
+
+// Succeeds when `mesh_path` (resolved, optionally "file.glb#Node") lies inside the folder of
+// `scene_path` or inside the current working folder, after resolving ".." and symlinks
+// (std::filesystem::weakly_canonical). Otherwise fails with
+// "scene.json: objects[2].mesh: "../x.obj" is outside the scene's folder and the working folder (allow with --allow-outside)",
+// quoting `mesh_text` (the field as written) at `field` (such as "objects[2].mesh").
+Status checkMeshInside(const std::string& scene_path, const std::string& field, const std::string& mesh_text,
+                       const std::string& mesh_path);
 
 }  // namespace apparent

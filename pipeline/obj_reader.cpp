@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -45,6 +46,10 @@ bool parseFinite(const std::string& token, double* out) {
 Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* scan) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return Status::failure(path + ": cannot open mesh file");
+    std::error_code ec;
+    if (const auto size = std::filesystem::file_size(path, ec); !ec && size > limits.max_file_bytes)
+        return Status::failure(path + ": " + std::to_string(size) + " bytes, larger than the limit of " +
+                               std::to_string(limits.max_file_bytes) + " bytes (raise with --max-file-bytes)");
     std::string line;
     size_t line_no = 0;
     auto fail = [&](const std::string& problem) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <map>
+#include <memory>
 #include <ostream>
 #include <sstream>
 
@@ -19,6 +20,7 @@
 #include "exporters/obj.h"
 #include "exporters/ply.h"
 #include "pipeline/mesh_check.h"
+#include "pipeline/mirror.h"
 
 namespace apparent {
 
@@ -103,7 +105,7 @@ SequenceInfo sequenceInfo(const Scene& scene, const std::vector<PreparedObject>&
     for (size_t i = 0; i < objects.size(); ++i) {
         ExportObject o;
         o.name = objects[i].spec.name;
-        o.base_color = objects[i].has_color ? objects[i].color : kPalette[i % kPalette.size()];
+        o.base_color = objectBaseColor(objects, i);
         info.objects.push_back(o);
     }
     info.camera.position = scene.camera.position;
@@ -115,10 +117,20 @@ SequenceInfo sequenceInfo(const Scene& scene, const std::vector<PreparedObject>&
 
 }  // namespace
 
+std::array<double, 4> objectBaseColor(const std::vector<PreparedObject>& objects, size_t i) {
+    return objects[i].has_color ? objects[i].color : kPalette[i % kPalette.size()];
+}
+
 Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<PreparedObject>* objects,
                       std::ostream& log, bool quiet) {
     std::map<std::string, LoadedMesh> cache;  // one read per mesh file
     for (const ObjectSpec& spec : scene.objects) {
+        // Step: the mesh path must stay where the scene may read (README "Hostile input").
+        if (!limits.allow_outside)
+            if (Status s = checkMeshInside(scene.path, spec.field_path + ".mesh",
+                                           spec.mesh_text.empty() ? spec.mesh_path : spec.mesh_text, spec.mesh_path);
+                !s.ok)
+                return s;
         auto it = cache.find(spec.mesh_path);
         if (it == cache.end()) {
             LoadedMesh mesh;
@@ -167,6 +179,8 @@ mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
     view.kind = (model == Model::Finite || model == Model::Relativistic) ? mesh4d::ViewKind::PastCone
                                                                          : mesh4d::ViewKind::Hyperplane;
     view.t_c = frameTime(scene.frames, k);
+    // The hyperplane models may look back by the stage's light delay (scene camera.instant_delay).
+    if (view.kind == mesh4d::ViewKind::Hyperplane) view.t_c -= scene.camera.instant_delay;
     view.apex = scene.camera.position;
     return view;
 }
@@ -244,6 +258,11 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         err << "error: " << s.message << "\n";
         return kExitBadInput;
     }
+    std::vector<MirrorPlane> mirrors;
+    if (Status s = findMirrors(objects, scene.path, &mirrors); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
     if (settings.verbose) {
         for (const auto& o : objects) {
             const Topology t = analyzeTopology(o.rest.positions, o.rest.triangles);
@@ -261,11 +280,29 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     }
 
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    // Bytes written by this run, and a check before each write against --max-output-bytes: files
+    // already written stay complete, nothing is written past the limit.
+    long long written = 0;
+    auto overLimit = [&](long long more, const std::string& what) {
+        if (written + more <= settings.max_output_bytes) return false;
+        err << "error: --max-output-bytes: " << what << (more ? " would bring" : " brought") << " the output to " << (written + more)
+            << " bytes, more than the limit of " << settings.max_output_bytes << " (" << written
+            << " bytes written, every written file is complete; raise it with --max-output-bytes)\n";
+        return true;
+    };
+    // Counts a written file; false (with the message) once the total is over the limit.
+    auto addWritten = [&](const std::string& path) {
+        std::error_code size_ec;
+        const auto n = std::filesystem::file_size(path, size_ec);
+        if (!size_ec) written += (long long)n;
+        return !overLimit(0, path);
+    };
     for (Model model : models) {
         const std::string name = modelName(model);
         // Step: build the static 4D world once per model.
         std::vector<mesh4d::World4D> worlds;
         for (const auto& o : objects) worlds.push_back(buildWorld(o, model, scene, first, last_excl - 1));
+        const MirrorReflections reflections(scene, objects, mirrors, model, first, last_excl - 1);
         const std::string frame_dir = (std::filesystem::path(settings.out_dir) / name).string();
         if (settings.write_ply || settings.write_obj) {
             std::filesystem::create_directories(frame_dir, ec);
@@ -278,7 +315,15 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         // Step: per frame, cut every world with the view surface (refined to the tolerance), then export.
         mesh4d::SliceSettings slice_settings;
         slice_settings.tolerance = scene.tolerance;
-        std::vector<ExportFrame> frames;
+        // The .glb streams: each frame's data leaves memory as soon as it is cut (GlbSequenceWriter).
+        const std::string glb = (std::filesystem::path(settings.out_dir) / (name + ".glb")).string();
+        std::unique_ptr<GlbSequenceWriter> glb_writer;
+        if (settings.write_glb) {
+            SequenceInfo info = sequenceInfo(scene, objects, name);
+            reflections.describe(&info);
+            glb_writer = std::make_unique<GlbSequenceWriter>(glb, info, settings.glb);
+        }
+        long long glb_min = 0;  // least size of the .glb without Draco (positions and indices alone)
         Progress progress(err, !settings.quiet, name, last_excl - first);
         size_t max_triangles = 0, limited = 0;
         // Frames are independent given the static worlds: cut a batch in parallel (TBB), then
@@ -293,14 +338,17 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                     frame.index = k;
                     frame.t_c = frameTime(scene.frames, k);
                     const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-                    for (const auto& w : worlds) {
+                    // Objects in parallel too (a short range of frames of a many-object scene),
+                    // each into its own slot: the result does not depend on the scheduling.
+                    frame.objects.resize(worlds.size());
+                    tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
+                        const mesh4d::World4D& w = worlds[o];
                         // --cull-view: an object wholly outside the camera's view is left empty.
-                        if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(w, view))) {
-                            frame.objects.emplace_back();
-                            continue;
-                        }
-                        frame.objects.push_back(mesh4d::sliceWorld(w, view, slice_settings));
-                    }
+                        if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(w, view))) return;
+                        frame.objects[o] = mesh4d::sliceWorld(w, view, slice_settings);
+                    });
+                    // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
+                    reflections.append(view, slice_settings, &frame.objects);
                 });
             });
             for (ExportFrame& frame : cut) {
@@ -308,17 +356,31 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                 max_triangles = std::max(max_triangles, frame.triangleCount());
                 for (const auto& o : frame.objects) limited += o.limited_triangles;
                 std::string error;
-                if (settings.write_ply &&
-                    !writePly((std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string(), frame, &error)) {
+                // A frame file holds at least 12 bytes per vertex and 12 per triangle, and the
+                // .glb as much again (NORMAL adds 12 per vertex): refuse before writing beyond the limit.
+                size_t frame_vertices = 0;
+                for (const auto& o : frame.objects) frame_vertices += o.positions.size();
+                const long long frame_min = 12 * (long long)frame_vertices + 12 * (long long)frame.triangleCount();
+                const std::string ply_path = (std::filesystem::path(frame_dir) / frameFileName(k, "ply")).string();
+                const std::string obj_path = (std::filesystem::path(frame_dir) / frameFileName(k, "obj")).string();
+                if (settings.write_ply && overLimit(frame_min, ply_path)) return kExitOutputError;
+                if (settings.write_ply && !writePly(ply_path, frame, &error)) {
                     err << "error: " << error << "\n";
                     return kExitOutputError;
                 }
-                if (settings.write_obj &&
-                    !writeObj((std::filesystem::path(frame_dir) / frameFileName(k, "obj")).string(), frame, &error)) {
+                if (settings.write_ply && !addWritten(ply_path)) return kExitOutputError;
+                if (settings.write_obj && overLimit(frame_min, obj_path)) return kExitOutputError;
+                if (settings.write_obj && !writeObj(obj_path, frame, &error)) {
                     err << "error: " << error << "\n";
                     return kExitOutputError;
                 }
-                if (settings.write_glb) frames.push_back(std::move(frame));
+                if (settings.write_obj && !addWritten(obj_path)) return kExitOutputError;
+                if (settings.write_glb && !settings.glb.draco) glb_min += frame_min;
+                if (settings.write_glb && overLimit(glb_min, name + ".glb")) return kExitOutputError;
+                if (glb_writer && !glb_writer->add(frame, &error)) {
+                    err << "error: " << error << "\n";
+                    return kExitOutputError;
+                }
                 progress.update(k - first + 1);
             }
         }
@@ -326,14 +388,13 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         // Step: the animated sequence.
         std::string summary;
         if (settings.write_glb) {
-            const SequenceInfo info = sequenceInfo(scene, objects, name);
             GlbStats stats;
             std::string error;
-            const std::string glb = (std::filesystem::path(settings.out_dir) / (name + ".glb")).string();
-            if (!writeAnimatedGlb(glb, frames, info, settings.glb, &stats, &error)) {
+            if (!glb_writer->finish(&stats, &error)) {
                 err << "error: " << error << "\n";
                 return kExitOutputError;
             }
+            if (!addWritten(glb)) return kExitOutputError;
             summary = ", " + glb + " (" + humanBytes(stats.bytes);
             if (settings.glb.draco) summary += " with Draco, " + humanBytes(stats.bytes_without_draco) + " without";
             summary += ")";

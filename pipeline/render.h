@@ -36,6 +36,7 @@ struct RenderSettings {
     bool quiet = false;
     bool verbose = false;
     long long max_frames = kDefaultMaxFrames;
+    long long max_output_bytes = 20LL << 30;  // --max-output-bytes: all files of the run together
     MeshLimits limits;
 };
 
@@ -46,6 +47,9 @@ struct PreparedObject {
     bool has_color = false;            // the mesh file gave a base colour
     std::array<double, 4> color{1, 1, 1, 1};
 };
+
+// The base colour object i is drawn with (linear RGBA): its mesh file's, else a palette colour.
+std::array<double, 4> objectBaseColor(const std::vector<PreparedObject>& objects, size_t i);
 
 // Loads every object's mesh and applies rotation and scale. Messages of counted warnings go to `log`.
 Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<PreparedObject>* objects,

@@ -3,6 +3,7 @@
 #include "pipeline/gltf_reader.h"
 #include "pipeline/scene_json.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -138,7 +139,7 @@ std::string formatNumber(double v) {
 void readObject(FieldReader& r, const json& j, const std::string& path, const std::filesystem::path& folder,
                 ObjectSpec* obj) {
     r.checkKeys(j, path, {"name", "mesh", "position", "t0", "velocity", "direction", "gamma", "rapidity",
-                          "rotation_deg", "scale", "exists"});
+                          "rotation_deg", "scale", "exists", "mirror"});
     r.string(j, "name", path, &obj->name);
     std::string mesh;
     if (!j.contains("mesh")) r.fail(path + ".mesh", "missing (the path of an OBJ file)");
@@ -146,6 +147,7 @@ void readObject(FieldReader& r, const json& j, const std::string& path, const st
     if (!mesh.empty()) {
         std::filesystem::path p(mesh);
         obj->mesh_path = (p.is_absolute() ? p : folder / p).lexically_normal().string();
+        obj->mesh_text = mesh;
     } else if (j.contains("mesh") && !r.failed()) {
         r.fail(path + ".mesh", "empty path");
     }
@@ -192,6 +194,13 @@ void readObject(FieldReader& r, const json& j, const std::string& path, const st
         for (int i = 0; i < 3 && !r.failed(); ++i)
             if (!(obj->scale[i] != 0)) r.fail(path + ".scale", "must be non-zero");
     }
+    if (auto it = j.find("mirror"); it != j.end()) {
+        if (!it->is_boolean()) r.fail(path + ".mirror", "expected true or false, got " + FieldReader::describe(*it));
+        else obj->mirror = it->get<bool>();
+        // A mirror at rest keeps the reflection a plane reflection of the light paths (DESIGN.md section 8).
+        if (!r.failed() && obj->mirror && (obj->speed != ObjectSpec::Speed::Velocity || mesh4d::norm(obj->velocity) != 0))
+            r.fail(path + ".mirror", "a mirror must be at rest (velocity [0, 0, 0])");
+    }
     if (auto it = j.find("exists"); it != j.end()) {
         const std::string p = path + ".exists";
         if (!it->is_array() || it->size() != 2) {
@@ -228,6 +237,12 @@ Status loadScene(const std::string& path, Scene* scene) {
         std::string what = e.what();
         const auto at = what.find("line ");
         return Status::failure(path + ": invalid JSON at " + (at == std::string::npos ? what : what.substr(at)));
+    } catch (const json::exception& e) {
+        // Not only parse errors: a number too large for a double throws out_of_range.406 (found by
+        // fuzzing, data/fixtures/scene_number_overflow.json). Keep the message after "] ".
+        const std::string what = e.what();
+        const auto close = what.find("] ");
+        return Status::failure(path + ": invalid JSON: " + (close == std::string::npos ? what : what.substr(close + 2)));
     }
     return parseScene(root, path, SceneJsonPaths{}, scene);
 }
@@ -243,13 +258,14 @@ Status parseScene(const json& root, const std::string& path, const SceneJsonPath
         r.fail(top.empty() ? "(top level)" : top, "expected a JSON object, got " + FieldReader::typeName(root));
         return status;
     }
-    r.checkKeys(root, top, {"camera", "frames", "model", "tolerance", "objects"});
+    r.checkKeys(root, top, {"camera", "light", "frames", "model", "tolerance", "objects"});
     const std::filesystem::path folder = std::filesystem::path(path).parent_path();
 
     // Step: camera.
     if (const json* cam = nullptr; r.object(root, "camera", top, &cam)) {
         const std::string cp = paths.camera.empty() ? at("camera") : paths.camera;
-        r.checkKeys(*cam, cp, {"position", "look_at", "up", "fov_deg"});
+        r.checkKeys(*cam, cp, {"position", "look_at", "up", "fov_deg", "instant_delay"});
+        r.number(*cam, "instant_delay", cp, &scene->camera.instant_delay);
         r.vec3(*cam, "position", cp, &scene->camera.position);
         r.vec3(*cam, "look_at", cp, &scene->camera.look_at);
         r.vec3(*cam, "up", cp, &scene->camera.up);
@@ -260,6 +276,28 @@ Status parseScene(const json& root, const std::string& path, const SceneJsonPath
         if (!r.failed() && !(mesh4d::norm(mesh4d::cross(dir, c.up)) > 0))
             r.fail(cp + ".up", "must be non-zero and not parallel to the view direction");
         if (!r.failed() && !(c.fov_deg > 0 && c.fov_deg < 180)) r.fail(cp + ".fov_deg", "must be in (0, 180)");
+    }
+
+    // Step: light (at rest): a point light at `position` or a directional one towards `direction`;
+    // by default directional from camera.up, i.e. overhead.
+    scene->light.direction = scene->camera.up / std::max(mesh4d::norm(scene->camera.up), 1e-300);
+    if (const json* li = nullptr; r.object(root, "light", top, &li)) {
+        const std::string lp = at("light");
+        r.checkKeys(*li, lp, {"position", "direction", "ambient"});
+        if (li->contains("position") == li->contains("direction")) {
+            r.fail(lp, "give exactly one of position (a point light) or direction (towards a distant light)");
+        } else if (li->contains("position")) {
+            scene->light.kind = LightSpec::Kind::Point;
+            r.vec3(*li, "position", lp, &scene->light.position);
+        } else {
+            Vec3 d;
+            r.vec3(*li, "direction", lp, &d);
+            if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(lp + ".direction", "must be non-zero");
+            if (!r.failed()) scene->light.direction = d / mesh4d::norm(d);
+        }
+        r.number(*li, "ambient", lp, &scene->light.ambient);
+        if (!r.failed() && !(scene->light.ambient >= 0 && scene->light.ambient <= 1))
+            r.fail(lp + ".ambient", "must be in [0, 1]");
     }
 
     // Step: frames.

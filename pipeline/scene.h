@@ -22,6 +22,18 @@ struct CameraSpec {
     mesh4d::Vec3 look_at{0, 0, -1};
     mesh4d::Vec3 up{0, 1, 0};
     double fov_deg = 60;
+    // Seconds by which the hyperplane models (instant, contracted) look into the past: they view
+    // t = t_k - instant_delay, so that with the light delay of the stage centre they show the
+    // objects where the light-speed models do (Black et al. 2007 advance their camera so).
+    double instant_delay = 0;
+};
+
+// The light that shades the raytracer's pictures, at rest in the lab (README "Scene format").
+struct LightSpec {
+    enum class Kind { Directional, Point } kind = Kind::Directional;
+    mesh4d::Vec3 position;              // Point: lab position
+    mesh4d::Vec3 direction{0, 1, 0};    // Directional: unit vector towards the light
+    double ambient = 0.2;               // fraction of the base colour lit regardless of the normal
 };
 
 struct FrameSpec {
@@ -34,6 +46,7 @@ struct ObjectSpec {
     std::string name;
     std::string field_path = "objects[0]";  // where the object is defined, for messages
     std::string mesh_path;             // resolved against the scene file's folder
+    std::string mesh_text;             // the mesh field as written (for messages)
     mesh4d::Vec3 position;             // lab position of the mesh origin at lab time t0
     double t0 = 0;
     mesh4d::Vec3 velocity;             // lab frame, units of c (derived when gamma/rapidity is given)
@@ -50,11 +63,15 @@ struct ObjectSpec {
     // A further linear map of the rest mesh, applied after scale and rotation (column-major 3x3):
     // the world rotation and scale of a glTF node that carries the object (identity otherwise).
     std::array<double, 9> linear{1, 0, 0, 0, 1, 0, 0, 0, 1};
+    // A planar mirror at rest: the raytracer bounces rays off it once, and the mesh pipeline adds
+    // the retarded reflections it shows (DESIGN.md section 8).
+    bool mirror = false;
 };
 
 struct Scene {
     std::string path;                  // the scene file, as given
     CameraSpec camera;
+    LightSpec light;                   // default: directional, from camera.up (overhead)
     FrameSpec frames;
     Model model = Model::Relativistic;
     double tolerance = 1e-3;          // light-seconds; 0 = vertex mode

@@ -18,11 +18,12 @@ jobs=${JOBS:-$(nproc)}
 # third-party meshes for import tests; nodejs/npm run the Khronos glTF-Validator.
 packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
-  libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels)
+  libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels libpng-dev)
 if [ "$mode" = test ]; then
   packages+=(chromium)            # three.js viewer test (tests/web), headless
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
   packages+=(blender python3-numpy)  # Blender imports the .glb (tests/blender); its importer needs numpy
+  packages+=(python3 clang-14 libclang-rt-14-dev)  # kill test (tests/kill_test.py); libFuzzer for scripts/fuzz.sh
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi

@@ -18,8 +18,12 @@ TEST(Scene, LoadsTheDefaultFlangeScene) {
     const Status st = loadScene(path, &s);
     ASSERT_TRUE(st.ok) << st.message;
     EXPECT_EQ(s.model, Model::Relativistic);
-    ASSERT_EQ(s.objects.size(), 3u);
+    ASSERT_EQ(s.objects.size(), 4u);  // two flanges, the stage floor, the mirrored backdrop
     EXPECT_DOUBLE_EQ(s.objects[0].velocity.x, 0.866);
+    EXPECT_TRUE(s.objects[3].mirror);
+    EXPECT_FALSE(s.objects[0].mirror);
+    EXPECT_DOUBLE_EQ(s.camera.instant_delay, 18.675);
+    EXPECT_EQ(s.light.kind, LightSpec::Kind::Point);
     EXPECT_EQ(frameCount(s.frames), 200);
     // Relative mesh paths resolve against the scene's folder.
     EXPECT_NE(s.objects[0].mesh_path.find("data/meshes/flange.obj"), std::string::npos) << s.objects[0].mesh_path;
@@ -87,11 +91,15 @@ TEST(Scene, GltfSceneMatchesItsJsonTwin) {
     EXPECT_EQ(gs.model, js.model);
     EXPECT_EQ(frameCount(gs.frames), frameCount(js.frames));
     EXPECT_NEAR(gs.camera.fov_deg, js.camera.fov_deg, 1e-9);
+    EXPECT_EQ(gs.camera.instant_delay, js.camera.instant_delay);
+    EXPECT_EQ(gs.light.position, js.light.position);
+    EXPECT_EQ(gs.light.ambient, js.light.ambient);
     for (size_t i = 0; i < js.objects.size(); ++i) {
         EXPECT_EQ(gs.objects[i].name, js.objects[i].name);
         EXPECT_EQ(gs.objects[i].position, js.objects[i].position);
         EXPECT_EQ(gs.objects[i].velocity, js.objects[i].velocity);
         EXPECT_EQ(gs.objects[i].t0, js.objects[i].t0);
+        EXPECT_EQ(gs.objects[i].mirror, js.objects[i].mirror);
         EXPECT_NE(gs.objects[i].mesh_path.find("flanges.gltf#" + js.objects[i].name), std::string::npos);
     }
 }

@@ -25,7 +25,7 @@ scene_json = json.load(open("flanges.json"))
 meshes, accessors, views = [], [], []
 blob = b""
 mesh_index = {}
-for name in ("flange", "stage"):
+for name in ("flange", "stage", "backdrop"):
     verts, faces = read_obj(f"../meshes/{name}.obj")
     pos = b"".join(struct.pack("<3f", *v) for v in verts)
     idx = b"".join(struct.pack("<3H", *f) for f in faces)
@@ -43,9 +43,11 @@ for name in ("flange", "stage"):
     meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": len(accessors) - 2},
                                                  "indices": len(accessors) - 1}]})
 
-nodes = [{"name": "camera", "camera": 0}]  # at the origin looking down -Z, like flanges.json
+# At the origin looking down -Z, like flanges.json; the instant model's look-back rides on the camera node.
+nodes = [{"name": "camera", "camera": 0,
+          "extras": {k: scene_json["camera"][k] for k in ("instant_delay",) if k in scene_json["camera"]}}]
 for obj in scene_json["objects"]:
-    extras = {k: obj[k] for k in ("t0", "velocity", "exists") if k in obj}
+    extras = {k: obj[k] for k in ("t0", "velocity", "exists", "mirror") if k in obj}
     extras.setdefault("velocity", [0, 0, 0])
     nodes.append({"name": obj["name"], "mesh": mesh_index[obj["mesh"].split("/")[-1][:-4]],
                   "translation": obj["position"], "extras": extras})
@@ -54,7 +56,7 @@ gltf = {
     "asset": {"version": "2.0", "generator": "apparent data/scenes/make_flanges_gltf.py"},
     "scene": 0,
     "scenes": [{"name": "flanges", "nodes": list(range(len(nodes))),
-                "extras": {k: scene_json[k] for k in ("frames", "model", "tolerance")}}],
+                "extras": {k: scene_json[k] for k in ("frames", "model", "tolerance", "light") if k in scene_json}}],
     "nodes": nodes,
     "cameras": [{"type": "perspective",
                  "perspective": {"yfov": scene_json["camera"]["fov_deg"] * 3.141592653589793 / 180,

@@ -1,0 +1,155 @@
+#include "ray4d.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mesh4d {
+
+namespace {
+
+using Vec4 = std::array<double, 4>;  // (t, x, y, z)
+
+Vec4 toVec4(const Event& e) { return {e.t, e.x.x, e.x.y, e.x.z}; }
+Vec4 minus(const Event& a, const Event& b) { return {a.t - b.t, a.x.x - b.x.x, a.x.y - b.x.y, a.x.z - b.x.z}; }
+double dot4(const Vec4& a, const Vec4& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+
+// 4D direction of the ray: dR/ds.
+Vec4 rayDirection(const Ray4D& ray) {
+    return {ray.along_cone ? -1.0 : 0.0, ray.direction.x, ray.direction.y, ray.direction.z};
+}
+
+double det3(double a0, double a1, double a2, double b0, double b1, double b2, double c0, double c1, double c2) {
+    return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0);
+}
+
+}  // namespace
+
+std::array<double, 4> flatNormal(const std::array<Event, 4>& v) {
+    const Vec4 a = minus(v[1], v[0]), b = minus(v[2], v[0]), c = minus(v[3], v[0]);
+    // Expansion of the formal determinant det[e; a; b; c] along its first row: N . a = det[a; a; b; c] = 0.
+    return {det3(a[1], a[2], a[3], b[1], b[2], b[3], c[1], c[2], c[3]),
+            -det3(a[0], a[2], a[3], b[0], b[2], b[3], c[0], c[2], c[3]),
+            det3(a[0], a[1], a[3], b[0], b[1], b[3], c[0], c[1], c[3]),
+            -det3(a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2])};
+}
+
+std::optional<TetHit> intersectTet(const Ray4D& ray, const std::array<Event, 4>& v, double s_max) {
+    // Step: the system [E1 E2 E3 -D] (l1, l2, l3, s)^T = R(0) - V0, rows t, x, y, z.
+    const Vec4 e1 = minus(v[1], v[0]), e2 = minus(v[2], v[0]), e3 = minus(v[3], v[0]);
+    const Vec4 d = rayDirection(ray);
+    const Vec4 rhs = minus(ray.origin, v[0]);
+    double m[4][5];
+    double scale = 0;
+    for (int r = 0; r < 4; ++r) {
+        m[r][0] = e1[size_t(r)];
+        m[r][1] = e2[size_t(r)];
+        m[r][2] = e3[size_t(r)];
+        m[r][3] = -d[size_t(r)];
+        m[r][4] = rhs[size_t(r)];
+        for (int c = 0; c < 3; ++c) scale = std::max(scale, std::fabs(m[r][c]));
+    }
+    // Step: eliminate with partial pivoting. A pivot below 1e-13 of the largest edge component
+    // (columns 0-2; column 3 is a unit vector) means the ray runs parallel to the tetrahedron's
+    // 3-flat or the tetrahedron is flat: no single hit point, reported as a miss.
+    for (int col = 0; col < 4; ++col) {
+        int piv = col;
+        for (int r = col + 1; r < 4; ++r)
+            if (std::fabs(m[r][col]) > std::fabs(m[piv][col])) piv = r;
+        const double col_scale = col < 3 ? scale : 1.0;
+        if (!(std::fabs(m[piv][col]) > 1e-13 * col_scale)) return std::nullopt;
+        if (piv != col)
+            for (int c = 0; c < 5; ++c) std::swap(m[piv][c], m[col][c]);
+        for (int r = col + 1; r < 4; ++r) {
+            const double f = m[r][col] / m[col][col];
+            for (int c = col; c < 5; ++c) m[r][c] -= f * m[col][c];
+        }
+    }
+    double x[4];
+    for (int r = 3; r >= 0; --r) {
+        double acc = m[r][4];
+        for (int c = r + 1; c < 4; ++c) acc -= m[r][c] * x[c];
+        x[r] = acc / m[r][r];
+    }
+    // Step: accept inside the tetrahedron (with kBaryEps of slack) and ahead of the origin.
+    const double l0 = 1 - x[0] - x[1] - x[2];
+    if (!(x[0] >= -kBaryEps && x[1] >= -kBaryEps && x[2] >= -kBaryEps && l0 >= -kBaryEps)) return std::nullopt;
+    if (!(x[3] > 0 && x[3] < s_max)) return std::nullopt;
+    TetHit hit;
+    hit.s = x[3];
+    hit.bary = {l0, x[0], x[1], x[2]};
+    return hit;
+}
+
+TraceWorld prepareTrace(const World4D& world) {
+    TraceWorld trace;
+    trace.world = &world;
+    if (world.empty()) return trace;
+    trace.prisms.resize(world.mesh.triangles.size());
+    for (size_t f = 0; f < world.mesh.triangles.size(); ++f) {
+        TraceWorld::Prism& p = trace.prisms[f];
+        // Step: the 3-flat, from the first tetrahedron of the prism (all three share it: the prism
+        // is the affine image of triangle x interval).
+        const auto& t = world.tets[3 * f];
+        const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
+        p.normal = flatNormal(v);
+        p.offset = dot4(p.normal, toVec4(v[0]));
+        // Step: bounds of the prism's six events.
+        p.lo = {INFINITY, INFINITY, INFINITY};
+        p.hi = {-INFINITY, -INFINITY, -INFINITY};
+        p.t_lo = INFINITY;
+        p.t_hi = -INFINITY;
+        for (uint32_t vi : world.mesh.triangles[f])
+            for (uint32_t cap = 0; cap < 2; ++cap) {
+                const Event& e = world.events[2 * vi + cap];
+                p.lo = {std::min(p.lo.x, e.x.x), std::min(p.lo.y, e.x.y), std::min(p.lo.z, e.x.z)};
+                p.hi = {std::max(p.hi.x, e.x.x), std::max(p.hi.y, e.x.y), std::max(p.hi.z, e.x.z)};
+                p.t_lo = std::min(p.t_lo, e.t);
+                p.t_hi = std::max(p.t_hi, e.t);
+            }
+    }
+    return trace;
+}
+
+std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max) {
+    if (!trace.world || trace.prisms.empty()) return std::nullopt;
+    const World4D& world = *trace.world;
+    const Vec4 d = rayDirection(ray);
+    const Vec4 o = toVec4(ray.origin);
+    std::optional<WorldHit> best;
+    double best_s = s_max;
+    for (size_t f = 0; f < trace.prisms.size(); ++f) {
+        const TraceWorld::Prism& p = trace.prisms[f];
+        // Step: cheap rejection: where the ray meets the prism's 3-flat must be ahead, nearer than
+        // the best hit so far and inside the prism's bounds (slack of 1e-9 of the box and the
+        // position, far above the rounding of s, far below any pixel).
+        const double nd = dot4(p.normal, d);
+        if (nd == 0) continue;
+        const double s_flat = (p.offset - dot4(p.normal, o)) / nd;
+        const double slack_s = 1e-9 * (std::fabs(s_flat) + 1);
+        if (!(s_flat > -slack_s && s_flat < best_s + slack_s)) continue;
+        const Event at = ray.at(s_flat);
+        const double slack = 1e-9 * (norm(p.hi - p.lo) + norm(at.x) + (p.t_hi - p.t_lo) + std::fabs(at.t));
+        if (at.x.x < p.lo.x - slack || at.x.x > p.hi.x + slack || at.x.y < p.lo.y - slack || at.x.y > p.hi.y + slack ||
+            at.x.z < p.lo.z - slack || at.x.z > p.hi.z + slack || at.t < p.t_lo - slack || at.t > p.t_hi + slack)
+            continue;
+        // Step: the prism's three tetrahedra by the 4D barycentric method; the nearest hit wins.
+        for (size_t j = 0; j < 3; ++j) {
+            const auto& t = world.tets[3 * f + j];
+            const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
+            const std::optional<TetHit> hit = intersectTet(ray, v, best_s);
+            if (!hit) continue;
+            best_s = hit->s;
+            WorldHit w;
+            w.s = hit->s;
+            w.event = ray.at(hit->s);
+            w.triangle = uint32_t(f);
+            const Vec3 n{p.normal[1], p.normal[2], p.normal[3]};
+            const double len = norm(n);
+            w.lab_normal = len > 0 ? n / len : Vec3{0, 0, 0};
+            best = w;
+        }
+    }
+    return best;
+}
+
+}  // namespace mesh4d

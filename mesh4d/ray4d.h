@@ -1,0 +1,84 @@
+// Light rays traced backwards through the static 4D world: the paper's own renderer (Black et al.
+// 2007, section III.C), kept independent of the cone cut of slice.h so each can check the other.
+//
+// A ray leaves the camera event (t_c, C) in the unit spatial direction d and runs back in time
+// along the past lightcone: R(s) = (t_c - s, C + s d), s >= 0 (c = 1, s is both the distance
+// and the delay). For the hyperplane models (infinite light speed) the ray stays at t = t_c:
+// R(s) = (t_c, C + s d). A mirror bounce restarts the ray at the hit event with the reflected
+// direction, still running back in time.
+//
+// A ray meets a tetrahedron V0..V3 where R(s) = V0 + l1 (V1 - V0) + l2 (V2 - V0) + l3 (V3 - V0):
+// four equations (t, x, y, z) in l1, l2, l3, s, solved by Gaussian elimination with partial
+// pivoting; the hit counts when l1, l2, l3 >= 0, l1 + l2 + l3 <= 1 (within kBaryEps, so rays
+// through the faces shared by neighbouring tetrahedra never slip between them) and s > 0. The
+// nearest hit over all tetrahedra wins (ordinary z-buffering along the ray, DESIGN.md section 8).
+//
+// The lab normal at the hit: all tetrahedra of a prism lie in one 3-flat of spacetime, with 4D
+// normal N (the generalised cross product of three edge vectors, N . E = 0 for every tangent E).
+// Its section by the lab instant t = t_hit is the object's triangle at that instant, whose tangents
+// (0, w) satisfy N_x . w = 0: the spatial part N_x is the lab-frame surface normal the paper
+// shades with (the contracted triangle's normal under a boost, the rest normal under a shear).
+// Reference: Black et al., Am. J. Phys. 75 (2007), sections III.B-C; DESIGN.md sections 6 and 8.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "event.h"
+#include "extrude.h"
+
+namespace mesh4d {
+
+// Slack on the barycentric coordinates of a hit, relative (they are dimensionless): wide enough
+// that a ray through a shared face or edge is caught by at least one neighbour, far below a pixel.
+constexpr double kBaryEps = 1e-9;
+
+struct Ray4D {
+    Event origin;     // the camera event, or the event of the last bounce
+    Vec3 direction;   // unit spatial direction d (from the camera into the scene)
+    bool along_cone = true;  // true: R(s) = (t - s, x + s d); false: R(s) = (t, x + s d)
+    Event at(double s) const { return {along_cone ? origin.t - s : origin.t, origin.x + s * direction}; }
+};
+
+struct TetHit {
+    double s = 0;                  // ray parameter: distance (and, along the cone, delay) from the origin
+    std::array<double, 4> bary{};  // barycentric coordinates of the hit in V0..V3
+};
+
+// The hit of `ray` with the tetrahedron v (4 events), s in (0, s_max). Empty for a miss, a
+// ray parallel to the tetrahedron's 3-flat, or a degenerate tetrahedron (singular system).
+std::optional<TetHit> intersectTet(const Ray4D& ray, const std::array<Event, 4>& v, double s_max);
+
+// The 4D normal (t, x, y, z components) of the 3-flat through v0..v3: the generalised cross
+// product of v1 - v0, v2 - v0, v3 - v0 (zero for a degenerate tetrahedron).
+std::array<double, 4> flatNormal(const std::array<Event, 4>& v);
+
+// One object's history prepared for tracing: per prism (input triangle) its 3-flat and the bounds
+// a ray must reach, built once per model and reused for every ray of every frame.
+struct TraceWorld {
+    const World4D* world = nullptr;
+    struct Prism {
+        std::array<double, 4> normal{};  // 4D normal of the prism's 3-flat
+        double offset = 0;               // normal . V for every event V of the prism
+        Vec3 lo, hi;                     // spatial bounding box of the prism's six events
+        double t_lo = 0, t_hi = 0;       // time range of the six events
+    };
+    std::vector<Prism> prisms;           // one per input triangle
+};
+
+// Builds the per-prism data of `world`. `world` must outlive the result.
+TraceWorld prepareTrace(const World4D& world);
+
+struct WorldHit {
+    double s = 0;           // ray parameter of the hit
+    Event event;            // the hit event: emission time and lab position
+    uint32_t triangle = 0;  // input triangle (prism) hit
+    Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant (unoriented)
+};
+
+// The nearest hit of `ray` with any tetrahedron of `trace`, s in (0, s_max). Empty for a miss.
+std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max);
+
+}  // namespace mesh4d

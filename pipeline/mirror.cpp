@@ -1,0 +1,199 @@
+#include "pipeline/mirror.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cmath>
+#include <sstream>
+
+namespace apparent {
+
+using mesh4d::Vec3;
+
+Vec3 reflectPoint(const MirrorPlane& m, const Vec3& p) {
+    return p - 2 * mesh4d::dot(p - m.point, m.normal) * m.normal;
+}
+
+Vec3 reflectDirection(const MirrorPlane& m, const Vec3& d) { return d - 2 * mesh4d::dot(d, m.normal) * m.normal; }
+
+Status findMirrors(const std::vector<PreparedObject>& objects, const std::string& scene_path,
+                   std::vector<MirrorPlane>* mirrors) {
+    mirrors->clear();
+    for (size_t i = 0; i < objects.size(); ++i) {
+        const PreparedObject& o = objects[i];
+        if (!o.spec.mirror) continue;
+        const std::string where = scene_path + ": " + o.spec.field_path + ".mirror: ";
+        // Step: the normal of the largest triangle (a closed mesh's area-weighted normal would
+        // vanish); a mirror is at rest, so lab = X0 + q.
+        Vec3 n{0, 0, 0};
+        for (const auto& t : o.rest.triangles) {
+            const Vec3 c = mesh4d::cross(o.rest.positions[t[1]] - o.rest.positions[t[0]],
+                                         o.rest.positions[t[2]] - o.rest.positions[t[0]]);
+            if (mesh4d::norm(c) > mesh4d::norm(n)) n = c;
+        }
+        if (!(mesh4d::norm(n) > 0)) return Status::failure(where + "the mesh has no area");
+        n = n / mesh4d::norm(n);
+        // Step: planarity, to 1e-9 of the mesh's bounding-box diagonal.
+        Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+        for (const Vec3& p : o.rest.positions) {
+            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+        const Vec3 p0 = o.rest.positions[o.rest.triangles[0][0]];  // on the plane through every vertex, if planar
+        double worst = 0;
+        for (const auto& t : o.rest.triangles)
+            for (uint32_t v : t) worst = std::max(worst, std::fabs(mesh4d::dot(o.rest.positions[v] - p0, n)));
+        if (worst > 1e-9 * mesh4d::norm(hi - lo)) {
+            std::ostringstream os;
+            os << where << "the mesh is not planar (a vertex lies " << worst << " ls off its plane; a mirror must be flat)";
+            return Status::failure(os.str());
+        }
+        mirrors->push_back({i, o.spec.position + p0, n});
+    }
+    return Status::success();
+}
+
+}  // namespace apparent
+
+namespace apparent {
+
+namespace {
+
+// Share of the reflected object's colour a mirror returns (as the raytracer's kMirrorReflectance).
+constexpr double kReflectance = 0.8;
+// Opacity given to a mirror's own material in the .glb, so the reflections behind it show.
+constexpr double kMirrorAlpha = 0.25;
+
+// Absolute lab position and time of output point i, and the reverse (one place knows the layout).
+Vec3 absolutePoint(const mesh4d::ApparentMesh& m, size_t i) { return m.absolutePosition(i); }
+double absoluteTime(const mesh4d::ApparentMesh& m, size_t i) { return m.absoluteTime(i); }
+
+// A polygon corner while clipping: position, emission time, rest point, and the input point it
+// is (-1 for a point the clip made), so that unclipped corners stay shared between triangles.
+struct Corner {
+    Vec3 p;
+    double t = 0;
+    Vec3 q;
+    int64_t source = -1;
+};
+
+Corner mix(const Corner& a, const Corner& b, double s) {
+    return {a.p + s * (b.p - a.p), a.t + s * (b.t - a.t), a.q + s * (b.q - a.q), -1};
+}
+
+// Sutherland-Hodgman: keeps the part of `poly` where dot(n, p - o) >= 0.
+std::vector<Corner> clipHalfSpace(const std::vector<Corner>& poly, const Vec3& o, const Vec3& n) {
+    std::vector<Corner> out;
+    for (size_t i = 0; i < poly.size(); ++i) {
+        const Corner& a = poly[i];
+        const Corner& b = poly[(i + 1) % poly.size()];
+        const double da = mesh4d::dot(n, a.p - o), db = mesh4d::dot(n, b.p - o);
+        if (da >= 0) out.push_back(a);
+        if ((da >= 0) != (db >= 0)) out.push_back(mix(a, b, da / (da - db)));
+    }
+    return out;
+}
+
+}  // namespace
+
+mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const MirrorPlane& mirror,
+                                    const std::vector<std::array<Vec3, 3>>& polygon, const Vec3& camera) {
+    mesh4d::ApparentMesh out;
+    // Step: the half-spaces: beyond the mirror plane as seen from the camera, and inside the
+    // pyramid from the camera over each mirror triangle.
+    const Vec3 beyond = mesh4d::dot(camera - mirror.point, mirror.normal) > 0 ? -mirror.normal : mirror.normal;
+    struct Pyramid {
+        std::array<Vec3, 3> n;
+    };
+    std::vector<Pyramid> pyramids;
+    for (const auto& tri : polygon) {
+        Pyramid py;
+        for (size_t e = 0; e < 3; ++e) {
+            Vec3 n = mesh4d::cross(tri[e] - camera, tri[(e + 1) % 3] - camera);
+            if (mesh4d::dot(n, tri[(e + 2) % 3] - camera) < 0) n = -n;
+            py.n[e] = n;
+        }
+        pyramids.push_back(py);
+    }
+    std::vector<uint32_t> shared(cut.positions.size(), UINT32_MAX);  // output index of each input point
+    // Step: reflect each triangle back (swapping two corners keeps its orientation), then clip.
+    for (size_t t = 0; t < cut.triangles.size(); ++t) {
+        std::vector<Corner> tri;
+        for (size_t c : {size_t(0), size_t(2), size_t(1)}) {
+            const uint32_t v = cut.triangles[t][c];
+            tri.push_back({reflectPoint(mirror, absolutePoint(cut, v)), absoluteTime(cut, v), cut.rest_points[v], int64_t(v)});
+        }
+        tri = clipHalfSpace(tri, mirror.point, beyond);
+        if (tri.size() < 3) continue;
+        for (const Pyramid& py : pyramids) {
+            std::vector<Corner> poly = tri;
+            for (size_t e = 0; e < 3 && poly.size() >= 3; ++e) poly = clipHalfSpace(poly, camera, py.n[e]);
+            if (poly.size() < 3) continue;
+            // Step: fan-triangulate the clipped convex polygon into the output.
+            std::vector<uint32_t> index;
+            for (const Corner& c : poly) {
+                if (c.source >= 0 && shared[size_t(c.source)] != UINT32_MAX) {
+                    index.push_back(shared[size_t(c.source)]);
+                    continue;
+                }
+                index.push_back(uint32_t(out.positions.size()));
+                if (c.source >= 0) shared[size_t(c.source)] = index.back();
+                out.positions.push_back(c.p);
+                out.emission_times.push_back(c.t);
+                out.rest_points.push_back(c.q);
+            }
+            for (size_t i = 1; i + 1 < poly.size(); ++i) {
+                out.triangles.push_back({index[0], index[i], index[i + 1]});
+                out.source_triangles.push_back(cut.source_triangles[t]);
+            }
+        }
+    }
+    return out;
+}
+
+MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<PreparedObject>& objects,
+                                     const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
+                                     long long last_frame)
+    : mirrors_(mirrors), camera_(scene.camera.position) {
+    for (const MirrorPlane& m : mirrors_) {
+        const PreparedObject& mo = objects[m.object];
+        std::vector<std::array<Vec3, 3>> tris;
+        for (const auto& t : mo.rest.triangles)
+            tris.push_back({mo.spec.position + mo.rest.positions[t[0]], mo.spec.position + mo.rest.positions[t[1]],
+                            mo.spec.position + mo.rest.positions[t[2]]});
+        mirror_triangles_.push_back(tris);
+        names_.push_back(mo.spec.name);
+    }
+    // Step: each non-mirror object's history over the span the image camera can see, once.
+    for (size_t mi = 0; mi < mirrors_.size(); ++mi) {
+        Scene image = scene;
+        image.camera.position = reflectPoint(mirrors_[mi], scene.camera.position);
+        for (size_t i = 0; i < objects.size(); ++i) {
+            if (objects[i].spec.mirror) continue;
+            targets_.push_back({mi, i, buildWorld(objects[i], model, image, first_frame, last_frame)});
+        }
+    }
+}
+
+void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
+                               std::vector<mesh4d::ApparentMesh>* objects) const {
+    for (const Target& target : targets_) {
+        const MirrorPlane& m = mirrors_[target.mirror];
+        mesh4d::ViewSurface image = view;
+        image.apex = reflectPoint(m, view.apex);
+        const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, settings);
+        objects->push_back(reflectAndClip(cut, m, mirror_triangles_[target.mirror], camera_));
+    }
+}
+
+void MirrorReflections::describe(SequenceInfo* info) const {
+    const std::vector<ExportObject> originals = info->objects;
+    for (const MirrorPlane& m : mirrors_) info->objects[m.object].base_color[3] = kMirrorAlpha;
+    for (const Target& target : targets_) {
+        ExportObject o = originals[target.object];
+        o.name = o.name + " (mirror " + names_[target.mirror] + ")";
+        for (int c = 0; c < 3; ++c) o.base_color[size_t(c)] *= kReflectance;
+        info->objects.push_back(o);
+    }
+}
+
+}  // namespace apparent

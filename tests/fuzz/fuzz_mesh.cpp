@@ -1,0 +1,52 @@
+// libFuzzer harness for one mesh reader, chosen at compile time by APPARENT_FUZZ_EXT (".obj",
+// ".ply", ".gltf" or ".glb"): the input bytes become a mesh file read through readMesh, the
+// dispatch the command uses, with small limits so that a valid header cannot ask for gigabytes.
+// A reader must return ok with finite positions and in-range triangles, or an error of one line
+// that starts with the path. For .gltf and .glb the same bytes are also read as a scene.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+
+#include "pipeline/mesh_input.h"
+#include "pipeline/scene.h"
+#include "tests/fuzz/fuzz_input.h"
+
+#ifndef APPARENT_FUZZ_EXT
+#error "define APPARENT_FUZZ_EXT"
+#endif
+
+namespace {
+
+void check(bool condition) {
+    if (!condition) std::abort();  // libFuzzer reports the input as a crash
+}
+
+void checkStatus(const apparent::Status& st, const std::string& path) {
+    if (!st.ok) check(st.message.rfind(path, 0) == 0 && st.message.find('\n') == std::string::npos);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    apparent_fuzz::removeInputFolderAtExit();
+    const std::string path = apparent_fuzz::writeInput(data, size, APPARENT_FUZZ_EXT);
+    apparent::MeshLimits limits;
+    limits.max_vertices = 1'000'000;
+    limits.max_faces = 1'000'000;
+    limits.max_file_bytes = 16u << 20;
+    apparent::LoadedMesh mesh;
+    apparent::MeshWarnings warnings;
+    const apparent::Status st = apparent::readMesh(path, limits, &mesh, &warnings);
+    checkStatus(st, path);
+    if (st.ok) {
+        check(!mesh.mesh.triangles.empty());
+        for (const auto& p : mesh.mesh.positions) check(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+        for (const auto& t : mesh.mesh.triangles)
+            for (uint32_t i : t) check(i < mesh.mesh.positions.size());
+    }
+    if (apparent::isGltfPath(path)) {
+        apparent::Scene scene;
+        checkStatus(apparent::loadScene(path, &scene), path);
+    }
+    return 0;
+}

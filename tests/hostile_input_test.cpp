@@ -1,0 +1,229 @@
+// Hostile input and failure (README "Hostile input"): inputs the fuzzers found, scene mesh paths
+// confined to the scene's folder or the working folder, the output-size limit, object names that
+// never reach file names, and writes that fail midway (a file size limit standing in for a full
+// disk) leaving the previous file untouched and no temporary file behind.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "exporters/atomic_file.h"
+#include "exporters/ply.h"
+#include "pipeline/cli.h"
+#include "pipeline/mesh_input.h"
+#include "pipeline/ply_reader.h"
+#include "pipeline/render.h"
+#include "pipeline/scene.h"
+
+using namespace apparent;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string source(const std::string& rel) { return std::string(APPARENT_SOURCE_DIR) + "/" + rel; }
+
+struct CommandResult {
+    int code = -1;
+    std::string out, err;
+};
+
+CommandResult apparentRun(std::vector<std::string> args) {
+    args.insert(args.begin(), "apparent");
+    std::vector<const char*> argv;
+    for (const auto& a : args) argv.push_back(a.c_str());
+    std::ostringstream out, err;
+    CommandResult r;
+    r.code = runCommandLine(int(argv.size()), argv.data(), out, err);
+    r.out = out.str();
+    r.err = err.str();
+    return r;
+}
+
+// A fresh folder under the temporary folder, removed at the end; restores the working folder.
+class Sandbox {
+public:
+    Sandbox() : cwd_(fs::current_path()) {
+        root_ = fs::temp_directory_path() / ("apparent_hostile_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
+        fs::remove_all(root_);
+        fs::create_directories(root_);
+        root_ = fs::canonical(root_);
+    }
+    ~Sandbox() {
+        fs::current_path(cwd_);
+        fs::remove_all(root_);
+    }
+    fs::path operator/(const std::string& s) const { return root_ / s; }
+
+private:
+    fs::path cwd_, root_;
+    static inline int counter_ = 0;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::vector<fs::path> filesUnder(const fs::path& dir) {
+    std::vector<fs::path> out;
+    if (!fs::exists(dir)) return out;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file()) out.push_back(e.path());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+// A scene folder with the tetrahedron one folder up: sandbox/project/scenes/scene.json -> ../meshes/tetra.obj.
+void writeProject(const Sandbox& box, const std::string& mesh_field) {
+    fs::create_directories(box / "project/scenes");
+    fs::create_directories(box / "project/meshes");
+    fs::create_directories(box / "elsewhere");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "project/meshes/tetra.obj");
+    std::ofstream(box / "project/scenes/scene.json")
+        << R"({ "frames": { "start": 10, "end": 10.3, "fps": 10 }, "objects": [ { "name": "t", "mesh": ")" << mesh_field
+        << R"(", "position": [0, 0, -10] } ] })";
+}
+
+}  // namespace
+
+// Inputs the fuzzers found (tests/fuzz, scripts/fuzz.sh), each a fixture, each refused with one line.
+TEST(HostileInput, FuzzFindingsAreRefusedWithOneLine) {
+    // nlohmann throws out_of_range (not parse_error) for a number beyond double: it escaped loadScene.
+    Scene scene;
+    const Status st = loadScene(source("data/fixtures/scene_number_overflow.json"), &scene);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("scene_number_overflow.json: invalid JSON: number overflow parsing '22222222222e2222'"),
+              std::string::npos) << st.message;
+    EXPECT_EQ(st.message.find('\n'), std::string::npos);
+}
+
+TEST(HostileInput, MeshPathsStayInTheScenesFolderOrTheWorkingFolder) {
+    Sandbox box;
+    writeProject(box, "../meshes/tetra.obj");
+    const std::string scene = (box / "project/scenes/scene.json").string();
+    const std::string out = (box / "out").string();
+    // Run from a folder that holds neither: refused, exit 2, nothing written.
+    fs::current_path(box / "elsewhere");
+    CommandResult r = apparentRun({"render", scene, "--out", out, "--quiet"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("scene.json: objects[0].mesh: \"../meshes/tetra.obj\" is outside the scene's folder and the "
+                         "working folder (allow with --allow-outside)"),
+              std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    // Allowed explicitly, or run from the project folder (the working folder holds the mesh).
+    r = apparentRun({"render", scene, "--out", out, "--quiet", "--allow-outside"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    fs::current_path(box / "project");
+    r = apparentRun({"render", scene, "--out", out, "--quiet"});
+    EXPECT_EQ(r.code, 0) << r.err;
+
+    // A symlink inside the scene's folder that points out of it is followed, and refused.
+    fs::current_path(box / "elsewhere");
+    fs::create_symlink(box / "project/meshes/tetra.obj", box / "project/scenes/link.obj");
+    Scene s;
+    ASSERT_TRUE(loadScene(scene, &s).ok);
+    EXPECT_FALSE(checkMeshInside(scene, "objects[0].mesh", "link.obj", (box / "project/scenes/link.obj").string()).ok);
+    // Absolute paths and ".." chains are resolved first; a path inside stays allowed.
+    EXPECT_FALSE(checkMeshInside(scene, "objects[0].mesh", "/etc/passwd", "/etc/passwd").ok);
+    EXPECT_FALSE(checkMeshInside(scene, "objects[0].mesh", "x", (box / "project/scenes/../../project/x.obj").string()).ok);
+    EXPECT_TRUE(checkMeshInside(scene, "objects[0].mesh", "x", (box / "project/scenes/sub/../x.obj").string()).ok);
+    EXPECT_TRUE(checkMeshInside(scene, "objects[0].mesh", "x", (box / "project/scenes/in.glb#Node").string()).ok);
+    // A folder whose name merely starts like the scene's folder is not inside it.
+    EXPECT_FALSE(checkMeshInside(scene, "objects[0].mesh", "x", (box / "project/scenes2/x.obj").string()).ok);
+}
+
+// Names in the scene never reach file names: frame files are named by model and number only.
+TEST(HostileInput, ObjectNamesNeverReachFileNames) {
+    Sandbox box;
+    fs::create_directories(box / "scene");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "scene/tetra.obj");
+    std::ofstream(box / "scene/scene.json")
+        << R"({ "frames": { "start": 10, "end": 10.2, "fps": 10 }, "objects": [ { "name": "../../../escaped", "mesh": "tetra.obj", "position": [0, 0, -10] } ] })";
+    const CommandResult r = apparentRun({"render", (box / "scene/scene.json").string(), "--out", (box / "out").string(),
+                                         "--format", "glb,ply,obj", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const auto& f : filesUnder(box / "")) {
+        const std::string rel = fs::relative(f, box / "").string();
+        EXPECT_TRUE(rel.rfind("out/", 0) == 0 || rel.rfind("scene/", 0) == 0) << rel;
+        EXPECT_EQ(rel.find("escaped"), std::string::npos) << rel;
+    }
+    EXPECT_EQ(filesUnder(box / "out").size(), 5u);  // relativistic.glb + 2 frames x (ply, obj)
+}
+
+// --max-output-bytes stops before the outputs pass the limit; every file written is complete and
+// the files of an earlier complete run are either untouched or replaced whole.
+TEST(HostileInput, OutputSizeLimitStopsWithExitThree) {
+    Sandbox box;
+    const std::string scene = source("data/fixtures/scene_tetra.json");
+    const std::string out = (box / "out").string();
+    CommandResult r = apparentRun({"render", scene, "--out", out, "--format", "ply", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto before = filesUnder(out);
+    ASSERT_EQ(before.size(), 5u);
+    const size_t one = fs::file_size(before[0]);
+    r = apparentRun({"render", scene, "--out", out, "--format", "ply", "--quiet", "--tolerance", "1e-4",
+                     "--max-output-bytes", std::to_string(2 * one)});
+    EXPECT_EQ(r.code, 3);
+    EXPECT_NE(r.err.find("error: --max-output-bytes: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("raise it with --max-output-bytes"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    const auto after = filesUnder(out);
+    EXPECT_EQ(after, before);  // same names, no temporary files
+    for (const auto& f : after) {
+        mesh4d::RestMesh m;
+        MeshWarnings w;
+        EXPECT_TRUE(readPly(f.string(), {}, &m, &w).ok) << f;
+    }
+    // Within the limit: exit 0.
+    r = apparentRun({"render", scene, "--out", out, "--format", "ply", "--quiet", "--max-output-bytes", "100000000"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    r = apparentRun({"render", scene, "--out", out, "--max-output-bytes", "0"});
+    EXPECT_EQ(r.code, 2);
+}
+
+// A write that fails midway (RLIMIT_FSIZE makes write(2) fail with EFBIG, as a full disk fails with
+// ENOSPC) reports the error and leaves the previous file byte for byte, without a temporary file.
+TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
+    Sandbox box;
+    fs::create_directories(box / "out");
+    const std::string path = (box / "out/frame_00000.ply").string();
+    ExportFrame frame;
+    mesh4d::ApparentMesh a;
+    for (int i = 0; i < 3000; ++i) {
+        a.positions.push_back({double(i), double(i % 7), 1.0 + i % 3});
+        a.emission_times.push_back(-double(i));
+    }
+    a.rest_points = a.positions;
+    for (uint32_t i = 0; i + 2 < 3000; i += 3) a.triangles.push_back({i, i + 1, i + 2});
+    frame.objects.push_back(a);
+    std::string error;
+    ExportFrame small = frame;
+    small.objects[0].triangles.resize(1);
+    ASSERT_TRUE(writePly(path, small, &error)) << error;
+    const std::string previous = slurp(path);
+
+    struct sigaction ignore {}, old_action {};
+    ignore.sa_handler = SIG_IGN;
+    ::sigaction(SIGXFSZ, &ignore, &old_action);
+    rlimit old_limit{};
+    ::getrlimit(RLIMIT_FSIZE, &old_limit);
+    rlimit limit = old_limit;
+    limit.rlim_cur = 4096;
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
+    const bool ok = writePly(path, frame, &error);
+    ::setrlimit(RLIMIT_FSIZE, &old_limit);
+    ::sigaction(SIGXFSZ, &old_action, nullptr);
+
+    EXPECT_FALSE(ok);
+    EXPECT_NE(error.find("frame_00000.ply: cannot write (4096 of "), std::string::npos) << error;
+    EXPECT_EQ(slurp(path), previous);
+    EXPECT_EQ(filesUnder(box / "out").size(), 1u);
+}
