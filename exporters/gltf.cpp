@@ -455,23 +455,42 @@ GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo
 
 GlbSequenceWriter::~GlbSequenceWriter() = default;
 
-bool GlbSequenceWriter::add(const ExportFrame& f, std::string* error) {
-    Impl& m = *impl_;
+struct GlbFrameData {
+    double origin[3] = {0, 0, 0};
+    std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
+    double far = 0, max_extent = 0, max_float_error = 0;
+};
+
+std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
+    auto d = std::make_shared<GlbFrameData>();
     // Step: the frame's origin (the centre of its bounding box) and the far distance.
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (const auto& o : f.objects)
         for (size_t i = 0; i < o.positions.size(); ++i) {
             const Vec3 p = o.absolutePosition(i);
-            m.far = std::max(m.far, mesh4d::norm(p - m.info.camera.position));
+            d->far = std::max(d->far, mesh4d::norm(p - impl_->info.camera.position));
             for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
         }
-    const double origin[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-    std::vector<PrimitiveData> data(f.objects.size());
+    for (int c = 0; c < 3; ++c) d->origin[c] = 0.5 * (lo[c] + hi[c]);
+    // Step: each object's float32 data with normals (crease split), relative to the origin.
+    d->data.resize(f.objects.size());
     if (f.triangleCount() > 0) {
-        for (int c = 0; c < 3; ++c) m.stats.max_extent = std::max(m.stats.max_extent, hi[c] - lo[c]);
+        for (int c = 0; c < 3; ++c) d->max_extent = std::max(d->max_extent, hi[c] - lo[c]);
         for (size_t o = 0; o < f.objects.size(); ++o)
-            if (!f.objects[o].triangles.empty()) data[o] = toPrimitive(f.objects[o], origin, &m.stats.max_float_error);
+            if (!f.objects[o].triangles.empty()) d->data[o] = toPrimitive(f.objects[o], d->origin, &d->max_float_error);
     }
+    return d;
+}
+
+bool GlbSequenceWriter::add(const ExportFrame& f, std::string* error) { return add(f, *prepare(f), error); }
+
+bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, std::string* error) {
+    Impl& m = *impl_;
+    m.far = std::max(m.far, prepared.far);
+    m.stats.max_extent = std::max(m.stats.max_extent, prepared.max_extent);
+    m.stats.max_float_error = std::max(m.stats.max_float_error, prepared.max_float_error);
+    const std::vector<PrimitiveData>& data = prepared.data;
+    const double* origin = prepared.origin;
     // Step: into the model (binary data to the spill file), and into the counted plain twin.
     if (!m.model.addFrame(f, data, origin, m.options.draco, &m.stats, error)) {
         *error = m.path + ": " + *error;

@@ -45,6 +45,8 @@ struct GlbStats {
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
 // under a temporary name and renames it into place. Memory does not grow with the frame data;
 // the disk briefly holds the binary data twice.
+struct GlbFrameData;  // one frame converted for the file (GlbSequenceWriter::prepare)
+
 class GlbSequenceWriter {
 public:
     GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options);
@@ -53,6 +55,11 @@ public:
     GlbSequenceWriter& operator=(const GlbSequenceWriter&) = delete;
     // Frames in order; false with a message naming the file on failure.
     bool add(const ExportFrame& frame, std::string* error);
+    // The same in two steps: prepare() (crease split, normals, float32 conversion: the costly
+    // part) may run on any thread and for several frames at once; add() then takes the frames in
+    // order. The file is the same either way.
+    std::shared_ptr<GlbFrameData> prepare(const ExportFrame& frame) const;  // shared: GlbFrameData is opaque here
+    bool add(const ExportFrame& frame, const GlbFrameData& prepared, std::string* error);
     // Writes the file; a .glb cannot exceed 4 GiB (refused with a message).
     bool finish(GlbStats* stats, std::string* error);
 

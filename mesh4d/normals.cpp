@@ -32,7 +32,13 @@ CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
     // Step: one normal per corner from the faces within the crease angle; corners of a vertex
     // with bit-identical normals share one output vertex.
     CreasedMesh out;
-    std::vector<std::vector<uint32_t>> copies(nv);  // output vertices made for each input vertex
+    // Output vertices made for each input vertex, as linked lists through the output ids (most
+    // vertices get one copy; no allocation per vertex).
+    std::vector<uint32_t> first_copy(nv, UINT32_MAX), next_copy;
+    next_copy.reserve(nv);
+    out.mesh.positions.reserve(nv);
+    out.mesh.emission_times.reserve(nv);
+    out.normals.reserve(nv);
     out.mesh.triangles.resize(nf);
     for (size_t f = 0; f < nf; ++f) {
         for (int c = 0; c < 3; ++c) {
@@ -44,14 +50,15 @@ CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
             }
             const Vec3 n = unitOr(sum, unitOr(area[f], {0, 0, 1}));
             uint32_t id = UINT32_MAX;
-            for (uint32_t o : copies[v])
+            for (uint32_t o = first_copy[v]; o != UINT32_MAX; o = next_copy[o])
                 if (out.normals[o] == n) id = o;
             if (id == UINT32_MAX) {
                 id = uint32_t(out.mesh.positions.size());
                 out.mesh.positions.push_back(mesh.positions[v]);
                 out.mesh.emission_times.push_back(mesh.emission_times[v]);
                 out.normals.push_back(n);
-                copies[v].push_back(id);
+                next_copy.push_back(first_copy[v]);  // prepend: the list's order does not matter
+                first_copy[v] = id;
             }
             out.mesh.triangles[f][c] = id;
         }

@@ -332,6 +332,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         for (long long b0 = first; b0 < last_excl; b0 += batch) {
             const long long b1 = std::min(last_excl, b0 + batch);
             std::vector<ExportFrame> cut(size_t(b1 - b0));
+            std::vector<std::shared_ptr<GlbFrameData>> glb_data(size_t(b1 - b0));
             arena.execute([&] {
                 tbb::parallel_for(b0, b1, [&](long long k) {
                     ExportFrame& frame = cut[size_t(k - b0)];
@@ -349,6 +350,8 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                     });
                     // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
                     reflections.append(view, slice_settings, &frame.objects);
+                    // The .glb's conversion of the frame (normals, float32) here too, in parallel.
+                    if (glb_writer) glb_data[size_t(k - b0)] = glb_writer->prepare(frame);
                 });
             });
             for (ExportFrame& frame : cut) {
@@ -377,7 +380,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                 if (settings.write_obj && !addWritten(obj_path)) return kExitOutputError;
                 if (settings.write_glb && !settings.glb.draco) glb_min += frame_min;
                 if (settings.write_glb && overLimit(glb_min, name + ".glb")) return kExitOutputError;
-                if (glb_writer && !glb_writer->add(frame, &error)) {
+                if (glb_writer && !glb_writer->add(frame, *glb_data[size_t(k - b0)], &error)) {
                     err << "error: " << error << "\n";
                     return kExitOutputError;
                 }
