@@ -15,7 +15,7 @@ for b in data["benchmarks"]:
         continue
     rows.setdefault(name, []).append(b)
 
-scenes = {"BM_Flanges": "flanges (relativistic, frame 100, 3 objects, size 4.90 ls)",
+scenes = {"BM_Flanges": "flanges (relativistic, frame 100, the default scene's 4 objects, size 4.90 ls)",
           "BM_Sphere": "sphere (320 faces, radius 1, 0.9c at 4 ls, relativistic, size 2 ls)"}
 md = ["# Accuracy against time", "",
       "Measured by `scripts/accuracy_report.sh` (Google Benchmark, `benchmarks/accuracy_bench.cpp`) on "
