@@ -13,16 +13,13 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "pipeline/mesh_check.h"
+#include "pipeline/openmesh_input.h"
 
 namespace apparent {
 
 namespace {
 
-struct DoubleTraits : OpenMesh::DefaultTraits {
-    typedef OpenMesh::Vec3d Point;
-    typedef OpenMesh::Vec3d Normal;
-};
-typedef OpenMesh::TriMesh_ArrayKernelT<DoubleTraits> ObjMesh;
+typedef InputTriMesh ObjMesh;
 
 struct ScanResult {
     size_t vertices = 0;
@@ -118,35 +115,12 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     OpenMesh::IO::Options opt;
     if (!OpenMesh::IO::read_mesh(om, path, opt)) return Status::failure(path + ": OpenMesh could not read the OBJ file");
 
-    mesh->positions.clear();
-    mesh->triangles.clear();
-    mesh->positions.reserve(om.n_vertices());
-    for (auto v : om.vertices()) {
-        const auto& p = om.point(v);
-        mesh->positions.push_back({p[0], p[1], p[2]});
-    }
-    for (auto f : om.faces()) {
-        std::array<uint32_t, 3> tri{};
-        int c = 0;
-        for (auto v : om.fv_range(f)) tri[c++] = uint32_t(v.idx());
-        mesh->triangles.push_back(tri);
-    }
-
-    // Step: count what changed. OpenMesh gives a face that would make an edge non-manifold copies of
-    // its vertices (so the vertex count grows), and drops faces it cannot add at all.
-    warnings->polygons_triangulated += scan.polygons;
-    warnings->degenerate_dropped += scan.repeated_index;
-    for (const auto& tri : mesh->triangles)
-        if (tri[0] >= scan.vertices || tri[1] >= scan.vertices || tri[2] >= scan.vertices) ++warnings->nonmanifold_split;
-    if (mesh->triangles.size() < scan.triangles)
-        return Status::failure(path + ": OpenMesh dropped " + std::to_string(scan.triangles - mesh->triangles.size()) +
-                               " of " + std::to_string(scan.triangles) + " triangles (malformed faces)");
-
-    // Step: zero-area triangles (exact predicate), dropped and counted.
-    const size_t dropped = dropDegenerateTriangles(mesh);
-    warnings->degenerate_dropped += dropped;
-    if (mesh->triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
-    return Status::success();
+    ScannedCounts counts;
+    counts.vertices = scan.vertices;
+    counts.triangles = scan.triangles;
+    counts.polygons = scan.polygons;
+    counts.repeated_index = scan.repeated_index;
+    return takeOpenMeshResult(om, counts, path, mesh, warnings);
 }
 
 }  // namespace apparent

@@ -16,16 +16,13 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "pipeline/mesh_check.h"
+#include "pipeline/openmesh_input.h"
 
 namespace apparent {
 
 namespace {
 
-struct DoubleTraits : OpenMesh::DefaultTraits {
-    typedef OpenMesh::Vec3d Point;
-    typedef OpenMesh::Vec3d Normal;
-};
-typedef OpenMesh::TriMesh_ArrayKernelT<DoubleTraits> PlyMesh;
+typedef InputTriMesh PlyMesh;
 
 enum class PlyFormat { Ascii, BinaryLittle, BinaryBig };
 enum class ScalarType { Int8, Uint8, Int16, Uint16, Int32, Uint32, Float32, Float64 };
@@ -417,36 +414,12 @@ Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
         return Status::failure(path + ": OpenMesh read " + std::to_string(om.n_vertices()) + " of " +
                                std::to_string(scan.vertices) + " vertices");
 
-    mesh->positions.clear();
-    mesh->triangles.clear();
-    mesh->positions.reserve(om.n_vertices());
-    for (auto v : om.vertices()) {
-        const auto& p = om.point(v);
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-            return Status::failure(path + ": vertex[" + std::to_string(v.idx()) + "]: not finite after reading");
-        mesh->positions.push_back({p[0], p[1], p[2]});
-    }
-    for (auto f : om.faces()) {
-        std::array<uint32_t, 3> tri{};
-        int c = 0;
-        for (auto v : om.fv_range(f))
-            if (c < 3) tri[c++] = uint32_t(v.idx());
-        mesh->triangles.push_back(tri);
-    }
-
-    // Step: count what changed (as for OBJ: non-manifold faces get their own vertices).
-    warnings->polygons_triangulated += scan.polygons;
-    warnings->degenerate_dropped += scan.repeated_index;
-    for (const auto& tri : mesh->triangles)
-        if (tri[0] >= scan.vertices || tri[1] >= scan.vertices || tri[2] >= scan.vertices) ++warnings->nonmanifold_split;
-    if (mesh->triangles.size() < scan.triangles)
-        return Status::failure(path + ": OpenMesh dropped " + std::to_string(scan.triangles - mesh->triangles.size()) +
-                               " of " + std::to_string(scan.triangles) + " triangles (malformed faces)");
-
-    // Step: zero-area triangles (exact predicate), dropped and counted.
-    warnings->degenerate_dropped += dropDegenerateTriangles(mesh);
-    if (mesh->triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
-    return Status::success();
+    ScannedCounts counts;
+    counts.vertices = scan.vertices;
+    counts.triangles = scan.triangles;
+    counts.polygons = scan.polygons;
+    counts.repeated_index = scan.repeated_index;
+    return takeOpenMeshResult(om, counts, path, mesh, warnings);
 }
 
 }  // namespace apparent

@@ -14,30 +14,16 @@
 
 #include "mesh4d/event.h"
 #include "pipeline/cli.h"
+#include "run_command.h"
 #include "pipeline/scene.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string source(const std::string& rel) { return std::string(APPARENT_SOURCE_DIR) + "/" + rel; }
-
-struct CommandResult {
-    int code = -1;
-    std::string out, err;
-};
-
-CommandResult apparentRun(std::vector<std::string> args) {
-    args.insert(args.begin(), "apparent");
-    std::vector<const char*> argv;
-    for (const auto& a : args) argv.push_back(a.c_str());
-    std::ostringstream out, err;
-    CommandResult r;
-    r.code = apparent::runCommandLine(int(argv.size()), argv.data(), out, err);
-    r.out = out.str();
-    r.err = err.str();
-    return r;
-}
+using testcli::apparentRun;
+using testcli::CommandResult;
+using testcli::source;
 
 class TempDir {
 public:

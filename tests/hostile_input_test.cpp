@@ -15,6 +15,7 @@
 #include "exporters/atomic_file.h"
 #include "exporters/ply.h"
 #include "pipeline/cli.h"
+#include "run_command.h"
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
 #include "pipeline/render.h"
@@ -25,24 +26,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string source(const std::string& rel) { return std::string(APPARENT_SOURCE_DIR) + "/" + rel; }
-
-struct CommandResult {
-    int code = -1;
-    std::string out, err;
-};
-
-CommandResult apparentRun(std::vector<std::string> args) {
-    args.insert(args.begin(), "apparent");
-    std::vector<const char*> argv;
-    for (const auto& a : args) argv.push_back(a.c_str());
-    std::ostringstream out, err;
-    CommandResult r;
-    r.code = runCommandLine(int(argv.size()), argv.data(), out, err);
-    r.out = out.str();
-    r.err = err.str();
-    return r;
-}
+using testcli::apparentRun;
+using testcli::CommandResult;
+using testcli::source;
 
 // A fresh folder under the temporary folder, removed at the end; restores the working folder.
 class Sandbox {
