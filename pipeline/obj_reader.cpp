@@ -21,12 +21,9 @@ namespace {
 
 typedef InputTriMesh ObjMesh;
 
-struct ScanResult {
-    size_t vertices = 0;
-    size_t faces = 0;              // faces OpenMesh should keep
-    size_t triangles = 0;          // triangles those faces give after fan triangulation
-    size_t polygons = 0;
-    size_t repeated_index = 0;
+// The scan's counts (openmesh_input.h), and the faces OpenMesh should keep.
+struct ScanResult : ScannedCounts {
+    size_t faces = 0;
 };
 
 bool parseFinite(const std::string& token, double* out) {
@@ -115,12 +112,7 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     OpenMesh::IO::Options opt;
     if (!OpenMesh::IO::read_mesh(om, path, opt)) return Status::failure(path + ": OpenMesh could not read the OBJ file");
 
-    ScannedCounts counts;
-    counts.vertices = scan.vertices;
-    counts.triangles = scan.triangles;
-    counts.polygons = scan.polygons;
-    counts.repeated_index = scan.repeated_index;
-    return takeOpenMeshResult(om, counts, path, mesh, warnings);
+    return takeOpenMeshResult(om, scan, path, mesh, warnings);
 }
 
 }  // namespace apparent

@@ -274,12 +274,7 @@ private:
     PlyFormat format_;
 };
 
-struct ScanResult {
-    uint64_t vertices = 0;
-    size_t triangles = 0;       // triangles the kept faces give after fan triangulation
-    size_t polygons = 0;        // kept faces of more than 3 vertices
-    size_t repeated_index = 0;  // faces OpenMesh drops for a repeated index
-};
+typedef ScannedCounts ScanResult;  // what the scan counts (openmesh_input.h)
 
 // Checks the header and every value of the body before OpenMesh sees the file.
 Status scanPly(const std::string& path, const std::vector<char>& bytes, const MeshLimits& limits, ScanResult* scan) {
@@ -414,12 +409,7 @@ Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
         return Status::failure(path + ": OpenMesh read " + std::to_string(om.n_vertices()) + " of " +
                                std::to_string(scan.vertices) + " vertices");
 
-    ScannedCounts counts;
-    counts.vertices = scan.vertices;
-    counts.triangles = scan.triangles;
-    counts.polygons = scan.polygons;
-    counts.repeated_index = scan.repeated_index;
-    return takeOpenMeshResult(om, counts, path, mesh, warnings);
+    return takeOpenMeshResult(om, scan, path, mesh, warnings);
 }
 
 }  // namespace apparent
