@@ -5,6 +5,7 @@
 //   BM_MemoryCopy          the machine's limit: bytes/s of a 256 MiB copy (one core)
 //   BM_CutVertexMode/N     1. and 2.: the cone cut alone, vertex mode, on a torus of N triangles,
 //                          one core: vertex-frames per second, time per frame against N
+//   BM_ClosedFormOnly/N    the closed form alone (no output mesh bookkeeping), one core
 //   BM_CutTolerance/N      the same at tolerance 1e-3 x the object's size
 //   BM_ExportFrame/F       1.: one frame of the 1M-triangle torus cut and written: F = 0 .glb, 1 PLY
 //   BM_Frames/N            3.: `apparent render` end to end, N frames of a 20k-triangle torus (.glb)
@@ -86,6 +87,22 @@ void cut(benchmark::State& state, double tolerance) {
     state.counters["vertex_frames_per_s"] = benchmark::Counter(vertices, benchmark::Counter::kIsIterationInvariantRate);
 }
 void BM_CutVertexMode(benchmark::State& state) { cut(state, 0.0); }
+
+// The closed form alone (mesh4d::cutRestLocalBatch): positions and emission times of every vertex,
+// without the output mesh's bookkeeping (triangles, rest points) that sliceWorld adds.
+void BM_ClosedFormOnly(benchmark::State& state) {
+    const Passing& p = passing(state.range(0));
+    const mesh4d::ViewAnchor anchor = mesh4d::viewAnchor(p.view, p.world.motion);
+    const size_t n = p.world.mesh.positions.size();
+    std::vector<Vec3> positions(n);
+    std::vector<double> times(n);
+    for (auto _ : state) {
+        mesh4d::cutRestLocalBatch(anchor, p.world.motion, p.world.mesh.positions.data(), n, positions.data(), times.data());
+        benchmark::DoNotOptimize(positions.data());
+        benchmark::ClobberMemory();
+    }
+    state.counters["vertex_frames_per_s"] = benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate);
+}
 void BM_CutTolerance(benchmark::State& state) { cut(state, 1e-3 * kTorusSize); }
 
 void BM_ExportFrame(benchmark::State& state) {
@@ -223,6 +240,7 @@ void BM_Million100(benchmark::State& state) {
 
 BENCHMARK(BM_MemoryCopy)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CutVertexMode)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClosedFormOnly)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CutTolerance)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExportFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Frames)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
