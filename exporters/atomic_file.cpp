@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <unistd.h>
 
 namespace apparent {
@@ -37,7 +38,15 @@ void unregisterTemp(int slot) {
     if (slot >= 0) g_slot_used[slot].store(false);
 }
 
+pthread_t g_main_thread;
+
 void onInterrupt(int sig) {
+    // A signal delivered to a worker thread (TBB) goes to the main thread, the only one that
+    // creates files: cleaning up there leaves no file created after the cleanup.
+    if (!pthread_equal(pthread_self(), g_main_thread)) {
+        pthread_kill(g_main_thread, sig);
+        return;
+    }
     for (int i = 0; i < kSlots; ++i)
         if (g_slot_used[i].load() && g_temp_paths[i][0] != '\0') ::unlink(g_temp_paths[i]);
     const char* msg = sig == SIGINT ? "apparent: interrupted (SIGINT): temporary files removed, written files are complete\n"
@@ -80,25 +89,42 @@ bool AtomicOutput::commitBytes(const std::string& bytes, std::string* error) {
         return false;
     }
     size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            *error = final_ + ": cannot write (" + std::to_string(done) + " of " + std::to_string(bytes.size()) +
-                     " bytes written): " + std::strerror(n < 0 ? errno : EIO);
-            ::close(fd);
-            return false;
-        }
-        done += size_t(n);
+    std::string why;
+    if (!writeAll(fd, bytes.data(), bytes.size(), &why, &done)) {
+        *error = final_ + ": cannot write (" + std::to_string(done) + " of " + std::to_string(bytes.size()) +
+                 " bytes written): " + why;
+        ::close(fd);
+        return false;
     }
-    if (::fsync(fd) != 0 || ::close(fd) != 0) {
-        *error = final_ + ": cannot write: " + std::strerror(errno);
+    // Always close, keeping the first failure's errno.
+    int failed = ::fsync(fd) != 0 ? errno : 0;
+    if (::close(fd) != 0 && failed == 0) failed = errno;
+    if (failed != 0) {
+        *error = final_ + ": cannot write: " + std::strerror(failed);
         return false;
     }
     return commit(error);
 }
 
+bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* written) {
+    const char* p = static_cast<const char*>(data);
+    size_t done = 0;
+    while (done < n) {
+        const ssize_t w = ::write(fd, p + done, n - done);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            *error = std::strerror(w < 0 ? errno : EIO);
+            if (written) *written = done;
+            return false;
+        }
+        done += size_t(w);
+    }
+    if (written) *written = done;
+    return true;
+}
+
 void installInterruptCleanup() {
+    g_main_thread = pthread_self();
     struct sigaction sa {};
     sa.sa_handler = &onInterrupt;
     sigemptyset(&sa.sa_mask);

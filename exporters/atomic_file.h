@@ -3,14 +3,15 @@
 // run leaves the previous file or the new one, never a truncated one.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace apparent {
 
 class AtomicOutput {
 public:
-    // `final_path` is where the file should end up. The temporary name keeps its extension, because
-    // OpenMesh picks the format from it: "dir/.name.tmp-PID.ext".
+    // `final_path` is where the file should end up. The temporary name is hidden and keeps the
+    // extension, so leftovers are easy to find and tell apart: "dir/.name.tmp-PID.ext".
     explicit AtomicOutput(std::string final_path);
     ~AtomicOutput();  // removes the temporary file unless commit() succeeded
     AtomicOutput(const AtomicOutput&) = delete;
@@ -31,6 +32,10 @@ private:
     bool committed_ = false;
     int slot_ = -1;  // entry in the registry of temporary files the interrupt handler removes
 };
+
+// Writes all `n` bytes to `fd`, retrying short and interrupted writes. On failure: false, errno's
+// message in `error` and the bytes written so far in `*written` (when given).
+bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* written = nullptr);
 
 // Installs handlers for SIGINT and SIGTERM (SIGINT only when it is not ignored) that remove every
 // temporary file of a live AtomicOutput, print one line and exit with 128 + the signal number

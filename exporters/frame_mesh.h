@@ -43,6 +43,12 @@ struct SequenceInfo {
     ExportCamera camera;
 };
 
+// "frame_00042": the name of global frame k in file and node names.
+inline std::string frameName(long long k) {
+    std::string digits = std::to_string(k);
+    return "frame_" + std::string(digits.size() < 5 ? 5 - digits.size() : 0, '0') + digits;
+}
+
 // All objects of a frame in one mesh with absolute lab positions and times (origin 0): PLY and
 // OBJ hold every object in one file.
 mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame);

@@ -33,22 +33,6 @@ struct PrimitiveData {
     size_t vertexCount() const { return emission.size(); }
 };
 
-// Writes all of `n` bytes to `fd`, retrying short writes; errno's message on failure.
-bool writeAll(int fd, const void* data, size_t n, std::string* error) {
-    const char* p = static_cast<const char*>(data);
-    while (n > 0) {
-        const ssize_t w = ::write(fd, p, n);
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) {
-            *error = std::strerror(w < 0 ? errno : EIO);
-            return false;
-        }
-        p += w;
-        n -= size_t(w);
-    }
-    return true;
-}
-
 // Where the BIN chunk goes while frames arrive: a spill file (so memory does not grow with the
 // frame count), or nowhere (counting only, for the size without Draco).
 struct BinSink {
@@ -305,8 +289,7 @@ struct SequenceModel {
     bool addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3], bool draco,
                   GlbStats* stats, std::string* error) {
         tinygltf::Node node;
-        node.name = "frame_" + std::string(std::max(0, 5 - int(std::to_string(f.index).size())), '0') +
-                    std::to_string(f.index);
+        node.name = frameName(f.index);
         if (f.triangleCount() > 0) {
             tinygltf::Mesh mesh;
             mesh.name = node.name;
@@ -503,6 +486,12 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     }
     if (!m.sink.error.empty()) {
         *error = m.spill.tempPath() + ": " + m.sink.error;
+        return false;
+    }
+    // A .glb's length field is 32 bits: stop as soon as the frame data alone passes 4 GiB.
+    if (m.sink.size > 0xffffffffull) {
+        *error = m.path + ": more than a .glb can hold (4 GiB) after frame " + std::to_string(f.index) +
+                 "; render fewer frames at once (--frames) or add --draco";
         return false;
     }
     return true;

@@ -1,9 +1,12 @@
 #include "exporters/png.h"
 
+#include <cerrno>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+
+#include <unistd.h>
 
 #include <png.h>
 
@@ -71,11 +74,13 @@ bool writePng(const std::string& path, const RgbImage& image, std::string* error
     png_write_image(png, rows.data());
     png_write_end(png, info);
     png_destroy_write_struct(&png, &info);
-    const bool flushed = std::fflush(file.f) == 0 && !std::ferror(file.f);
-    std::fclose(file.f);
+    // Flushed, synced and closed, each checked (as every output: README "Hostile input").
+    int failed = (std::fflush(file.f) != 0 || std::ferror(file.f)) ? (errno ? errno : EIO) : 0;
+    if (!failed && ::fsync(fileno(file.f)) != 0) failed = errno;
+    if (std::fclose(file.f) != 0 && !failed) failed = errno;
     file.f = nullptr;
-    if (!flushed) {
-        *error = path + ": write failed: " + std::strerror(errno);
+    if (failed) {
+        *error = path + ": write failed: " + std::strerror(failed);
         return false;
     }
     return out.commit(error);

@@ -63,6 +63,21 @@ bool parseSize(const std::string& text, int* width, int* height) {
 
 }  // namespace
 
+// Runs a command; what it cannot handle itself becomes one line: out of memory (exit 3) or a broken
+// invariant (exit 1), never std::terminate.
+template <class Command>
+int guarded(Command command, std::ostream& err) {
+    try {
+        return command();
+    } catch (const std::bad_alloc&) {
+        err << "error: out of memory (try a coarser --tolerance, fewer frames or a smaller --size)\n";
+        return kExitOutputError;
+    } catch (const std::exception& e) {
+        err << "error: internal: " << e.what() << "\n";
+        return 1;
+    }
+}
+
 int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
     CLI::App app(kDescription, "apparent");
     app.set_version_flag("--version", "apparent 0.1.0");
@@ -166,14 +181,14 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.frame_from, &ts.frame_to))
             return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
         if (ts.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
-        return raytrace(ts, out, err);
+        return guarded([&] { return raytrace(ts, out, err); }, err);
     }
     if (figure_cmd->parsed()) {
         if (!figure_size_text.empty() && !parseSize(figure_size_text, &fs.width, &fs.height))
             return usage("--size: '" + figure_size_text + "' is not WxH with W and H in 1..16384");
         if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
         if (fs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
-        return figure(fs, out, err);
+        return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (!render_cmd->parsed()) return kExitBadInput;
     if (!model_text.empty()) {
@@ -222,16 +237,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     rs.limits.max_vertices = size_t(max_vertices);
     rs.limits.max_faces = size_t(max_faces);
     rs.limits.max_file_bytes = size_t(max_file_bytes);
-    try {
-        return render(rs, out, err);
-    } catch (const std::bad_alloc&) {
-        err << "error: out of memory (raise no limit; try a coarser --tolerance or fewer frames)\n";
-        return kExitOutputError;
-    } catch (const std::exception& e) {
-        // A broken invariant, not bad input: say so plainly.
-        err << "error: internal: " << e.what() << "\n";
-        return 1;
-    }
+    return guarded([&] { return render(rs, out, err); }, err);
 }
 
 }  // namespace apparent

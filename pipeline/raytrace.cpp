@@ -51,11 +51,6 @@ mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scen
     return mesh4d::extrude(object.rest, direct.motion, tau_a, tau_b, real_a, real_b);
 }
 
-std::string frameName(long long k) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "frame_%05lld.png", k);
-    return buf;
-}
 
 }  // namespace
 
@@ -233,7 +228,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& 
             TracedFrame frame;
             arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height); });
             std::string error;
-            if (!writePng((std::filesystem::path(dir) / frameName(k)).string(), frame.image, &error)) {
+            if (!writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error)) {
                 err << "error: " << error << "\n";
                 return kExitOutputError;
             }

@@ -82,11 +82,7 @@ private:
     double last_ = -1;
 };
 
-std::string frameFileName(long long k, const char* ext) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "frame_%05lld.%s", k, ext);
-    return buf;
-}
+std::string frameFileName(long long k, const char* ext) { return frameName(k) + "." + ext; }
 
 // Distinct base colours for objects without their own (linear RGB, roughly equal lightness).
 constexpr std::array<std::array<double, 4>, 6> kPalette = {{{0.85, 0.45, 0.10, 1.0},
@@ -169,16 +165,20 @@ bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound)
     const double cos_angle = std::clamp(mesh4d::dot(d, f) / (dist * mesh4d::norm(f)), -1.0, 1.0);
     const double angle = std::acos(cos_angle);                  // centre off the view axis
     const double angular_radius = std::asin(bound.radius / dist);
-    const double half_fov = 0.5 * camera.fov_deg * M_PI / 180.0;
+    const double half_fov = 0.5 * camera.fov_deg * kPi / 180.0;
     const double half_diagonal = std::atan(std::tan(half_fov) * std::sqrt(1 + kCullAspect * kCullAspect));
     return angle - angular_radius <= half_diagonal;
 }
 
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
+    return viewAt(scene, model, frameTime(scene.frames, k));
+}
+
+mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c) {
     mesh4d::ViewSurface view;
     view.kind = (model == Model::Finite || model == Model::Relativistic) ? mesh4d::ViewKind::PastCone
                                                                          : mesh4d::ViewKind::Hyperplane;
-    view.t_c = frameTime(scene.frames, k);
+    view.t_c = t_c;
     // The hyperplane models may look back by the stage's light delay (scene camera.instant_delay).
     if (view.kind == mesh4d::ViewKind::Hyperplane) view.t_c -= scene.camera.instant_delay;
     view.apex = scene.camera.position;

@@ -62,12 +62,14 @@ mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scen
 
 // View culling (--cull-view): whether a sphere may show in the camera's view, a circular cone
 // around the view axis whose half-angle reaches the corners of a kCullAspect:1 frame with the
-// camera's vertical field of view (wider than any common screen, so viewers never miss a part).
+// camera's vertical field of view (wider than 16:9 and 21:9 screens; a 32:9 screen at the same
+// vertical field of view could miss parts at its far left and right).
 constexpr double kCullAspect = 2.4;
 bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound);
 
-// The view surface of global frame k for `model`.
+// The view surface of global frame k for `model`, and at any camera time t_c.
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k);
+mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c);
 
 int render(const RenderSettings& settings, std::ostream& log, std::ostream& err);
 

@@ -1,6 +1,7 @@
 // Measured distance between an apparent mesh and the exact apparent surface, both directions,
 // shared by the tests and the accuracy benchmark. The exact surface is evaluated point by point
-// with the closed form (exactLocalPoint, in the mesh's local coordinates), independently of how the mesh was refined.
+// with the direct closed form (exactRelative below), independently of how the mesh was refined and
+// of the anchored form that made its points.
 #pragma once
 
 #include <algorithm>
@@ -13,6 +14,13 @@ namespace errmeasure {
 using mesh4d::ApparentMesh;
 using mesh4d::Vec3;
 
+// The exact apparent point of rest point q relative to `origin`, by the direct closed form of the
+// cut from where the point is now (lightcone.h cutRestWorldline: one quadratic in the whole delay),
+// not by the anchored form (delay of the origin plus a second quadratic) that the mesh is made with.
+inline Vec3 exactRelative(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const Vec3& q, const Vec3& origin) {
+    return mesh4d::cutRestWorldline(view, w.motion, mesh4d::nowBase(view, w.motion), q).x - origin;
+}
+
 // Barycentric sample points: vertices, edge midpoints, the centroid and interior points.
 inline const double kSamples[12][3] = {{1, 0, 0},     {0, 1, 0},   {0, 0, 1},   {0.5, 0.5, 0},
                                        {0, 0.5, 0.5}, {0.5, 0, 0.5}, {1. / 3, 1. / 3, 1. / 3}, {0.6, 0.2, 0.2},
@@ -22,7 +30,6 @@ inline const double kSamples[12][3] = {{1, 0, 0},     {0, 1, 0},   {0, 0, 1},   
 // mesh (linear on each triangle) and F the exact image of the same rest point. Bounds the
 // distance from every sampled output point to the exact surface.
 inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m) {
-    const Vec3 shift = mesh4d::viewAnchor(view, w.motion).origin - m.origin;  // 0 for sliceWorld's own output
     double worst = 0;
     for (const auto& t : m.triangles)
         for (const auto& b : kSamples) {
@@ -31,7 +38,7 @@ inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface&
                 rest += m.rest_points[t[k]] * b[k];
                 out += m.positions[t[k]] * b[k];
             }
-            worst = std::max(worst, mesh4d::norm((shift + mesh4d::exactLocalPoint(w, view, rest).x) - out));
+            worst = std::max(worst, mesh4d::norm(exactRelative(w, view, rest, m.origin) - out));
         }
     return worst;
 }
@@ -41,7 +48,6 @@ inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface&
 // lie on that input triangle). Bounds the distance from every sampled exact point to the mesh.
 inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m,
                             int grid) {
-    const Vec3 shift = mesh4d::viewAnchor(view, w.motion).origin - m.origin;  // 0 for sliceWorld's own output
     std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
     for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
     double worst = 0;
@@ -53,7 +59,7 @@ inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface&
             for (int j = 0; i + j <= grid; ++j) {
                 const double l1 = double(i) / grid, l2 = double(j) / grid;
                 const Vec3 q = a * (1 - l1 - l2) + b * l1 + c * l2;
-                const Vec3 exact = shift + mesh4d::exactLocalPoint(w, view, q).x;
+                const Vec3 exact = exactRelative(w, view, q, m.origin);
                 double best = INFINITY;
                 for (size_t t : by_source[f]) {
                     const auto& ot = m.triangles[t];

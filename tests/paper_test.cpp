@@ -55,15 +55,8 @@ protected:
         return slot;
     }
 
-    // The view at camera time t_c (not only frame times), as viewForFrame builds it.
-    mesh4d::ViewSurface view(Model model, double t_c) const {
-        mesh4d::ViewSurface v;
-        v.kind = (model == Model::Instant || model == Model::Contracted) ? mesh4d::ViewKind::Hyperplane
-                                                                          : mesh4d::ViewKind::PastCone;
-        v.t_c = v.kind == mesh4d::ViewKind::Hyperplane ? t_c - scene_.camera.instant_delay : t_c;
-        v.apex = scene_.camera.position;
-        return v;
-    }
+    // The view at camera time t_c (not only frame times): the pipeline's own (instant_delay included).
+    mesh4d::ViewSurface view(Model model, double t_c) const { return viewAt(scene_, model, t_c); }
 
     // Measured on the mesh: the y = 0 section of the front plate's output triangles.
     Section section(Model model, size_t object, double t_c) {
