@@ -65,10 +65,9 @@ Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now
 //     (1 - b^2) delta^2 + 2 B delta - K = 0,   B = S + s.v,   K = 2 s.Y0 + |s|^2,
 // whose physical root is delta = K / (B + sqrt(B^2 + (1 - b^2) K)) (B >= 0; otherwise the
 // conjugate form). The apparent point relative to the anchor is s - v delta, emitted delta before
-// the origin's emission: no term of the size of the distance enters the shape. (This holds for
-// the images of rest points. Clip points where an object begins or ends existing are
-// interpolated between the absolute 4D events of World4D and carry their rounding, about one ulp
-// of the distance.)
+// the origin's emission: no term of the size of the distance enters the shape. (Clip points
+// where an object begins or ends existing are images of rest points too, so they stay exactly on
+// the surface; only where along the cap edge they fall is found from the absolute 4D events.)
 struct ViewAnchor {
     Vec3 origin;             // lab position the local coordinates are relative to: C + Y0
     double time_origin = 0;  // lab time local emission times are relative to: t_c - D

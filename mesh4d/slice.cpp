@@ -67,8 +67,6 @@ struct FrameBuilder {
         out.source_triangles.push_back(uint32_t(f));
     }
 
-    // A lab event (a clip point made from the absolute 4D events) in local coordinates.
-    Event toLocal(const Event& e) const { return {e.t - anchor.time_origin, e.x - anchor.origin}; }
 
     uint32_t emit(const Event& e, const Vec3& rest) {
         out.positions.push_back(e.x);
@@ -132,7 +130,10 @@ struct FrameBuilder {
             if (s == 0 && side[e.lo] == Side::Inside) return slot = vertexPoint(e.lo);
             if (s == 1 && side[e.hi] == Side::Inside) return slot = vertexPoint(e.hi);
             const Vec3 rest = world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s;
-            slot = emit(toLocal(lerp(p0, p1, s)), rest);
+            // The crossing event lies on the worldline of `rest` (a worldline meets the view surface
+            // once), so its image is the anchored cut of that rest point: relative accuracy however
+            // far the object is; only the parameter s carries the absolute events' rounding.
+            slot = emit(cutRestLocal(anchor, world.motion, rest), rest);
         }
         return slot;
     }
@@ -280,7 +281,10 @@ struct FrameBuilder {
         uint32_t id;
         if (s == 0 && first->side == Side::Inside && first->id != kUnset) id = first->id;  // as in crossingPoint
         else if (s == 1 && second->side == Side::Inside && second->id != kUnset) id = second->id;
-        else id = emit(toLocal(lerp(e0, e1, s)), restOf(*first, v) * (1 - s) + restOf(*second, v) * s);
+        else {
+            const Vec3 rest = restOf(*first, v) * (1 - s) + restOf(*second, v) * s;
+            id = emit(cutRestLocal(anchor, world.motion, rest), rest);  // as in crossingPoint
+        }
         (edge != kUnset ? sub_crossings : local)[key] = id;
         return id;
     }

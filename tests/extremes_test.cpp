@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <quadmath.h>
+
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
 #include "pipeline/mesh_check.h"
@@ -295,4 +297,52 @@ TEST(Extremes, ApparentBoundHoldsTheShape) {
                     }
                 }
     EXPECT_EQ(checked, 2 * 3 * 3 * 2 * 2);
+}
+
+// Clip points far away: a 1e-3 ls rod, transverse, 1e9 ls from the camera, passing at 0.8c
+// (Galilean), seen while its start of existence cuts it. Every output point, clip points included,
+// is the image of its rest point to 1e-9 of the rod's length, against the same cut computed
+// independently in binary128 from the scene's doubles. (Clip points interpolated between the
+// absolute 4D events were off by the rounding of the 1e9 distance, about 1e-7 ls.)
+TEST(Extremes, ClipPointsFarAwayStayOnTheSurface) {
+    typedef __float128 Quad;
+    const double L = 1e-3, D = 1e9, b = 0.8;
+    const RestMesh rod = testmesh::rod(L, 1e-4 * L);
+    RestMesh transverse = rod;  // along x instead of z
+    for (auto& p : transverse.positions) p = {-p.z, p.x, 0};
+    // At lab time 0, when it begins existing, the rod is 1e9 ls away, 0.6 of that off the axis:
+    // light from its points leaves at t = 0 and arrives at t_c = 1e9 + 0.6 x, so for 0.6 L of
+    // camera time the frames see part of it existing and part not yet.
+    const Motion m = makeMotion(Kinematics::Galilean, 0.0, {0.6 * D, 0, -0.8 * D}, {b, 0, 0});
+    const World4D w = extrude(transverse, m, 0.0, 10.0, true, false);
+    int clipped_frames = 0;
+    for (double dt = -2e-4; dt <= 8e-4; dt += 2.5e-5) {
+        const ViewSurface view{ViewKind::PastCone, D + dt, {0, 0, 0}};
+        const ApparentMesh out = sliceWorld(w, view);
+        clipped_frames += out.clipped_triangles > 0;
+        // Binary128: e = X0 - C + v (t_c - t0) + q, d the positive root, y = C + e - v d. The shape
+        // is what is compared: every point relative to the first (the absolute place of the whole
+        // carries the rounding of the 1e9 distance, in both computations).
+        auto image = [&](const Vec3& q, Quad* y) {
+            const Quad ex = Quad(0.6 * D) + Quad(b) * Quad(view.t_c) + Quad(q.x), ey = Quad(q.y),
+                       ez = Quad(-0.8 * D) + Quad(q.z);
+            const Quad ev = ex * Quad(b), ee = ex * ex + ey * ey + ez * ez, a = 1 - Quad(b) * Quad(b);
+            const Quad d = (sqrtq(ev * ev + a * ee) - ev) / a;
+            y[0] = ex - Quad(b) * d;
+            y[1] = ey;
+            y[2] = ez;
+        };
+        if (out.positions.empty()) continue;
+        Quad y0[3];
+        image(out.rest_points[0], y0);
+        for (size_t i = 1; i < out.positions.size(); ++i) {
+            Quad y[3];
+            image(out.rest_points[i], y);
+            const Vec3 got = out.positions[i] - out.positions[0];
+            ASSERT_NEAR(got.x, double(y[0] - y0[0]), 1e-9 * L) << dt << " point " << i;
+            ASSERT_NEAR(got.y, double(y[1] - y0[1]), 1e-9 * L) << dt << " point " << i;
+            ASSERT_NEAR(got.z, double(y[2] - y0[2]), 1e-9 * L) << dt << " point " << i;
+        }
+    }
+    EXPECT_GT(clipped_frames, 10);
 }
