@@ -25,6 +25,7 @@ struct ExportFrame {
 struct ExportObject {
     std::string name;
     std::array<double, 4> base_color{0.8, 0.8, 0.8, 1.0};  // linear RGBA
+    std::string mirror;  // a reflection: the name of the mirror it is seen in; empty for the scene's own objects
 };
 
 struct ExportCamera {

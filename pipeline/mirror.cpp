@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace apparent {
 
@@ -101,16 +102,44 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
     // Step: the half-spaces: beyond the mirror plane as seen from the camera, and inside the
     // pyramid from the camera over each mirror triangle.
     const Vec3 beyond = mesh4d::dot(camera - mirror.point, mirror.normal) > 0 ? -mirror.normal : mirror.normal;
+    // Each pyramid also has its triangle's box in plane coordinates (u, v): a clipped triangle,
+    // beyond the plane, is seen through the plane within the box of its corners' central
+    // projections onto it, so pyramids whose box misses that are skipped (a mirror of many
+    // triangles costs little more than one).
     struct Pyramid {
         std::array<Vec3, 3> n;
+        double lo[2], hi[2];
+    };
+    const Vec3 across = mesh4d::cross(mirror.normal, std::fabs(mirror.normal.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0});
+    const Vec3 axis_u = across / mesh4d::norm(across);
+    const Vec3 axis_v = mesh4d::cross(mirror.normal, axis_u);
+    const double camera_height = mesh4d::dot(camera - mirror.point, mirror.normal);
+    auto planeCoordinates = [&](const Vec3& p, double uv[2]) {  // p's central projection from the camera
+        const double h = mesh4d::dot(p - mirror.point, mirror.normal);
+        const Vec3 m = camera + (camera_height / (camera_height - h)) * (p - camera);
+        uv[0] = mesh4d::dot(m - mirror.point, axis_u);
+        uv[1] = mesh4d::dot(m - mirror.point, axis_v);
     };
     std::vector<Pyramid> pyramids;
     for (const auto& tri : polygon) {
-        Pyramid py;
+        Pyramid py{};
+        py.lo[0] = py.lo[1] = INFINITY;
+        py.hi[0] = py.hi[1] = -INFINITY;
         for (size_t e = 0; e < 3; ++e) {
             Vec3 n = mesh4d::cross(tri[e] - camera, tri[(e + 1) % 3] - camera);
             if (mesh4d::dot(n, tri[(e + 2) % 3] - camera) < 0) n = -n;
             py.n[e] = n;
+            const double uv[2] = {mesh4d::dot(tri[e] - mirror.point, axis_u), mesh4d::dot(tri[e] - mirror.point, axis_v)};
+            for (int c = 0; c < 2; ++c) {
+                py.lo[c] = std::min(py.lo[c], uv[c]);
+                py.hi[c] = std::max(py.hi[c], uv[c]);
+            }
+        }
+        // Widened by a relative 1e-9: the box only skips work, the half-spaces decide.
+        const double pad = 1e-9 * (std::fabs(py.lo[0]) + std::fabs(py.hi[0]) + std::fabs(py.lo[1]) + std::fabs(py.hi[1]) + 1);
+        for (int c = 0; c < 2; ++c) {
+            py.lo[c] -= pad;
+            py.hi[c] += pad;
         }
         pyramids.push_back(py);
     }
@@ -124,7 +153,17 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
         }
         tri = clipHalfSpace(tri, mirror.point, beyond);
         if (tri.size() < 3) continue;
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        for (const Corner& c : tri) {
+            double uv[2];
+            planeCoordinates(c.p, uv);
+            for (int k = 0; k < 2; ++k) {
+                lo[k] = std::min(lo[k], uv[k]);
+                hi[k] = std::max(hi[k], uv[k]);
+            }
+        }
         for (const Pyramid& py : pyramids) {
+            if (lo[0] > py.hi[0] || hi[0] < py.lo[0] || lo[1] > py.hi[1] || hi[1] < py.lo[1]) continue;
             std::vector<Corner> poly = tri;
             for (size_t e = 0; e < 3 && poly.size() >= 3; ++e) poly = clipHalfSpace(poly, camera, py.n[e]);
             if (poly.size() < 3) continue;
@@ -153,16 +192,8 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
 MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<PreparedObject>& objects,
                                      const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
                                      long long last_frame)
-    : mirrors_(mirrors), camera_(scene.camera.position) {
-    for (const MirrorPlane& m : mirrors_) {
-        const PreparedObject& mo = objects[m.object];
-        std::vector<std::array<Vec3, 3>> tris;
-        for (const auto& t : mo.rest.triangles)
-            tris.push_back({mo.spec.position + mo.rest.positions[t[0]], mo.spec.position + mo.rest.positions[t[1]],
-                            mo.spec.position + mo.rest.positions[t[2]]});
-        mirror_triangles_.push_back(tris);
-        names_.push_back(mo.spec.name);
-    }
+    : mirrors_(mirrors), camera_(scene.camera.position), scene_objects_(objects.size()) {
+    for (const MirrorPlane& m : mirrors_) names_.push_back(objects[m.object].spec.name);
     // Step: each non-mirror object's history over the span the image camera can see, once.
     for (size_t mi = 0; mi < mirrors_.size(); ++mi) {
         Scene image = scene;
@@ -176,12 +207,31 @@ MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<Prepa
 
 void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                                std::vector<mesh4d::ApparentMesh>* objects) const {
+    // Step: each mirror as the camera sees it in this frame (its own cut, `exists` included):
+    // what is seen through it is clipped to these triangles. Slivers give no pyramid.
+    if (objects->size() < scene_objects_)
+        throw std::logic_error("MirrorReflections::append: the frame's scene objects are missing");
+    std::vector<std::vector<std::array<Vec3, 3>>> seen(mirrors_.size());
+    for (size_t mi = 0; mi < mirrors_.size(); ++mi) {
+        const mesh4d::ApparentMesh& m = (*objects)[mirrors_[mi].object];
+        for (const auto& t : m.triangles) {
+            const std::array<Vec3, 3> tri{m.absolutePosition(t[0]), m.absolutePosition(t[1]), m.absolutePosition(t[2])};
+            const double area2 = mesh4d::norm(mesh4d::cross(tri[1] - tri[0], tri[2] - tri[0]));
+            const double longest = std::max({mesh4d::norm(tri[1] - tri[0]), mesh4d::norm(tri[2] - tri[1]),
+                                             mesh4d::norm(tri[0] - tri[2])});
+            if (area2 > 1e-12 * longest * longest) seen[mi].push_back(tri);
+        }
+    }
     for (const Target& target : targets_) {
         const MirrorPlane& m = mirrors_[target.mirror];
+        if (seen[target.mirror].empty()) {  // the mirror shows nothing: not in view or not existing
+            objects->emplace_back();
+            continue;
+        }
         mesh4d::ViewSurface image = view;
         image.apex = reflectPoint(m, view.apex);
         const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, settings);
-        objects->push_back(reflectAndClip(cut, m, mirror_triangles_[target.mirror], camera_));
+        objects->push_back(reflectAndClip(cut, m, seen[target.mirror], camera_));
     }
 }
 
@@ -191,6 +241,7 @@ void MirrorReflections::describe(SequenceInfo* info) const {
     for (const Target& target : targets_) {
         ExportObject o = originals[target.object];
         o.name = o.name + " (mirror " + names_[target.mirror] + ")";
+        o.mirror = names_[target.mirror];
         for (int c = 0; c < 3; ++c) o.base_color[size_t(c)] *= kReflectance;
         info->objects.push_back(o);
     }

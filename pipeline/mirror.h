@@ -35,9 +35,12 @@ Status findMirrors(const std::vector<PreparedObject>& objects, const std::string
 // once, over the span the image cameras can see; each frame then cuts them with the image
 // camera's view, reflects the cut back through the plane (orientation restored) and clips it to
 // the pyramid from the camera over each mirror triangle, and to the far side of the plane.
-// Limits: one bounce (mirrors are not seen in mirrors), a mirror's `exists` is not applied, the
-// clip is exact on the straight output edges (it adds points on them; emission times and rest
-// points of those are interpolated linearly along the edge).
+// The clip is to the mirror as the camera sees it in that frame (the mirror's own cut, so its
+// `exists` applies: no reflection where the mirror is not yet or no longer there).
+// Limits: one bounce (mirrors are not seen in mirrors), the clip is exact on the straight output
+// edges (it adds points on them; emission times and rest points of those are interpolated
+// linearly along the edge), and a mirror whose existence begins or ends within view is clipped to
+// its cut's chords of the cap curve (DESIGN.md section 6), not the curve.
 class MirrorReflections {
 public:
     MirrorReflections(const Scene& scene, const std::vector<PreparedObject>& objects,
@@ -46,6 +49,8 @@ public:
     bool empty() const { return mirrors_.empty(); }
     // Appends the reflections for `view` to `objects`, mirror by mirror, object by object (the
     // order of describe()). `view` is the frame's view for the camera; its apex is replaced.
+    // `objects` must already hold the frame's cut of every scene object, in scene order: each
+    // mirror's cut is what its reflections are clipped to (empty cut: empty reflections).
     void append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                 std::vector<mesh4d::ApparentMesh>* objects) const;
     // Appends the reflections' names and colours (the object's, darkened by the mirror's
@@ -59,9 +64,9 @@ private:
         mesh4d::World4D world;  // the object's history over the span the image camera sees
     };
     std::vector<MirrorPlane> mirrors_;
-    std::vector<std::vector<std::array<mesh4d::Vec3, 3>>> mirror_triangles_;  // lab triangles per mirror
     std::vector<std::string> names_;
     mesh4d::Vec3 camera_;
+    size_t scene_objects_ = 0;
     std::vector<Target> targets_;
 };
 
