@@ -286,20 +286,31 @@ struct SequenceModel {
     }
 
     // Step: frame k's node (node 1 + k), given each object's primitive data (empty: not shown).
+    // The scene's own objects go into the frame node's mesh; reflections (ExportObject::mirror)
+    // into one mesh per mirror, whose child node of the frame node is made in finish(), after all
+    // frame nodes, so that frame k stays node 1 + k. Meshes are numbered in frame order either way.
     bool addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3], bool draco,
                   GlbStats* stats, std::string* error) {
         tinygltf::Node node;
         node.name = frameName(f.index);
-        if (f.triangleCount() > 0) {
+        // Step: the objects' groups in order of first appearance: "" (the frame node) then mirrors.
+        std::vector<std::string> groups;
+        for (size_t o = 0; o < f.objects.size(); ++o) {
+            if (f.objects[o].triangles.empty()) continue;
+            const std::string& g = groupOf(o);
+            if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+        }
+        std::stable_partition(groups.begin(), groups.end(), [](const std::string& g) { return g.empty(); });
+        for (const std::string& group : groups) {
             tinygltf::Mesh mesh;
-            mesh.name = node.name;
+            mesh.name = group.empty() ? node.name : reflectionName(node.name, group);
             for (size_t o = 0; o < f.objects.size(); ++o) {
-                if (f.objects[o].triangles.empty()) continue;
+                if (f.objects[o].triangles.empty() || groupOf(o) != group) continue;
                 tinygltf::Primitive prim;
                 if (draco) {
                     double qerr = 0;
                     if (!b.dracoPrimitive(data[o], &prim, &qerr, error)) {
-                        *error = node.name + ": " + *error;
+                        *error = mesh.name + ": " + *error;
                         return false;
                     }
                     stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
@@ -310,9 +321,13 @@ struct SequenceModel {
                 mesh.primitives.push_back(prim);
             }
             b.model.meshes.push_back(mesh);
-            node.mesh = int(b.model.meshes.size()) - 1;
-            node.translation = {origin[0], origin[1], origin[2]};
+            if (group.empty())
+                node.mesh = int(b.model.meshes.size()) - 1;
+            else
+                reflections.push_back({frames, group, int(b.model.meshes.size()) - 1});
         }
+        // Reflections are relative to the same origin: their child nodes need no transform.
+        if (!groups.empty()) node.translation = {origin[0], origin[1], origin[2]};
         const double s = frames == 0 ? 1.0 : 0.0;
         node.scale = {s, s, s};
         b.model.nodes.push_back(node);
@@ -321,6 +336,15 @@ struct SequenceModel {
         if (frames == 0) first_frame = f.index;
         ++frames;
         return true;
+    }
+
+    // "frame_00042 mirror backdrop": the node (and mesh) of frame 42's reflections in mirror "backdrop".
+    static std::string reflectionName(const std::string& frame, const std::string& mirror) {
+        return frame + " mirror " + mirror;
+    }
+    const std::string& groupOf(size_t object) const {
+        static const std::string none;
+        return object < info.objects.size() ? info.objects[object].mirror : none;
     }
 
     // Step: what needs the whole sequence: the camera's clip planes, the animation (at most 3 keys
@@ -367,6 +391,16 @@ struct SequenceModel {
         }
         model.animations.push_back(anim);
 
+        // Step: the reflections' nodes, children of their frame nodes (so shown and hidden with them).
+        for (const Reflection& r : reflections) {
+            tinygltf::Node child;
+            child.name = reflectionName(model.nodes[1 + r.frame].name, r.mirror);
+            child.mesh = r.mesh;
+            child.extras = tinygltf::Value(tinygltf::Value::Object{{"mirror", tinygltf::Value(r.mirror)}});
+            model.nodes.push_back(child);
+            model.nodes[1 + r.frame].children.push_back(int(model.nodes.size()) - 1);
+        }
+
         // Scene extras: what was computed, in which units, at which camera times.
         tinygltf::Value::Array object_names;
         for (const auto& o : info.objects) object_names.push_back(tinygltf::Value(o.name));
@@ -401,6 +435,12 @@ struct SequenceModel {
     tinygltf::Value::Array frame_times;
     long long first_frame = 0;
     size_t frames = 0;
+    struct Reflection {
+        size_t frame;        // frame node 1 + frame is the parent
+        std::string mirror;  // the mirror's name
+        int mesh;
+    };
+    std::vector<Reflection> reflections;
 };
 
 size_t padded4(size_t n) { return (n + 3) / 4 * 4; }

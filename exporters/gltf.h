@@ -8,6 +8,10 @@
 //   origin keep their precision. Each primitive has NORMAL (area-weighted) and a float
 //   _EMISSION_TIME (the lab time the light left the point). A frame with nothing visible gets a
 //   node without a mesh (glTF forbids empty accessors).
+// - reflections (ExportObject::mirror set) are their own nodes: a child "frame_NNNNN mirror M" of
+//   frame node k per mirror M showing something in frame k, with one primitive per reflected
+//   object, relative to the same origin (no transform of their own; the frame's animation shows
+//   and hides them with it) and extras {"mirror": M}. They come after all frame nodes.
 // - one animation "frames" of STEP scale channels: node k is visible (scale 1) during
 //   [k/fps, (k+1)/fps) and hidden (scale 0) otherwise; the last frame stays visible at the final
 //   key n/fps, which closes the sequence (../shared/notes/dependencies.md section 4).

@@ -163,6 +163,69 @@ TEST(Cli, GlbHoldsEveryFrameAsAStepAnimation) {
     EXPECT_EQ(extras.Get("model").Get<std::string>(), "relativistic");
 }
 
+// Mirrors (issue #7): the reflections of each frame are their own node, a child of the frame
+// node named "frame_NNNNN mirror <mirror>", with no transform of its own (the frame's origin and
+// animation apply), one primitive per reflected object with that reflection's material; the
+// animation still targets the frame nodes 1 + k. Checked against the frame's PLY (same triangle
+// count over the frame node and its child) and the geometry: reflections lie behind the mirror
+// plane z = -23.675, everything else in front of it.
+TEST(Cli, ReflectionsAreChildNodesOfTheirFrames) {
+    TempDir dir;
+    ASSERT_EQ(apparentRun({"render", source("data/scenes/flanges.json"), "--out", dir.str(), "--format", "glb,ply",
+                           "--frames", "95:105", "--quiet"}).code, 0);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir / "relativistic.glb").string())) << err;
+    const size_t frames = 10;
+    ASSERT_EQ(model.nodes.size(), 1 + 2 * frames);  // camera, frame nodes, one reflection node per frame
+    ASSERT_EQ(model.animations.at(0).channels.size(), frames);
+    const std::vector<int>& roots = model.scenes.at(0).nodes;
+    auto readPositions = [&](const tinygltf::Primitive& p) {
+        const auto& acc = model.accessors[p.attributes.at("POSITION")];
+        const auto& view = model.bufferViews[acc.bufferView];
+        const uint8_t* base = model.buffers[view.buffer].data.data() + view.byteOffset + acc.byteOffset;
+        std::vector<std::array<float, 3>> out(acc.count);
+        for (size_t i = 0; i < acc.count; ++i) std::memcpy(out[i].data(), base + i * acc.ByteStride(view), 12);
+        return out;
+    };
+    const double mirror_z = -23.675;
+    for (size_t k = 0; k < frames; ++k) {
+        EXPECT_EQ(model.animations[0].channels[k].target_node, int(1 + k));
+        const tinygltf::Node& frame = model.nodes[1 + k];
+        const std::string name = (k < 5 ? "frame_000" : "frame_00") + std::to_string(95 + k);
+        ASSERT_EQ(frame.name, name);
+        ASSERT_EQ(frame.children.size(), 1u) << name;
+        const int ci = frame.children[0];
+        EXPECT_GT(ci, int(frames));  // after every frame node
+        EXPECT_EQ(std::count(roots.begin(), roots.end(), ci), 0) << "a child is no scene root";
+        const tinygltf::Node& child = model.nodes[size_t(ci)];
+        EXPECT_EQ(child.name, name + " mirror backdrop");
+        EXPECT_EQ(child.extras.Get("mirror").Get<std::string>(), "backdrop");
+        EXPECT_TRUE(child.translation.empty() && child.rotation.empty() && child.scale.empty() && child.matrix.empty());
+        ASSERT_GE(child.mesh, 0);
+        ASSERT_GE(frame.mesh, 0);
+        size_t triangles = 0;
+        for (const bool reflection : {false, true}) {
+            const tinygltf::Mesh& mesh = model.meshes[size_t(reflection ? child.mesh : frame.mesh)];
+            for (const auto& prim : mesh.primitives) {
+                triangles += model.accessors[size_t(prim.indices)].count / 3;
+                const std::string& material = model.materials.at(size_t(prim.material)).name;
+                EXPECT_EQ(material.find("(mirror backdrop)") != std::string::npos, reflection) << material;
+                for (const auto& p : readPositions(prim)) {
+                    const double z = frame.translation[2] + double(p[2]);
+                    if (reflection) EXPECT_LT(z, mirror_z + 1e-4) << material;
+                    else EXPECT_GT(z, mirror_z - 1e-4) << material;
+                }
+            }
+        }
+        PlyMesh ply;
+        OpenMesh::IO::Options opt;
+        ASSERT_TRUE(OpenMesh::IO::read_mesh(ply, (dir / ("relativistic/" + name + ".ply")).string(), opt));
+        EXPECT_EQ(triangles, ply.n_faces()) << name;
+    }
+}
+
 // Bad input: exit 2, one line naming file and field, and nothing written at all.
 TEST(Cli, BadInputExitsTwoAndWritesNothing) {
     const std::pair<const char*, const char*> cases[] = {

@@ -158,8 +158,15 @@ async function loadModel(m) {
     const name = json.nodes[ni].name || '';
     const mm = FRAME_NODE.exec(name);
     if (!mm) return;
+    // reflections in mirrors: child glTF nodes of the frame node ("frame_NNNNN mirror M")
+    const children = [];
+    o.traverse((c) => {
+      if (c !== o && gltf.parser.associations.get(c)?.nodes !== undefined) {
+        children.push({ object: c, vertices: nodeVertexCount(c, gltf.parser) });
+      }
+    });
     m.frames.push({ index: ni, name, number: Number(mm[1]), object: o,
-      vertices: nodeVertexCount(o, gltf.parser) });
+      vertices: nodeVertexCount(o, gltf.parser), children });
   });
   m.frames.sort((a, b) => a.number - b.number);
 
@@ -275,7 +282,8 @@ function applyTime(t) {
 
 function visibleOf(m) {
   if (!m.loaded) return [];
-  return m.frames.filter((f) => isShown(f.object)).map((f) => ({ name: f.name, vertices: f.vertices }));
+  return m.frames.filter((f) => isShown(f.object)).map((f) => ({ name: f.name, vertices: f.vertices,
+    reflected: f.children.filter((c) => isShown(c.object)).reduce((n, c) => n + c.vertices, 0) }));
 }
 
 function frameIndexAt(m, t) {
@@ -289,7 +297,8 @@ function updateLabels() {
     const vis = visibleOf(m);
     const k = frameIndexAt(m, time);
     const camT = k >= 0 && m.frameTimes[k] !== undefined ? ` · camera t ${Number(m.frameTimes[k]).toFixed(3)} s` : '';
-    const shown = vis.length ? vis.map((v) => `${v.name} · ${v.vertices} vertices`).join(', ') : 'empty frame';
+    const shown = vis.length ? vis.map((v) => `${v.name} · ${v.vertices} vertices` +
+      (v.reflected ? ` + ${v.reflected} in mirrors` : '')).join(', ') : 'empty frame';
     m.sub.textContent = `${shown}${camT}`;
     m.label.title = `${m.url}\n${m.cameraNote || ''}${zoom !== 1 ? `\nzoom ${zoom.toFixed(2)}×` : ''}`;
   }
@@ -486,7 +495,8 @@ window.apparentViewer = {
   get duration() { return maxDuration; },
   render,
   info,
-  // { model: [{ name: 'frame_00100', vertices: 16 }, ...] } for the frame nodes shown right now
+  // { model: [{ name: 'frame_00100', vertices: 16, reflected: 40 }, ...] } for the frame nodes shown right now
+  // (reflected: the vertices of its reflection child nodes shown with it)
   visibleFrames: () => Object.fromEntries(models.map((m) => [m.name, visibleOf(m)])),
   // { model: {x, y, width, height} } CSS pixels of each model's drawing area, relative to the page viewport
   viewports: () => Object.fromEntries(models.map((m) => {

@@ -10,6 +10,8 @@
 #     accepted and reported), MESH for a node with a mesh and EMPTY for an empty frame; the camera node too;
 #   - mesh vertex counts match the file (plain files: the referenced vertices of every primitive, which is what
 #     the importer keeps);
+#   - reflection nodes (children "frame_NNNNN mirror M" of frame nodes) are child objects of their frame objects,
+#     with the file's vertex counts, and shown exactly when their frame is;
 #   - the animation imported: every frame object has an action with scale fcurves (x, y, z), all keyframes
 #     CONSTANT (glTF STEP), at Blender frames = glTF seconds * scene.render.fps (what the importer uses);
 #   - at t = (k + 0.5) / fps for several k, and at t = duration, exactly frame object k has a non-zero world
@@ -141,6 +143,26 @@ def step_sample(times, values, t):
     return values[k]
 
 
+def mesh_summary(js, binc, mesh):
+    """(vertices Blender keeps, Draco?, POSITION min, max) of glTF mesh `mesh` (None: no mesh)."""
+    verts, draco, lo, hi = 0, False, [math.inf] * 3, [-math.inf] * 3
+    if mesh is None:
+        return verts, draco, lo, hi
+    for p in js['meshes'][mesh]['primitives']:
+        pa = js['accessors'][p['attributes']['POSITION']]
+        if 'min' in pa and 'max' in pa:
+            lo = [min(a, b) for a, b in zip(lo, pa['min'])]
+            hi = [max(a, b) for a, b in zip(hi, pa['max'])]
+        if (p.get('extensions') or {}).get('KHR_draco_mesh_compression'):
+            draco = True
+            verts += pa['count']
+        elif 'indices' in p:
+            verts += len({v[0] for v in read_accessor(js, binc, p['indices'])})
+        else:
+            verts += pa['count']
+    return verts, draco, lo, hi
+
+
 def describe(path):
     js, binc = read_glb(path)
     scene = (js.get('scenes') or [{}])[js.get('scene', 0)]
@@ -151,22 +173,15 @@ def describe(path):
         m = FRAME_NODE.match(nd.get('name', ''))
         if not m:
             continue
-        verts, draco, lo, hi = 0, False, [math.inf] * 3, [-math.inf] * 3
-        if 'mesh' in nd:
-            for p in js['meshes'][nd['mesh']]['primitives']:
-                pa = js['accessors'][p['attributes']['POSITION']]
-                if 'min' in pa and 'max' in pa:
-                    lo = [min(a, b) for a, b in zip(lo, pa['min'])]
-                    hi = [max(a, b) for a, b in zip(hi, pa['max'])]
-                if (p.get('extensions') or {}).get('KHR_draco_mesh_compression'):
-                    draco = True
-                    verts += js['accessors'][p['attributes']['POSITION']]['count']
-                elif 'indices' in p:
-                    verts += len({v[0] for v in read_accessor(js, binc, p['indices'])})
-                else:
-                    verts += js['accessors'][p['attributes']['POSITION']]['count']
+        verts, draco, lo, hi = mesh_summary(js, binc, nd.get('mesh'))
+        children = []
+        for ci in nd.get('children') or []:
+            cn = nodes[ci]
+            cv, cd, _, _ = mesh_summary(js, binc, cn.get('mesh'))
+            children.append({'index': ci, 'name': cn.get('name', ''), 'verts': cv, 'draco': cd})
         frames.append({'index': idx, 'name': nd['name'], 'number': int(m.group(1)), 'mesh': 'mesh' in nd,
-                       'verts': verts, 'draco': draco, 'bbox': (lo, hi) if lo[0] <= hi[0] else None})
+                       'verts': verts, 'draco': draco, 'bbox': (lo, hi) if lo[0] <= hi[0] else None,
+                       'children': children})
     frames.sort(key=lambda f: f['number'])
     anims = js.get('animations') or []
     anim = next((a for a in anims if a.get('name') == 'frames'), anims[0] if anims else None)
@@ -370,6 +385,28 @@ def check_file(path):
                         f'file {[round(x, 4) for x in list(wlo) + list(whi)]}')
     r.check(not badb, 'mesh bounding boxes match the POSITION min/max of the file',
             f'{len(badb)} differ, e.g. {"; ".join(badb[:2])}')
+    # reflections in mirrors (issue #7): child nodes "frame_NNNNN mirror M" of the frame nodes, imported as child
+    # objects of their frame objects with the file's vertex counts
+    new_by_name = {}
+    for o in new:
+        new_by_name.setdefault(re.sub(r'\.\d{3}$', '', o.name), []).append(o)
+    child_objs, bad_child = {}, []
+    for f, o in zip(d['frames'], objs):
+        for c in f['children']:
+            cand = new_by_name.get(c['name'], [])
+            if len(cand) != 1:
+                bad_child.append(f'{c["name"]}: {len(cand)} objects')
+                continue
+            co = cand[0]
+            child_objs[c['name']] = co
+            if o is not None and co.parent != o:
+                bad_child.append(f'{c["name"]}: parent {co.parent.name if co.parent else None}, not {o.name}')
+            nv = len(co.data.vertices) if co.type == 'MESH' else 0
+            if not ((0 < nv <= c['verts']) if c['draco'] else (nv == c['verts'])):
+                bad_child.append(f'{c["name"]}: Blender {nv} vertices, file {c["verts"]}')
+    n_children = sum(len(f['children']) for f in d['frames'])
+    r.check(not bad_child, f'{n_children} reflection nodes imported as children of their frame objects with the '
+            'file\'s vertex counts', f'{len(bad_child)} wrong, e.g. {"; ".join(bad_child[:3])}')
     tot_v = sum(len(o.data.vertices) for o in objs if o and o.type == 'MESH')
     tot_f = sum(len(o.data.polygons) for o in objs if o and o.type == 'MESH')
     print(f'  geometry: {tot_v} vertices, {tot_f} faces in Blender')
@@ -423,8 +460,13 @@ def check_file(path):
                       f'file shows {file_says[:5]}')
         ok2 = r.check(shown == [want], f'{label} (t={t:.3f} s, Blender frame {bf:.3f}): Blender shows exactly {want}',
                       f'Blender shows {shown[:5]}{" ..." if len(shown) > 5 else ""} ({len(shown)} objects)')
-        if ok1 and ok2:
-            print(f'  ok   {label}: t={t:.3f} s = Blender frame {bf:.3f} -> {shown[0]} only')
+        shown_children = sorted(name for name, co in child_objs.items() if world_scale_nonzero(co))
+        want_children = sorted(c['name'] for c in d['frames'][k]['children'])
+        ok3 = r.check(shown_children == want_children, f'{label}: Blender shows exactly the reflections of {want}',
+                      f'Blender shows {shown_children[:3]}, file {want_children[:3]}')
+        if ok1 and ok2 and ok3:
+            print(f'  ok   {label}: t={t:.3f} s = Blender frame {bf:.3f} -> {shown[0]} only'
+                  + (f' (+ {len(shown_children)} reflection nodes)' if shown_children else ''))
 
     # playback: every whole Blender frame from 0 to the end of the animation shows exactly one frame object, the
     # one the file's animation shows at that time (this is what the timeline plays)

@@ -11,9 +11,9 @@
 //   - model-viewer fires 'load' (no 'error'), availableAnimations includes "frames", duration = frames / fps;
 //   - with "frames" selected and paused, at currentTime = (k + 0.5) / fps for several k (0, 1, 3n/4, n-1, the
 //     shot frame and a quarter of it; or --frames): the element screenshot shows geometry, and the pixels that show
-//     geometry all belong to frame node k. model-viewer's public surfaceFromPoint(x, y) names the glTF mesh under a
-//     pixel, and the file maps meshes to frame nodes; the expectation is also evaluated from the file's own
-//     animation data (tests/web/glb.js);
+//     geometry all belong to frame node k (its own mesh or its reflection child nodes). model-viewer's public
+//     surfaceFromPoint(x, y) names the glTF mesh under a pixel, and the file maps meshes to frame nodes; the
+//     expectation is also evaluated from the file's own animation data (tests/web/glb.js);
 //   - the screenshot at t = --shot-time (default 10 s, taken mid-frame) shows geometry (non-background pixels), and
 //     differs from the one at a quarter of that time;
 //   - pressing play advances currentTime;
@@ -160,7 +160,13 @@ async function main() {
     f.draco = d.frames.some((x) => x.draco);
     // glTF mesh index -> frame node (what surfaceFromPoint reports is the mesh index)
     f.meshToFrame = new Map();
-    d.frames.forEach((fr, k) => { const m = d.json.nodes[fr.index].mesh; if (m !== undefined) f.meshToFrame.set(m, k); });
+    // (a frame's reflection child nodes, "frame_NNNNN mirror M", belong to it too)
+    d.frames.forEach((fr, k) => {
+      for (const ni of [fr.index, ...fr.children.map((c) => c.index)]) {
+        const m = d.json.nodes[ni].mesh;
+        if (m !== undefined) f.meshToFrame.set(m, k);
+      }
+    });
   }
   if (!files.some((f) => f.draco)) warn('no KHR_draco_mesh_compression file among the inputs: Draco not checked');
   if (!files.some((f) => !f.draco)) warn('no plain (non-Draco) file among the inputs');
@@ -254,7 +260,7 @@ async function main() {
         const img = decodePNG(png);
         if (shotFile) shots[k] = { img, file: shotFile, t };
         const fg = foreground(img);
-        if (!want.hasMesh) {
+        if (!want.hasMesh && !want.children.some((c) => c.vertices > 0)) {
           check(fg.length === 0, `${f.label} frame #${k}: empty frame shows nothing`, `${fg.length} pixels`);
           continue;
         }

@@ -94,8 +94,19 @@ function describe(file) {
         if (p.extensions && p.extensions.KHR_draco_mesh_compression) draco.push(true);
       }
     }
+    // reflection nodes: the frame node's descendants, each with its POSITION count
+    const children = [];
+    const below = [...(n.children || [])];
+    while (below.length) {
+      const c = below.pop();
+      const cn = json.nodes[c] || {};
+      let cv = 0;
+      if (cn.mesh !== undefined) for (const p of json.meshes[cn.mesh].primitives) cv += (json.accessors[p.attributes.POSITION] || {}).count || 0;
+      children.push({ index: c, name: cn.name, vertices: cv });
+      below.push(...(cn.children || []));
+    }
     frames.push({ index: i, name: n.name, number: Number(m[1]), vertices, hasMesh: n.mesh !== undefined,
-      draco: draco.length > 0, digits: m[1].length });
+      draco: draco.length > 0, digits: m[1].length, children });
   });
   frames.sort((a, b) => a.number - b.number);
   const anims = json.animations || [];
@@ -137,7 +148,8 @@ function expectedVisible(desc, t) {
     }
     return true;
   };
-  return desc.frames.filter((f) => shown(f.index)).map((f) => ({ name: f.name, vertices: f.vertices }));
+  return desc.frames.filter((f) => shown(f.index)).map((f) => ({ name: f.name, vertices: f.vertices,
+    reflected: f.children.filter((c) => shown(c.index)).reduce((n, c) => n + c.vertices, 0) }));
 }
 
 module.exports = { readGlb, readFloatAccessor, describe, expectedVisible, FRAME_NODE };
