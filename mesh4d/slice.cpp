@@ -51,6 +51,8 @@ struct FrameBuilder {
     // Cap crossings on segments of refined mesh edges, keyed by (edge, segment, cap).
     std::map<std::pair<uint64_t, uint64_t>, uint32_t> sub_crossings;
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being refined
+    bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restTriangle
+    double rest_tolerance = 0;          // the tolerance restTriangle keeps (settings.tolerance is 0 at rest)
     size_t limited_edges = 0;           // edges that reached max_segments before the tolerance
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
@@ -151,6 +153,110 @@ struct FrameBuilder {
         if (world.cap_b_real && viewSideSign(view, on_b) > 0) return Side::Gone;
         return Side::Inside;
     }
+
+    // Clip curves on the past cone (objects at rest, see restTriangle). On a cap, events are affine in the rest
+    // point, and h = viewSide = (t_c - t) - |x - C| is concave along them: negative at every corner
+    // of a segment or triangle, it may still be positive inside (a cap curve poking in between
+    // samples: the middle of a large triangle seen first). Its excess over the corners' largest
+    // value is at most L^2 / (8 d) on a segment and L^2 / (6 d) on a triangle (L: longest side of
+    // the cap events, d: their least distance from the camera). This returns how much finer the
+    // piece must get, as a ratio in levelFor's sense (<= 1: it cannot hide a crossing). A poke
+    // whose h stays below limit^2 / (2 d) is ignored: near its top h falls off about as
+    // rho^2 / (2 d) with the distance rho from it, so it is narrower than `limit`.
+    double hiddenCrossingRatio(const Event* e, const double* h, int n, double limit) const {
+        double hmax = -INFINITY, L = 0, dmin = INFINITY;
+        for (int i = 0; i < n; ++i) {
+            if (!(h[i] < 0)) return 0;  // a corner on the inside: no hidden crossing to fear
+            hmax = std::max(hmax, h[i]);
+            dmin = std::min(dmin, norm(e[i].x - view.apex));
+            for (int j = i + 1; j < n; ++j) L = std::max(L, norm(e[i].x - e[j].x));
+        }
+        if (view.kind != ViewKind::PastCone) return 0;  // h is affine on a hyperplane
+        const double d = dmin - L;
+        if (!(d > 0)) return INFINITY;  // the camera among the events: as fine as allowed
+        const double excess = L * L / ((n == 2 ? 8.0 : 6.0) * d);
+        const double narrow = limit * limit / (2 * d);
+        if (hmax + excess <= narrow) return 0;
+        // Twice the ratio that would just pass, so a refined piece clears the bound with margin.
+        return 2 * excess / std::max(-hmax, narrow);
+    }
+
+    bool capReal(int cap) const { return cap == 0 ? world.cap_a_real : world.cap_b_real; }
+
+    // The cap event of the rest point with barycentrics `l` on vertices `v` (affine in l).
+    Event capAt(const uint32_t v[3], const double l[3], int cap) const {
+        Event r{0, {0, 0, 0}};
+        for (int c = 0; c < 3; ++c) {
+            const Event& e = world.events[2 * v[c] + cap];
+            r.t += l[c] * e.t;
+            r.x += e.x * l[c];
+        }
+        return r;
+    }
+
+    // How much finer the domain must get around the piece (a, b, c) (barycentrics on `v`) for its
+    // clip to hold: a real cap's curve may not hide in it or its sides, and where the curve
+    // crosses it the straight output edge between the two exact crossings must lie within `limit`
+    // of the curve's image (measured at the chord's middle, against the curve point found on the
+    // line across the chord there). Ratio as in levelFor; <= 1 when the piece passes.
+    double clipRatio(const uint32_t v[3], const double* la, const double* lb, const double* lc, double limit) const {
+        if (view.kind != ViewKind::PastCone) return 0;  // hyperplane: straight clip lines, exact crossings
+        const double* l[3] = {la, lb, lc};
+        double ratio = 0;
+        for (int cap = 0; cap < 2; ++cap) {
+            if (!capReal(cap)) continue;
+            Event e[3];
+            double h[3];
+            for (int i = 0; i < 3; ++i) {
+                e[i] = capAt(v, l[i], cap);
+                h[i] = viewSide(view, e[i]);
+            }
+            ratio = std::max(ratio, hiddenCrossingRatio(e, h, 3, limit));
+            // The curve's crossings of the sides; a side with both ends outside may hide two.
+            double cross[2][3];
+            int found = 0;
+            for (int i = 0; i < 3; ++i) {
+                const int j = (i + 1) % 3;
+                if ((h[i] < 0) == (h[j] < 0)) {
+                    const Event se[2] = {e[i], e[j]};
+                    const double sh[2] = {h[i], h[j]};
+                    ratio = std::max(ratio, hiddenCrossingRatio(se, sh, 2, limit));
+                    continue;
+                }
+                if (found == 2) continue;
+                const double t = cutSegment(view, e[i], e[j]);
+                for (int k = 0; k < 3; ++k) cross[found][k] = l[i][k] * (1 - t) + l[j][k] * t;
+                ++found;
+            }
+            if (found != 2) continue;
+            double mid[3], across[3];
+            for (int k = 0; k < 3; ++k) mid[k] = 0.5 * (cross[0][k] + cross[1][k]);
+            // Across the chord in the (u, v) = (l1, l2) parameter plane, as long as the chord.
+            const double du = cross[1][1] - cross[0][1], dv = cross[1][2] - cross[0][2];
+            across[1] = -dv;
+            across[2] = du;
+            across[0] = -(across[1] + across[2]);
+            double p0[3], p1[3];
+            for (int k = 0; k < 3; ++k) {
+                p0[k] = mid[k] - across[k];
+                p1[k] = mid[k] + across[k];
+            }
+            const Event q0 = capAt(v, p0, cap), q1 = capAt(v, p1, cap);
+            if ((viewSide(view, q0) < 0) == (viewSide(view, q1) < 0)) {
+                ratio = std::max(ratio, 4.0);  // the curve bends away by more than the chord: halve it
+                continue;
+            }
+            const double t = cutSegment(view, q0, q1);
+            double on[3];
+            for (int k = 0; k < 3; ++k) on[k] = p0[k] * (1 - t) + p1[k] * t;
+            const Vec3 chord_mid = (surfaceAt(v, cross[0]).x + surfaceAt(v, cross[1]).x) * 0.5;
+            const double dev = norm(surfaceAt(v, on).x - chord_mid);
+            if (!(dev == dev)) return INFINITY;
+            ratio = std::max(ratio, dev / limit);
+        }
+        return ratio;
+    }
+
 
     // Step (refinement): split edge `edge` into the fewest equal parameter segments whose exact
     // midpoints lie within T/8 of their chords; decided once per frame, from lo to hi, from the
@@ -441,10 +547,155 @@ struct FrameBuilder {
         for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
     }
 
+    // Step (objects at rest on the past cone, with a real cap, tolerance > 0). The surface is the
+    // input itself (the cut is affine), but a cap meets the cone in a sphere, so the clip curves
+    // are circles. A triangle a cap may cut is split in four, recursively, where a cap's curve could
+    // hide in a piece or its chord through the piece lies farther than T/4 from the circle
+    // (clipRatio); the pieces are clipped at exact crossings as in vertex mode. Splitting only near
+    // the curve keeps the output small; the triangle is flat, so pieces of different sizes meet
+    // without gaps (at T-junctions). A whole mesh edge keeps its shared crossing (crossingPoint).
+    static constexpr int kRestDepth = 20;            // deepest split: pieces 2^-20 of the triangle
+    static constexpr int64_t kRestOne = int64_t(1) << kRestDepth;  // barycentric 1 in piece keys
+
+    struct RestPiece {
+        int64_t k[3][2];  // each corner's barycentrics on corners 1 and 2, in units of 2^-kRestDepth
+    };
+
+    void restTriangle(size_t f) {
+        const auto& tri = world.mesh.triangles[f];
+        const uint32_t v[3] = {tri[0], tri[1], tri[2]};
+        for (int c = 0; c < 3; ++c) cur_edges[c] = world.triangle_edges[f][c];
+        const bool agree = side[v[0]] == side[v[1]] && side[v[1]] == side[v[2]];
+        if (agree && side[v[0]] == Side::Gone) return;  // h > 0 at the corners of cap b holds inside
+        const RestPiece whole{{{0, 0}, {kRestOne, 0}, {0, kRestOne}}};
+        const double limit = kMidpointShare * rest_tolerance;
+        if (agree && pieceRatio(v, whole, limit) <= 1) {
+            if (side[v[0]] == Side::Inside) addOutput(f, {vertexPoint(v[0]), vertexPoint(v[1]), vertexPoint(v[2])});
+            return;
+        }
+        ++out.clipped_triangles;
+        std::map<std::pair<int64_t, int64_t>, uint32_t> points;                      // piece corner -> output
+        std::map<std::pair<std::pair<int64_t, int64_t>, int64_t>, uint32_t> crossings;  // piece side, cap -> output
+        bool limited = false;
+        restPiece(f, v, whole, 0, limit, points, crossings, &limited);
+        if (limited) ++out.limited_triangles;
+    }
+
+    static void pieceBarycentrics(const RestPiece& p, int c, double l[3]) {
+        l[1] = double(p.k[c][0]) / double(kRestOne);
+        l[2] = double(p.k[c][1]) / double(kRestOne);
+        l[0] = double(kRestOne - p.k[c][0] - p.k[c][1]) / double(kRestOne);
+    }
+
+    double pieceRatio(const uint32_t v[3], const RestPiece& p, double limit) const {
+        double l[3][3];
+        for (int c = 0; c < 3; ++c) pieceBarycentrics(p, c, l[c]);
+        return clipRatio(v, l[0], l[1], l[2], limit);
+    }
+
+    // The triangle corner a piece corner is, or -1.
+    static int cornerOf(const int64_t k[2]) {
+        if (k[0] == 0 && k[1] == 0) return 0;
+        if (k[0] == kRestOne && k[1] == 0) return 1;
+        if (k[0] == 0 && k[1] == kRestOne) return 2;
+        return -1;
+    }
+
+    void restPiece(size_t f, const uint32_t v[3], const RestPiece& p, int depth, double limit,
+                   std::map<std::pair<int64_t, int64_t>, uint32_t>& points,
+                   std::map<std::pair<std::pair<int64_t, int64_t>, int64_t>, uint32_t>& crossings, bool* limited) {
+        const double ratio = pieceRatio(v, p, limit);
+        if (ratio > 1 && depth < kRestDepth) {
+            // Step: split in four at the sides' midpoints (exact in the integer keys).
+            int64_t m[3][2];
+            for (int c = 0; c < 3; ++c)
+                for (int a = 0; a < 2; ++a) m[c][a] = (p.k[c][a] + p.k[(c + 1) % 3][a]) / 2;
+            const RestPiece kids[4] = {
+                {{{p.k[0][0], p.k[0][1]}, {m[0][0], m[0][1]}, {m[2][0], m[2][1]}}},
+                {{{m[0][0], m[0][1]}, {p.k[1][0], p.k[1][1]}, {m[1][0], m[1][1]}}},
+                {{{m[2][0], m[2][1]}, {m[1][0], m[1][1]}, {p.k[2][0], p.k[2][1]}}},
+                {{{m[0][0], m[0][1]}, {m[1][0], m[1][1]}, {m[2][0], m[2][1]}}}};
+            for (const RestPiece& kid : kids) restPiece(f, v, kid, depth + 1, limit, points, crossings, limited);
+            return;
+        }
+        if (ratio > 1) *limited = true;
+        // Step: the piece's corners: sides (exact sign at its cap events) and output points.
+        Side sd[3];
+        double l[3][3];
+        for (int c = 0; c < 3; ++c) {
+            pieceBarycentrics(p, c, l[c]);
+            const int corner = cornerOf(p.k[c]);
+            sd[c] = corner >= 0 ? side[v[corner]] : sideOf(capAt(v, l[c], 0), capAt(v, l[c], 1));
+        }
+        auto pointAt = [&](int c) -> uint32_t {
+            const int corner = cornerOf(p.k[c]);
+            if (corner >= 0) return vertexPoint(v[corner]);
+            uint32_t& id = points.try_emplace({p.k[c][0], p.k[c][1]}, kUnset).first->second;
+            if (id == kUnset) {
+                const Vec3 rest = restAt(v, l[c]);
+                id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+            }
+            return id;
+        };
+        // The crossing of side c -> c + 1 with cap `cap`, the same for both pieces along that side.
+        auto crossingAt = [&](int c, int cap) -> uint32_t {
+            const int d = (c + 1) % 3;
+            const int ca = cornerOf(p.k[c]), cb = cornerOf(p.k[d]);
+            if (ca >= 0 && cb >= 0) {  // a whole mesh edge: shared with the neighbouring triangle
+                for (int e = 0; e < 3; ++e) {
+                    const Edge& edge = world.edges[cur_edges[e]];
+                    if ((edge.lo == v[ca] && edge.hi == v[cb]) || (edge.lo == v[cb] && edge.hi == v[ca]))
+                        return crossingPoint(cur_edges[e], cap);
+                }
+            }
+            // Parametrised from the corner with the smaller key, so both pieces make the same point.
+            const std::pair<int64_t, int64_t> kc{p.k[c][0], p.k[c][1]}, kd{p.k[d][0], p.k[d][1]};
+            const bool forward = kc < kd;
+            const std::pair<int64_t, int64_t> k0 = forward ? kc : kd, k1 = forward ? kd : kc;
+            uint32_t& id = crossings.try_emplace({{k0.first * (kRestOne + 1) + k0.second,
+                                                   k1.first * (kRestOne + 1) + k1.second}, cap}, kUnset).first->second;
+            if (id != kUnset) return id;
+            const double* l0 = forward ? l[c] : l[d];
+            const double* l1 = forward ? l[d] : l[c];
+            const double s = cutSegment(view, capAt(v, l0, cap), capAt(v, l1, cap));
+            double lm[3];
+            for (int a = 0; a < 3; ++a) lm[a] = l0[a] * (1 - s) + l1[a] * s;
+            const Vec3 rest = restAt(v, lm);
+            return id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+        };
+        // Step: keep the part between the caps (Sutherland-Hodgman, as clipWhole).
+        if (sd[0] == Side::Inside && sd[1] == Side::Inside && sd[2] == Side::Inside) {
+            addOutput(f, {pointAt(0), pointAt(1), pointAt(2)});
+            return;
+        }
+        if (sd[0] == sd[1] && sd[1] == sd[2]) return;
+        uint32_t polygon[6];
+        int n = 0;
+        for (int c = 0; c < 3; ++c) {
+            const Side si = sd[c], sj = sd[(c + 1) % 3];
+            if (si == Side::Inside) polygon[n++] = pointAt(c);
+            if (si == sj) continue;
+            const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
+            const bool cross_b = si == Side::Gone || sj == Side::Gone;
+            const bool a_first = si == Side::NotYet || sj == Side::Gone;
+            if (cross_a && cross_b) {
+                polygon[n++] = crossingAt(c, a_first ? 0 : 1);
+                polygon[n++] = crossingAt(c, a_first ? 1 : 0);
+            } else {
+                polygon[n++] = crossingAt(c, cross_a ? 0 : 1);
+            }
+        }
+        for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
+    }
+
     // Step: one triangle: whole, refined, or clipped to the span.
     void addTriangle(size_t f) {
         const auto& tri = world.mesh.triangles[f];
         const Side s0 = side[tri[0]], s1 = side[tri[1]], s2 = side[tri[2]];
+        if (rest_clip) {
+            restTriangle(f);
+            return;
+        }
         const bool inside = s0 == Side::Inside && s1 == Side::Inside && s2 == Side::Inside;
         if (!inside && s0 == s1 && s1 == s2) return;  // wholly before or after existence
         if (!inside) ++out.clipped_triangles;
@@ -496,8 +747,14 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     // Model only what the cut requires: on a hyperplane, or at rest, the map from the rest
     // surface to the apparent one is affine, so straight edges are exact and nothing is refined.
     SliceSettings settings = requested;
+    // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
+    // are refined (FrameBuilder::restTriangle).
+    const bool rest_clip = view.kind == ViewKind::PastCone && world.motion.beta == 0 && settings.tolerance > 0 &&
+                           (world.cap_a_real || world.cap_b_real);
     if (view.kind == ViewKind::Hyperplane || world.motion.beta == 0) settings.tolerance = 0;
     FrameBuilder b(world, view, settings);
+    b.rest_clip = rest_clip;
+    b.rest_tolerance = requested.tolerance;
     if (world.empty()) return std::move(b.out);
     // Step: the fast path of vertex mode when nothing is clipped: output vertex i is the image of
     // input vertex i and the triangles are the input's (the same result as below, made in one pass).

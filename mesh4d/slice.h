@@ -37,6 +37,12 @@
 // so neighbours share them): the clip curve is a polyline whose vertices lie exactly on the
 // tilted cap and on the cone; inside chords are checked as above, the clip chords themselves are
 // measured by the tests, not bounded.
+// An object at rest on the past cone is its input (an affine cut), except where a real cap clips
+// it: the cap is one lab time, so the cone meets it in a sphere and the clip curves are circles.
+// With T > 0 such a triangle is split in four, recursively, only where a cap's curve could hide in
+// a piece (the side function is concave: its excess over the corners is bounded) or a chord
+// through a piece lies more than T/4 from the curve, and the pieces are clipped at exact
+// crossings: a large triangle whose middle is seen before its corners shows that middle.
 #pragma once
 
 #include <array>

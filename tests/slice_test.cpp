@@ -1,6 +1,7 @@
 // Tests of one frame's cut against closed forms (DESIGN.md section 10) and against the inverse map.
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <random>
 
 #include "mesh4d/normals.h"
@@ -202,7 +203,9 @@ TEST(Slice, ClippedSurfaceHasNoCracks) {
         if (out.triangles.empty()) continue;
         const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
         EXPECT_TRUE(t.manifold) << "t_c " << t_c;
-        if (out.clipped_triangles == 0) EXPECT_TRUE(t.closed) << "t_c " << t_c;
+        if (out.clipped_triangles == 0) {
+            EXPECT_TRUE(t.closed) << "t_c " << t_c;
+        }
     }
 }
 
@@ -246,4 +249,75 @@ TEST(Normals, CreaseSplitKeepsCurvesSmoothAndFoldsSharp) {
     EXPECT_EQ(c.mesh.positions.size(), s.positions.size());
     for (size_t i = 0; i < c.normals.size(); ++i)
         EXPECT_GT(dot(c.normals[i], c.mesh.positions[i]), 0.99);  // close to the radial direction
+}
+
+// An object at rest that exists for lab time [-16, -10] (a 30 x 8 ls quad of two triangles, 23.675
+// ls in front of the camera, like the default scene's backdrop) is seen where its distance from
+// the camera lies in [t_c + 10, t_c + 16]: the quad's plane cut by two spheres, so its clip
+// curves are circles about the foot F of the camera on the plane. With a tolerance (restTriangle)
+// the output stays within T of that region both ways, its vertices lie inside it, and at t_c = 8
+// s, when only a disc of radius 3.94 ls about F is seen (every corner of the quad still too far),
+// the output has the disc's area less the segment below the quad's lower edge (closed form).
+TEST(Slice, ObjectsAtRestAppearAlongCircles) {
+    RestMesh quad;
+    quad.positions = {{-15, 0, 0}, {15, 0, 0}, {15, 8, 0}, {-15, 8, 0}};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    const Vec3 origin{0, -2.05, -23.675};
+    const Motion m = makeMotion(Kinematics::Lorentz, 0.0, origin, {0, 0, 0});
+    const World4D w = extrude(quad, m, -16, -10, true, true);
+    SliceSettings s;
+    s.tolerance = 1e-3;
+    const double p = 23.675;  // distance of the camera (origin) from the quad's plane z = -23.675
+    for (double t_c : {7.8, 8.0, 9.0, 12.0, 15.0, 17.0, 18.5}) {
+        const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
+        const ApparentMesh out = testmesh::sliceAbsolute(w, view, s);
+        const double R_out = t_c + 16, R_in = t_c + 10;
+        const double r_out = R_out > p ? std::sqrt((R_out - p) * (R_out + p)) : -1;
+        const double r_in = R_in > p ? std::sqrt((R_in - p) * (R_in + p)) : 0;
+        auto rho = [&](const Vec3& x) { return std::hypot(x.x, x.y); };  // in-plane distance from F = (0, 0)
+        if (r_out < 0) {
+            EXPECT_TRUE(out.triangles.empty()) << "t_c " << t_c;
+            continue;
+        }
+        // Vertices inside the region (to rounding); sampled output points within T of it.
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const double d = norm(out.positions[i]);
+            EXPECT_LE(d, R_out + 1e-9) << "t_c " << t_c;
+            EXPECT_GE(d, R_in - 1e-9) << "t_c " << t_c;
+            EXPECT_NEAR(out.positions[i].z, -p, 1e-12);
+        }
+        double area = 0;
+        for (const auto& t : out.triangles) {
+            const Vec3 a = out.positions[t[0]], b = out.positions[t[1]], c = out.positions[t[2]];
+            area += 0.5 * norm(cross(b - a, c - a));
+            for (const Vec3& x : {(a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5, (a + b + c) / 3.0})
+                EXPECT_LE(std::max({rho(x) - r_out, r_in - rho(x), 0.0}), s.tolerance) << "t_c " << t_c;
+        }
+        // Every seen point of a grid over the quad within T of the output (planar: distance in the plane).
+        double worst = 0;
+        size_t seen = 0;
+        for (int i = 0; i <= 150; ++i)
+            for (int j = 0; j <= 40; ++j) {
+                const Vec3 x = origin + Vec3{-15 + 0.2 * i, 0.2 * j, 0};
+                if (rho(x) > r_out || rho(x) < r_in) continue;
+                ++seen;
+                double best = INFINITY;
+                for (const auto& t : out.triangles) {
+                    best = std::min(best, pointTriangleDistance(x, out.positions[t[0]], out.positions[t[1]],
+                                                                out.positions[t[2]]));
+                    if (best == 0) break;
+                }
+                worst = std::max(worst, best);
+            }
+        std::cout << "[rest clip] t_c " << t_c << ": " << out.triangles.size() << " triangles, " << seen
+                  << " seen grid points, farthest from the output " << worst << " ls\n";
+        EXPECT_LE(worst, s.tolerance) << "t_c " << t_c;
+        if (t_c == 8.0) {
+            // Disc of radius r about F, less the segment beyond the lower edge 2.05 ls below F.
+            const double r = r_out, a = 2.05;
+            const double exact = M_PI * r * r - (r * r * std::acos(a / r) - a * std::sqrt(r * r - a * a));
+            EXPECT_GT(seen, 100u);
+            EXPECT_NEAR(area, exact, 2 * M_PI * r * s.tolerance) << "every corner outside, the middle seen";
+        }
+    }
 }
