@@ -112,7 +112,7 @@ void BM_ExportFrame(benchmark::State& state) {
     apparent::SequenceInfo info;
     info.model = "relativistic";
     info.fps = 10;
-    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, ""});
+    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, -1, ""});
     for (auto _ : state) {
         apparent::ExportFrame frame;
         frame.objects.push_back(mesh4d::sliceWorld(p.world, p.view, {}));

@@ -25,7 +25,10 @@ struct ExportFrame {
 struct ExportObject {
     std::string name;
     std::array<double, 4> base_color{0.8, 0.8, 0.8, 1.0};  // linear RGBA
-    std::string mirror;  // a reflection: the name of the mirror it is seen in; empty for the scene's own objects
+    // A reflection: the mirror it is seen in, as an index among the scene's mirrors (-1: one of the
+    // scene's own objects) and by name (for node names).
+    int mirror_index = -1;
+    std::string mirror;
 };
 
 struct ExportCamera {

@@ -293,17 +293,17 @@ struct SequenceModel {
                   GlbStats* stats, std::string* error) {
         tinygltf::Node node;
         node.name = frameName(f.index);
-        // Step: the objects' groups in order of first appearance: "" (the frame node) then mirrors.
-        std::vector<std::string> groups;
+        // Step: the objects' groups in order: -1 (the frame node) first, then mirrors as they appear.
+        std::vector<int> groups;
         for (size_t o = 0; o < f.objects.size(); ++o) {
             if (f.objects[o].triangles.empty()) continue;
-            const std::string& g = groupOf(o);
+            const int g = groupOf(o);
             if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
         }
-        std::stable_partition(groups.begin(), groups.end(), [](const std::string& g) { return g.empty(); });
-        for (const std::string& group : groups) {
+        std::stable_partition(groups.begin(), groups.end(), [](int g) { return g < 0; });
+        for (const int group : groups) {
             tinygltf::Mesh mesh;
-            mesh.name = group.empty() ? node.name : reflectionName(node.name, group);
+            mesh.name = group < 0 ? node.name : reflectionName(node.name, mirrorName(group));
             for (size_t o = 0; o < f.objects.size(); ++o) {
                 if (f.objects[o].triangles.empty() || groupOf(o) != group) continue;
                 tinygltf::Primitive prim;
@@ -321,10 +321,10 @@ struct SequenceModel {
                 mesh.primitives.push_back(prim);
             }
             b.model.meshes.push_back(mesh);
-            if (group.empty())
+            if (group < 0)
                 node.mesh = int(b.model.meshes.size()) - 1;
             else
-                reflections.push_back({frames, group, int(b.model.meshes.size()) - 1});
+                reflections.push_back({frames, mirrorName(group), int(b.model.meshes.size()) - 1});
         }
         // Reflections are relative to the same origin: their child nodes need no transform.
         if (!groups.empty()) node.translation = {origin[0], origin[1], origin[2]};
@@ -342,9 +342,12 @@ struct SequenceModel {
     static std::string reflectionName(const std::string& frame, const std::string& mirror) {
         return frame + " mirror " + mirror;
     }
-    const std::string& groupOf(size_t object) const {
-        static const std::string none;
-        return object < info.objects.size() ? info.objects[object].mirror : none;
+    int groupOf(size_t object) const { return object < info.objects.size() ? info.objects[object].mirror_index : -1; }
+    // The name of mirror `index` (of its first reflection), or "#index" when it has none.
+    std::string mirrorName(int index) const {
+        for (const ExportObject& o : info.objects)
+            if (o.mirror_index == index && !o.mirror.empty()) return o.mirror;
+        return "#" + std::to_string(index);
     }
 
     // Step: what needs the whole sequence: the camera's clip planes, the animation (at most 3 keys

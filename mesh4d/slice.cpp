@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "exact_side.h"
 #include "robust.h"
@@ -51,8 +52,8 @@ struct FrameBuilder {
     // Cap crossings on segments of refined mesh edges, keyed by (edge, segment, cap).
     std::map<std::pair<uint64_t, uint64_t>, uint32_t> sub_crossings;
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being refined
-    bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restTriangle
-    double rest_tolerance = 0;          // the tolerance restTriangle keeps (settings.tolerance is 0 at rest)
+    bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restPlan
+    double rest_tolerance = 0;          // the tolerance restPlan keeps (settings.tolerance is 0 at rest)
     size_t limited_edges = 0;           // edges that reached max_segments before the tolerance
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
@@ -154,28 +155,34 @@ struct FrameBuilder {
         return Side::Inside;
     }
 
-    // Clip curves on the past cone (objects at rest, see restTriangle). On a cap, events are affine in the rest
+    // Clip curves on the past cone (objects at rest, see restPlan). On a cap, events are affine in the rest
     // point, and h = viewSide = (t_c - t) - |x - C| is concave along them: negative at every corner
     // of a segment or triangle, it may still be positive inside (a cap curve poking in between
     // samples: the middle of a large triangle seen first). Its excess over the corners' largest
     // value is at most L^2 / (8 d) on a segment and L^2 / (6 d) on a triangle (L: longest side of
     // the cap events, d: their least distance from the camera). This returns how much finer the
     // piece must get, as a ratio in levelFor's sense (<= 1: it cannot hide a crossing). A poke
-    // whose h stays below limit^2 / (2 d) is ignored: near its top h falls off about as
-    // rho^2 / (2 d) with the distance rho from it, so it is narrower than `limit`.
+    // whose h stays below limit^2 / (2 dmin) is ignored: about its top (at distance r0 <= dmin
+    // from the camera) h falls off as rho^2 / (2 r0) with the distance rho, so it is narrower
+    // than `limit`.
     double hiddenCrossingRatio(const Event* e, const double* h, int n, double limit) const {
-        double hmax = -INFINITY, L = 0, dmin = INFINITY;
+        double hmax = -INFINITY, L = 0, dmin = INFINITY, tmax = -INFINITY;
         for (int i = 0; i < n; ++i) {
             if (!(h[i] < 0)) return 0;  // a corner on the inside: no hidden crossing to fear
             hmax = std::max(hmax, h[i]);
+            tmax = std::max(tmax, view.t_c - e[i].t);
             dmin = std::min(dmin, norm(e[i].x - view.apex));
             for (int j = i + 1; j < n; ++j) L = std::max(L, norm(e[i].x - e[j].x));
         }
         if (view.kind != ViewKind::PastCone) return 0;  // h is affine on a hyperplane
         const double d = dmin - L;
-        if (!(d > 0)) return INFINITY;  // the camera among the events: as fine as allowed
+        if (!(d > 0)) {
+            // The camera among the events: h <= t_c - t there; the light has not left any of them
+            // yet, or so little time ago that whatever shows is narrower than the limit.
+            return tmax <= limit ? 0 : INFINITY;
+        }
         const double excess = L * L / ((n == 2 ? 8.0 : 6.0) * d);
-        const double narrow = limit * limit / (2 * d);
+        const double narrow = limit * limit / (2 * dmin);
         if (hmax + excess <= narrow) return 0;
         // Twice the ratio that would just pass, so a refined piece clears the bound with margin.
         return 2 * excess / std::max(-hmax, narrow);
@@ -229,6 +236,7 @@ struct FrameBuilder {
                 ++found;
             }
             if (found != 2) continue;
+            if (cross[0][1] == cross[1][1] && cross[0][2] == cross[1][2]) continue;  // through a corner: no chord
             double mid[3], across[3];
             for (int k = 0; k < 3; ++k) mid[k] = 0.5 * (cross[0][k] + cross[1][k]);
             // Across the chord in the (u, v) = (l1, l2) parameter plane, as long as the chord.
@@ -551,141 +559,307 @@ struct FrameBuilder {
     // input itself (the cut is affine), but a cap meets the cone in a sphere, so the clip curves
     // are circles. A triangle a cap may cut is split in four, recursively, where a cap's curve could
     // hide in a piece or its chord through the piece lies farther than T/4 from the circle
-    // (clipRatio); the pieces are clipped at exact crossings as in vertex mode. Splitting only near
-    // the curve keeps the output small; the triangle is flat, so pieces of different sizes meet
-    // without gaps (at T-junctions). A whole mesh edge keeps its shared crossing (crossingPoint).
-    static constexpr int kRestDepth = 20;            // deepest split: pieces 2^-20 of the triangle
+    // (clipRatio), at most to 2^-depth of the triangle with 2^depth <= max_segments. Each leaf
+    // piece is then a convex polygon: its corners and the corners of finer neighbours on its sides
+    // (so the pieces of a triangle meet edge to edge), clipped at exact crossings as in vertex mode.
+    // Points and crossings on a mesh edge are keyed by the edge and their place along it, so the
+    // two triangles of the edge share those they both make; where the two split the edge
+    // differently they meet at T-junctions (the edge is straight: no gap). A whole mesh edge keeps
+    // its vertex-mode crossing (crossingPoint).
+    static constexpr int kRestDepth = 20;                          // deepest split the keys can hold
     static constexpr int64_t kRestOne = int64_t(1) << kRestDepth;  // barycentric 1 in piece keys
+    using Key = std::pair<int64_t, int64_t>;                       // barycentrics on corners 1, 2 (x 2^-20)
 
     struct RestPiece {
-        int64_t k[3][2];  // each corner's barycentrics on corners 1 and 2, in units of 2^-kRestDepth
+        Key k[3];
     };
 
-    void restTriangle(size_t f) {
-        const auto& tri = world.mesh.triangles[f];
-        const uint32_t v[3] = {tri[0], tri[1], tri[2]};
-        for (int c = 0; c < 3; ++c) cur_edges[c] = world.triangle_edges[f][c];
-        const bool agree = side[v[0]] == side[v[1]] && side[v[1]] == side[v[2]];
-        if (agree && side[v[0]] == Side::Gone) return;  // h > 0 at the corners of cap b holds inside
-        const RestPiece whole{{{0, 0}, {kRestOne, 0}, {0, kRestOne}}};
-        const double limit = kMidpointShare * rest_tolerance;
-        if (agree && pieceRatio(v, whole, limit) <= 1) {
-            if (side[v[0]] == Side::Inside) addOutput(f, {vertexPoint(v[0]), vertexPoint(v[1]), vertexPoint(v[2])});
-            return;
-        }
-        ++out.clipped_triangles;
-        std::map<std::pair<int64_t, int64_t>, uint32_t> points;                      // piece corner -> output
-        std::map<std::pair<std::pair<int64_t, int64_t>, int64_t>, uint32_t> crossings;  // piece side, cap -> output
-        bool limited = false;
-        restPiece(f, v, whole, 0, limit, points, crossings, &limited);
-        if (limited) ++out.limited_triangles;
-    }
+    // Points on mesh edges (per frame): (edge, place from lo in 2^-20) -> output vertex, and crossings
+    // on a stretch of a mesh edge: (edge, from, to, cap) -> output vertex.
+    std::map<std::pair<uint32_t, int64_t>, uint32_t> rest_edge_points;
+    std::map<std::pair<std::pair<uint32_t, int64_t>, std::pair<int64_t, int>>, uint32_t> rest_edge_crossings;
 
-    static void pieceBarycentrics(const RestPiece& p, int c, double l[3]) {
-        l[1] = double(p.k[c][0]) / double(kRestOne);
-        l[2] = double(p.k[c][1]) / double(kRestOne);
-        l[0] = double(kRestOne - p.k[c][0] - p.k[c][1]) / double(kRestOne);
+    static void barycentrics(const Key& k, double l[3]) {
+        l[1] = double(k.first) / double(kRestOne);
+        l[2] = double(k.second) / double(kRestOne);
+        l[0] = double(kRestOne - k.first - k.second) / double(kRestOne);
     }
 
     double pieceRatio(const uint32_t v[3], const RestPiece& p, double limit) const {
         double l[3][3];
-        for (int c = 0; c < 3; ++c) pieceBarycentrics(p, c, l[c]);
+        for (int c = 0; c < 3; ++c) barycentrics(p.k[c], l[c]);
         return clipRatio(v, l[0], l[1], l[2], limit);
     }
 
-    // The triangle corner a piece corner is, or -1.
-    static int cornerOf(const int64_t k[2]) {
-        if (k[0] == 0 && k[1] == 0) return 0;
-        if (k[0] == kRestOne && k[1] == 0) return 1;
-        if (k[0] == 0 && k[1] == kRestOne) return 2;
+    // The triangle corner a key is, or -1.
+    static int cornerOf(const Key& k) {
+        if (k.first == 0 && k.second == 0) return 0;
+        if (k.first == kRestOne && k.second == 0) return 1;
+        if (k.first == 0 && k.second == kRestOne) return 2;
         return -1;
     }
 
-    void restPiece(size_t f, const uint32_t v[3], const RestPiece& p, int depth, double limit,
-                   std::map<std::pair<int64_t, int64_t>, uint32_t>& points,
-                   std::map<std::pair<std::pair<int64_t, int64_t>, int64_t>, uint32_t>& crossings, bool* limited) {
-        const double ratio = pieceRatio(v, p, limit);
-        if (ratio > 1 && depth < kRestDepth) {
-            // Step: split in four at the sides' midpoints (exact in the integer keys).
-            int64_t m[3][2];
+    // Whether a key lies on triangle side s (0: corners 0-1, 1: 1-2, 2: 2-0), and its place along
+    // the side from the side's first corner.
+    static bool onSide(const Key& k, int s, int64_t* place) {
+        if (s == 0 && k.second == 0) { *place = k.first; return true; }
+        if (s == 1 && k.first + k.second == kRestOne) { *place = k.second; return true; }
+        if (s == 2 && k.first == 0) { *place = kRestOne - k.second; return true; }
+        return false;
+    }
+    // The side a point that is no corner lies on, or -1.
+    static int sideOfKey(const Key& k, int64_t* place) {
+        for (int s = 0; s < 3; ++s)
+            if (onSide(k, s, place)) return s;
+        return -1;
+    }
+
+    // Pass 1 (restPlan, every triangle): the leaf pieces, and their places along the mesh edges;
+    // pass 2 (restEmit, once all triangles are planned): the polygons, with the corners of finer
+    // neighbours on every side, also across mesh edges, so the pieces meet edge to edge.
+    struct RestPlan {
+        size_t f = 0;
+        std::vector<RestPiece> leaves;
+        std::set<Key> corners;
+    };
+    std::vector<RestPlan> rest_plans;
+    std::map<uint32_t, std::set<int64_t>> rest_edge_places;  // mesh edge -> leaf corners on it (place from lo)
+
+    void restPlan(size_t f) {
+        const auto& tri = world.mesh.triangles[f];
+        const uint32_t v[3] = {tri[0], tri[1], tri[2]};
+        const bool agree = side[v[0]] == side[v[1]] && side[v[1]] == side[v[2]];
+        if (agree && side[v[0]] == Side::Gone) return;  // h > 0 at the corners of cap b holds inside
+        const RestPiece whole{{{0, 0}, {kRestOne, 0}, {0, kRestOne}}};
+        const double limit = kMidpointShare * rest_tolerance;
+        const double whole_ratio = pieceRatio(v, whole, limit);
+        if (agree && side[v[0]] == Side::NotYet && whole_ratio <= 1) return;  // nothing can show yet
+        if (!agree || whole_ratio > 1) ++out.clipped_triangles;
+        RestPlan plan;
+        plan.f = f;
+        int max_depth = 0;
+        while (max_depth < kRestDepth && (int64_t(1) << (max_depth + 1)) <= std::max(settings.max_segments, 1)) ++max_depth;
+        bool limited = false;
+        splitPiece(v, whole, whole_ratio, 0, max_depth, limit, &plan.leaves, &plan.corners, &limited);
+        if (limited) ++out.limited_triangles;
+        for (const Key& k : plan.corners) {
+            for (int sd = 0; sd < 3; ++sd) {
+                int64_t place = 0;
+                if (cornerOf(k) >= 0 || !onSide(k, sd, &place)) continue;
+                const uint32_t edge = world.triangle_edges[f][sd];
+                rest_edge_places[edge].insert(world.edges[edge].lo == v[sd] ? place : kRestOne - place);
+            }
+        }
+        rest_plans.push_back(std::move(plan));
+    }
+
+    void restEmit(const RestPlan& plan) {
+        const size_t f = plan.f;
+        const auto& tri = world.mesh.triangles[f];
+        const uint32_t v[3] = {tri[0], tri[1], tri[2]};
+        for (int c = 0; c < 3; ++c) cur_edges[c] = world.triangle_edges[f][c];
+        std::map<Key, uint32_t> points;                                     // inner point -> output vertex
+        std::map<std::pair<std::pair<Key, Key>, int>, uint32_t> crossings;  // inner stretch, cap -> output vertex
+        std::vector<Key> poly;
+        for (const RestPiece& p : plan.leaves) {
+            poly.clear();
+            for (int c = 0; c < 3; ++c) {
+                poly.push_back(p.k[c]);
+                hangingCorners(v, p.k[c], p.k[(c + 1) % 3], plan.corners, &poly);
+            }
+            clipRestPolygon(f, v, poly, points, crossings);
+        }
+    }
+
+    // The key of the point at `place` along triangle side s from its first corner.
+    static Key keyOnSide(int s, int64_t place) {
+        if (s == 0) return {place, 0};
+        if (s == 1) return {kRestOne - place, place};
+        return {0, kRestOne - place};
+    }
+
+    void splitPiece(const uint32_t v[3], const RestPiece& p, double ratio, int depth, int max_depth, double limit,
+                    std::vector<RestPiece>* leaves, std::set<Key>* corners, bool* limited) const {
+        if (ratio > 1 && depth < max_depth) {
+            Key m[3];
             for (int c = 0; c < 3; ++c)
-                for (int a = 0; a < 2; ++a) m[c][a] = (p.k[c][a] + p.k[(c + 1) % 3][a]) / 2;
-            const RestPiece kids[4] = {
-                {{{p.k[0][0], p.k[0][1]}, {m[0][0], m[0][1]}, {m[2][0], m[2][1]}}},
-                {{{m[0][0], m[0][1]}, {p.k[1][0], p.k[1][1]}, {m[1][0], m[1][1]}}},
-                {{{m[2][0], m[2][1]}, {m[1][0], m[1][1]}, {p.k[2][0], p.k[2][1]}}},
-                {{{m[0][0], m[0][1]}, {m[1][0], m[1][1]}, {m[2][0], m[2][1]}}}};
-            for (const RestPiece& kid : kids) restPiece(f, v, kid, depth + 1, limit, points, crossings, limited);
+                m[c] = {(p.k[c].first + p.k[(c + 1) % 3].first) / 2, (p.k[c].second + p.k[(c + 1) % 3].second) / 2};
+            const RestPiece kids[4] = {{{p.k[0], m[0], m[2]}}, {{m[0], p.k[1], m[1]}}, {{m[2], m[1], p.k[2]}},
+                                       {{m[0], m[1], m[2]}}};
+            for (const RestPiece& kid : kids)
+                splitPiece(v, kid, pieceRatio(v, kid, limit), depth + 1, max_depth, limit, leaves, corners, limited);
             return;
         }
         if (ratio > 1) *limited = true;
-        // Step: the piece's corners: sides (exact sign at its cap events) and output points.
-        Side sd[3];
-        double l[3][3];
-        for (int c = 0; c < 3; ++c) {
-            pieceBarycentrics(p, c, l[c]);
-            const int corner = cornerOf(p.k[c]);
-            sd[c] = corner >= 0 ? side[v[corner]] : sideOf(capAt(v, l[c], 0), capAt(v, l[c], 1));
-        }
-        auto pointAt = [&](int c) -> uint32_t {
-            const int corner = cornerOf(p.k[c]);
-            if (corner >= 0) return vertexPoint(v[corner]);
-            uint32_t& id = points.try_emplace({p.k[c][0], p.k[c][1]}, kUnset).first->second;
-            if (id == kUnset) {
-                const Vec3 rest = restAt(v, l[c]);
-                id = emit(cutRestLocal(anchor, world.motion, rest), rest);
-            }
-            return id;
-        };
-        // The crossing of side c -> c + 1 with cap `cap`, the same for both pieces along that side.
-        auto crossingAt = [&](int c, int cap) -> uint32_t {
-            const int d = (c + 1) % 3;
-            const int ca = cornerOf(p.k[c]), cb = cornerOf(p.k[d]);
-            if (ca >= 0 && cb >= 0) {  // a whole mesh edge: shared with the neighbouring triangle
-                for (int e = 0; e < 3; ++e) {
-                    const Edge& edge = world.edges[cur_edges[e]];
-                    if ((edge.lo == v[ca] && edge.hi == v[cb]) || (edge.lo == v[cb] && edge.hi == v[ca]))
-                        return crossingPoint(cur_edges[e], cap);
-                }
-            }
-            // Parametrised from the corner with the smaller key, so both pieces make the same point.
-            const std::pair<int64_t, int64_t> kc{p.k[c][0], p.k[c][1]}, kd{p.k[d][0], p.k[d][1]};
-            const bool forward = kc < kd;
-            const std::pair<int64_t, int64_t> k0 = forward ? kc : kd, k1 = forward ? kd : kc;
-            uint32_t& id = crossings.try_emplace({{k0.first * (kRestOne + 1) + k0.second,
-                                                   k1.first * (kRestOne + 1) + k1.second}, cap}, kUnset).first->second;
-            if (id != kUnset) return id;
-            const double* l0 = forward ? l[c] : l[d];
-            const double* l1 = forward ? l[d] : l[c];
-            const double s = cutSegment(view, capAt(v, l0, cap), capAt(v, l1, cap));
-            double lm[3];
-            for (int a = 0; a < 3; ++a) lm[a] = l0[a] * (1 - s) + l1[a] * s;
-            const Vec3 rest = restAt(v, lm);
-            return id = emit(cutRestLocal(anchor, world.motion, rest), rest);
-        };
-        // Step: keep the part between the caps (Sutherland-Hodgman, as clipWhole).
-        if (sd[0] == Side::Inside && sd[1] == Side::Inside && sd[2] == Side::Inside) {
-            addOutput(f, {pointAt(0), pointAt(1), pointAt(2)});
+        leaves->push_back(p);
+        for (const Key& k : p.k) corners->insert(k);
+    }
+
+    // Corners of other leaves strictly inside the side a -> b, in order: on a mesh edge, those of
+    // both triangles of the edge; inside the triangle, those of its finer leaves (which halve the
+    // side dyadically).
+    void hangingCorners(const uint32_t v[3], const Key& a, const Key& b, const std::set<Key>& corners,
+                        std::vector<Key>* out_keys) const {
+        for (int sd = 0; sd < 3; ++sd) {
+            int64_t pa = 0, pb = 0;
+            if (!onSide(a, sd, &pa) || !onSide(b, sd, &pb)) continue;
+            const uint32_t edge = cur_edges[sd];
+            auto it = rest_edge_places.find(edge);
+            if (it == rest_edge_places.end()) return;
+            const bool from_lo = world.edges[edge].lo == v[sd];
+            const int64_t qa = from_lo ? pa : kRestOne - pa, qb = from_lo ? pb : kRestOne - pb;
+            std::vector<int64_t> between(it->second.upper_bound(std::min(qa, qb)), it->second.lower_bound(std::max(qa, qb)));
+            if (qa > qb) std::reverse(between.begin(), between.end());
+            for (int64_t q : between) out_keys->push_back(keyOnSide(sd, from_lo ? q : kRestOne - q));
             return;
         }
-        if (sd[0] == sd[1] && sd[1] == sd[2]) return;
-        uint32_t polygon[6];
-        int n = 0;
-        for (int c = 0; c < 3; ++c) {
-            const Side si = sd[c], sj = sd[(c + 1) % 3];
-            if (si == Side::Inside) polygon[n++] = pointAt(c);
+        innerHanging(a, b, corners, out_keys);
+    }
+
+    static void innerHanging(const Key& a, const Key& b, const std::set<Key>& corners, std::vector<Key>* out_keys) {
+        if ((a.first + b.first) % 2 != 0 || (a.second + b.second) % 2 != 0) return;
+        const Key m{(a.first + b.first) / 2, (a.second + b.second) / 2};
+        if (!corners.count(m)) return;
+        innerHanging(a, m, corners, out_keys);
+        out_keys->push_back(m);
+        innerHanging(m, b, corners, out_keys);
+    }
+
+    // Output vertex of a piece corner: a mesh vertex, a point on a mesh edge (shared by the edge's
+    // triangles), or an inner point of this triangle.
+    uint32_t restPoint(const uint32_t v[3], const Key& k, std::map<Key, uint32_t>& points) {
+        const int corner = cornerOf(k);
+        if (corner >= 0) return vertexPoint(v[corner]);
+        double l[3];
+        barycentrics(k, l);
+        int64_t place = 0;
+        const int on = sideOfKey(k, &place);
+        uint32_t* id;
+        if (on >= 0) {
+            const uint32_t edge = cur_edges[on];
+            const bool forward = world.edges[edge].lo == v[on];
+            id = &rest_edge_points.try_emplace({edge, forward ? place : kRestOne - place}, kUnset).first->second;
+        } else {
+            id = &points.try_emplace(k, kUnset).first->second;
+        }
+        if (*id == kUnset) {
+            const Vec3 rest = restAt(v, l);
+            *id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+        }
+        return *id;
+    }
+
+    Side restSide(const uint32_t v[3], const Key& k) const {
+        const int corner = cornerOf(k);
+        if (corner >= 0) return side[v[corner]];
+        double l[3];
+        barycentrics(k, l);
+        return sideOf(capAt(v, l, 0), capAt(v, l, 1));
+    }
+
+    // The crossing of the stretch a -> b of a piece's boundary with cap `cap`.
+    uint32_t restCrossing(const uint32_t v[3], const Key& a, const Key& b, Side sa, Side sb, int cap,
+                          std::map<Key, uint32_t>& points, std::map<std::pair<std::pair<Key, Key>, int>, uint32_t>& crossings) {
+        // Parametrised from the smaller key so both pieces along the stretch make the same point.
+        const bool forward = a < b;
+        const Key& k0 = forward ? a : b;
+        const Key& k1 = forward ? b : a;
+        const Side s0 = forward ? sa : sb, s1 = forward ? sb : sa;
+        const int c0 = cornerOf(k0), c1 = cornerOf(k1);
+        if (c0 >= 0 && c1 >= 0) {  // a whole mesh edge: its vertex-mode crossing
+            for (int e = 0; e < 3; ++e) {
+                const Edge& edge = world.edges[cur_edges[e]];
+                if ((edge.lo == v[c0] && edge.hi == v[c1]) || (edge.lo == v[c1] && edge.hi == v[c0]))
+                    return crossingPoint(cur_edges[e], cap);
+            }
+        }
+        // On a mesh edge: keyed by the edge and the stretch's places along it from lo.
+        int64_t p0 = 0, p1 = 0;
+        int on = -1;
+        for (int side_index = 0; side_index < 3 && on < 0; ++side_index)
+            if (onSide(k0, side_index, &p0) && onSide(k1, side_index, &p1)) on = side_index;
+        uint32_t* id;
+        bool flip = false;  // parametrise from the edge's lo end
+        if (on >= 0) {
+            const uint32_t edge = cur_edges[on];
+            const bool from_lo = world.edges[edge].lo == v[on];
+            int64_t q0 = from_lo ? p0 : kRestOne - p0, q1 = from_lo ? p1 : kRestOne - p1;
+            if (q1 < q0) {
+                std::swap(q0, q1);
+                flip = true;
+            }
+            id = &rest_edge_crossings.try_emplace({{edge, q0}, {q1, cap}}, kUnset).first->second;
+        } else {
+            id = &crossings.try_emplace({{k0, k1}, cap}, kUnset).first->second;
+        }
+        if (*id != kUnset) return *id;
+        const Key& from = flip ? k1 : k0;
+        const Key& to = flip ? k0 : k1;
+        const Side sfrom = flip ? s1 : s0, sto = flip ? s0 : s1;
+        double l0[3], l1[3];
+        barycentrics(from, l0);
+        barycentrics(to, l1);
+        const double s = cutSegment(view, capAt(v, l0, cap), capAt(v, l1, cap));
+        // The cap passes exactly through a visible end: the crossing is that point (as crossingPoint).
+        if (s == 0 && sfrom == Side::Inside) return *id = restPoint(v, from, points);
+        if (s == 1 && sto == Side::Inside) return *id = restPoint(v, to, points);
+        double lm[3];
+        for (int c = 0; c < 3; ++c) lm[c] = l0[c] * (1 - s) + l1[c] * s;
+        const Vec3 rest = restAt(v, lm);
+        return *id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+    }
+
+    // One leaf polygon (convex, possibly with straight runs of corners) clipped to the span and
+    // emitted: as a fan from its first kept corner when no three consecutive corners are in line,
+    // else as a fan about the centre of its corners (no zero-area triangles).
+    void clipRestPolygon(size_t f, const uint32_t v[3], const std::vector<Key>& poly, std::map<Key, uint32_t>& points,
+                         std::map<std::pair<std::pair<Key, Key>, int>, uint32_t>& crossings) {
+        const size_t n = poly.size();
+        std::vector<Side> sd(n);
+        bool all_inside = true, all_same = true;
+        for (size_t i = 0; i < n; ++i) {
+            sd[i] = restSide(v, poly[i]);
+            all_inside &= sd[i] == Side::Inside;
+            all_same &= sd[i] == sd[0];
+        }
+        if (all_same && !all_inside) return;
+        std::vector<uint32_t> ids;
+        for (size_t i = 0; i < n; ++i) {
+            const size_t j = (i + 1) % n;
+            const Side si = sd[i], sj = sd[j];
+            if (si == Side::Inside) ids.push_back(restPoint(v, poly[i], points));
             if (si == sj) continue;
             const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
             const bool cross_b = si == Side::Gone || sj == Side::Gone;
             const bool a_first = si == Side::NotYet || sj == Side::Gone;
             if (cross_a && cross_b) {
-                polygon[n++] = crossingAt(c, a_first ? 0 : 1);
-                polygon[n++] = crossingAt(c, a_first ? 1 : 0);
+                ids.push_back(restCrossing(v, poly[i], poly[j], si, sj, a_first ? 0 : 1, points, crossings));
+                ids.push_back(restCrossing(v, poly[i], poly[j], si, sj, a_first ? 1 : 0, points, crossings));
             } else {
-                polygon[n++] = crossingAt(c, cross_a ? 0 : 1);
+                ids.push_back(restCrossing(v, poly[i], poly[j], si, sj, cross_a ? 0 : 1, points, crossings));
             }
         }
-        for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
+        // Drop repeats (a crossing that is a kept corner), then triangulate.
+        std::vector<uint32_t> ring;
+        for (uint32_t id : ids)
+            if (ring.empty() || ring.back() != id) ring.push_back(id);
+        while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+        if (ring.size() < 3) return;
+        auto inLine = [&](uint32_t a, uint32_t b, uint32_t c) {
+            const Vec3 ab = out.positions[b] - out.positions[a], ac = out.positions[c] - out.positions[a];
+            return norm(cross(ab, ac)) <= 1e-12 * norm2(ab) + 1e-12 * norm2(ac);
+        };
+        bool straight_run = false;
+        for (size_t i = 0; i < ring.size() && !straight_run; ++i)
+            straight_run = inLine(ring[i], ring[(i + 1) % ring.size()], ring[(i + 2) % ring.size()]);
+        if (!straight_run) {
+            for (size_t k = 1; k + 1 < ring.size(); ++k) addOutput(f, {ring[0], ring[k], ring[k + 1]});
+            return;
+        }
+        Vec3 rest{0, 0, 0};
+        for (uint32_t id : ring) rest += out.rest_points[id] * (1.0 / double(ring.size()));
+        const uint32_t centre = emit(cutRestLocal(anchor, world.motion, rest), rest);
+        for (size_t k = 0; k < ring.size(); ++k) addOutput(f, {centre, ring[k], ring[(k + 1) % ring.size()]});
     }
 
     // Step: one triangle: whole, refined, or clipped to the span.
@@ -693,7 +867,7 @@ struct FrameBuilder {
         const auto& tri = world.mesh.triangles[f];
         const Side s0 = side[tri[0]], s1 = side[tri[1]], s2 = side[tri[2]];
         if (rest_clip) {
-            restTriangle(f);
+            restPlan(f);
             return;
         }
         const bool inside = s0 == Side::Inside && s1 == Side::Inside && s2 == Side::Inside;
@@ -748,7 +922,7 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     // surface to the apparent one is affine, so straight edges are exact and nothing is refined.
     SliceSettings settings = requested;
     // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
-    // are refined (FrameBuilder::restTriangle).
+    // are refined (FrameBuilder::restPlan).
     const bool rest_clip = view.kind == ViewKind::PastCone && world.motion.beta == 0 && settings.tolerance > 0 &&
                            (world.cap_a_real || world.cap_b_real);
     if (view.kind == ViewKind::Hyperplane || world.motion.beta == 0) settings.tolerance = 0;
@@ -802,6 +976,7 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     } else {
         for (size_t f = 0; f < world.mesh.triangles.size(); ++f) b.addTriangle(f);
     }
+    for (const auto& plan : b.rest_plans) b.restEmit(plan);
     b.out.limited_triangles += b.limited_edges;
     return std::move(b.out);
 }

@@ -41,8 +41,10 @@
 // it: the cap is one lab time, so the cone meets it in a sphere and the clip curves are circles.
 // With T > 0 such a triangle is split in four, recursively, only where a cap's curve could hide in
 // a piece (the side function is concave: its excess over the corners is bounded) or a chord
-// through a piece lies more than T/4 from the curve, and the pieces are clipped at exact
-// crossings: a large triangle whose middle is seen before its corners shows that middle.
+// through a piece lies more than T/4 from the curve (at most to 1/max_segments of the triangle),
+// and the pieces, with their finer neighbours' corners on their sides, are clipped at exact
+// crossings: a large triangle whose middle is seen before its corners shows that middle, and
+// pieces meet edge to edge, also across mesh edges.
 #pragma once
 
 #include <array>

@@ -114,6 +114,8 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
     const Vec3 axis_u = across / mesh4d::norm(across);
     const Vec3 axis_v = mesh4d::cross(mirror.normal, axis_u);
     const double camera_height = mesh4d::dot(camera - mirror.point, mirror.normal);
+    // A camera in the mirror's plane sees it edge on: no reflection.
+    if (!(std::fabs(camera_height) > 1e-12 * (mesh4d::norm(camera - mirror.point) + 1))) return out;
     auto planeCoordinates = [&](const Vec3& p, double uv[2]) {  // p's central projection from the camera
         const double h = mesh4d::dot(p - mirror.point, mirror.normal);
         const Vec3 m = camera + (camera_height / (camera_height - h)) * (p - camera);
@@ -129,7 +131,8 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
             Vec3 n = mesh4d::cross(tri[e] - camera, tri[(e + 1) % 3] - camera);
             if (mesh4d::dot(n, tri[(e + 2) % 3] - camera) < 0) n = -n;
             py.n[e] = n;
-            const double uv[2] = {mesh4d::dot(tri[e] - mirror.point, axis_u), mesh4d::dot(tri[e] - mirror.point, axis_v)};
+            double uv[2];
+            planeCoordinates(tri[e], uv);  // on the plane to rounding (findMirrors): through the camera, exact
             for (int c = 0; c < 2; ++c) {
                 py.lo[c] = std::min(py.lo[c], uv[c]);
                 py.hi[c] = std::max(py.hi[c], uv[c]);
@@ -241,6 +244,7 @@ void MirrorReflections::describe(SequenceInfo* info) const {
     for (const Target& target : targets_) {
         ExportObject o = originals[target.object];
         o.name = o.name + " (mirror " + names_[target.mirror] + ")";
+        o.mirror_index = int(target.mirror);
         o.mirror = names_[target.mirror];
         for (int c = 0; c < 3; ++c) o.base_color[size_t(c)] *= kReflectance;
         info->objects.push_back(o);

@@ -1,8 +1,10 @@
 // Tests of one frame's cut against closed forms (DESIGN.md section 10) and against the inverse map.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <random>
+#include <tuple>
 
 #include "mesh4d/normals.h"
 #include "mesh4d/robust.h"
@@ -267,6 +269,7 @@ TEST(Slice, ObjectsAtRestAppearAlongCircles) {
     const World4D w = extrude(quad, m, -16, -10, true, true);
     SliceSettings s;
     s.tolerance = 1e-3;
+    s.max_segments = 4096;  // a 2.4 ls circle in a 30 ls triangle needs pieces of 1/512 (256 is the default limit)
     const double p = 23.675;  // distance of the camera (origin) from the quad's plane z = -23.675
     for (double t_c : {7.8, 8.0, 9.0, 12.0, 15.0, 17.0, 18.5}) {
         const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
@@ -309,7 +312,21 @@ TEST(Slice, ObjectsAtRestAppearAlongCircles) {
                 }
                 worst = std::max(worst, best);
             }
-        std::cout << "[rest clip] t_c " << t_c << ": " << out.triangles.size() << " triangles, " << seen
+        // One oriented piece of surface (or two, where the hole of the end cap cuts through):
+        // pieces meet edge to edge, no point twice, nothing limited.
+        const apparent::Topology topo = apparent::analyzeTopology(out.positions, out.triangles);
+        EXPECT_TRUE(topo.manifold) << "t_c " << t_c;
+        EXPECT_LE(topo.components, 2u) << "t_c " << t_c;
+        EXPECT_EQ(out.limited_triangles, 0u) << "t_c " << t_c;
+        std::vector<Vec3> sorted = out.positions;
+        std::sort(sorted.begin(), sorted.end(), [](const Vec3& a, const Vec3& b) {
+            return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+        });
+        size_t twins = 0;
+        for (size_t i = 0; i + 1 < sorted.size(); ++i) twins += norm(sorted[i + 1] - sorted[i]) < 1e-9;
+        EXPECT_EQ(twins, 0u) << "t_c " << t_c;
+        std::cout << "[rest clip] t_c " << t_c << ": " << out.triangles.size() << " triangles, " << topo.components
+                  << " component(s), " << topo.boundary_loops << " boundary loop(s), " << seen
                   << " seen grid points, farthest from the output " << worst << " ls\n";
         EXPECT_LE(worst, s.tolerance) << "t_c " << t_c;
         if (t_c == 8.0) {
@@ -320,4 +337,32 @@ TEST(Slice, ObjectsAtRestAppearAlongCircles) {
             EXPECT_NEAR(area, exact, 2 * M_PI * r * s.tolerance) << "every corner outside, the middle seen";
         }
     }
+}
+
+// The cap through a vertex of an object at rest: a triangle whose nearest point to the camera is a
+// corner exactly 5 ls away (3-4-5), existing from lab time -16, seen at t_c = -11: the cone meets
+// the cap exactly at that corner, which is inside (zero counts as inside). The clip point there is the corner itself:
+// no zero-area triangle, no point twice, no piece split to the limit.
+TEST(Slice, RestClipThroughAVertex) {
+    RestMesh tri;
+    tri.positions = {{0, 4, 0}, {3, 8, 0}, {-3, 8, 0}};  // nearest to the camera's foot (0, 0): the corner
+    tri.triangles = {{0, 1, 2}};
+    const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -3}, {0, 0, 0});
+    const World4D w = extrude(tri, m, -16, 100, true, false);
+    SliceSettings s;
+    s.tolerance = 1e-3;
+    const ApparentMesh out = testmesh::sliceAbsolute(w, {ViewKind::PastCone, -11.0, {0, 0, 0}}, s);
+    EXPECT_EQ(out.limited_triangles, 0u);
+    for (const auto& t : out.triangles) {
+        const Vec3 a = out.positions[t[0]], b = out.positions[t[1]], c = out.positions[t[2]];
+        EXPECT_GT(norm(cross(b - a, c - a)), 0.0);
+    }
+    size_t at_corner = 0;
+    for (const Vec3& p : out.positions) at_corner += norm(p - Vec3{0, 4, -3}) < 1e-12;
+    EXPECT_LE(at_corner, 1u);
+    // The rest of the triangle is farther than 5 ls: nothing else is seen yet.
+    double area = 0;
+    for (const auto& t : out.triangles)
+        area += 0.5 * norm(cross(out.positions[t[1]] - out.positions[t[0]], out.positions[t[2]] - out.positions[t[0]]));
+    EXPECT_LT(area, 1e-9);
 }
