@@ -607,6 +607,11 @@ struct FrameBuilder {
         if (s == 2 && k.first == 0) { *place = kRestOne - k.second; return true; }
         return false;
     }
+    // A place along triangle f's side s (from the side's first corner), counted from its mesh
+    // edge's lo end instead: the same number for both triangles of the edge.
+    int64_t placeFromLo(const uint32_t v[3], int s, uint32_t edge, int64_t place) const {
+        return world.edges[edge].lo == v[s] ? place : kRestOne - place;
+    }
     // The side a point that is no corner lies on, or -1.
     static int sideOfKey(const Key& k, int64_t* place) {
         for (int s = 0; s < 3; ++s)
@@ -647,7 +652,7 @@ struct FrameBuilder {
                 int64_t place = 0;
                 if (cornerOf(k) >= 0 || !onSide(k, sd, &place)) continue;
                 const uint32_t edge = world.triangle_edges[f][sd];
-                rest_edge_places[edge].insert(world.edges[edge].lo == v[sd] ? place : kRestOne - place);
+                rest_edge_places[edge].insert(placeFromLo(v, sd, edge, place));
             }
         }
         rest_plans.push_back(std::move(plan));
@@ -706,11 +711,10 @@ struct FrameBuilder {
             const uint32_t edge = cur_edges[sd];
             auto it = rest_edge_places.find(edge);
             if (it == rest_edge_places.end()) return;
-            const bool from_lo = world.edges[edge].lo == v[sd];
-            const int64_t qa = from_lo ? pa : kRestOne - pa, qb = from_lo ? pb : kRestOne - pb;
+            const int64_t qa = placeFromLo(v, sd, edge, pa), qb = placeFromLo(v, sd, edge, pb);
             std::vector<int64_t> between(it->second.upper_bound(std::min(qa, qb)), it->second.lower_bound(std::max(qa, qb)));
             if (qa > qb) std::reverse(between.begin(), between.end());
-            for (int64_t q : between) out_keys->push_back(keyOnSide(sd, from_lo ? q : kRestOne - q));
+            for (int64_t q : between) out_keys->push_back(keyOnSide(sd, placeFromLo(v, sd, edge, q)));  // its own inverse
             return;
         }
         innerHanging(a, b, corners, out_keys);
@@ -737,8 +741,7 @@ struct FrameBuilder {
         uint32_t* id;
         if (on >= 0) {
             const uint32_t edge = cur_edges[on];
-            const bool forward = world.edges[edge].lo == v[on];
-            id = &rest_edge_points.try_emplace({edge, forward ? place : kRestOne - place}, kUnset).first->second;
+            id = &rest_edge_points.try_emplace({edge, placeFromLo(v, on, edge, place)}, kUnset).first->second;
         } else {
             id = &points.try_emplace(k, kUnset).first->second;
         }
@@ -765,25 +768,18 @@ struct FrameBuilder {
         const Key& k0 = forward ? a : b;
         const Key& k1 = forward ? b : a;
         const Side s0 = forward ? sa : sb, s1 = forward ? sb : sa;
-        const int c0 = cornerOf(k0), c1 = cornerOf(k1);
-        if (c0 >= 0 && c1 >= 0) {  // a whole mesh edge: its vertex-mode crossing
-            for (int e = 0; e < 3; ++e) {
-                const Edge& edge = world.edges[cur_edges[e]];
-                if ((edge.lo == v[c0] && edge.hi == v[c1]) || (edge.lo == v[c1] && edge.hi == v[c0]))
-                    return crossingPoint(cur_edges[e], cap);
-            }
-        }
         // On a mesh edge: keyed by the edge and the stretch's places along it from lo.
         int64_t p0 = 0, p1 = 0;
         int on = -1;
         for (int side_index = 0; side_index < 3 && on < 0; ++side_index)
             if (onSide(k0, side_index, &p0) && onSide(k1, side_index, &p1)) on = side_index;
+        // Two triangle corners: a whole mesh edge, whose vertex-mode crossing both triangles use.
+        if (on >= 0 && cornerOf(k0) >= 0 && cornerOf(k1) >= 0) return crossingPoint(cur_edges[on], cap);
         uint32_t* id;
         bool flip = false;  // parametrise from the edge's lo end
         if (on >= 0) {
             const uint32_t edge = cur_edges[on];
-            const bool from_lo = world.edges[edge].lo == v[on];
-            int64_t q0 = from_lo ? p0 : kRestOne - p0, q1 = from_lo ? p1 : kRestOne - p1;
+            int64_t q0 = placeFromLo(v, on, edge, p0), q1 = placeFromLo(v, on, edge, p1);
             if (q1 < q0) {
                 std::swap(q0, q1);
                 flip = true;
