@@ -52,6 +52,28 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         }
     }
 
+    // The cycle of slots around each edge (World4D::slot_next).
+    {
+        const uint32_t unset = 0xffffffffu;
+        std::vector<uint32_t> first(world.edges.size(), unset), last(world.edges.size(), unset);
+        world.slot_next.resize(3 * mesh.triangles.size());
+        for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+            const auto& t = mesh.triangles[f];
+            const bool degenerate = t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
+            for (int c = 0; c < 3; ++c) {
+                const uint32_t slot = uint32_t(3 * f + c);
+                world.slot_next[slot] = slot;
+                if (degenerate) continue;
+                const uint32_t e = world.triangle_edges[f][c];
+                if (first[e] == unset) first[e] = slot;
+                else world.slot_next[last[e]] = slot;
+                last[e] = slot;
+            }
+        }
+        for (size_t e = 0; e < world.edges.size(); ++e)
+            if (last[e] != unset) world.slot_next[last[e]] = first[e];
+    }
+
     // Three tetrahedra per prism, staircase split over the vertices sorted by id.
     world.tets.reserve(3 * mesh.triangles.size());
     for (const auto& tri : mesh.triangles) {

@@ -65,6 +65,12 @@ struct World4D {
     std::vector<std::array<uint32_t, 4>> tets;  // 3 per triangle, indices into events
     std::vector<Edge> edges;                    // unique undirected edges of the mesh
     std::vector<std::array<uint32_t, 3>> triangle_edges;  // edge of (v0,v1), (v1,v2), (v2,v0)
+    // The triangles around each edge as a cycle of slots: slot 3 f + c (edge c of triangle f) ->
+    // the next slot on the same mesh edge, in triangle order, the last back to the first; a
+    // boundary edge's slot points to itself (two slots on a manifold edge, more on a non-manifold
+    // one). Triangles that repeat an index are left out (their slots point to themselves). The
+    // adaptive refinement (slice.cpp) splits an edge in every triangle of its cycle.
+    std::vector<uint32_t> slot_next;
     std::vector<uint8_t> vertex_used;           // 1 where a triangle references the rest vertex
     std::vector<TriangleChunk> chunks;          // runs of kChunkTriangles triangles, in order
     double shape_radius = 0;                    // max |q| over the used rest vertices

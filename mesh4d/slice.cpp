@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <set>
+#include <unordered_map>
 
+#include "chord_error.h"
 #include "exact_side.h"
 #include "robust.h"
-#include "tessellate.h"
 
 namespace mesh4d {
 
@@ -18,22 +21,34 @@ enum class Side : uint8_t { NotYet, Inside, Gone };
 
 constexpr uint32_t kUnset = 0xffffffffu;
 
-// Refinement (see slice.h): each inner output chord's exact midpoint must lie within this
-// fraction of the tolerance, and each segment of a split mesh edge within half of it. A triangle
-// of the ring next to an edge spans a whole edge segment, so its inner chords are about as long
-// as that segment: the stricter edge limit leaves them room to pass at the inner limit instead of
-// forcing an ever finer interior grid. Any output triangle's three midpoints then sum to at most
-// 3/4 of the tolerance (at most 5/8 next to an edge).
+// The rest clip (restPlan): a chord of a cap's clip circle through a piece must lie within this
+// fraction of the tolerance of the circle.
 constexpr double kMidpointShare = 0.25;
-constexpr double kEdgeMidpointShare = 0.125;
 
-// Segment count or lattice level from a deviation ratio (chord error falls as 1/n^2): the ratio
-// is clamped in double before the conversion, so NaN, infinities and huge ratios give `cap`
-// instead of undefined behaviour.
-uint32_t levelFor(double current, double ratio, uint32_t cap) {
-    const double want = current * std::sqrt(ratio);
-    if (!(want < double(cap))) return cap;  // also NaN
-    return std::max<uint32_t>(1, uint32_t(std::ceil(want)));
+// Sutherland-Hodgman over the span between the caps, for a convex polygon of n corners whose
+// sides are s[i]: the corners inside the span, and on each side i -> i + 1 whose ends lie on
+// different sides of a cap, that cap's crossing (both caps' crossings, in order along the side,
+// when it runs from before existing to after). corner(i) and crossing(i, j, cap) give output ids.
+// Writes at most 2 n ids to `out` and returns their count (a triangle gives at most 5).
+template <class Corner, class Crossing>
+int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t* out) {
+    int k = 0;
+    for (int i = 0; i < n; ++i) {
+        const int j = (i + 1) % n;
+        const Side si = s[i], sj = s[j];
+        if (si == Side::Inside) out[k++] = corner(i);
+        if (si == sj) continue;
+        const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
+        const bool cross_b = si == Side::Gone || sj == Side::Gone;
+        const bool a_first = si == Side::NotYet || sj == Side::Gone;
+        if (cross_a && cross_b) {
+            out[k++] = crossing(i, j, a_first ? 0 : 1);
+            out[k++] = crossing(i, j, a_first ? 1 : 0);
+        } else {
+            out[k++] = crossing(i, j, cross_a ? 0 : 1);
+        }
+    }
+    return k;
 }
 
 struct FrameBuilder {
@@ -45,16 +60,9 @@ struct FrameBuilder {
     std::vector<Side> side;
     std::vector<uint32_t> vertex_out;     // rest vertex -> output vertex
     std::vector<uint32_t> crossing_out;   // 2 * edge + cap -> output vertex
-    // Refinement of each edge: its segment count (0 = not yet decided), and the events and output
-    // ids (made on first use) of its inner points from lo to hi, at edge_first[e] .. + segments - 2.
-    std::vector<uint32_t> edge_segments, edge_first, edge_ids;
-    std::vector<Event> edge_events;
-    // Cap crossings on segments of refined mesh edges, keyed by (edge, segment, cap).
-    std::map<std::pair<uint64_t, uint64_t>, uint32_t> sub_crossings;
-    uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being refined
+    uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being clipped (rest clip)
     bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restPlan
     double rest_tolerance = 0;          // the tolerance restPlan keeps (settings.tolerance is 0 at rest)
-    size_t limited_edges = 0;           // edges that reached max_segments before the tolerance
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)) {
@@ -142,10 +150,9 @@ struct FrameBuilder {
     }
 
     // The exact image of vertex i (local coordinates), without emitting it.
-    Event vertexEvent(uint32_t i) const { return cutRestLocal(anchor, world.motion, world.mesh.positions[i]); }
-    // Its position: the emitted one when the vertex is visible (the same value, computed once).
-    Vec3 vertexImage(uint32_t i) const {
-        return vertex_out[i] != kUnset ? out.positions[vertex_out[i]] : vertexEvent(i).x;
+    Event vertexEvent(uint32_t i) const {
+        if (i < r_pos.size()) return {r_time[i], r_pos[i]};  // the refinement's batch cut (bit-identical)
+        return cutRestLocal(anchor, world.motion, world.mesh.positions[i]);
     }
 
     // Which side of the real caps a rest point falls on, from its events on both caps.
@@ -161,7 +168,7 @@ struct FrameBuilder {
     // samples: the middle of a large triangle seen first). Its excess over the corners' largest
     // value is at most L^2 / (8 d) on a segment and L^2 / (6 d) on a triangle (L: longest side of
     // the cap events, d: their least distance from the camera). This returns how much finer the
-    // piece must get, as a ratio in levelFor's sense (<= 1: it cannot hide a crossing). A poke
+    // piece must get, as a ratio of squared sizes (<= 1: it cannot hide a crossing). A poke
     // whose h stays below limit^2 / (2 dmin) is ignored: about its top (at distance r0 <= dmin
     // from the camera) h falls off as rho^2 / (2 r0) with the distance rho, so it is narrower
     // than `limit`.
@@ -205,7 +212,7 @@ struct FrameBuilder {
     // clip to hold: a real cap's curve may not hide in it or its sides, and where the curve
     // crosses it the straight output edge between the two exact crossings must lie within `limit`
     // of the curve's image (measured at the chord's middle, against the curve point found on the
-    // line across the chord there). Ratio as in levelFor; <= 1 when the piece passes.
+    // line across the chord there). A ratio of squared sizes; <= 1 when the piece passes.
     double clipRatio(const uint32_t v[3], const double* la, const double* lb, const double* lc, double limit) const {
         if (view.kind != ViewKind::PastCone) return 0;  // hyperplane: straight clip lines, exact crossings
         const double* l[3] = {la, lb, lc};
@@ -266,291 +273,422 @@ struct FrameBuilder {
     }
 
 
-    // Step (refinement): split edge `edge` into the fewest equal parameter segments whose exact
-    // midpoints lie within T/8 of their chords; decided once per frame, from lo to hi, from the
-    // edge alone. The inner points' events are kept; output vertices are made on first use.
-    void refineEdge(uint32_t edge) {
-        if (edge_segments[edge] != 0) return;
-        const Edge& e = world.edges[edge];
-        const uint32_t v[3] = {e.lo, e.hi, e.hi};
-        const double limit = kEdgeMidpointShare * settings.tolerance;
-        const Vec3 y0 = vertexImage(e.lo), y1 = vertexImage(e.hi);
-        auto at = [&](double s) {
-            const double l[3] = {1 - s, s, 0};
-            return surfaceAt(v, l);
-        };
-        // First guess from the whole edge's midpoint deviation: chord error shrinks as 1/n^2.
-        const double dev1 = norm(at(0.5).x - (y0 + y1) * 0.5);
-        const uint32_t cap_n = uint32_t(std::max(settings.max_segments, 1));
-        int n = dev1 <= limit ? 1 : int(levelFor(1.0, dev1 / limit, cap_n));
-        std::vector<Event> pts;
-        for (;;) {
-            n = std::min(n, settings.max_segments);
-            pts.assign(size_t(n) + 1, Event{});
-            for (int i = 1; i < n; ++i) pts[size_t(i)] = at(double(i) / n);
-            pts[0] = {0, y0};
-            pts[size_t(n)] = {0, y1};
-            double worst = 0;
-            for (int i = 0; i < n; ++i)
-                worst = std::max(worst, norm(at((i + 0.5) / n).x - (pts[size_t(i)].x + pts[size_t(i) + 1].x) * 0.5));
-            if (worst <= limit || n >= settings.max_segments || !(worst == worst)) {
-                if (!(worst <= limit)) ++limited_edges;
-                break;
-            }
-            n = std::max(n + 1, int(levelFor(n, worst / limit, cap_n)));
-        }
-        edge_segments[edge] = uint32_t(n);
-        edge_first[edge] = uint32_t(edge_events.size());
-        for (int i = 1; i < n; ++i) {
-            edge_events.push_back(pts[size_t(i)]);
-            edge_ids.push_back(kUnset);
-        }
-    }
+    // ---- Step (refinement, tolerance > 0, moving, past cone): conforming bisection ----
+    // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
+    // ids edge midpoints made when first needed. `side` and `vertex_out` grow with them.
+    uint32_t r_nv = 0, r_nt = 0;
+    std::vector<Vec3> r_pos;      // exact local image of every id (mesh vertices: from the batch cut)
+    std::vector<double> r_time;   // its local emission time, -delta
+    std::vector<Vec3> r_rest;     // rest point of ids >= r_nv
+    std::vector<Event> r_cap;     // cap events (2 per id >= r_nv) when a cap is real
+    // Midpoints of mesh edges: exact local images (batch), and their vertex ids once made.
+    std::vector<Vec3> e_pos;
+    std::vector<double> e_time;
+    std::vector<uint8_t> e_done;
+    std::vector<uint32_t> e_id;
 
-    // Output vertex of inner point k (1 .. n-1, counted from lo) of a refined edge.
-    uint32_t edgePoint(uint32_t edge, uint32_t k) {
-        uint32_t& id = edge_ids[edge_first[edge] + k - 1];
-        if (id == kUnset) {
-            const Edge& e = world.edges[edge];
-            const double s = double(k) / edge_segments[edge];
-            id = emit(edge_events[edge_first[edge] + k - 1], world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s);
-        }
-        return id;
-    }
-
-    // A point of a refined triangle's domain: a corner (vertex id), a refined edge's point (edge,
-    // index from lo), or an interior lattice point (barycentrics on the triangle's vertices).
-    struct DomainPoint {
-        enum Kind : uint8_t { Corner, EdgePoint, Interior } kind = Interior;
-        uint32_t a = 0, k = 0;
-        double l[3] = {0, 0, 0};
-        Side side = Side::Inside;
-        uint32_t id = kUnset;
+    // Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
+    // touched), later ids the halves made by splits. Each slot c is the edge from v[c] to v[c + 1];
+    // the slots on one edge form a cycle (next), as World4D::slot_next does for the mesh, so that an
+    // edge is split in every triangle that has it: no T-junctions, however the splits go.
+    struct RTri {
+        uint32_t v[3];
+        uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
+        uint32_t mid[3];   // midpoint vertex of a slot that is not a whole mesh edge, once made
+        uint32_t edge[3];  // the mesh edge while the slot is a whole mesh edge, else kUnset
+        uint32_t child[2];
+        uint32_t src;      // the mesh triangle it lies on
+        uint32_t depth;    // bisections since the mesh triangle
     };
+    std::vector<RTri> r_base;  // ids < r_nt, valid where r_init is set
+    std::vector<uint8_t> r_init;
+    std::vector<RTri> r_kids;  // ids >= r_nt
+    std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
+    uint32_t r_max_depth = 0;
+    std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
 
-    // The event of a domain point on cap `cap`; edge points are parametrised from lo, as refineEdge does.
-    Event capEvent(const DomainPoint& p, const uint32_t v[3], int cap) const {
-        if (p.kind == DomainPoint::Corner) return world.events[2 * p.a + cap];
-        if (p.kind == DomainPoint::EdgePoint) {
-            const Edge& e = world.edges[p.a];
-            return lerp(world.events[2 * e.lo + cap], world.events[2 * e.hi + cap], double(p.k) / edge_segments[p.a]);
-        }
-        Event r{0, {0, 0, 0}};
+    RTri& tri(uint32_t id) { return id < r_nt ? r_base[id] : r_kids[id - r_nt]; }
+    Vec3 restOfId(uint32_t id) const { return id < r_nv ? world.mesh.positions[id] : r_rest[id - r_nv]; }
+    Event capOfId(uint32_t id, int cap) const { return id < r_nv ? world.events[2 * id + cap] : r_cap[2 * (id - r_nv) + cap]; }
+    Event eventOfId(uint32_t id) const { return {r_time[id], r_pos[id]}; }
+
+    void ensureBase(uint32_t id) {
+        if (id >= r_nt || r_init[id]) return;
+        r_init[id] = 1;
+        RTri& t = r_base[id];
         for (int c = 0; c < 3; ++c) {
-            const Event& e = world.events[2 * v[c] + cap];
-            r.t += p.l[c] * e.t;
-            r.x += e.x * p.l[c];
+            t.v[c] = world.mesh.triangles[id][c];
+            t.next[c] = world.slot_next[3 * id + c];
+            t.mid[c] = kUnset;
+            t.edge[c] = world.triangle_edges[id][c];
         }
-        return r;
+        t.child[0] = t.child[1] = kUnset;
+        t.src = id;
+        t.depth = 0;
+    }
+    // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
+    uint32_t nextOf(uint32_t p) {
+        const uint32_t id = p / 3;
+        if (id < r_nt && !r_init[id]) return world.slot_next[p];
+        return tri(id).next[p % 3];
+    }
+    void setNext(uint32_t p, uint32_t to) {
+        ensureBase(p / 3);
+        tri(p / 3).next[p % 3] = to;
     }
 
-    Vec3 restOf(const DomainPoint& p, const uint32_t v[3]) const {
-        if (p.kind == DomainPoint::Corner) return world.mesh.positions[p.a];
-        if (p.kind == DomainPoint::EdgePoint) {
-            const Edge& e = world.edges[p.a];
-            const double s = double(p.k) / edge_segments[p.a];
-            return world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s;
-        }
-        return restAt(v, p.l);
-    }
-
-    // The crossing of the domain segment p -> q with cap `cap`. A segment of a mesh edge is keyed by
-    // (edge, segment, cap) and parametrised from lo, so the triangle on the other side of the edge
-    // makes the same point; other segments are keyed within the triangle.
-    uint32_t subCrossing(const DomainPoint& p, const DomainPoint& q, uint32_t pi, uint32_t qi, const uint32_t v[3], int cap,
-                         std::map<std::pair<uint64_t, uint64_t>, uint32_t>& local) {
-        uint32_t edge = kUnset, kp = 0, kq = 0;
-        auto onEdge = [&](const DomainPoint& d, uint32_t e, uint32_t* k) {
-            if (d.kind == DomainPoint::EdgePoint && d.a == e) { *k = d.k; return true; }
-            if (d.kind == DomainPoint::Corner && d.a == world.edges[e].lo) { *k = 0; return true; }
-            if (d.kind == DomainPoint::Corner && d.a == world.edges[e].hi) { *k = edge_segments[e]; return true; }
-            return false;
-        };
-        const uint32_t candidate = p.kind == DomainPoint::EdgePoint ? p.a : (q.kind == DomainPoint::EdgePoint ? q.a : kUnset);
-        if (candidate != kUnset && onEdge(p, candidate, &kp) && onEdge(q, candidate, &kq) &&
-            (kp + 1 == kq || kq + 1 == kp))
-            edge = candidate;
-        if (edge == kUnset && p.kind == DomainPoint::Corner && q.kind == DomainPoint::Corner) {
-            // A whole unsplit mesh edge: the vertex-mode crossing, keyed by the edge.
-            for (int c = 0; c < 3; ++c) {
-                const Edge& e = world.edges[cur_edges[c]];
-                if ((e.lo == p.a && e.hi == q.a) || (e.lo == q.a && e.hi == p.a)) return crossingPoint(cur_edges[c], cap);
+    uint32_t newVertex(const Vec3& rest, const Event& e, uint32_t a, uint32_t b) {
+        const uint32_t id = uint32_t(r_pos.size());
+        r_pos.push_back(e.x);
+        r_time.push_back(e.t);
+        r_rest.push_back(rest);
+        Side s = Side::Inside;
+        if (world.cap_a_real || world.cap_b_real) {
+            Event cap[2];
+            for (int k = 0; k < 2; ++k) {
+                const Event ea = capOfId(a, k), eb = capOfId(b, k);
+                cap[k] = {0.5 * (ea.t + eb.t), (ea.x + eb.x) * 0.5};  // symmetric in a, b
+                r_cap.push_back(cap[k]);
             }
+            s = sideOf(cap[0], cap[1]);
         }
-        std::pair<uint64_t, uint64_t> key;
-        const DomainPoint *first = &p, *second = &q;
-        if (edge != kUnset) {
-            key = {uint64_t(edge) << 1 | 1u, (uint64_t(std::min(kp, kq)) << 1) | uint64_t(cap)};
-            if (kq < kp) std::swap(first, second);
-            auto it = sub_crossings.find(key);
-            if (it != sub_crossings.end()) return it->second;
-        } else {
-            key = {(uint64_t(std::min(pi, qi)) << 32) | std::max(pi, qi), uint64_t(cap)};
-            if (qi < pi) std::swap(first, second);
-            auto it = local.find(key);
-            if (it != local.end()) return it->second;
-        }
-        const Event e0 = capEvent(*first, v, cap), e1 = capEvent(*second, v, cap);
-        const double s = cutSegment(view, e0, e1);
-        uint32_t id;
-        if (s == 0 && first->side == Side::Inside && first->id != kUnset) id = first->id;  // as in crossingPoint
-        else if (s == 1 && second->side == Side::Inside && second->id != kUnset) id = second->id;
-        else {
-            const Vec3 rest = restOf(*first, v) * (1 - s) + restOf(*second, v) * s;
-            id = emit(cutRestLocal(anchor, world.motion, rest), rest);  // as in crossingPoint
-        }
-        (edge != kUnset ? sub_crossings : local)[key] = id;
+        side.push_back(s);
+        vertex_out.push_back(kUnset);
         return id;
     }
 
-    // Step (refinement): one triangle to the tolerance; `clipped` when a real cap cuts it.
-    void refineTriangle(size_t f, bool clipped) {
-        const auto& tri = world.mesh.triangles[f];
-        const uint32_t v[3] = {tri[0], tri[1], tri[2]};
-        uint32_t n[3];
-        for (int c = 0; c < 3; ++c) {
-            cur_edges[c] = world.triangle_edges[f][c];
-            refineEdge(cur_edges[c]);
-            n[c] = edge_segments[cur_edges[c]];
+    uint32_t edgeMidVertex(uint32_t e) {
+        if (e_id[e] == kUnset) {
+            const Edge& ed = world.edges[e];
+            const Vec3 rest = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
+            if (!e_done[e]) {
+                const Event ev = cutRestLocal(anchor, world.motion, rest);
+                e_pos[e] = ev.x;
+                e_time[e] = ev.t;
+                e_done[e] = 1;
+            }
+            e_id[e] = newVertex(rest, {e_time[e], e_pos[e]}, ed.lo, ed.hi);
         }
-        const double limit = kMidpointShare * settings.tolerance;
-        const Vec3 y[3] = {vertexImage(v[0]), vertexImage(v[1]), vertexImage(v[2])};
-        const double third[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
-        const double centroid_dev = norm(surfaceAt(v, third).x - (y[0] + y[1] + y[2]) / 3.0);
-        if (n[0] == 1 && n[1] == 1 && n[2] == 1 && centroid_dev <= limit) {
-            if (clipped) clipWhole(f);
-            else addOutput(f, {vertexPoint(v[0]), vertexPoint(v[1]), vertexPoint(v[2])});
+        return e_id[e];
+    }
+
+    // The midpoint vertex of slot c of triangle id: a mesh edge's from the batch, otherwise made
+    // once and given to every slot on the edge.
+    uint32_t midVertex(uint32_t id, int c) {
+        {
+            const RTri& t = tri(id);
+            if (t.edge[c] != kUnset) return edgeMidVertex(t.edge[c]);
+            if (t.mid[c] != kUnset) return t.mid[c];
+        }
+        const uint32_t a = tri(id).v[c], b = tri(id).v[(c + 1) % 3];
+        const Vec3 rest = (restOfId(a) + restOfId(b)) * 0.5;
+        const uint32_t m = newVertex(rest, cutRestLocal(anchor, world.motion, rest), a, b);
+        const uint32_t start = 3 * id + uint32_t(c);
+        uint32_t p = start;
+        do {
+            tri(p / 3).mid[p % 3] = m;
+            p = nextOf(p);
+        } while (p != start);
+        return m;
+    }
+
+    // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
+    // in the edge's cycle.
+    void moveSlot(uint32_t from, uint32_t to, const RTri& old) {
+        const uint32_t nx = nextOf(from);
+        RTri& t = tri(to / 3);
+        t.mid[to % 3] = old.mid[from % 3];
+        t.edge[to % 3] = old.edge[from % 3];
+        if (nx == from) {
+            t.next[to % 3] = to;
             return;
         }
-        ++out.refined_triangles;
-        const bool caps = world.cap_a_real || world.cap_b_real;
+        t.next[to % 3] = nx;
+        uint32_t p = nx;
+        while (nextOf(p) != from) p = nextOf(p);
+        setNext(p, to);
+    }
 
-        // The domain is triangulated with each edge's own points and an interior grid of level
-        // `level` (tessellate.h); the level grows until every inner chord passes.
-        const uint32_t cap_level = uint32_t(std::max(settings.max_segments, 3));
-        uint32_t level = levelFor(1.0, centroid_dev / limit, cap_level);
-        level = std::max({level, n[0], n[1], n[2], 3u});
-        for (;;) {
-            level = std::min<uint32_t>(level, cap_level);
-            const DomainTriangulation dom = triangulateDomain(n, level);
+    uint32_t newTri() {
+        r_kids.push_back(RTri{});
+        return r_nt + uint32_t(r_kids.size() - 1);
+    }
 
-            // Step: describe every domain point and decide its side; visible boundary points get
-            // their (shared) output vertices now, so that a retry below drops interior points only.
-            std::vector<DomainPoint> dp(dom.points.size());
+    // Halves the edge of slot c of triangle id at its midpoint, in every triangle around the edge:
+    // each becomes (a, m, o) and (m, b, o). The halves' new slots on the edge form two new cycles.
+    void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
+        const uint32_t m = midVertex(id, c);
+        const uint32_t lo = std::min(tri(id).v[c], tri(id).v[(c + 1) % 3]);
+        std::vector<uint32_t> members;
+        const uint32_t start = 3 * id + uint32_t(c);
+        uint32_t p = start;
+        do {
+            members.push_back(p);
+            p = nextOf(p);
+        } while (p != start);
+        std::vector<uint32_t> lo_half, hi_half;
+        for (uint32_t q : members) {
+            const uint32_t u = q / 3;
+            const int cu = int(q % 3);
+            ensureBase(u);
+            const RTri old = tri(u);
+            const uint32_t a = old.v[cu], b = old.v[(cu + 1) % 3], o = old.v[(cu + 2) % 3];
+            const uint32_t A = newTri(), B = newTri();
+            RTri& ta = tri(A);
+            ta = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
+                      {kUnset, kUnset}, old.src, old.depth + 1};
+            RTri& tb = tri(B);
+            tb = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
+                      {kUnset, kUnset}, old.src, old.depth + 1};
+            moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2, old);
+            moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1, old);
+            (a == lo ? lo_half : hi_half).push_back(3 * A + 0);
+            (a == lo ? hi_half : lo_half).push_back(3 * B + 0);
+            tri(u).child[0] = A;
+            tri(u).child[1] = B;
+            if (u < r_nt) ++out.refined_triangles;
+            stack.push_back(B);
+            stack.push_back(A);
+        }
+        for (const auto* ring : {&lo_half, &hi_half})
+            for (size_t k = 0; k < ring->size(); ++k) tri((*ring)[k] / 3).next[(*ring)[k] % 3] = (*ring)[(k + 1) % ring->size()];
+    }
+
+    // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
+    // wholly before or after existing (it shows nothing), or it reached the depth limit.
+    void drain(std::vector<uint32_t>& stack) {
+        while (!stack.empty()) {
+            const uint32_t id = stack.back();
+            stack.pop_back();
+            const RTri t = tri(id);
+            if (t.child[0] != kUnset) continue;  // split meanwhile, as a neighbour
+            const Side s0 = side[t.v[0]];
+            if (s0 != Side::Inside && side[t.v[1]] == s0 && side[t.v[2]] == s0) continue;
+            Event corner[3], mid[3];
             for (int c = 0; c < 3; ++c) {
-                const uint32_t edge = cur_edges[c];
-                const bool forward = v[c] == world.edges[edge].lo;  // edge points run lo -> hi
-                DomainPoint& corner = dp[boundaryIndex(n, c, 0)];
-                corner.kind = DomainPoint::Corner;
-                corner.a = v[c];
-                corner.side = side[v[c]];
-                for (uint32_t k = 1; k < n[c]; ++k) {
-                    DomainPoint& d = dp[boundaryIndex(n, c, k)];
-                    d.kind = DomainPoint::EdgePoint;
-                    d.a = edge;
-                    d.k = forward ? k : n[c] - k;
-                }
+                corner[c] = eventOfId(t.v[c]);
+                mid[c] = eventOfId(midVertex(id, c));
             }
-            for (size_t p = dom.boundary_count; p < dom.points.size(); ++p) {
-                dp[p].l[0] = 1 - dom.points[p][0] - dom.points[p][1];
-                dp[p].l[1] = dom.points[p][0];
-                dp[p].l[2] = dom.points[p][1];
+            const ChordError ce = chordError(anchor, world.motion, corner, mid);
+            if (ce.bound <= settings.tolerance) continue;
+            if (t.depth >= r_max_depth) {
+                r_limited[t.src] = 1;
+                continue;
             }
-            for (auto& d : dp)
-                if (d.kind != DomainPoint::Corner && caps) d.side = sideOf(capEvent(d, v, 0), capEvent(d, v, 1));
-            for (auto& d : dp) {
-                if (d.side != Side::Inside) continue;
-                if (d.kind == DomainPoint::Corner) d.id = vertexPoint(d.a);
-                else if (d.kind == DomainPoint::EdgePoint) d.id = edgePoint(d.a, d.k);
-            }
-            const size_t first_interior = out.positions.size();
-            for (auto& d : dp)
-                if (d.kind == DomainPoint::Interior && d.side == Side::Inside) d.id = emit(surfaceAt(v, d.l), restAt(v, d.l));
-
-            // Step: check every visible chord that is not a boundary segment (those passed refineEdge).
-            auto isBoundarySegment = [&](uint32_t a, uint32_t b) {
-                const size_t nb = dom.boundary_count;
-                return a < nb && b < nb && ((a + 1) % nb == b || (b + 1) % nb == a);
-            };
-            double worst = 0;
-            for (const auto& t : dom.triangles) {
-                for (int c = 0; c < 3; ++c) {
-                    const uint32_t a = t[c], b = t[(c + 1) % 3];
-                    if (a > b || isBoundarySegment(a, b) || dp[a].side != Side::Inside || dp[b].side != Side::Inside)
-                        continue;  // each inner chord once
-                    const double pu = 0.5 * (dom.points[a][0] + dom.points[b][0]);
-                    const double pv = 0.5 * (dom.points[a][1] + dom.points[b][1]);
-                    const double l[3] = {1 - pu - pv, pu, pv};
-                    const Vec3 mid = (out.positions[dp[a].id] + out.positions[dp[b].id]) * 0.5;
-                    worst = std::max(worst, norm(surfaceAt(v, l).x - mid));
-                }
-            }
-            if (worst <= limit || level >= cap_level || !(worst == worst)) {
-                if (!(worst <= limit)) ++out.limited_triangles;
-                emitDomain(f, dom, dp, v);
-                return;
-            }
-            // Too coarse: drop this attempt's interior points and refine the grid.
-            out.positions.resize(first_interior);
-            out.emission_times.resize(first_interior);
-            out.rest_points.resize(first_interior);
-            level = std::max(level + 1, levelFor(level, worst / limit, cap_level));
+            splitLongestPath(id, stack);
+            if (tri(id).child[0] == kUnset) stack.push_back(id);  // a coarser neighbour went first
         }
     }
 
-    // Step: the domain's triangles; those a real cap cuts are clipped at exact cap crossings.
-    void emitDomain(size_t f, const DomainTriangulation& dom, const std::vector<DomainPoint>& dp, const uint32_t v[3]) {
-        std::map<std::pair<uint64_t, uint64_t>, uint32_t> local;
-        for (const auto& t : dom.triangles) {
-            const Side s[3] = {dp[t[0]].side, dp[t[1]].side, dp[t[2]].side};
-            if (s[0] == Side::Inside && s[1] == Side::Inside && s[2] == Side::Inside) {
-                addOutput(f, {dp[t[0]].id, dp[t[1]].id, dp[t[2]].id});
+    // Edge lengths in the map's metric (chord_error.h edgeLength), ordered totally: ties go by the
+    // edge's vertex ids, so every triangle of an edge ranks it the same.
+    struct Rank {
+        double length;
+        uint32_t lo, hi;
+        bool operator<(const Rank& o) const {
+            if (length != o.length) return length < o.length;
+            return lo != o.lo ? lo < o.lo : hi < o.hi;
+        }
+    };
+    Rank rankOf(uint32_t id, int c) {
+        const uint32_t a = tri(id).v[c], b = tri(id).v[(c + 1) % 3];
+        const double len = edgeLength(anchor, world.motion, eventOfId(a), eventOfId(b), eventOfId(midVertex(id, c)));
+        return {len, std::min(a, b), std::max(a, b)};
+    }
+    int longestSlot(uint32_t id) {
+        ensureBase(id);
+        int best = 0;
+        Rank r = rankOf(id, 0);
+        for (int c = 1; c < 3; ++c) {
+            const Rank rc = rankOf(id, c);
+            if (r < rc) {
+                r = rc;
+                best = c;
+            }
+        }
+        return best;
+    }
+
+    // Longest-edge bisection (Rivara): a triangle's longest edge is halved only once it is the
+    // longest edge of every triangle around it; until then the neighbour whose longest edge is
+    // another is refined first, along the path of ever longer edges (it ends: lengths grow
+    // strictly along it in the total order). One split per call. Angles stay bounded in the
+    // map's metric, so the pieces follow the stretch (long across the motion where the map
+    // bends along it) without slivers.
+    void splitLongestPath(uint32_t id, std::vector<uint32_t>& stack) {
+        uint32_t t = id;
+        for (;;) {
+            const int c = longestSlot(t);
+            const uint32_t start = 3 * t + uint32_t(c);
+            uint32_t other = kUnset;
+            for (uint32_t p = nextOf(start); p != start; p = nextOf(p))
+                if (longestSlot(p / 3) != int(p % 3)) {
+                    other = p / 3;
+                    break;
+                }
+            if (other == kUnset) {
+                splitEdge(t, c, stack);
+                return;
+            }
+            t = other;
+        }
+    }
+
+    uint32_t outId(uint32_t id) {
+        if (vertex_out[id] == kUnset) vertex_out[id] = emit(eventOfId(id), restOfId(id));
+        return vertex_out[id];
+    }
+
+    // The clip point of the leaf side a -> b at cap `cap`: keyed by the two ends, parametrised
+    // from the smaller id, so both leaves on the side share it (on a whole mesh edge it is the
+    // point crossingPoint makes in vertex mode).
+    uint32_t leafCrossing(uint32_t a, uint32_t b, int cap) {
+        const uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        auto [it, inserted] = r_crossings[cap].try_emplace((uint64_t(lo) << 32) | hi, kUnset);
+        if (!inserted) return it->second;
+        const double s = cutSegment(view, capOfId(lo, cap), capOfId(hi, cap));
+        if (s == 0 && side[lo] == Side::Inside) return it->second = outId(lo);
+        if (s == 1 && side[hi] == Side::Inside) return it->second = outId(hi);
+        const Vec3 rest = restOfId(lo) * (1 - s) + restOfId(hi) * s;
+        const uint32_t id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+        return it->second = id;
+    }
+
+    void emitLeaf(uint32_t src, const uint32_t v[3]) {
+        const Side s[3] = {side[v[0]], side[v[1]], side[v[2]]};
+        if (s[0] == Side::Inside && s[1] == Side::Inside && s[2] == Side::Inside) {
+            addOutput(src, {outId(v[0]), outId(v[1]), outId(v[2])});
+            return;
+        }
+        uint32_t polygon[6];
+        const int n = clipToSpan(3, s, [&](int i) { return outId(v[i]); },
+                                 [&](int i, int j, int cap) { return leafCrossing(v[i], v[j], cap); }, polygon);
+        for (int k = 1; k + 1 < n; ++k) addOutput(src, {polygon[0], polygon[k], polygon[k + 1]});
+    }
+
+    // The whole frame with the tolerance: bounds of every live mesh triangle from its corners and
+    // edge midpoints (cut in batches), splits where a bound exceeds the tolerance, then the leaves
+    // in mesh order. `live`: one flag per chunk (the cull), or null.
+    void refineFrame(const std::vector<uint8_t>* live) {
+        r_nv = uint32_t(world.mesh.positions.size());
+        r_nt = uint32_t(world.mesh.triangles.size());
+        const size_t ne = world.edges.size();
+        int levels = 1;
+        while (levels < 30 && (int64_t(1) << levels) < int64_t(std::max(settings.max_segments, 2))) ++levels;
+        r_max_depth = uint32_t(2 * levels);  // about max_segments pieces along each direction of a triangle
+        auto isLive = [&](size_t f) { return !live || (*live)[f / kChunkTriangles]; };
+
+        // Step: images of every vertex, and of the midpoints of the live triangles' edges.
+        r_pos.resize(r_nv);
+        r_time.resize(r_nv);
+        cutRestLocalBatch(anchor, world.motion, world.mesh.positions.data(), r_nv, r_pos.data(), r_time.data());
+        e_pos.resize(ne);
+        e_time.resize(ne);
+        e_done.assign(ne, live ? 0 : 1);
+        e_id.assign(ne, kUnset);
+        {
+            std::vector<uint32_t> which;
+            if (live) {
+                for (size_t f = 0; f < r_nt; ++f)
+                    if (isLive(f))
+                        for (uint32_t e : world.triangle_edges[f])
+                            if (!e_done[e]) {
+                                e_done[e] = 1;
+                                which.push_back(e);
+                            }
+            }
+            const size_t n = live ? which.size() : ne;
+            std::vector<Vec3> rest(n), pos(n);
+            std::vector<double> time(n);
+            for (size_t k = 0; k < n; ++k) {
+                const Edge& ed = world.edges[live ? which[k] : k];
+                rest[k] = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
+            }
+            cutRestLocalBatch(anchor, world.motion, rest.data(), n, pos.data(), time.data());
+            for (size_t k = 0; k < n; ++k) {
+                const size_t e = live ? which[k] : k;
+                e_pos[e] = pos[k];
+                e_time[e] = time[k];
+            }
+        }
+
+        // Step: which mesh triangles fail their bound (those wholly before or after existing never do).
+        const bool caps = world.cap_a_real || world.cap_b_real;
+        if (caps) classifyVertices(live);
+        else side.assign(r_nv, Side::Inside);
+        std::vector<uint32_t> failing;
+        for (size_t f = 0; f < r_nt; ++f) {
+            if (!isLive(f)) continue;
+            const auto& t = world.mesh.triangles[f];
+            const Side s0 = side[t[0]];
+            if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;
+            if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
+            Event corner[3], mid[3];
+            for (int c = 0; c < 3; ++c) {
+                corner[c] = {r_time[t[c]], r_pos[t[c]]};
+                const uint32_t e = world.triangle_edges[f][c];
+                mid[c] = {e_time[e], e_pos[e]};
+            }
+            if (chordError(anchor, world.motion, corner, mid).bound > settings.tolerance) failing.push_back(uint32_t(f));
+        }
+        // Nothing to refine on a simple mesh that exists throughout: vertex mode's output.
+        if (failing.empty() && !caps && world.simple) {
+            out.positions = std::move(r_pos);
+            out.emission_times = std::move(r_time);
+            out.rest_points = world.mesh.positions;
+            out.triangles = world.mesh.triangles;
+            out.source_triangles.resize(r_nt);
+            for (size_t f = 0; f < r_nt; ++f) out.source_triangles[f] = uint32_t(f);
+            return;
+        }
+        if (!caps) classifyVertices(live);  // visible vertices first, in input order
+
+        // Step: split until every piece passes.
+        if (!failing.empty()) {
+            r_base.resize(r_nt);  // records made on first touch (ensureBase)
+            r_init.assign(r_nt, 0);
+            r_limited.assign(r_nt, 0);
+            std::vector<uint32_t> stack;
+            for (uint32_t f : failing) {
+                ensureBase(f);
+                stack.push_back(f);
+                drain(stack);
+            }
+            for (uint8_t l : r_limited) out.limited_triangles += l;
+        }
+
+        // Step: the leaves, mesh triangle by mesh triangle, each tree depth first.
+        std::vector<uint32_t> stack;
+        for (size_t f = 0; f < r_nt; ++f) {
+            if (!isLive(f)) continue;
+            if (r_init.empty() || !r_init[f]) {
+                const auto& t = world.mesh.triangles[f];
+                const uint32_t v[3] = {t[0], t[1], t[2]};
+                emitLeaf(uint32_t(f), v);
                 continue;
             }
-            if (s[0] == s[1] && s[1] == s[2]) continue;
-            uint32_t polygon[6];
-            int n = 0;
-            for (int c = 0; c < 3; ++c) {
-                const uint32_t pi = t[c], qi = t[(c + 1) % 3];
-                const Side si = s[c], sj = s[(c + 1) % 3];
-                if (si == Side::Inside) polygon[n++] = dp[pi].id;
-                if (si == sj) continue;
-                const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
-                const bool cross_b = si == Side::Gone || sj == Side::Gone;
-                const bool a_first = si == Side::NotYet || sj == Side::Gone;
-                if (cross_a && cross_b) {
-                    polygon[n++] = subCrossing(dp[pi], dp[qi], pi, qi, v, a_first ? 0 : 1, local);
-                    polygon[n++] = subCrossing(dp[pi], dp[qi], pi, qi, v, a_first ? 1 : 0, local);
+            stack.push_back(uint32_t(f));
+            while (!stack.empty()) {
+                const RTri t = tri(stack.back());
+                stack.pop_back();
+                if (t.child[0] != kUnset) {
+                    stack.push_back(t.child[1]);
+                    stack.push_back(t.child[0]);
                 } else {
-                    polygon[n++] = subCrossing(dp[pi], dp[qi], pi, qi, v, cross_a ? 0 : 1, local);
+                    emitLeaf(t.src, t.v);
                 }
             }
-            for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
         }
     }
 
     // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).
     void clipWhole(size_t f) {
         const auto& tri = world.mesh.triangles[f];
-        uint32_t polygon[6];  // a triangle clipped by a slab has at most 5 corners
-        int n = 0;
-        for (int c = 0; c < 3; ++c) {
-            const uint32_t vi = tri[c], vj = tri[(c + 1) % 3];
-            const Side si = side[vi], sj = side[vj];
-            const uint32_t edge = world.triangle_edges[f][c];
-            if (si == Side::Inside) polygon[n++] = vertexPoint(vi);
-            if (si == sj) continue;
-            // Caps crossed going from vi to vj, in order along the edge.
-            const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
-            const bool cross_b = si == Side::Gone || sj == Side::Gone;
-            const bool a_first = si == Side::NotYet || sj == Side::Gone;
-            if (cross_a && cross_b) {
-                polygon[n++] = crossingPoint(edge, a_first ? 0 : 1);
-                polygon[n++] = crossingPoint(edge, a_first ? 1 : 0);
-            } else {
-                polygon[n++] = crossingPoint(edge, cross_a ? 0 : 1);
-            }
-        }
+        const Side s[3] = {side[tri[0]], side[tri[1]], side[tri[2]]};
+        uint32_t polygon[6];
+        const int n = clipToSpan(3, s, [&](int i) { return vertexPoint(tri[size_t(i)]); },
+                                 [&](int i, int, int cap) { return crossingPoint(world.triangle_edges[f][size_t(i)], cap); },
+                                 polygon);
         // Fan over the clipped polygon, convex in the triangle's parameter domain.
         for (int k = 1; k + 1 < n; ++k) addOutput(f, {polygon[0], polygon[k], polygon[k + 1]});
     }
@@ -819,22 +957,13 @@ struct FrameBuilder {
             all_same &= sd[i] == sd[0];
         }
         if (all_same && !all_inside) return;
-        std::vector<uint32_t> ids;
-        for (size_t i = 0; i < n; ++i) {
-            const size_t j = (i + 1) % n;
-            const Side si = sd[i], sj = sd[j];
-            if (si == Side::Inside) ids.push_back(restPoint(v, poly[i], points));
-            if (si == sj) continue;
-            const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
-            const bool cross_b = si == Side::Gone || sj == Side::Gone;
-            const bool a_first = si == Side::NotYet || sj == Side::Gone;
-            if (cross_a && cross_b) {
-                ids.push_back(restCrossing(v, poly[i], poly[j], si, sj, a_first ? 0 : 1, points, crossings));
-                ids.push_back(restCrossing(v, poly[i], poly[j], si, sj, a_first ? 1 : 0, points, crossings));
-            } else {
-                ids.push_back(restCrossing(v, poly[i], poly[j], si, sj, cross_a ? 0 : 1, points, crossings));
-            }
-        }
+        std::vector<uint32_t> ids(2 * n);
+        ids.resize(size_t(clipToSpan(
+            int(n), sd.data(), [&](int i) { return restPoint(v, poly[size_t(i)], points); },
+            [&](int i, int j, int cap) {
+                return restCrossing(v, poly[size_t(i)], poly[size_t(j)], sd[size_t(i)], sd[size_t(j)], cap, points, crossings);
+            },
+            ids.data())));
         // Drop repeats (a crossing that is a kept corner), then triangulate.
         std::vector<uint32_t> ring;
         for (uint32_t id : ids)
@@ -869,8 +998,7 @@ struct FrameBuilder {
         const bool inside = s0 == Side::Inside && s1 == Side::Inside && s2 == Side::Inside;
         if (!inside && s0 == s1 && s1 == s2) return;  // wholly before or after existence
         if (!inside) ++out.clipped_triangles;
-        if (settings.tolerance > 0) refineTriangle(f, !inside);
-        else if (inside) addOutput(f, {vertexPoint(tri[0]), vertexPoint(tri[1]), vertexPoint(tri[2])});
+        if (inside) addOutput(f, {vertexPoint(tri[0]), vertexPoint(tri[1]), vertexPoint(tri[2])});
         else clipWhole(f);
     }
 };
@@ -954,6 +1082,10 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
         }
         if (!any) return std::move(b.out);
     }
+    if (settings.tolerance > 0) {  // moving, on the past cone
+        b.refineFrame(culling ? &live : nullptr);
+        return std::move(b.out);
+    }
     b.out.positions.reserve(world.mesh.positions.size());
     b.out.emission_times.reserve(world.mesh.positions.size());
     b.out.rest_points.reserve(world.mesh.positions.size());
@@ -961,10 +1093,6 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     b.out.source_triangles.reserve(world.mesh.triangles.size());
     b.classifyVertices(culling ? &live : nullptr);
     b.crossing_out.assign(2 * world.edges.size(), kUnset);
-    if (settings.tolerance > 0) {
-        b.edge_segments.assign(world.edges.size(), 0);
-        b.edge_first.assign(world.edges.size(), 0);
-    }
     if (culling) {
         for (size_t c = 0; c < world.chunks.size(); ++c)
             if (live[c])
@@ -973,7 +1101,6 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
         for (size_t f = 0; f < world.mesh.triangles.size(); ++f) b.addTriangle(f);
     }
     for (const auto& plan : b.rest_plans) b.restEmit(plan);
-    b.out.limited_triangles += b.limited_edges;
     return std::move(b.out);
 }
 

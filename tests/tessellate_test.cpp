@@ -10,7 +10,6 @@
 
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
-#include "mesh4d/tessellate.h"
 #include "pipeline/mesh_check.h"
 #include "error_measure.h"
 #include "test_meshes.h"
@@ -188,31 +187,6 @@ TEST(Tessellate, PenroseOutlineOfARelativisticSphereIsACircle) {
         EXPECT_GT(finite, 30 * rel) << "T = " << tolerance;
     }
     std::printf("; finite 0.9c: %.3f\n", finite);
-}
-
-// The domain pattern itself: any mix of edge segment counts and interior level tiles the
-// parameter triangle (areas add to 1/2) with counter-clockwise triangles only, and the boundary
-// points are exactly each edge's equal subdivision.
-TEST(Tessellate, DomainPatternTilesTheTriangle) {
-    for (uint32_t n0 = 1; n0 <= 7; n0 += 3)
-        for (uint32_t n1 = 1; n1 <= 9; n1 += 4)
-            for (uint32_t n2 = 1; n2 <= 5; n2 += 2)
-                for (uint32_t level : {3u, 4u, 9u, 20u}) {
-                    const uint32_t n[3] = {n0, n1, n2};
-                    const DomainTriangulation d = triangulateDomain(n, level);
-                    double area = 0;
-                    for (const auto& t : d.triangles) {
-                        const auto &a = d.points[t[0]], &b = d.points[t[1]], &c = d.points[t[2]];
-                        const double A = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-                        EXPECT_GT(A, 0) << n0 << " " << n1 << " " << n2 << " N " << level;
-                        area += A;
-                    }
-                    EXPECT_NEAR(area, 0.5, 1e-12) << n0 << " " << n1 << " " << n2 << " N " << level;
-                    EXPECT_EQ(d.boundary_count, size_t(n0 + n1 + n2));
-                    const auto& p = d.points[boundaryIndex(n, 1, 1)];  // first point of edge 1
-                    EXPECT_DOUBLE_EQ(p[1], 1.0 / n1);
-                    EXPECT_DOUBLE_EQ(p[0] + p[1], 1.0);
-                }
 }
 
 // Objects that begin or end existing inside the frames, refined: the clipped surface stays a

@@ -1,0 +1,66 @@
+#include "chord_error.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mesh4d {
+
+double bubbleMax(double c01, double c12, double c20) {
+    // a_k: coefficient of the edge opposite corner k.
+    const double a0 = c12, a1 = c20, a2 = c01;
+    double best = 0.25 * std::max({a0, a1, a2});  // edge middles
+    const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
+    const double den = w0 + w1 + w2;  // = 2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2
+    if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);
+    return best;
+}
+
+namespace {
+// |u|_M = sqrt((u.v)^2 + (1 - b^2) |u|^2).
+double normM(const Vec3& u, const Motion& m) {
+    const double uv = dot(u, m.velocity);
+    return std::sqrt(uv * uv + m.one_minus_beta2 * norm2(u));
+}
+}  // namespace
+
+ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3]) {
+    ChordError r;
+    if (m.beta == 0) return r;
+    // Delays (delta = -t) and the midpoint bubbles, |beta| (delta is convex: beta <= 0 up to rounding).
+    double c[3];
+    for (int e = 0; e < 3; ++e) {
+        const double d0 = -corner[e].t, d1 = -corner[(e + 1) % 3].t, dm = -mid[e].t;
+        c[e] = 4 * std::fabs(dm - 0.5 * (d0 + d1));
+    }
+    const double Q = bubbleMax(c[0], c[1], c[2]);
+    // Shape offsets s = y + v delta, their centroid, the M-radius r_M and |x_i|_M.
+    Vec3 s[3];
+    double xm_min = INFINITY;
+    for (int i = 0; i < 3; ++i) {
+        const double delta = -corner[i].t;
+        s[i] = corner[i].x + m.velocity * delta;
+        xm_min = std::min(xm_min, anchor.S + dot(corner[i].x, m.velocity) + delta);
+    }
+    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
+    double rM = 0;
+    for (int i = 0; i < 3; ++i) rM = std::max(rM, normM(s[i] - centre, m));
+    const double mlow = xm_min - 2 * rM;
+    const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
+    r.quadratic = m.beta * Q;
+    r.bound = m.beta * (Q + R);
+    if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
+    return r;
+}
+
+double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid) {
+    const double da = -a.t, db = -b.t;
+    const double c = 4 * std::fabs(-mid.t - 0.5 * (da + db));
+    const Vec3 sa = a.x + m.velocity * da, sb = b.x + m.velocity * db;
+    const double l = normM(sb - sa, m);
+    const double xm = std::min(anchor.S + dot(a.x, m.velocity) + da, anchor.S + dot(b.x, m.velocity) + db) - l;
+    const double third = xm > 0 ? 8 * l * l * l / (9 * std::sqrt(3.0) * m.one_minus_beta2 * xm * xm) : INFINITY;
+    const double length = c + third;
+    return length == length ? length : INFINITY;
+}
+
+}  // namespace mesh4d

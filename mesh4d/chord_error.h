@@ -1,0 +1,78 @@
+// How far a straight output triangle lies from the exact apparent surface: the bound the adaptive
+// refinement (slice.h) accepts a triangle by.
+//
+// The map. For uniform motion the apparent point of rest point q is, in the frame's local
+// coordinates (lightcone.h, ViewAnchor),
+//     F(q) = s(q) - v delta(q),
+// where s(q) = shapeOffset(q) is affine in q and delta(q) = d(E + s(q)) - D is the light delay
+// relative to the object's origin, with d(x) = (x.v + |x|_M) / (1 - b^2) the delay of a point now
+// at x (relative to the camera) and |x|_M = sqrt((x.v)^2 + (1 - b^2)|x|^2), a norm. So d, and
+// delta along any line of rest points, are convex, and the whole non-linearity of F is one scalar
+// function times the fixed vector v. On a triangle with exact corners the linear interpolant L of
+// F therefore differs from it by
+//     F(p) - L(p) = -v (delta(p) - L delta(p)),     |F - L| = b |delta - L delta|,
+// and |F - L| bounds both one-sided distances between the output triangle and the exact surface
+// patch (each output point L(p) has the exact point F(p), and back).
+//
+// The bound, term by term. Let I2 be the quadratic interpolant of delta through the corners and
+// the three edge midpoints (the values the refinement computes anyway: one closed form per edge),
+// and beta_ij = delta(m_ij) - (delta_i + delta_j) / 2 <= 0 the midpoint bubbles. Then
+//     delta - L delta = (I2 delta - L I2 delta) + (delta - I2 delta),
+//     I2 delta - L I2 delta = sum_{i<j} 4 beta_ij l_i l_j      (l the barycentrics),
+// whose largest magnitude over the triangle, Q, has a closed form (bubbleMax). The remainder is
+// bounded with the Taylor quadratic T of delta at the centroid c: I2 reproduces quadratics and
+// its Lebesgue constant on a triangle is 5/3, so |delta - I2 delta| <= (1 + 5/3) sup |delta - T|,
+// and sup |delta - T| <= sup |D^3 delta| r_M^3 / 6 along the segments from c. For the norm,
+// |D^3 |x|_M [u]^3| <= (2 / sqrt 3) |u|_M^3 / |x|_M^2 (the Euclidean case in the coordinates
+// where |.|_M is Euclidean: max over the angle of 3 sin^2 cos / r^2), so with r_M the largest
+// M-distance from c to a corner and m a lower bound of |x|_M on the triangle,
+//     R = (8/3) (1/6) (2/sqrt 3) r_M^3 / ((1 - b^2) m^2) = 8 r_M^3 / (9 sqrt 3 (1 - b^2) m^2),
+//     |F - L| <= b (Q + R)  everywhere on the triangle.
+// m: |x|_M >= |x_i|_M - |x - x_i|_M and |x - x_i|_M <= 2 r_M inside the triangle, so
+// m = min_i |x_i|_M - 2 r_M (a triangle reaching the camera, m <= 0, gets an infinite bound).
+// |x_i|_M needs no extra work: it is B + (1 - b^2) delta = S + s.v + (1 - b^2) delta, and with
+// the local position y = s - v delta that is S + y.v + delta.
+// R falls as the cube of the triangle's size and Q as the square: R / Q is about h / |x|, small
+// once a triangle is small against its distance from the camera, so the bound is tight (the
+// refinement's measured error is 0.5 to 1 times the tolerance; docs/ACCURACY.md).
+// Rounding: the inputs carry relative errors of a few ulps of the local coordinates; the bubbles
+// are differences of local delays (no term of the size of the distance), so their rounding is a
+// few ulps of the object's size, far below any tolerance the program accepts.
+//
+// Hyperplane views (the instant and contracted models) and objects at rest map affinely: there
+// is nothing to bound and the refinement does not call this.
+#pragma once
+
+#include "boost.h"
+#include "event.h"
+#include "lightcone.h"
+
+namespace mesh4d {
+
+// The largest value over the triangle (l0, l1, l2 >= 0, sum 1) of
+//     c01 l0 l1 + c12 l1 l2 + c20 l2 l0,   every c >= 0:
+// on an edge c/4 at its middle; inside, where the gradient is parallel to (1, 1, 1), at
+// l_k proportional to a_k (a_i + a_j - a_k) ... (a_k the coefficient of the edge opposite corner
+// k), with value a0 a1 a2 / (2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2) when the three a
+// satisfy the triangle inequality (the point is inside then).
+double bubbleMax(double c01, double c12, double c20);
+
+struct ChordError {
+    double bound = 0;      // b (Q + R): bound of |F - L| on the triangle, light-seconds (INFINITY if unbounded)
+    double quadratic = 0;  // b Q, the part of the bubbles alone
+};
+
+// The bound above for the triangle with exact corner events `corner` (local coordinates: t = -delta,
+// x = y) and exact edge-midpoint events `mid` (mid[c] on corners c, c + 1), for an object moving
+// with `m` seen through the past cone anchored at `anchor` (anchor.cone must be true).
+ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3]);
+
+// The length of an edge in the map's own metric, which the refinement halves longest first
+// (Rivara's longest-edge bisection, with this length): its bubble coefficient 4 |beta| (the
+// second difference of delta along the edge, i.e. its squared length in the Hessian's metric)
+// plus the edge's share of the third-order term, 8 l_M^3 / (9 sqrt 3 (1 - b^2) m^2) with l_M its
+// M-length and m = min |x|_M of its ends minus l_M. A property of the edge alone, so both
+// triangles of an edge agree on it; INFINITY when the edge reaches the camera.
+double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid);
+
+}  // namespace mesh4d
