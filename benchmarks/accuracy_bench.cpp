@@ -1,7 +1,7 @@
 // The speed-accuracy trade of the tolerance (issue: accuracy on a dial). For each scene and each
 // tolerance T (vertex mode first, then T = 1e-1 ... 1e-6 times the object size) it times the cut
 // of one frame and reports, as counters, the output triangles and the measured maximum error in
-// both directions (tests/error_measure.h: output -> exact surface and exact surface -> output).
+// both directions (mesh4d/measure.h: output -> exact surface and exact surface -> output).
 //
 //   flanges: data/scenes/flanges.json, relativistic, frame 100 (the flanges crossing the
 //            centreline); size = the flange's diagonal, sqrt(2^2 + 4^2 + 2^2) light-seconds.
@@ -14,7 +14,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "error_measure.h"
+#include "mesh4d/measure.h"
 #include "pipeline/cli.h"
 #include "pipeline/render.h"
 #include "test_meshes.h"
@@ -76,8 +76,8 @@ void cutFrame(benchmark::State& state, const BenchScene& scene) {
     double out_err = 0, in_err = 0;
     for (const auto& w : scene.worlds) {
         const mesh4d::ApparentMesh m = mesh4d::sliceWorld(w, scene.view, settings);
-        out_err = std::max(out_err, errmeasure::outputToExact(w, scene.view, m));
-        in_err = std::max(in_err, errmeasure::exactToOutput(w, scene.view, m, 8));
+        out_err = std::max(out_err, mesh4d::measure::outputToExact(w, scene.view, m));
+        in_err = std::max(in_err, mesh4d::measure::exactToOutput(w, scene.view, m, 8));
     }
     state.counters["tolerance_rel"] = k == 0 ? 0.0 : std::pow(10.0, -k);
     state.counters["triangles"] = double(triangles);

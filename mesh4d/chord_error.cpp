@@ -52,6 +52,27 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
     return r;
 }
 
+double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Event corner[3]) {
+    if (m.beta == 0) return 0;
+    Vec3 s[3];
+    double xm_min = INFINITY;
+    for (int i = 0; i < 3; ++i) {
+        const double delta = -corner[i].t;
+        s[i] = corner[i].x + m.velocity * delta;
+        xm_min = std::min(xm_min, anchor.S + dot(corner[i].x, m.velocity) + delta);
+    }
+    double d2 = 0;  // d_M^2
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[(i + 1) % 3] - s[i];
+        const double uv = dot(u, m.velocity);
+        d2 = std::max(d2, uv * uv + m.one_minus_beta2 * norm2(u));
+    }
+    const double mlow = xm_min - std::sqrt(d2);
+    if (!(mlow > 0)) return INFINITY;
+    const double bound = m.beta * d2 / (6 * m.one_minus_beta2 * mlow);
+    return bound == bound ? bound : INFINITY;
+}
+
 double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid) {
     const double da = -a.t, db = -b.t;
     const double c = 4 * std::fabs(-mid.t - 0.5 * (da + db));

@@ -43,6 +43,8 @@
 // is nothing to bound and the refinement does not call this.
 #pragma once
 
+#include <algorithm>
+
 #include "boost.h"
 #include "event.h"
 #include "lightcone.h"
@@ -66,6 +68,32 @@ struct ChordError {
 // x = y) and exact edge-midpoint events `mid` (mid[c] on corners c, c + 1), for an object moving
 // with `m` seen through the past cone anchored at `anchor` (anchor.cone must be true).
 ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3]);
+
+// A bound from the corners alone, for triangles that need no refinement: no midpoint is cut.
+// The Hessian of delta satisfies u^T H u <= |u|_M^2 / ((1 - b^2) |x|_M) (that of a norm is at
+// most M / |x|_M), and the linear interpolant of a function with such a Hessian errs by at most
+// half its bound times sum_i l_i |p - x_i|_M^2 <= d_M^2 / 3 (the spread of three weighted points
+// no farther apart than the longest side d_M). With m = min_i |x_i|_M - d_M <= |x|_M on the
+// triangle:
+//     |F - L| <= b d_M^2 / (6 (1 - b^2) m).
+// Looser than chordError (it ignores the direction of the motion), so it only ever saves work:
+// a triangle passing it passes chordError's bound too, up to the slack between the two.
+double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Event corner[3]);
+
+// The same test without a square root or a division, for the per-frame pass over every triangle:
+// true only when chordErrorFromCorners <= tolerance holds with m >= |x|_M,min / 2 in place of
+// m (sufficient: d_M^2 <= xm^2 / 4 gives d_M <= xm / 2). s: shape offsets y + v delta of the
+// corners; xm: their |x|_M = S + y.v + delta (chordErrorFromCorners shows both).
+inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion& m, double tolerance) {
+    const double xmin = std::min(xm[0], std::min(xm[1], xm[2]));
+    double d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[(i + 1) % 3] - s[i];
+        const double uv = dot(u, m.velocity);
+        d2 = std::max(d2, uv * uv + m.one_minus_beta2 * norm2(u));
+    }
+    return xmin > 0 && 4 * d2 <= xmin * xmin && m.beta * d2 <= 3 * m.one_minus_beta2 * tolerance * xmin;
+}
 
 // The length of an edge in the map's own metric, which the refinement halves longest first
 // (Rivara's longest-edge bisection, with this length): its bubble coefficient 4 |beta| (the

@@ -286,6 +286,8 @@ struct FrameBuilder {
     std::vector<double> e_time;
     std::vector<uint8_t> e_done;
     std::vector<uint32_t> e_id;
+    std::vector<double> e_len;  // edgeLength of mesh edges, NaN until needed
+    std::vector<uint32_t> scratch_members, scratch_lo, scratch_hi;
 
     // Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
     // touched), later ids the halves made by splits. Each slot c is the edge from v[c] to v[c + 1];
@@ -296,6 +298,7 @@ struct FrameBuilder {
         uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
         uint32_t mid[3];   // midpoint vertex of a slot that is not a whole mesh edge, once made
         uint32_t edge[3];  // the mesh edge while the slot is a whole mesh edge, else kUnset
+        double len[3];     // edgeLength of a slot that is not a whole mesh edge, once known (else NaN)
         uint32_t child[2];
         uint32_t src;      // the mesh triangle it lies on
         uint32_t depth;    // bisections since the mesh triangle
@@ -321,6 +324,7 @@ struct FrameBuilder {
             t.next[c] = world.slot_next[3 * id + c];
             t.mid[c] = kUnset;
             t.edge[c] = world.triangle_edges[id][c];
+            t.len[c] = NAN;
         }
         t.child[0] = t.child[1] = kUnset;
         t.src = id;
@@ -383,10 +387,12 @@ struct FrameBuilder {
         const uint32_t a = tri(id).v[c], b = tri(id).v[(c + 1) % 3];
         const Vec3 rest = (restOfId(a) + restOfId(b)) * 0.5;
         const uint32_t m = newVertex(rest, cutRestLocal(anchor, world.motion, rest), a, b);
+        const double len = edgeLength(anchor, world.motion, eventOfId(a), eventOfId(b), eventOfId(m));
         const uint32_t start = 3 * id + uint32_t(c);
         uint32_t p = start;
         do {
             tri(p / 3).mid[p % 3] = m;
+            tri(p / 3).len[p % 3] = len;
             p = nextOf(p);
         } while (p != start);
         return m;
@@ -399,6 +405,7 @@ struct FrameBuilder {
         RTri& t = tri(to / 3);
         t.mid[to % 3] = old.mid[from % 3];
         t.edge[to % 3] = old.edge[from % 3];
+        t.len[to % 3] = old.len[from % 3];
         if (nx == from) {
             t.next[to % 3] = to;
             return;
@@ -419,14 +426,18 @@ struct FrameBuilder {
     void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
         const uint32_t lo = std::min(tri(id).v[c], tri(id).v[(c + 1) % 3]);
-        std::vector<uint32_t> members;
+        std::vector<uint32_t>& members = scratch_members;
+        members.clear();
         const uint32_t start = 3 * id + uint32_t(c);
         uint32_t p = start;
         do {
             members.push_back(p);
             p = nextOf(p);
         } while (p != start);
-        std::vector<uint32_t> lo_half, hi_half;
+        std::vector<uint32_t>& lo_half = scratch_lo;
+        std::vector<uint32_t>& hi_half = scratch_hi;
+        lo_half.clear();
+        hi_half.clear();
         for (uint32_t q : members) {
             const uint32_t u = q / 3;
             const int cu = int(q % 3);
@@ -436,10 +447,10 @@ struct FrameBuilder {
             const uint32_t A = newTri(), B = newTri();
             RTri& ta = tri(A);
             ta = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
-                      {kUnset, kUnset}, old.src, old.depth + 1};
+                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1};
             RTri& tb = tri(B);
             tb = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
-                      {kUnset, kUnset}, old.src, old.depth + 1};
+                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1};
             moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2, old);
             moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1, old);
             (a == lo ? lo_half : hi_half).push_back(3 * A + 0);
@@ -460,19 +471,19 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            const RTri t = tri(id);
-            if (t.child[0] != kUnset) continue;  // split meanwhile, as a neighbour
-            const Side s0 = side[t.v[0]];
-            if (s0 != Side::Inside && side[t.v[1]] == s0 && side[t.v[2]] == s0) continue;
+            if (tri(id).child[0] != kUnset) continue;  // split meanwhile, as a neighbour
+            const uint32_t v[3] = {tri(id).v[0], tri(id).v[1], tri(id).v[2]};
+            const Side s0 = side[v[0]];
+            if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
             Event corner[3], mid[3];
             for (int c = 0; c < 3; ++c) {
-                corner[c] = eventOfId(t.v[c]);
+                corner[c] = eventOfId(v[c]);
                 mid[c] = eventOfId(midVertex(id, c));
             }
             const ChordError ce = chordError(anchor, world.motion, corner, mid);
             if (ce.bound <= settings.tolerance) continue;
-            if (t.depth >= r_max_depth) {
-                r_limited[t.src] = 1;
+            if (tri(id).depth >= r_max_depth) {
+                r_limited[tri(id).src] = 1;
                 continue;
             }
             splitLongestPath(id, stack);
@@ -492,7 +503,15 @@ struct FrameBuilder {
     };
     Rank rankOf(uint32_t id, int c) {
         const uint32_t a = tri(id).v[c], b = tri(id).v[(c + 1) % 3];
-        const double len = edgeLength(anchor, world.motion, eventOfId(a), eventOfId(b), eventOfId(midVertex(id, c)));
+        double len;
+        if (tri(id).edge[c] != kUnset) {
+            double& cached = e_len[tri(id).edge[c]];
+            if (cached != cached) cached = edgeLength(anchor, world.motion, eventOfId(a), eventOfId(b), eventOfId(midVertex(id, c)));
+            len = cached;
+        } else {
+            if (tri(id).len[c] != tri(id).len[c]) midVertex(id, c);  // sets len around the edge
+            len = tri(id).len[c];
+        }
         return {len, std::min(a, b), std::max(a, b)};
     }
     int longestSlot(uint32_t id) {
@@ -578,58 +597,73 @@ struct FrameBuilder {
         r_max_depth = uint32_t(2 * levels);  // about max_segments pieces along each direction of a triangle
         auto isLive = [&](size_t f) { return !live || (*live)[f / kChunkTriangles]; };
 
-        // Step: images of every vertex, and of the midpoints of the live triangles' edges.
+        // Step: images of every vertex.
         r_pos.resize(r_nv);
         r_time.resize(r_nv);
         cutRestLocalBatch(anchor, world.motion, world.mesh.positions.data(), r_nv, r_pos.data(), r_time.data());
-        e_pos.resize(ne);
-        e_time.resize(ne);
-        e_done.assign(ne, live ? 0 : 1);
-        e_id.assign(ne, kUnset);
-        {
-            std::vector<uint32_t> which;
-            if (live) {
-                for (size_t f = 0; f < r_nt; ++f)
-                    if (isLive(f))
-                        for (uint32_t e : world.triangle_edges[f])
-                            if (!e_done[e]) {
-                                e_done[e] = 1;
-                                which.push_back(e);
-                            }
-            }
-            const size_t n = live ? which.size() : ne;
-            std::vector<Vec3> rest(n), pos(n);
-            std::vector<double> time(n);
-            for (size_t k = 0; k < n; ++k) {
-                const Edge& ed = world.edges[live ? which[k] : k];
-                rest[k] = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
-            }
-            cutRestLocalBatch(anchor, world.motion, rest.data(), n, pos.data(), time.data());
-            for (size_t k = 0; k < n; ++k) {
-                const size_t e = live ? which[k] : k;
-                e_pos[e] = pos[k];
-                e_time[e] = time[k];
-            }
-        }
-
-        // Step: which mesh triangles fail their bound (those wholly before or after existing never do).
         const bool caps = world.cap_a_real || world.cap_b_real;
         if (caps) classifyVertices(live);
         else side.assign(r_nv, Side::Inside);
-        std::vector<uint32_t> failing;
+
+        // Step: the corners' bound (no midpoint needed) passes most triangles that need no
+        // refinement; the others get the full bound, from their edges' midpoints cut in batches.
+        std::vector<uint32_t> candidates, failing;
+        std::vector<Vec3> shape(r_nv);  // y + v delta
+        std::vector<double> xm(r_nv);   // |x|_M
+        for (size_t i = 0; i < r_nv; ++i) {
+            const double delta = -r_time[i];
+            shape[i] = r_pos[i] + world.motion.velocity * delta;
+            xm[i] = anchor.S + dot(r_pos[i], world.motion.velocity) + delta;
+        }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             const auto& t = world.mesh.triangles[f];
             const Side s0 = side[t[0]];
-            if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;
+            if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
-            Event corner[3], mid[3];
-            for (int c = 0; c < 3; ++c) {
-                corner[c] = {r_time[t[c]], r_pos[t[c]]};
-                const uint32_t e = world.triangle_edges[f][c];
-                mid[c] = {e_time[e], e_pos[e]};
+            const Vec3 sc[3] = {shape[t[0]], shape[t[1]], shape[t[2]]};
+            const double xc[3] = {xm[t[0]], xm[t[1]], xm[t[2]]};
+            if (passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
+            const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
+            if (chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance) candidates.push_back(uint32_t(f));
+        }
+        if (!candidates.empty()) {
+            e_id.assign(ne, kUnset);
+            e_done.assign(ne, 0);
+            e_pos.resize(ne);
+            e_time.resize(ne);
+            e_len.assign(ne, NAN);
+            std::vector<uint32_t> which;
+            for (uint32_t f : candidates)
+                for (uint32_t e : world.triangle_edges[f])
+                    if (!e_done[e]) {
+                        e_done[e] = 1;
+                        which.push_back(e);
+                    }
+            constexpr size_t kBatch = 1024;  // rest points cut per call, kept in cache
+            Vec3 rest[kBatch], pos[kBatch];
+            double time[kBatch];
+            for (size_t k0 = 0; k0 < which.size(); k0 += kBatch) {
+                const size_t n = std::min(kBatch, which.size() - k0);
+                for (size_t k = 0; k < n; ++k) {
+                    const Edge& ed = world.edges[which[k0 + k]];
+                    rest[k] = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
+                }
+                cutRestLocalBatch(anchor, world.motion, rest, n, pos, time);
+                for (size_t k = 0; k < n; ++k) {
+                    e_pos[which[k0 + k]] = pos[k];
+                    e_time[which[k0 + k]] = time[k];
+                }
             }
-            if (chordError(anchor, world.motion, corner, mid).bound > settings.tolerance) failing.push_back(uint32_t(f));
+            for (uint32_t f : candidates) {
+                Event corner[3], mid[3];
+                for (int c = 0; c < 3; ++c) {
+                    const uint32_t v = world.mesh.triangles[f][c], e = world.triangle_edges[f][c];
+                    corner[c] = {r_time[v], r_pos[v]};
+                    mid[c] = {e_time[e], e_pos[e]};
+                }
+                if (chordError(anchor, world.motion, corner, mid).bound > settings.tolerance) failing.push_back(f);
+            }
         }
         // Nothing to refine on a simple mesh that exists throughout: vertex mode's output.
         if (failing.empty() && !caps && world.simple) {
@@ -669,11 +703,12 @@ struct FrameBuilder {
             }
             stack.push_back(uint32_t(f));
             while (!stack.empty()) {
-                const RTri t = tri(stack.back());
+                const RTri& t = tri(stack.back());
                 stack.pop_back();
                 if (t.child[0] != kUnset) {
-                    stack.push_back(t.child[1]);
-                    stack.push_back(t.child[0]);
+                    const uint32_t a = t.child[0], b = t.child[1];
+                    stack.push_back(b);
+                    stack.push_back(a);
                 } else {
                     emitLeaf(t.src, t.v);
                 }

@@ -11,15 +11,15 @@
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
 #include "pipeline/mesh_check.h"
-#include "error_measure.h"
+#include "mesh4d/measure.h"
 #include "test_meshes.h"
 
 using namespace mesh4d;
 
 namespace {
 
-using errmeasure::exactToOutput;
-using errmeasure::outputToExact;
+using mesh4d::measure::exactToOutput;
+using mesh4d::measure::outputToExact;
 
 double restSize(const RestMesh& m) {
     Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};

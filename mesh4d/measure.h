@@ -1,5 +1,5 @@
 // Measured distance between an apparent mesh and the exact apparent surface, both directions,
-// shared by the tests and the accuracy benchmark. The exact surface is evaluated point by point
+// shared by the tests, the accuracy benchmark and `apparent trade`. The exact surface is evaluated point by point
 // with the direct closed form (exactRelative below), independently of how the mesh was refined and
 // of the anchored form that made its points.
 #pragma once
@@ -7,18 +7,18 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mesh4d/slice.h"
+#include <vector>
 
-namespace errmeasure {
+#include "slice.h"
 
-using mesh4d::ApparentMesh;
-using mesh4d::Vec3;
+namespace mesh4d::measure {
+
 
 // The exact apparent point of rest point q relative to `origin`, by the direct closed form of the
 // cut from where the point is now (lightcone.h cutRestWorldline: one quadratic in the whole delay),
 // not by the anchored form (delay of the origin plus a second quadratic) that the mesh is made with.
-inline Vec3 exactRelative(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const Vec3& q, const Vec3& origin) {
-    return mesh4d::cutRestWorldline(view, w.motion, mesh4d::nowBase(view, w.motion), q).x - origin;
+inline Vec3 exactRelative(const World4D& w, const ViewSurface& view, const Vec3& q, const Vec3& origin) {
+    return cutRestWorldline(view, w.motion, nowBase(view, w.motion), q).x - origin;
 }
 
 // Barycentric sample points: vertices, edge midpoints, the centroid and interior points.
@@ -29,7 +29,7 @@ inline const double kSamples[12][3] = {{1, 0, 0},     {0, 1, 0},   {0, 0, 1},   
 // Output -> exact: the largest |L(p) - F(p)| over samples of every output triangle, where L is the
 // mesh (linear on each triangle) and F the exact image of the same rest point. Bounds the
 // distance from every sampled output point to the exact surface.
-inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m) {
+inline double outputToExact(const World4D& w, const ViewSurface& view, const ApparentMesh& m) {
     double worst = 0;
     for (const auto& t : m.triangles)
         for (const auto& b : kSamples) {
@@ -38,7 +38,7 @@ inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface&
                 rest += m.rest_points[t[k]] * b[k];
                 out += m.positions[t[k]] * b[k];
             }
-            worst = std::max(worst, mesh4d::norm(exactRelative(w, view, rest, m.origin) - out));
+            worst = std::max(worst, norm(exactRelative(w, view, rest, m.origin) - out));
         }
     return worst;
 }
@@ -46,7 +46,7 @@ inline double outputToExact(const mesh4d::World4D& w, const mesh4d::ViewSurface&
 // Exact -> output: for points on a barycentric grid of every input triangle, the distance from
 // the exact point to the output point at the same rest point (found in the output triangles that
 // lie on that input triangle). Bounds the distance from every sampled exact point to the mesh.
-inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const ApparentMesh& m,
+inline double exactToOutput(const World4D& w, const ViewSurface& view, const ApparentMesh& m,
                             int grid) {
     std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
     for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
@@ -54,7 +54,7 @@ inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface&
     for (size_t f = 0; f < w.mesh.triangles.size(); ++f) {
         const auto& it = w.mesh.triangles[f];
         const Vec3 a = w.mesh.positions[it[0]], b = w.mesh.positions[it[1]], c = w.mesh.positions[it[2]];
-        const Vec3 n = mesh4d::cross(b - a, c - a);
+        const Vec3 n = cross(b - a, c - a);
         for (int i = 0; i <= grid; ++i)
             for (int j = 0; i + j <= grid; ++j) {
                 const double l1 = double(i) / grid, l2 = double(j) / grid;
@@ -64,14 +64,14 @@ inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface&
                 for (size_t t : by_source[f]) {
                     const auto& ot = m.triangles[t];
                     const Vec3 p0 = m.rest_points[ot[0]], p1 = m.rest_points[ot[1]], p2 = m.rest_points[ot[2]];
-                    const double area = mesh4d::dot(mesh4d::cross(p1 - p0, p2 - p0), n);
+                    const double area = dot(cross(p1 - p0, p2 - p0), n);
                     if (area == 0) continue;
-                    const double l[3] = {mesh4d::dot(mesh4d::cross(p1 - q, p2 - q), n) / area,
-                                         mesh4d::dot(mesh4d::cross(p2 - q, p0 - q), n) / area,
-                                         mesh4d::dot(mesh4d::cross(p0 - q, p1 - q), n) / area};
+                    const double l[3] = {dot(cross(p1 - q, p2 - q), n) / area,
+                                         dot(cross(p2 - q, p0 - q), n) / area,
+                                         dot(cross(p0 - q, p1 - q), n) / area};
                     if (std::min({l[0], l[1], l[2]}) < -1e-9) continue;
                     const Vec3 out = m.positions[ot[0]] * l[0] + m.positions[ot[1]] * l[1] + m.positions[ot[2]] * l[2];
-                    best = std::min(best, mesh4d::norm(exact - out));
+                    best = std::min(best, norm(exact - out));
                 }
                 worst = std::max(worst, best);
             }
@@ -79,4 +79,12 @@ inline double exactToOutput(const mesh4d::World4D& w, const mesh4d::ViewSurface&
     return worst;
 }
 
-}  // namespace errmeasure
+
+// The two-sided distance as the tests measure it: the larger of both directions (grid 8 on each
+// input triangle for exact -> output).
+inline double twoSided(const World4D& w, const ViewSurface& view, const ApparentMesh& m, int grid = 8) {
+    if (m.triangles.empty()) return 0;
+    return std::max(outputToExact(w, view, m), exactToOutput(w, view, m, grid));
+}
+
+}  // namespace mesh4d::measure
