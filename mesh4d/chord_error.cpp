@@ -79,9 +79,12 @@ double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, con
     const Vec3 sa = a.x + m.velocity * da, sb = b.x + m.velocity * db;
     const double l = normM(sb - sa, m);
     const double xm = std::min(anchor.S + dot(a.x, m.velocity) + da, anchor.S + dot(b.x, m.velocity) + db) - l;
-    const double third = xm > 0 ? 8 * l * l * l / (9 * std::sqrt(3.0) * m.one_minus_beta2 * xm * xm) : INFINITY;
+    // m is floored at l: finite near the camera, where halving an edge must still shorten it
+    // (longest-edge bisection ends only if the halves and medians are shorter than their edge).
+    const double mf = std::max(xm, l);
+    const double third = mf > 0 ? 8 * l * l * l / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mf * mf) : 0.0;
     const double length = c + third;
-    return length == length ? length : INFINITY;
+    return length == length ? length : 0.0;
 }
 
 }  // namespace mesh4d

@@ -99,8 +99,9 @@ inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion&
 // (Rivara's longest-edge bisection, with this length): its bubble coefficient 4 |beta| (the
 // second difference of delta along the edge, i.e. its squared length in the Hessian's metric)
 // plus the edge's share of the third-order term, 8 l_M^3 / (9 sqrt 3 (1 - b^2) m^2) with l_M its
-// M-length and m = min |x|_M of its ends minus l_M. A property of the edge alone, so both
-// triangles of an edge agree on it; INFINITY when the edge reaches the camera.
+// M-length and m = max(min |x|_M of its ends minus l_M, l_M) (floored so that an edge reaching
+// the camera still has a finite length that halving reduces). A property of the edge alone, so
+// both triangles of an edge agree on it.
 double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid);
 
 }  // namespace mesh4d
