@@ -23,7 +23,8 @@ double normM(const Vec3& u, const Motion& m) {
 }
 }  // namespace
 
-ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3]) {
+ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
+                      double tolerance) {
     ChordError r;
     if (m.beta == 0) return r;
     // Delays (delta = -t) and the midpoint bubbles, |beta| (delta is convex: beta <= 0 up to rounding).
@@ -33,6 +34,12 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
         c[e] = 4 * std::fabs(dm - 0.5 * (d0 + d1));
     }
     const double Q = bubbleMax(c[0], c[1], c[2]);
+    r.quadratic = m.beta * Q;
+    // Over the tolerance on the bubbles alone: R only adds (callers compare the bound only).
+    if (!(r.quadratic <= tolerance)) {
+        r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
+        return r;
+    }
     // Shape offsets s = y + v delta, their centroid, the M-radius r_M and |x_i|_M.
     Vec3 s[3];
     double xm_min = INFINITY;
@@ -46,7 +53,6 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
     for (int i = 0; i < 3; ++i) rM = std::max(rM, normM(s[i] - centre, m));
     const double mlow = xm_min - 2 * rM;
     const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
-    r.quadratic = m.beta * Q;
     r.bound = m.beta * (Q + R);
     if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
     return r;

@@ -44,6 +44,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 #include "boost.h"
 #include "event.h"
@@ -66,8 +67,10 @@ struct ChordError {
 
 // The bound above for the triangle with exact corner events `corner` (local coordinates: t = -delta,
 // x = y) and exact edge-midpoint events `mid` (mid[c] on corners c, c + 1), for an object moving
-// with `m` seen through the past cone anchored at `anchor` (anchor.cone must be true).
-ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3]);
+// with `m` seen through the past cone anchored at `anchor` (anchor.cone must be true). When the
+// bubbles alone exceed `tolerance`, the bound returned is b Q (already over it; R is not computed).
+ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
+                      double tolerance = INFINITY);
 
 // A bound from the corners alone, for triangles that need no refinement: no midpoint is cut.
 // The Hessian of delta satisfies u^T H u <= |u|_M^2 / ((1 - b^2) |x|_M) (that of a norm is at

@@ -2,8 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include <deque>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -302,10 +301,11 @@ struct FrameBuilder {
         uint32_t child[2];
         uint32_t src;      // the mesh triangle it lies on
         uint32_t depth;    // bisections since the mesh triangle
+        int longest = -1;  // the slot of its longest edge, once known
     };
     std::vector<RTri> r_base;  // ids < r_nt, valid where r_init is set
     std::vector<uint8_t> r_init;
-    std::vector<RTri> r_kids;  // ids >= r_nt
+    std::deque<RTri> r_kids;   // ids >= r_nt (a deque: growing never moves the records)
     std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
     uint32_t r_max_depth = 0;
     std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
@@ -329,6 +329,7 @@ struct FrameBuilder {
         t.child[0] = t.child[1] = kUnset;
         t.src = id;
         t.depth = 0;
+        t.longest = -1;
     }
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
     uint32_t nextOf(uint32_t p) {
@@ -447,10 +448,10 @@ struct FrameBuilder {
             const uint32_t A = newTri(), B = newTri();
             RTri& ta = tri(A);
             ta = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
-                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1};
+                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1};
             RTri& tb = tri(B);
             tb = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
-                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1};
+                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1};
             moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2, old);
             moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1, old);
             (a == lo ? lo_half : hi_half).push_back(3 * A + 0);
@@ -480,7 +481,7 @@ struct FrameBuilder {
                 corner[c] = eventOfId(v[c]);
                 mid[c] = eventOfId(midVertex(id, c));
             }
-            const ChordError ce = chordError(anchor, world.motion, corner, mid);
+            const ChordError ce = chordError(anchor, world.motion, corner, mid, settings.tolerance);
             if (ce.bound <= settings.tolerance) continue;
             if (tri(id).depth >= r_max_depth) {
                 r_limited[tri(id).src] = 1;
@@ -516,6 +517,7 @@ struct FrameBuilder {
     }
     int longestSlot(uint32_t id) {
         ensureBase(id);
+        if (tri(id).longest >= 0) return tri(id).longest;
         int best = 0;
         Rank r = rankOf(id, 0);
         for (int c = 1; c < 3; ++c) {
@@ -525,6 +527,7 @@ struct FrameBuilder {
                 best = c;
             }
         }
+        tri(id).longest = best;
         return best;
     }
 
@@ -662,7 +665,7 @@ struct FrameBuilder {
                     corner[c] = {r_time[v], r_pos[v]};
                     mid[c] = {e_time[e], e_pos[e]};
                 }
-                if (chordError(anchor, world.motion, corner, mid).bound > settings.tolerance) failing.push_back(f);
+                if (chordError(anchor, world.motion, corner, mid, settings.tolerance).bound > settings.tolerance) failing.push_back(f);
             }
         }
         // Nothing to refine on a simple mesh that exists throughout: vertex mode's output.

@@ -7,6 +7,7 @@
 
 #include "pipeline/raytrace.h"
 #include "pipeline/render.h"
+#include "pipeline/trade.h"
 
 namespace apparent {
 
@@ -146,6 +147,30 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_flag("--allow-outside", fs.limits.allow_outside,
                          "Let scene mesh paths leave the scene's folder and the working folder");
 
+    // `trade`: the speed-accuracy trade measured on the user's scene (pipeline/trade.h).
+    TradeSettings trs;
+    std::string trade_model_text, trade_frames_text, trade_tolerances_text;
+    CLI::App* trade_cmd = app.add_subcommand(
+        "trade", "Measure error against time and size on a scene: vertex mode, uniform subdivision, a ladder of tolerances");
+    trade_cmd->add_option("scene", trs.scene_path, "Scene file (JSON or glTF)")->required();
+    trade_cmd->add_option("--out", trs.out_dir, "Folder for trade.csv, trade.png and trade.gp (created if missing)")
+        ->capture_default_str();
+    trade_cmd->add_option("--model", trade_model_text, "finite|relativistic (default: the scene's model)");
+    trade_cmd->add_option("--frames", trade_frames_text, "A:B measures frames A..B-1 (default: 5 frames spread over the scene)");
+    trade_cmd->add_option("--levels", trs.levels, "Uniform subdivision levels 1..N to compare")->capture_default_str();
+    trade_cmd->add_option("--tolerances", trade_tolerances_text,
+                          "Comma list of tolerances relative to the largest object size (default 1e-1,3e-2,...,1e-4)");
+    trade_cmd->add_option("--max-triangles", trs.max_triangles, "Skip rows with more output triangles per frame")
+        ->capture_default_str();
+    trade_cmd->add_flag("--quiet,-q", trs.quiet, "Only the table");
+    trade_cmd->add_flag("--allow-outside", trs.limits.allow_outside,
+                        "Let scene mesh paths leave the scene's folder and the working folder");
+    trade_cmd->footer(
+        "Prints, for each row: the measured two-sided error to the exact apparent surface (sampled as the tests do),\n"
+        "output triangles per frame, cut time per frame (one thread) and .glb bytes per frame; writes DIR/trade.csv\n"
+        "and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex mode's error and for a\n"
+        "tenth of it.");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
@@ -189,6 +214,30 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
         if (fs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
         return guarded([&] { return figure(fs, out, err); }, err);
+    }
+    if (trade_cmd->parsed()) {
+        if (!trade_model_text.empty() && !parseModel(trade_model_text, &trs.model))
+            return usage("--model: unknown model '" + trade_model_text + "' (instant, finite, relativistic, contracted)");
+        trs.has_model = !trade_model_text.empty();
+        if (!trade_frames_text.empty() && !parseFrames(trade_frames_text, &trs.frame_from, &trs.frame_to))
+            return usage("--frames: '" + trade_frames_text + "' is not A:B with 0 <= A < B");
+        if (trs.levels < 0 || trs.levels > 8) return usage("--levels: must be in 0..8");
+        if (trs.max_triangles <= 0) return usage("--max-triangles: must be positive");
+        std::stringstream ss(trade_tolerances_text);
+        std::string item;
+        while (!trade_tolerances_text.empty() && std::getline(ss, item, ',')) {
+            size_t used = 0;
+            double t = 0;
+            try {
+                t = std::stod(item, &used);
+            } catch (...) {
+                used = 0;
+            }
+            if (used != item.size() || !(t > 0) || !(t < 1e3))
+                return usage("--tolerances: '" + item + "' is not a positive number (a fraction of the object size)");
+            trs.tolerances_rel.push_back(t);
+        }
+        return guarded([&] { return trade(trs, out, err); }, err);
     }
     if (!render_cmd->parsed()) return kExitBadInput;
     if (!model_text.empty()) {

@@ -1,0 +1,302 @@
+#include "pipeline/trade.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <ostream>
+#include <sstream>
+#include <unistd.h>
+
+#include "exporters/gltf.h"
+#include "mesh4d/measure.h"
+#include "mesh4d/subdivide.h"
+#include "pipeline/render.h"
+
+namespace apparent {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The bounding-box diagonal of a rest mesh.
+double restSize(const mesh4d::RestMesh& m) {
+    mesh4d::Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (const auto& p : m.positions) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    return m.positions.empty() ? 0.0 : mesh4d::norm(hi - lo);
+}
+
+std::string formatG(double x, int digits = 3) {
+    std::ostringstream s;
+    s << std::setprecision(digits) << x;
+    return s.str();
+}
+
+// Measures one configuration: `objects` (already subdivided for the uniform family) at
+// `tolerance` over `frames`.
+TradeRow measure(const std::vector<PreparedObject>& objects, const Scene& scene, Model model,
+                 const std::vector<long long>& frames, double tolerance, long long max_triangles,
+                 const std::string& glb_path, bool* too_large) {
+    TradeRow row;
+    const long long first = frames.front(), last = frames.back();
+    std::vector<mesh4d::World4D> worlds;
+    worlds.reserve(objects.size());
+    for (const auto& o : objects) worlds.push_back(buildWorld(o, model, scene, first, last));
+    mesh4d::SliceSettings settings;
+    settings.tolerance = tolerance;
+    settings.max_segments = 4096;
+    std::vector<ExportFrame> exported;
+    double seconds = 0, triangles = 0;
+    *too_large = false;
+    for (long long k : frames) {
+        const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
+        ExportFrame frame;
+        frame.index = k;
+        frame.t_c = frameTime(scene.frames, k);
+        // Timed over repeats until at least 2 ms, so that small frames are measured above the clock's grain.
+        int repeats = 0;
+        double spent = 0;
+        do {
+            frame.objects.clear();
+            const auto t0 = Clock::now();
+            for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view, settings));
+            spent += std::chrono::duration<double>(Clock::now() - t0).count();
+            ++repeats;
+        } while (spent < 2e-3 && repeats < 1000);
+        seconds += spent / repeats;
+        const size_t n = frame.triangleCount();
+        triangles += double(n);
+        if ((long long)n > max_triangles) {
+            *too_large = true;
+            return row;
+        }
+        for (size_t i = 0; i < worlds.size(); ++i)
+            row.error = std::max(row.error, mesh4d::measure::twoSided(worlds[i], view, frame.objects[i]));
+        exported.push_back(std::move(frame));
+    }
+    // The .glb of these frames, written by the real writer (its size is what a viewer downloads).
+    SequenceInfo info;
+    info.model = modelName(model);
+    info.tolerance = tolerance;
+    info.fps = scene.frames.fps;
+    info.scene_path = scene.path;
+    for (size_t i = 0; i < objects.size(); ++i) {
+        ExportObject o;
+        o.name = objects[i].spec.name;
+        o.base_color = objectBaseColor(objects, i);
+        info.objects.push_back(o);
+    }
+    GlbStats stats;
+    std::string error;
+    const auto w0 = Clock::now();
+    if (writeAnimatedGlb(glb_path, exported, info, GlbOptions{}, &stats, &error)) row.glb_bytes = double(stats.bytes) / double(frames.size());
+    row.export_seconds = std::chrono::duration<double>(Clock::now() - w0).count() / double(frames.size());
+    std::error_code ec;
+    std::filesystem::remove(glb_path, ec);
+    row.seconds = seconds / double(frames.size());
+    row.triangles = triangles / double(frames.size());
+    return row;
+}
+
+// Writes DIR/trade.gp and runs gnuplot on it, when gnuplot is installed.
+bool plot(const std::string& dir, const std::vector<TradeRow>& rows, double size, std::ostream& err) {
+    const std::string dat = dir + "/trade.dat", gp = dir + "/trade.gp", png = dir + "/trade.png";
+    {
+        std::ofstream d(dat);
+        for (const char* family : {"vertex", "uniform", "tolerance"}) {
+            d << "# " << family << "\n";
+            for (const auto& r : rows)
+                if (r.family == family && !r.skipped) d << r.total() * 1e3 << " " << r.error / size << "\n";
+            d << "\n\n";
+        }
+        if (!d) return false;
+    }
+    {
+        std::ofstream g(gp);
+        g << "set terminal pngcairo size 900,560 font ',11'\n"
+          << "set output 'trade.png'\n"
+          << "set logscale xy\n"
+          << "set xlabel 'time per frame, cut and .glb export, one thread (milliseconds)'\n"
+          << "set ylabel 'measured two-sided error / largest object size'\n"
+          << "set grid\nset key top right\n"
+          << "set title 'apparent trade: error against time'\n"
+          << "plot 'trade.dat' index 0 using 1:2 with points pt 7 ps 2 title 'vertex mode', \\\n"
+          << "     'trade.dat' index 1 using 1:2 with linespoints lw 2 pt 5 title 'uniform subdivision (levels 1..k)', \\\n"
+          << "     'trade.dat' index 2 using 1:2 with linespoints lw 2 pt 9 title '--tolerance T (adaptive)'\n";
+        if (!g) return false;
+    }
+    const std::string cmd = "cd '" + dir + "' && gnuplot trade.gp 2>&1";
+    if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+        err << "note: gnuplot is not installed: " << png << " not drawn (" << gp << " draws it; Debian: gnuplot-nox)\n";
+        return true;
+    }
+    if (std::system(cmd.c_str()) != 0) {
+        err << "warning: gnuplot failed on " << gp << ": " << png << " not drawn\n";
+    }
+    return true;
+}
+
+}  // namespace
+
+const TradeRow* cheapestWithin(const std::vector<TradeRow>& rows, double error) {
+    const TradeRow* best = nullptr;
+    for (const auto& r : rows)
+        if (!r.skipped && r.error <= error && (!best || r.total() < best->total())) best = &r;
+    return best;
+}
+
+int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
+    // Step: the scene, its model and frames, and the objects' meshes.
+    Scene scene;
+    if (Status s = loadScene(settings.scene_path, &scene); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
+    const Model model = settings.has_model ? settings.model : scene.model;
+    if (Status s = checkSceneForModel(scene, model); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
+    const long long total = frameCount(scene.frames);
+    if (total > settings.max_frames) {
+        err << "error: " << scene.path << ": frames: " << total << " frames requested, more than the limit of "
+            << settings.max_frames << " (raise it with --max-frames)\n";
+        return kExitBadInput;
+    }
+    std::vector<long long> frames;
+    if (settings.frame_from >= 0) {
+        const long long to = settings.frame_to < 0 ? total : settings.frame_to;
+        if (!(settings.frame_from < to && to <= total)) {
+            err << "error: --frames: " << settings.frame_from << ":" << to << " is outside the scene's frames 0:" << total << "\n";
+            return kExitBadInput;
+        }
+        for (long long k = settings.frame_from; k < to; ++k) frames.push_back(k);
+    } else {
+        const long long n = std::min<long long>(5, total);
+        for (long long i = 0; i < n; ++i) frames.push_back(n == 1 ? 0 : i * (total - 1) / (n - 1));
+    }
+    if (model == Model::Instant || model == Model::Contracted) {
+        out << "The " << modelName(model) << " model cuts the histories with a hyperplane: the map from the rest "
+            << "mesh is affine, so vertex mode is exact (error 0) and no tolerance or subdivision changes it.\n";
+        return kExitOk;
+    }
+    std::vector<PreparedObject> objects;
+    if (Status s = prepareObjects(scene, settings.limits, &objects, err, settings.quiet); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
+    // The size tolerances are relative to: the largest moving object (objects at rest map affinely
+    // and are never refined), or the largest object when none moves.
+    double size = 0, size_any = 0;
+    for (const auto& o : objects) {
+        size_any = std::max(size_any, restSize(o.rest));
+        if (mesh4d::norm(o.spec.velocity) > 0 || o.spec.speed != ObjectSpec::Speed::Velocity) size = std::max(size, restSize(o.rest));
+    }
+    if (size == 0) size = size_any;
+    std::error_code ec;
+    std::filesystem::create_directories(settings.out_dir, ec);
+    if (ec) {
+        err << "error: " << settings.out_dir << ": cannot create output folder: " << ec.message() << "\n";
+        return kExitOutputError;
+    }
+    const std::string glb_tmp = settings.out_dir + "/.trade-" + std::to_string(getpid()) + ".glb";
+
+    // Step: the three families.
+    std::vector<TradeRow> rows;
+    auto run = [&](const std::string& family, double parameter, const std::vector<PreparedObject>& objs, double tolerance) {
+        bool too_large = false;
+        TradeRow r = measure(objs, scene, model, frames, tolerance, settings.max_triangles, glb_tmp, &too_large);
+        r.family = family;
+        r.parameter = parameter;
+        r.skipped = too_large;
+        if (!settings.quiet)
+            err << "trade: " << family << " " << formatG(parameter) << (too_large ? ": skipped (over --max-triangles)" : "")
+                << "\n";
+        rows.push_back(r);
+        return !too_large;
+    };
+    run("vertex", 0, objects, 0);
+    for (int level = 1; level <= settings.levels; ++level) {
+        std::vector<PreparedObject> finer = objects;
+        for (auto& o : finer) o.rest = mesh4d::subdivideUniform(o.rest, level);
+        if (!run("uniform", level, finer, 0)) break;
+    }
+    std::vector<double> ladder = settings.tolerances_rel;
+    if (ladder.empty()) ladder = {1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4};
+    for (double rel : ladder)
+        if (!run("tolerance", rel * size, objects, rel * size)) break;
+
+    // Step: the table, the file and the plot.
+    std::ostringstream table;
+    table << "apparent trade: " << scene.path << ", model " << modelName(model) << ", " << frames.size()
+          << " frames, largest moving object size " << formatG(size, 4) << " ls; one thread\n";
+    table << std::left << std::setw(22) << "family" << std::right << std::setw(11) << "error (ls)" << std::setw(11)
+          << "error/size" << std::setw(8) << "err/T" << std::setw(11) << "triangles" << std::setw(10) << "cut ms"
+          << std::setw(10) << "glb ms" << std::setw(10) << "total ms" << std::setw(12) << "glb B" << "   (per frame)\n";
+    std::ostringstream csv;
+    csv << "family,parameter,error_ls,error_rel,triangles_per_frame,cut_seconds_per_frame,export_seconds_per_frame,"
+           "glb_bytes_per_frame,skipped\n";
+    for (const auto& r : rows) {
+        std::string name = r.family;
+        if (r.family == "uniform") name += " level " + formatG(r.parameter);
+        if (r.family == "tolerance") name = "T = " + formatG(r.parameter / size, 2) + " x size";
+        csv << r.family << "," << std::setprecision(10) << r.parameter << "," << r.error << "," << r.error / size << ","
+            << r.triangles << "," << r.seconds << "," << r.export_seconds << "," << r.glb_bytes << "," << (r.skipped ? 1 : 0)
+            << "\n";
+        table << std::left << std::setw(22) << name << std::right;
+        if (r.skipped) {
+            table << "  skipped: more than " << settings.max_triangles << " triangles per frame (--max-triangles)\n";
+            continue;
+        }
+        table << std::setw(11) << formatG(r.error) << std::setw(11) << formatG(r.error / size) << std::setw(8)
+              << (r.family == "tolerance" ? formatG(r.error / r.parameter, 2) : std::string("-")) << std::setw(11)
+              << std::fixed << std::setprecision(0) << r.triangles << std::setprecision(3) << std::setw(10)
+              << r.seconds * 1e3 << std::setw(10) << r.export_seconds * 1e3 << std::setw(10)
+              << (r.seconds + r.export_seconds) * 1e3 << std::setw(12) << std::setprecision(0) << r.glb_bytes
+              << std::defaultfloat << "\n";
+    }
+    const double vertex_error = rows.front().error;
+    auto pick = [&](double target, const char* what) {
+        const TradeRow* best = nullptr;
+        for (const auto& r : rows)
+            if (r.family == "tolerance" && !r.skipped && r.error <= target && (!best || r.total() < best->total())) best = &r;
+        const TradeRow* any = cheapestWithin(rows, target);
+        table << "For " << what << " (" << formatG(target) << " ls): ";
+        if (best) table << "--tolerance " << formatG(best->parameter, 4) << " (" << formatG(best->total() * 1e3) << " ms/frame)";
+        else table << "no tolerance of the ladder";
+        if (any && any != best)
+            table << "; fastest of all rows: " << any->family << " " << formatG(any->parameter) << " ("
+                  << formatG(any->total() * 1e3) << " ms/frame)";
+        table << "\n";
+    };
+    if (vertex_error > 0) {
+        pick(vertex_error, "vertex mode's error");
+        pick(vertex_error / 10, "a tenth of it");
+    } else {
+        table << "Vertex mode is exact on these frames (error 0): nothing to trade.\n";
+    }
+    out << table.str();
+    const std::string csv_path = settings.out_dir + "/trade.csv";
+    std::ofstream f(csv_path);
+    f << csv.str();
+    f.close();
+    if (!f) {
+        err << "error: " << csv_path << ": cannot write\n";
+        return kExitOutputError;
+    }
+    if (!plot(settings.out_dir, rows, size, err)) {
+        err << "error: " << settings.out_dir << ": cannot write the plot files\n";
+        return kExitOutputError;
+    }
+    if (!settings.quiet) err << "wrote " << csv_path << " and " << settings.out_dir << "/trade.png\n";
+    return kExitOk;
+}
+
+}  // namespace apparent

@@ -1,0 +1,70 @@
+// `apparent trade SCENE [--model M] [--frames A:B] [--out DIR]`: the speed-accuracy trade measured
+// on the user's own scene, against what a user would pick instead.
+//
+// Three families of output, each cut from the same scene, frames and model, on one thread:
+//   vertex     exact vertices joined by straight edges (--tolerance vertex, what per-vertex
+//              engines do);
+//   uniform k  every input triangle split 4-to-1 at its edge midpoints k times, then vertex mode
+//              (mesh4d/subdivide.h: OpenRelativity's ObjectMeshDensity), k = 1 .. --levels;
+//   T          the adaptive refinement at tolerance T (slice.h), a ladder of T = 1e-1, 3e-2,
+//              1e-2, ... 1e-4 x the largest moving object's size (its bounding-box diagonal;
+//              objects at rest are never refined).
+// Each row reports the measured two-sided error (mesh4d/measure.h: sampled output points against
+// the exact surface and exact-surface lattice points against the output, the largest over the
+// objects and frames), output triangles per frame, the time of the cut per frame (all objects,
+// refinement included, repeated until at least 2 ms are timed), the time to write the frames as a
+// .glb (the real writer: normals, float32, file; written to a temporary file and removed) and the
+// .glb bytes per frame. End to end is the sum of the two times. It prints the table, writes DIR/trade.csv and, with gnuplot installed,
+// DIR/trade.png (log-log error against time, one curve per family; DIR/trade.gp regenerates it),
+// and names the tolerance that gives the least time for vertex mode's error and for a tenth of it.
+//
+// Frames: A:B measures every frame in [A, B); without it, five frames evenly spaced over the
+// scene. Rows whose output would pass --max-triangles per frame are skipped and said so.
+// The instant and contracted models map the rest mesh affinely (a hyperplane cut): vertex mode
+// is exact there, and the command says so instead of measuring.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "pipeline/mesh_input.h"
+#include "pipeline/scene.h"
+
+namespace apparent {
+
+struct TradeSettings {
+    std::string scene_path;
+    std::string out_dir = "out";
+    bool has_model = false;    // --model, else the scene's
+    Model model = Model::Relativistic;
+    long long frame_from = -1;  // --frames A:B (B exclusive); -1: five frames spread over the scene
+    long long frame_to = -1;
+    int levels = 4;                       // uniform subdivision levels 1..levels
+    std::vector<double> tolerances_rel;   // empty: 1e-1, 3e-2, ... 1e-4 x size
+    long long max_triangles = 4'000'000;  // per frame; larger rows are skipped
+    bool quiet = false;
+    long long max_frames = kDefaultMaxFrames;
+    MeshLimits limits;
+};
+
+// One measured row of the table.
+struct TradeRow {
+    std::string family;      // "vertex", "uniform", "tolerance"
+    double parameter = 0;    // uniform: level; tolerance: T in light-seconds
+    double error = 0;        // measured two-sided error, light-seconds
+    double triangles = 0;    // output triangles per frame (mean)
+    double seconds = 0;      // cut time per frame (mean), refinement included
+    double export_seconds = 0;  // .glb writing per frame (normals, float32, file), the real writer
+    double glb_bytes = 0;    // .glb bytes per frame
+    bool skipped = false;    // over max_triangles
+    double total() const { return seconds + export_seconds; }
+};
+
+// Runs the measurement; returns an exit code (0, 2 bad input, 3 output could not be written).
+int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err);
+
+// The row of least time end to end (cut and .glb) whose error is at most `error` (nullptr if none).
+const TradeRow* cheapestWithin(const std::vector<TradeRow>& rows, double error);
+
+}  // namespace apparent
