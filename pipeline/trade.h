@@ -12,9 +12,10 @@
 // Each row reports the measured two-sided error (mesh4d/measure.h: sampled output points against
 // the exact surface and exact-surface lattice points against the output, the largest over the
 // objects and frames), output triangles per frame, the time of the cut per frame (all objects,
-// refinement included, repeated until at least 2 ms are timed), the time to write the frames as a
-// .glb (the real writer: normals, float32, file; written to a temporary file and removed) and the
-// .glb bytes per frame. End to end is the sum of the two times. It prints the table, writes DIR/trade.csv and, with gnuplot installed,
+// refinement included, repeated until at least 2 ms are timed), the time to convert a frame for
+// the .glb (the real writer's per-frame work: crease split, normals, float32; timed the same way,
+// the file's fixed costs left out) and the .glb bytes per frame (the frames written to a temporary
+// file, then removed). End to end is the sum of the two times. It prints the table, writes DIR/trade.csv and, with gnuplot installed,
 // DIR/trade.png (log-log error against time, one curve per family; DIR/trade.gp regenerates it),
 // and names the tolerance that gives the least time for vertex mode's error and for a tenth of it.
 //
@@ -55,7 +56,7 @@ struct TradeRow {
     double error = 0;        // measured two-sided error, light-seconds
     double triangles = 0;    // output triangles per frame (mean)
     double seconds = 0;      // cut time per frame (mean), refinement included
-    double export_seconds = 0;  // .glb writing per frame (normals, float32, file), the real writer
+    double export_seconds = 0;  // .glb conversion per frame (GlbSequenceWriter::prepare)
     double glb_bytes = 0;    // .glb bytes per frame
     bool skipped = false;    // over max_triangles
     double total() const { return seconds + export_seconds; }
