@@ -1,7 +1,7 @@
 // One frame of the apparent shape: the static 4D history of an object cut by a view surface.
 //
 // For a subluminal object every rest point's worldline meets the view surface exactly once, so
-// the cut of a prism is a graph over its triangle (DESIGN.md section 6): the three tetrahedra of
+// the cut of a prism is a graph over its triangle (docs/DESIGN.md section 6): the three tetrahedra of
 // the prism are bookkeeping and never show in the output. Vertex mode (this file) places exact
 // vertices and joins them with straight edges:
 //   - a rest vertex whose worldline crossing lies inside the extruded span gives its exact
@@ -15,28 +15,27 @@
 // decided by the exact sign of viewSide at the cap event (exact_side.h), once per vertex; zero
 // counts as inside.
 // Straight edges between exact vertices leave an error that grows with triangle size, speed and
-// nearness (DESIGN.md section 6). With a tolerance T > 0 the cut is refined where the surface
-// departs from the chord, and nowhere else (see "Refinement" in slice.cpp):
-//   - each mesh edge is split, once per frame and keyed by its id, into the fewest equal
-//     parameter segments whose exact midpoints lie within T/8 of the chord; both triangles of the
-//     edge use the same points, so watertight input stays watertight (no T-junctions);
-//   - a triangle whose edges need no split and whose exact centroid lies within T/4 of its plane is
-//     kept whole; otherwise its parameter domain gets a regular interior grid of level N, zipped
-//     to the edge points (tessellate.h), and N grows until every output edge's exact midpoint
-//     lies within T/4 of the chord.
-// Why that bounds the error: on an output triangle with exact corners, the difference e(p) between
-// the exact map F and the linear interpolant L is, to second order, a quadratic vanishing at the
-// corners, e = sum over edges c_ij l_i l_j; its edge-midpoint values are c_ij / 4 and
-// |e| <= (|c_01| + |c_12| + |c_20|) / 4 <= 3 T / 4 everywhere on the triangle (each midpoint
-// deviates at most T/4, T/8 on edge segments). |F(p) - L(p)| bounds
-// both one-sided Hausdorff distances (each output point L(p) has the exact point F(p), and back),
-// so the two-sided distance is <= 3T/4 plus third-order terms, which the remaining T/4 covers once
-// the mesh resolves the curvature. The test suite measures the true error on samples of every
-// output triangle. A refined triangle cut by a real cap is refined the same way, then each small
-// triangle is clipped at the exact cap crossings of its edges (keyed by mesh edge and segment,
-// so neighbours share them): the clip curve is a polyline whose vertices lie exactly on the
-// tilted cap and on the cone; inside chords are checked as above, the clip chords themselves are
-// measured by the tests, not bounded.
+// nearness (docs/DESIGN.md section 6). With a tolerance T > 0 the cut is refined where the exact
+// surface departs from the output, and only there ("Refinement" in slice.cpp):
+//   - each triangle is accepted when the bound of chord_error.h on |F - L| (the exact image
+//     against the linear interpolant of its exact corners) is <= T: first from its corners alone
+//     (no extra cut), else from the exact images of its three edge midpoints (one closed form per
+//     edge, shared by the edge's triangles) plus a third-order term. The bound is on the whole
+//     triangle (the quadratic interpolant's largest error, in closed form), so the measured error
+//     of a refined mesh is 0.5 to 1 times T;
+//   - a triangle that fails is halved by longest-edge bisection (Rivara) in the map's own metric
+//     (edge lengths from the midpoint bubbles: chord_error.h edgeLength), so pieces are short
+//     across the direction the map bends and long along it, and only where it bends;
+//   - an edge is always halved in every triangle that has it (the cycle of slots around it,
+//     World4D::slot_next): no T-junctions, a watertight input stays watertight, genus is kept;
+//   - a piece wholly before or after existing is not refined; a piece a real cap cuts is clipped
+//     at the exact crossings of its sides (keyed by the side's two vertices, so neighbours share
+//     them); the clip chords are measured by the tests, not bounded;
+//   - a piece is halved at most 2 log2(max_segments) times (counted in limited_triangles); splits
+//     that keep a neighbour conforming are never refused.
+// |F - L| bounds both one-sided distances between the output and the exact surface, so the
+// two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
+// no triangle needs refining, identical to vertex mode's.
 // An object at rest on the past cone is its input (an affine cut), except where a real cap clips
 // it: the cap is one lab time, so the cone meets it in a sphere and the clip curves are circles.
 // With T > 0 such a triangle is split in four, recursively, only where a cap's curve could hide in
@@ -70,7 +69,7 @@ struct ApparentMesh {
     std::vector<uint32_t> source_triangles;  // the input triangle each output triangle lies on
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame
     size_t refined_triangles = 0;         // input triangles split by the tolerance
-    size_t limited_triangles = 0;         // input triangles and edges that reached max_segments first
+    size_t limited_triangles = 0;         // input triangles whose refinement reached max_segments first
     size_t culled_triangles = 0;          // input triangles skipped by the 4D-box cull (SliceSettings::cull)
 
     Vec3 absolutePosition(size_t i) const { return origin + positions[i]; }
@@ -81,9 +80,10 @@ struct SliceSettings {
     // Two-sided distance bound to the exact apparent surface, light-seconds; 0 is vertex mode
     // (exact vertices, straight edges: what real-time engines do). 0 is the safe default.
     double tolerance = 0;
-    // Most segments per input edge, and most interior grid levels per input triangle (at least 3);
-    // an edge or triangle that would need more is counted in ApparentMesh::limited_triangles and
-    // keeps this level. Values below 1 count as 1.
+    // Finest refinement, as pieces along an input edge: a piece is halved at most
+    // 2 ceil(log2(max_segments)) times; an input triangle whose pieces would need more is counted in
+    // ApparentMesh::limited_triangles. The rest clip splits at most to 1/max_segments of a triangle.
+    // Values below 2 count as 2.
     int max_segments = 256;
     // Skip runs of triangles (World4D::chunks) whose cap events all lie on one side of the view
     // surface: before a real cap a (not yet existing) or after a real cap b (gone), decided from
