@@ -1,6 +1,6 @@
 // Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
 //
-// Relativistic (Lorentz boost with velocity v, b = |v|, g = 1/sqrt(1 - b^2), u = v/b; DESIGN.md s.3):
+// Relativistic (Lorentz boost with velocity v, b = |v|, g = 1/sqrt(1 - b^2), u = v/b; docs/DESIGN.md section 3):
 //     t = t0 + g (tau + v.q)
 //     x = X0 + q + (g - 1)(q.u) u + g v tau
 // Pre-relativistic (Galilean, finite light speed only):

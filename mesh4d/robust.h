@@ -6,7 +6,7 @@
 //   with the sign-chosen form q = -(h + sign(h) sqrt(h^2 - a k)), s1 = q / a, s2 = k / q, which never
 //   subtracts nearly equal numbers (Numerical Recipes 5.6; pbrt's Quadratic).
 // - oneMinusSquare(b) = 1 - b^2 evaluated as (1 - b)(1 + b), exact to 1 ulp even for b near 1
-//   (DESIGN.md section 5: never 1 - b*b).
+//   (docs/DESIGN.md section 5: never 1 - b*b).
 #pragma once
 
 #include <cmath>

@@ -197,7 +197,7 @@ void readObject(FieldReader& r, const json& j, const std::string& path, const st
     if (auto it = j.find("mirror"); it != j.end()) {
         if (!it->is_boolean()) r.fail(path + ".mirror", "expected true or false, got " + FieldReader::describe(*it));
         else obj->mirror = it->get<bool>();
-        // A mirror at rest keeps the reflection a plane reflection of the light paths (DESIGN.md section 8).
+        // A mirror at rest keeps the reflection a plane reflection of the light paths (docs/DESIGN.md section 8).
         if (!r.failed() && obj->mirror && (obj->speed != ObjectSpec::Speed::Velocity || mesh4d::norm(obj->velocity) != 0))
             r.fail(path + ".mirror", "a mirror must be at rest (velocity [0, 0, 0])");
     }

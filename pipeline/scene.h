@@ -64,7 +64,7 @@ struct ObjectSpec {
     // the world rotation and scale of a glTF node that carries the object (identity otherwise).
     std::array<double, 9> linear{1, 0, 0, 0, 1, 0, 0, 0, 1};
     // A planar mirror at rest: the raytracer bounces rays off it once, and the mesh pipeline adds
-    // the retarded reflections it shows (DESIGN.md section 8).
+    // the retarded reflections it shows (docs/DESIGN.md section 8).
     bool mirror = false;
 };
 

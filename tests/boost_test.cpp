@@ -1,4 +1,4 @@
-// Tests of the rest-to-lab maps against closed forms of special relativity (DESIGN.md section 3).
+// Tests of the rest-to-lab maps against closed forms of special relativity (docs/DESIGN.md section 3).
 #include <gtest/gtest.h>
 
 #include <random>

@@ -1,4 +1,4 @@
-// glTF import through tinygltf: real third-party files (the Khronos samples in ../shared and the
+// glTF import through tinygltf: real third-party files (the Khronos samples in tests/data and the
 // glTF files of Debian's assimp-testmodels) import or are refused with a reason, never crash;
 // expected counts come from the files' own documentation (SOURCES.md) and accessor bounds.
 #include <gtest/gtest.h>
@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string fixture(const std::string& name) { return std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/gltf/" + name; }
-const fs::path kSamples = fs::path(APPARENT_SOURCE_DIR) / "../shared/data/gltf-samples";
+const fs::path kSamples = fs::path(APPARENT_SOURCE_DIR) / "tests/data/gltf-samples";
 const fs::path kAssimp = "/usr/share/assimp/models/glTF2";
 
 Status load(const std::string& path, LoadedMesh* m, MeshWarnings* w = nullptr) {
@@ -31,7 +31,7 @@ Status load(const std::string& path, LoadedMesh* m, MeshWarnings* w = nullptr) {
 
 }  // namespace
 
-// Triangle counts from ../shared/data/gltf-samples/SOURCES.md ("drawn in default scene").
+// Triangle counts from tests/data/gltf-samples/SOURCES.md ("drawn in default scene").
 TEST(GltfReader, KhronosSamplesGiveTheirDocumentedTriangleCounts) {
     ASSERT_TRUE(fs::exists(kSamples)) << kSamples;
     const std::pair<const char*, size_t> expected[] = {
