@@ -26,7 +26,8 @@ struct Motion {
     double gamma = 1;     // 1/sqrt(1 - b^2) (Lorentz), 1 (Galilean)
     double inv_gamma2 = 1;  // 1/g^2 = 1 - b^2 without cancellation (Lorentz), 1 (Galilean)
     // 1 - b^2 for the light-delay quadratic, in both kinematics; exact when the speed was given
-    // as gamma or rapidity (makeMotionExact), else (1 - b)(1 + b) of the rounded |v|.
+    // as gamma or rapidity (makeMotionExact), else 1 - |v|^2 from the components of v with a
+    // compensated sum (robust.h oneMinusNorm2: within 1 ulp, oblique velocities included).
     double one_minus_beta2 = 1;
 };
 
