@@ -20,12 +20,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string listOf(const std::vector<std::string>& keys) {
-    std::string list;
-    for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
-    return list;
-}
-
 // A node that carries an object, as found by the walk.
 struct ObjectNode {
     int node;
@@ -73,7 +67,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
                 if (near.empty()) continue;
                 const std::string at = where + ".extras." + it.key();
                 r.warn(at, "looks like the object field " + near + ", but the node's extras hold none of the object fields (" +
-                               listOf(markers) + "), so the node is not an object");
+                               fieldList(markers) + "), so the node is not an object");
                 if (near_miss.empty()) near_miss = at + " looks like a misspelt " + near;
             }
             return Status::success();
@@ -130,7 +124,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
 
     // Step: the objects, read by the JSON scene's object readers from their nodes' extras.
     if (objects.empty() && !r.failed())
-        r.fail("nodes", "no node carries object extras (" + listOf(markers) + ") in scene " + std::to_string(si) +
+        r.fail("nodes", "no node carries object extras (" + fieldList(markers) + ") in scene " + std::to_string(si) +
                             (near_miss.empty() ? std::string() : "; " + near_miss));
     const std::string file = fs::path(path).filename().string();
     const fs::path folder = fs::path(path).parent_path();

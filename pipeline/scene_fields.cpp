@@ -19,13 +19,13 @@ void FieldReader::warn(const std::string& path, const std::string& problem) {
     warnings_.push_back(file_ + ": " + path + ": " + problem);
 }
 
-namespace {
-
-std::string listOf(const std::vector<std::string>& keys) {
+std::string fieldList(const std::vector<std::string>& keys) {
     std::string list;
     for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
     return list;
 }
+
+namespace {
 
 bool isComment(const std::string& key) { return key.rfind('_', 0) == 0; }
 
@@ -34,7 +34,7 @@ bool isComment(const std::string& key) { return key.rfind('_', 0) == 0; }
 void FieldReader::checkKeys(const json& obj, const std::string& path, const std::vector<std::string>& known) {
     for (auto it = obj.begin(); it != obj.end(); ++it) {
         if (isComment(it.key()) || std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
-        fail(join(path, it.key()), "unknown field (known: " + listOf(known) + ")");
+        fail(join(path, it.key()), "unknown field (known: " + fieldList(known) + ")");
         return;
     }
 }
@@ -44,7 +44,7 @@ void FieldReader::warnUnknownKeys(const json& obj, const std::string& path, cons
         if (isComment(it.key()) || std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
         const std::string near = nearestField(it.key(), known);
         warn(join(path, it.key()), "unknown field, ignored" + (near.empty() ? std::string() : " (did you mean " + near + "?)") +
-                                       "; known fields: " + listOf(known));
+                                       "; known fields: " + fieldList(known));
     }
 }
 

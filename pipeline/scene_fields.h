@@ -52,6 +52,9 @@ private:
     std::vector<std::string> warnings_;
 };
 
+// "a, b, c": field names for messages.
+std::string fieldList(const std::vector<std::string>& keys);
+
 // 17 significant digits: a number in a message reads back as the same double.
 std::string formatNumber(double v);
 

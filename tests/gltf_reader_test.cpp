@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/cli.h"
+#include "pipeline/gltf_document.h"
 #include "pipeline/mesh_input.h"
 
 using namespace apparent;
@@ -156,6 +157,14 @@ TEST(GltfReader, DracoPrimitivesDecodeLikeThePlainFile) {
         EXPECT_NEAR(dhi, phi, 1e-3 * (phi - plo)) << c;
     }
     EXPECT_GT(extent, 0);
+    // Read again, the file is neither parsed nor Draco-decoded again (gltf_document.h): the
+    // document comes from the cache, with the same result.
+    const size_t parses = gltfParseCount();
+    LoadedMesh again;
+    ASSERT_TRUE(load((kAssimp / "draco/2CylinderEngine.gltf").string(), &again).ok);
+    EXPECT_EQ(gltfParseCount(), parses);
+    EXPECT_EQ(again.mesh.positions, draco.mesh.positions);
+    EXPECT_EQ(again.mesh.triangles, draco.mesh.triangles);
 }
 
 TEST(GltfReader, NodeTransformsAndNodeSelection) {
