@@ -24,7 +24,7 @@ namespace {
 struct ObjectNode {
     int node;
     Affine world;
-    json extras;
+    const json* extras;  // in the document
 };
 
 }  // namespace
@@ -80,7 +80,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         if (!names.insert(node.name).second)
             return Status::failure(path + ": " + where + ".name: '" + node.name + "' names two object nodes");
         is_object[size_t(n)] = true;
-        objects.push_back({n, world, ex});
+        objects.push_back({n, world, &ex});
         return Status::success();
     });
     if (!walked.ok) return walked;
@@ -139,7 +139,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         for (int c = 0; c < 3; ++c)
             for (int row = 0; row < 3; ++row) obj.linear[size_t(c * 3 + row)] = o.world.m[c * 4 + row];
         obj.field_path = "nodes[" + std::to_string(o.node) + "].extras";
-        readObjectFields(r, o.extras, obj.field_path, folder, ObjectSource::GltfNode, &obj);
+        readObjectFields(r, *o.extras, obj.field_path, folder, ObjectSource::GltfNode, &obj);
         scene->objects.push_back(obj);
     }
     scene->warnings = r.warnings();
