@@ -11,7 +11,7 @@ Motion makeMotion(Kinematics kinematics, double t0, const Vec3& origin, const Ve
     m.origin = origin;
     m.velocity = velocity;
     m.beta = norm(velocity);
-    m.one_minus_beta2 = oneMinusSquare(m.beta);
+    m.one_minus_beta2 = oneMinusNorm2(velocity.x, velocity.y, velocity.z);  // exact to rounding, any direction
     if (kinematics == Kinematics::Lorentz) {
         m.inv_gamma2 = m.one_minus_beta2;
         m.gamma = 1.0 / std::sqrt(m.inv_gamma2);

@@ -1,6 +1,6 @@
 // Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
 //
-// Relativistic (Lorentz boost with velocity v, b = |v|, g = 1/sqrt(1 - b^2), u = v/b; DESIGN.md s.3):
+// Relativistic (Lorentz boost with velocity v, b = |v|, g = 1/sqrt(1 - b^2), u = v/b; docs/DESIGN.md section 3):
 //     t = t0 + g (tau + v.q)
 //     x = X0 + q + (g - 1)(q.u) u + g v tau
 // Pre-relativistic (Galilean, finite light speed only):
@@ -26,7 +26,8 @@ struct Motion {
     double gamma = 1;     // 1/sqrt(1 - b^2) (Lorentz), 1 (Galilean)
     double inv_gamma2 = 1;  // 1/g^2 = 1 - b^2 without cancellation (Lorentz), 1 (Galilean)
     // 1 - b^2 for the light-delay quadratic, in both kinematics; exact when the speed was given
-    // as gamma or rapidity (makeMotionExact), else (1 - b)(1 + b) of the rounded |v|.
+    // as gamma or rapidity (makeMotionExact), else 1 - |v|^2 from the components of v with a
+    // compensated sum (robust.h oneMinusNorm2: within 1 ulp, oblique velocities included).
     double one_minus_beta2 = 1;
 };
 

@@ -1,6 +1,6 @@
 // Events and 3-vectors of flat spacetime.
 //
-// Conventions (DESIGN.md section 2): c = 1, lengths in light-seconds, times in seconds, velocities
+// Conventions (docs/DESIGN.md section 2): c = 1, lengths in light-seconds, times in seconds, velocities
 // as fractions of c. An event is (t, x) in the lab frame, the camera's rest frame. Everything is
 // double; float32 appears only in exporters/, relative to a local origin.
 //

@@ -1,5 +1,5 @@
 // Temporal extrusion: a triangle mesh at rest, swept along its worldlines, becomes a static
-// tetrahedral 3-manifold in 4D, the object's history (Black et al. 2007, section III; DESIGN.md
+// tetrahedral 3-manifold in 4D, the object's history (Black et al. 2007, section III; docs/DESIGN.md
 // sections 1 and 3).
 //
 // Each rest vertex q_i gives two lab events, E(i, a) = labFromRest(tau_a, q_i) and
@@ -12,7 +12,7 @@
 // ids only, so the prisms of neighbouring triangles share their quad diagonals exactly and the
 // tetrahedra form a conforming complex.
 //
-// Only the proper-time span [tau_a, tau_b] the frames can see is extruded (DESIGN.md section 7).
+// Only the proper-time span [tau_a, tau_b] the frames can see is extruded (docs/DESIGN.md section 7).
 // A cap is "real" where the object begins or ends existing there, and "open" where the span was
 // cut to what the frames see: only real caps clip the apparent surface.
 #pragma once

@@ -19,7 +19,7 @@ double retardedDelay(const Vec3& e, const Vec3& v, double one_minus_b2) {
     if (ee == 0) return 0;
     const double ev = dot(e, v);
     const double s = std::sqrt(ev * ev + one_minus_b2 * ee);
-    // Choose the branch that adds quantities of the same sign (DESIGN.md section 5).
+    // Choose the branch that adds quantities of the same sign (docs/DESIGN.md section 5).
     if (ev >= 0) return ee / (ev + s);
     return (s - ev) / one_minus_b2;
 }

@@ -11,13 +11,13 @@
 // strictly along it, at rate <= -(1 - |v|)). With e = a + v (t_c - t_a) - C, where the point is
 // "now" seen from the camera, the light delay d = t_c - t_e >= 0 is the non-negative root of
 //     (1 - b^2) d^2 + 2 (e.v) d - |e|^2 = 0,
-// taken in the cancellation-free form of DESIGN.md section 5:
+// taken in the cancellation-free form of docs/DESIGN.md section 5:
 //     s = sqrt((e.v)^2 + (1 - b^2)|e|^2);  e.v >= 0: d = |e|^2 / (e.v + s);  else d = (s - e.v)/(1 - b^2).
 // The apparent point is y = C + e - v d. A point at the camera (e = 0) gives d = 0, y = C.
 // A spacelike segment whose end events lie on opposite sides (h changes sign) crosses the view
 // surface exactly once, because h is concave along any segment (affine minus a norm); the crossing
 // is the root of a quadratic in the segment parameter, chosen on the past sheet.
-// Reference: Black et al., Am. J. Phys. 2007, section III.B; DESIGN.md sections 5 and 6.
+// Reference: Black et al., Am. J. Phys. 2007, section III.B; docs/DESIGN.md sections 5 and 6.
 #pragma once
 
 #include "boost.h"
@@ -50,13 +50,13 @@ WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Ve
 
 // The crossing of the worldline of rest point q (an object moving with `m`) with the view surface,
 // from where the point is at t_c relative to the camera: e = (X0 - C) + v (t_c - t0) + shape(q),
-// the large terms summed first and once (DESIGN.md section 5's e). Anchoring at an event far
+// the large terms summed first and once (docs/DESIGN.md section 5's e). Anchoring at an event far
 // from t_c instead would make e a difference of large numbers, whose rounding the light delay
 // then multiplies by up to 2 gamma^2. `now_base` = (X0 - C) + v (t_c - t0), computed once a frame.
 Vec3 nowBase(const ViewSurface& view, const Motion& m);
 Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q);
 
-// Per-object origins (DESIGN.md section 5, "scale"): an object far from the camera (|e| ~ 1e9) but
+// Per-object origins (docs/DESIGN.md section 5, "scale"): an object far from the camera (|e| ~ 1e9) but
 // small (|shape| ~ 1e-6) would lose its shape to the rounding of C + e - v d, and of e itself.
 // Instead the cut is anchored once per frame at the object's origin, d = D + delta, with
 //     D    the delay of the origin (e = E = now_base), S = sqrt((E.v)^2 + (1 - b^2)|E|^2),

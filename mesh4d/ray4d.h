@@ -11,14 +11,14 @@
 // four equations (t, x, y, z) in l1, l2, l3, s, solved by Gaussian elimination with partial
 // pivoting; the hit counts when l1, l2, l3 >= 0, l1 + l2 + l3 <= 1 (within kBaryEps, so rays
 // through the faces shared by neighbouring tetrahedra never slip between them) and s > 0. The
-// nearest hit over all tetrahedra wins (ordinary z-buffering along the ray, DESIGN.md section 8).
+// nearest hit over all tetrahedra wins (ordinary z-buffering along the ray, docs/DESIGN.md section 8).
 //
 // The lab normal at the hit: all tetrahedra of a prism lie in one 3-flat of spacetime, with 4D
 // normal N (the generalised cross product of three edge vectors, N . E = 0 for every tangent E).
 // Its section by the lab instant t = t_hit is the object's triangle at that instant, whose tangents
 // (0, w) satisfy N_x . w = 0: the spatial part N_x is the lab-frame surface normal the paper
 // shades with (the contracted triangle's normal under a boost, the rest normal under a shear).
-// Reference: Black et al., Am. J. Phys. 75 (2007), sections III.B-C; DESIGN.md sections 6 and 8.
+// Reference: Black et al., Am. J. Phys. 75 (2007), sections III.B-C; docs/DESIGN.md sections 6 and 8.
 #pragma once
 
 #include <array>

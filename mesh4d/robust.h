@@ -6,7 +6,14 @@
 //   with the sign-chosen form q = -(h + sign(h) sqrt(h^2 - a k)), s1 = q / a, s2 = k / q, which never
 //   subtracts nearly equal numbers (Numerical Recipes 5.6; pbrt's Quadratic).
 // - oneMinusSquare(b) = 1 - b^2 evaluated as (1 - b)(1 + b), exact to 1 ulp even for b near 1
-//   (DESIGN.md section 5: never 1 - b*b).
+//   (docs/DESIGN.md section 5: never 1 - b*b).
+// - oneMinusNorm2(x, y, z) = 1 - (x^2 + y^2 + z^2) from the components of a velocity, for
+//   oblique ones: taking |v| first rounds it (relative 1e-16), and 1 - |v| then carries that
+//   rounding relative to itself (2.2e-11 relative at b = 0.999999 with three equal components).
+//   Each square is split exactly into x*x + fma(x, x, -x*x) and the seven terms are summed with
+//   error-free additions (Ogita, Rump, Oishi 2005, "Accurate sum and dot product", Sum2): error
+//   <= eps |result| + gamma_6^2 (1 + x^2 + y^2 + z^2), i.e. within 1 ulp of the exact value for
+//   any |v| <= 2 (the second term is below 1e-30).
 #pragma once
 
 #include <cmath>
@@ -21,6 +28,27 @@ inline double differenceOfProducts(double a, double b, double c, double d) {
 }
 
 inline double oneMinusSquare(double b) { return (1.0 - b) * (1.0 + b); }
+
+// s + e = a + b exactly (Knuth's TwoSum; no branch, any order of magnitudes).
+inline void twoSum(double a, double b, double* s, double* e) {
+    *s = a + b;
+    const double bb = *s - a;
+    *e = (a - (*s - bb)) + (b - bb);
+}
+
+inline double oneMinusNorm2(double x, double y, double z) {
+    const double hi[3] = {x * x, y * y, z * z};
+    const double lo[3] = {std::fma(x, x, -hi[0]), std::fma(y, y, -hi[1]), std::fma(z, z, -hi[2])};
+    // Step: large terms first, then the exact low parts; every rounding error is kept in c.
+    const double terms[6] = {-hi[0], -hi[1], -hi[2], -lo[0], -lo[1], -lo[2]};
+    double s = 1.0, c = 0.0;
+    for (double t : terms) {
+        double e;
+        twoSum(s, t, &s, &e);
+        c += e;
+    }
+    return s + c;
+}
 
 struct QuadraticRoots {
     int count = 0;       // 0, 1 or 2 real roots

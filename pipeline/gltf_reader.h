@@ -15,6 +15,9 @@
 // the node graph, counts over the limits. tinygltf indexes some arrays without checking them
 // while it decodes Draco (tiny_gltf.h 2.7.0, ParseDracoExtension), so those references are
 // checked on the JSON before tinygltf sees the file.
+//
+// The file is read and parsed once per run (gltf_document.h): reading several nodes of one file,
+// as the objects of a glTF scene do, parses it once. The node graph is walked by gltf_nodes.h.
 #pragma once
 
 #include <string>

@@ -64,7 +64,7 @@ struct ObjectSpec {
     // the world rotation and scale of a glTF node that carries the object (identity otherwise).
     std::array<double, 9> linear{1, 0, 0, 0, 1, 0, 0, 0, 1};
     // A planar mirror at rest: the raytracer bounces rays off it once, and the mesh pipeline adds
-    // the retarded reflections it shows (DESIGN.md section 8).
+    // the retarded reflections it shows (docs/DESIGN.md section 8).
     bool mirror = false;
 };
 
@@ -76,6 +76,11 @@ struct Scene {
     Model model = Model::Relativistic;
     double tolerance = 1e-3;          // light-seconds; 0 = vertex mode
     std::vector<ObjectSpec> objects;
+    // What was read but not used, one line each ("file: field: problem"): in a glTF scene, extras
+    // keys that are not scene fields (other tools keep custom properties there), misspelt ones
+    // with the field they resemble, and nodes left out because their extras hold only such
+    // near-misses. A JSON scene refuses unknown keys instead, so it has none. Callers print them.
+    std::vector<std::string> warnings;
 };
 
 // Maximum number of frames a scene may ask for (a typo such as fps = 1e9 would otherwise run for
@@ -85,8 +90,10 @@ constexpr long long kDefaultMaxFrames = 100000;
 // True for a .gltf or .glb path: a scene authored in glTF (README "Scenes in glTF").
 bool isGltfPath(const std::string& path);
 
-// Reads and validates a scene file, JSON or glTF (dispatching on the extension). On failure the message names the file, the field (a JSON
-// path such as objects[1].velocity) and the problem with the valid range.
+// Reads and validates a scene file, JSON or glTF (dispatching on the extension). On failure the
+// message names the file, the field (a JSON path such as objects[1].velocity, or
+// nodes[3].extras.velocity in glTF) and the problem with the valid range. Both forms read their
+// fields with the same code (pipeline/scene_fields.h); warnings go to scene->warnings.
 Status loadScene(const std::string& path, Scene* scene);
 
 // Checks what depends on the model: |velocity| < 1 wherever light or a Lorentz boost is involved.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes every input reader (README "Hostile input"): builds the libFuzzer harnesses of tests/fuzz
 # with clang (-fsanitize=fuzzer,address,undefined) in build-fuzz, writes the seed corpora
-# (tests/fuzz/make_corpus.py: data/, ../shared/data/gltf-samples, assimp-testmodels) and runs each
+# (tests/fuzz/make_corpus.py: data/, tests/data/gltf-samples, assimp-testmodels) and runs each
 # target for a fixed number of inputs with a fixed seed. Exits non-zero on any crash, leak,
 # timeout or out-of-memory; the reproducer is left in build-fuzz/fuzz-artifacts/<target>/.
 #   scripts/fuzz.sh                 the CI step: every target, FUZZ_RUNS inputs each

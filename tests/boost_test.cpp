@@ -1,6 +1,8 @@
-// Tests of the rest-to-lab maps against closed forms of special relativity (DESIGN.md section 3).
+// Tests of the rest-to-lab maps against closed forms of special relativity (docs/DESIGN.md section 3).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <random>
 
 #include "mesh4d/boost.h"
@@ -95,6 +97,48 @@ TEST(Robust, OneMinusSquareNearOne) {
     const double b = 1.0 - 1e-9;
     const long double exact = (1.0L - (long double)b) * (1.0L + (long double)b);
     EXPECT_GT(std::fabs((long double)(1.0 - b * b) - exact) / exact, 1e-10);
+}
+
+// 1 - |v|^2 for oblique velocities, against exact arithmetic in __float128 (113-bit
+// significand): each square of a double is exact in 106 bits, and with every component at least
+// 1/8 in magnitude (squares >= 2^-6, lowest bit >= 2^-111) the sum and 1 - sum span at most 112
+// bits, so the reference is exact until its one final rounding to double. The result must be
+// within 1 ulp of it. Before the compensated sum, 1 - b^2 was (1 - b)(1 + b) of the rounded
+// b = |v|: 2.2e-11 relative at b = 0.999999 with three equal components (checked below).
+TEST(Robust, OneMinusNorm2OfObliqueVelocitiesIsExactToRounding) {
+    auto exact = [](const Vec3& v) {
+        const __float128 x = v.x, y = v.y, z = v.z;
+        return double(__float128(1) - (x * x + y * y + z * z));
+    };
+    auto withinUlp = [](double got, double ref) {
+        return got >= std::nextafter(ref, -INFINITY) && got <= std::nextafter(ref, INFINITY);
+    };
+    // Step: the case from the issue: three equal components, b = 0.999999.
+    const double c = 0.999999 / std::sqrt(3.0);
+    const Vec3 v{c, c, c};
+    const double ref = exact(v);
+    EXPECT_TRUE(withinUlp(oneMinusNorm2(v.x, v.y, v.z), ref)) << oneMinusNorm2(v.x, v.y, v.z) << " vs " << ref;
+    const double old_way = oneMinusSquare(norm(v));
+    EXPECT_GT(std::fabs(old_way - ref) / ref, 1e-12) << "the test no longer tells the two forms apart";
+    const Motion m = makeMotion(Kinematics::Lorentz, 0, {0, 0, 0}, v);
+    EXPECT_TRUE(withinUlp(m.one_minus_beta2, ref));
+    EXPECT_TRUE(withinUlp(m.inv_gamma2, ref));
+    // Step: random directions and speeds up to 1 - 1e-12, seed fixed per case.
+    for (const double b : {0.5, 0.9, 0.999999, 1 - 1e-9, 1 - 1e-12}) {
+        std::mt19937_64 rng(std::hash<double>{}(b));
+        for (int i = 0; i < 2000; ++i) {
+            Vec3 w;
+            do w = randomVelocity(rng, b);
+            while (std::fabs(w.x) < 0.125 || std::fabs(w.y) < 0.125 || std::fabs(w.z) < 0.125);
+            const double r = exact(w);
+            ASSERT_TRUE(withinUlp(oneMinusNorm2(w.x, w.y, w.z), r))
+                << "b " << b << " i " << i << " v " << w.x << " " << w.y << " " << w.z << ": got "
+                << oneMinusNorm2(w.x, w.y, w.z) << ", exact " << r;
+        }
+    }
+    // Step: along an axis the result is correctly rounded as well (1 - b*b exactly split).
+    EXPECT_TRUE(withinUlp(oneMinusNorm2(0.999999, 0, 0), exact({0.999999, 0, 0})));
+    EXPECT_EQ(oneMinusNorm2(0, 0, 0), 1.0);
 }
 
 TEST(Robust, QuadraticRootsAgainstClosedForm) {

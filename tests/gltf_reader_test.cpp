@@ -1,4 +1,4 @@
-// glTF import through tinygltf: real third-party files (the Khronos samples in ../shared and the
+// glTF import through tinygltf: real third-party files (the Khronos samples in tests/data and the
 // glTF files of Debian's assimp-testmodels) import or are refused with a reason, never crash;
 // expected counts come from the files' own documentation (SOURCES.md) and accessor bounds.
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/cli.h"
+#include "pipeline/gltf_document.h"
 #include "pipeline/mesh_input.h"
 
 using namespace apparent;
@@ -21,7 +22,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string fixture(const std::string& name) { return std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/gltf/" + name; }
-const fs::path kSamples = fs::path(APPARENT_SOURCE_DIR) / "../shared/data/gltf-samples";
+const fs::path kSamples = fs::path(APPARENT_SOURCE_DIR) / "tests/data/gltf-samples";
 const fs::path kAssimp = "/usr/share/assimp/models/glTF2";
 
 Status load(const std::string& path, LoadedMesh* m, MeshWarnings* w = nullptr) {
@@ -31,7 +32,7 @@ Status load(const std::string& path, LoadedMesh* m, MeshWarnings* w = nullptr) {
 
 }  // namespace
 
-// Triangle counts from ../shared/data/gltf-samples/SOURCES.md ("drawn in default scene").
+// Triangle counts from tests/data/gltf-samples/SOURCES.md ("drawn in default scene").
 TEST(GltfReader, KhronosSamplesGiveTheirDocumentedTriangleCounts) {
     ASSERT_TRUE(fs::exists(kSamples)) << kSamples;
     const std::pair<const char*, size_t> expected[] = {
@@ -156,6 +157,14 @@ TEST(GltfReader, DracoPrimitivesDecodeLikeThePlainFile) {
         EXPECT_NEAR(dhi, phi, 1e-3 * (phi - plo)) << c;
     }
     EXPECT_GT(extent, 0);
+    // Read again, the file is neither parsed nor Draco-decoded again (gltf_document.h): the
+    // document comes from the cache, with the same result.
+    const size_t parses = gltfParseCount();
+    LoadedMesh again;
+    ASSERT_TRUE(load((kAssimp / "draco/2CylinderEngine.gltf").string(), &again).ok);
+    EXPECT_EQ(gltfParseCount(), parses);
+    EXPECT_EQ(again.mesh.positions, draco.mesh.positions);
+    EXPECT_EQ(again.mesh.triangles, draco.mesh.triangles);
 }
 
 TEST(GltfReader, NodeTransformsAndNodeSelection) {

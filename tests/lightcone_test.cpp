@@ -1,4 +1,4 @@
-// Tests of the retarded point (DESIGN.md section 5) against an independent solve and the inverse map.
+// Tests of the retarded point (docs/DESIGN.md section 5) against an independent solve and the inverse map.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -64,7 +64,7 @@ TEST(Lightcone, DelayMatchesIndependentSolve) {
     }
 }
 
-// The retarded event lies on the past cone and on the worldline; un-retarding it (DESIGN.md
+// The retarded event lies on the past cone and on the worldline; un-retarding it (docs/DESIGN.md
 // section 5's inverse: z = y - v (t_c - |y - C| - t0)) lands where the worldline is at t0.
 TEST(Lightcone, CutIsOnConeAndWorldlineBothDirections) {
     for (int seed = 0; seed < 500; ++seed) {
@@ -95,7 +95,7 @@ TEST(Lightcone, ClosedFormsOnTheLineOfSight) {
     EXPECT_EQ(retardedDelay({0, 0, 0}, {0, 0, b}, oneMinusSquare(b)), 0.0);  // at the camera
 }
 
-// A point now at closest approach r is seen at distance gamma r (DESIGN.md section 10), arcsin(b)
+// A point now at closest approach r is seen at distance gamma r (docs/DESIGN.md section 10), arcsin(b)
 // behind the perpendicular.
 TEST(Lightcone, ClosestApproachAppearsAtGammaR) {
     for (double b : {0.1, 0.5, 0.866, 0.99, 0.999999}) {

@@ -1,9 +1,9 @@
 // The observations of Black et al. 2007 (Results section), measured on the apparent meshes of the
-// default scene (DESIGN.md section 12): with finite light speed the flanges appear to reach the
+// default scene (docs/DESIGN.md section 12): with finite light speed the flanges appear to reach the
 // centreline at another time than in the instant model, approach faster and recede slower, and
 // look wider approaching and narrower receding. Every measurement is made on sliceWorld's output
 // (tolerance 2e-4 ls) and compared with an independent oracle: the retarded time solved here by
-// bisection in long double from the scene's own numbers, and the closed forms of DESIGN.md
+// bisection in long double from the scene's own numbers, and the closed forms of docs/DESIGN.md
 // section 10 (apparent speed b / (1 - b cos theta)). The figures are printed.
 //
 // Flange rest mesh (data/meshes/flange.obj), seen from the camera at +z:
@@ -163,7 +163,7 @@ TEST_F(Flanges, CentrelineArrival) {
 // Apparent speed of the leading edge's eye-level point, and the front plate's apparent width at
 // eye level, where the plate's apparent centre is 6 ls before and after the centreline. Oracles:
 // the closed form b / (1 - b cos theta) (theta between the motion and the line of sight, at the
-// apparent point; DESIGN.md section 10) for the speed, the bisected retarded points for the width.
+// apparent point; docs/DESIGN.md section 10) for the speed, the bisected retarded points for the width.
 TEST_F(Flanges, ApproachFasterRecedeSlowerWiderThenNarrower) {
     std::cout << std::fixed << std::setprecision(4);
     constexpr double kOffset = 6, kDt = 0.05;

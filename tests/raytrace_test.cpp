@@ -66,7 +66,7 @@ TEST(Ray4D, StaticSquareOnTheAxis) {
 
 // For random rest points on a moving square (speeds up to 0.99c, both kinematics, random
 // directions), the ray from the camera towards the point's closed-form apparent position
-// (DESIGN.md section 5, lightcone.h) hits the 4D history at that distance and emission time.
+// (docs/DESIGN.md section 5, lightcone.h) hits the 4D history at that distance and emission time.
 TEST(Ray4D, HitsTheClosedFormRetardedPoint) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(-1, 1);

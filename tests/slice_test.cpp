@@ -1,4 +1,4 @@
-// Tests of one frame's cut against closed forms (DESIGN.md section 10) and against the inverse map.
+// Tests of one frame's cut against closed forms (docs/DESIGN.md section 10) and against the inverse map.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,7 +72,7 @@ TEST(Slice, OutputVerticesAreOnConeAndWorldtube) {
     }
 }
 
-// Lampa (1924), DESIGN.md section 10: a rod of rest length L on the line of sight appears
+// Lampa (1924), docs/DESIGN.md section 10: a rod of rest length L on the line of sight appears
 // L/(1-b) approaching and L/(1+b) receding with finite light speed alone, and
 // L sqrt((1+b)/(1-b)), L sqrt((1-b)/(1+b)) with the Lorentz contraction too.
 TEST(Slice, RodOnTheLineOfSight) {

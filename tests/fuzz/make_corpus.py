@@ -3,7 +3,7 @@
 scene  the shipped scenes and scene fixtures (data/scenes, data/fixtures);
 obj    data/meshes, data/fixtures and Debian's assimp-testmodels OBJ files;
 ply    data/fixtures/ply and assimp-testmodels PLY files;
-gltf   data/fixtures/gltf, data/scenes/flanges.gltf, ../shared/data/gltf-samples and
+gltf   data/fixtures/gltf, data/scenes/flanges.gltf, tests/data/gltf-samples and
        assimp-testmodels .gltf files, each with its external buffers inlined as data: URIs
        (the harness reads one file; a relative URI would only find nothing);
 glb    the .glb files of the same sources, and every one-buffer glTF seed packed as a .glb.
@@ -18,7 +18,7 @@ import struct
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SAMPLES = os.path.normpath(os.path.join(ROOT, "..", "shared", "data", "gltf-samples"))
+SAMPLES = os.path.join(ROOT, "tests", "data", "gltf-samples")
 ASSIMP = "/usr/share/assimp/models"
 
 

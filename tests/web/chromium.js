@@ -1,5 +1,5 @@
 // Launching Debian's Chromium headless for the browser checks (tests/web, tests/model_viewer), with
-// the flags this machine needs (../shared/notes/dependencies.md section 6): no sandbox as root, no
+// the flags this machine needs (docs/DEPENDENCIES.md section 6): no sandbox as root, no
 // background networking (the network is closed), WebGL through SwiftShader.
 'use strict';
 

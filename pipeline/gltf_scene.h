@@ -1,0 +1,28 @@
+// A scene authored in glTF (README "Scenes in glTF"): the camera, the objects and the scene
+// settings come from the default scene of a .gltf/.glb file instead of a JSON scene file.
+//
+// - Objects: every node whose `extras` hold an object field other than name, mesh and position
+//   (t0, velocity, direction, gamma, rapidity, rotation_deg, scale, mirror, exists) is an object.
+//   Its name is the node name (unique, without '#'), its mesh the node's subtree
+//   ("file.gltf#Name"), its position the node's world translation, and its world rotation and
+//   scale apply to the rest mesh (ObjectSpec::linear). The extras are read by the JSON scene's own
+//   object readers (scene_fields.h), with the same errors at "nodes[i].extras.<field>". Objects
+//   cannot nest.
+// - Camera: the first node with a camera (glTF cameras look down local -Z, +Y up; yfov gives
+//   fov_deg); its extras may hold instant_delay.
+// - The scene's extras may hold frames, light, model and tolerance, as in the JSON file.
+// Keys the reader does not know are warnings (Scene::warnings), not errors, because other tools
+// keep custom properties in extras; a key that looks like a misspelt field names the field, and
+// a node left out because its extras hold only such near-misses is reported. The file is parsed
+// once (gltf_document.h): the objects' meshes read the same parsed document.
+#pragma once
+
+#include <string>
+
+#include "pipeline/scene.h"
+
+namespace apparent {
+
+Status loadGltfScene(const std::string& path, Scene* scene);
+
+}  // namespace apparent

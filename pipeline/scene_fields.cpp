@@ -1,0 +1,405 @@
+#include "pipeline/scene_fields.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace apparent {
+
+using nlohmann::json;
+using mesh4d::Vec3;
+
+void FieldReader::fail(const std::string& path, const std::string& problem) {
+    if (status_->ok) *status_ = Status::failure(file_ + ": " + path + ": " + problem);
+}
+
+void FieldReader::warn(const std::string& path, const std::string& problem) {
+    warnings_.push_back(file_ + ": " + path + ": " + problem);
+}
+
+std::string fieldList(const std::vector<std::string>& keys) {
+    std::string list;
+    for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
+    return list;
+}
+
+namespace {
+
+bool isComment(const std::string& key) { return key.rfind('_', 0) == 0; }
+
+}  // namespace
+
+void FieldReader::checkKeys(const json& obj, const std::string& path, const std::vector<std::string>& known) {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+        if (isComment(it.key()) || std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
+        fail(join(path, it.key()), "unknown field (known: " + fieldList(known) + ")");
+        return;
+    }
+}
+
+void FieldReader::warnUnknownKeys(const json& obj, const std::string& path, const std::vector<std::string>& known) {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+        if (isComment(it.key()) || std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
+        const std::string near = nearestField(it.key(), known);
+        warn(join(path, it.key()), "unknown field, ignored" + (near.empty() ? std::string() : " (did you mean " + near + "?)") +
+                                       "; known fields: " + fieldList(known));
+    }
+}
+
+bool FieldReader::object(const json& parent, const char* key, const std::string& path, const json** out) {
+    auto it = parent.find(key);
+    if (it == parent.end()) return false;
+    if (!it->is_object()) {
+        fail(join(path, key), "expected an object, got " + typeName(*it));
+        return false;
+    }
+    *out = &*it;
+    return true;
+}
+
+void FieldReader::number(const json& parent, const char* key, const std::string& path, double* out) {
+    auto it = parent.find(key);
+    if (it == parent.end()) return;
+    readNumber(*it, join(path, key), out);
+}
+
+void FieldReader::vec3(const json& parent, const char* key, const std::string& path, Vec3* out) {
+    auto it = parent.find(key);
+    if (it == parent.end()) return;
+    const std::string p = join(path, key);
+    if (!it->is_array() || it->size() != 3) {
+        fail(p, "expected an array of 3 numbers, got " + describe(*it));
+        return;
+    }
+    double v[3];
+    for (int i = 0; i < 3; ++i) readNumber((*it)[size_t(i)], p + "[" + std::to_string(i) + "]", &v[i]);
+    *out = {v[0], v[1], v[2]};
+}
+
+void FieldReader::string(const json& parent, const char* key, const std::string& path, std::string* out) {
+    auto it = parent.find(key);
+    if (it == parent.end()) return;
+    if (!it->is_string()) {
+        fail(join(path, key), "expected a string, got " + typeName(*it));
+        return;
+    }
+    *out = it->get<std::string>();
+}
+
+std::string FieldReader::join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+}
+
+void FieldReader::readNumber(const json& j, const std::string& path, double* out) {
+    if (!j.is_number()) {
+        fail(path, "expected a number, got " + describe(j));
+        return;
+    }
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) {
+        fail(path, "must be finite");
+        return;
+    }
+    *out = v;
+}
+
+std::string FieldReader::describe(const json& j) {
+    std::string s = j.dump();
+    if (s.size() > 40) s = s.substr(0, 37) + "...";
+    return std::string(j.type_name()) + " " + s;
+}
+
+std::string formatNumber(double v) {
+    std::ostringstream os;
+    os.precision(17);
+    os << v;
+    return os.str();
+}
+
+std::string nearestField(const std::string& key, const std::vector<std::string>& known) {
+    auto lower = [](std::string s) {
+        for (char& c : s) c = char(std::tolower((unsigned char)c));
+        return s;
+    };
+    // Edit distance with adjacent transpositions (optimal string alignment): "modle" is one edit
+    // from "model", "velocty" one from "velocity". Case is ignored ("Velocity").
+    auto distance = [](const std::string& a, const std::string& b) {
+        std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+        for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+        for (size_t k = 0; k <= b.size(); ++k) d[0][k] = k;
+        for (size_t i = 1; i <= a.size(); ++i)
+            for (size_t k = 1; k <= b.size(); ++k) {
+                d[i][k] = std::min({d[i - 1][k] + 1, d[i][k - 1] + 1, d[i - 1][k - 1] + (a[i - 1] == b[k - 1] ? 0 : 1)});
+                if (i > 1 && k > 1 && a[i - 1] == b[k - 2] && a[i - 2] == b[k - 1]) d[i][k] = std::min(d[i][k], d[i - 2][k - 2] + 1);
+            }
+        return d[a.size()][b.size()];
+    };
+    const std::string k = lower(key);
+    if (k.size() > 64) return {};  // no field is that long; keeps the table small
+    std::string best;
+    size_t best_d = SIZE_MAX;
+    for (const std::string& f : known) {
+        const std::string lf = lower(f);
+        size_t d = distance(k, lf);
+        // A truncated or extended name ("rotation" for "rotation_deg", "velocity_x") counts as near.
+        if (k.size() >= 4 && lf.size() >= 4 && (lf.rfind(k, 0) == 0 || k.rfind(lf, 0) == 0)) d = std::min<size_t>(d, 1);
+        if (d < best_d) { best_d = d; best = f; }
+    }
+    // At most 2 edits, and fewer than half the key's length: "t1" is not a misspelt "t0".
+    if (best_d <= 2 && 2 * best_d < k.size()) return best;
+    return {};
+}
+
+// Step: the object fields, one reader each, in the order they are read.
+namespace {
+
+void readName(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.string(j, "name", path, &obj->name);
+}
+
+void readMeshPath(FieldReader& r, const json& j, const std::string& path, const ObjectContext& context, ObjectSpec* obj) {
+    std::string mesh;
+    if (!j.contains("mesh")) r.fail(path + ".mesh", "missing (the path of an OBJ file)");
+    r.string(j, "mesh", path, &mesh);
+    if (!mesh.empty()) {
+        const std::filesystem::path p(mesh);
+        obj->mesh_path = (p.is_absolute() ? p : context.folder / p).lexically_normal().string();
+        obj->mesh_text = mesh;
+    } else if (j.contains("mesh") && !r.failed()) {
+        r.fail(path + ".mesh", "empty path");
+    }
+}
+
+void readPosition(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.vec3(j, "position", path, &obj->position);
+}
+
+void readT0(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.number(j, "t0", path, &obj->t0);
+}
+
+void readVelocity(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.vec3(j, "velocity", path, &obj->velocity);
+}
+
+// An exactly stated speed: a unit direction with gamma or rapidity (README "Scene format").
+void readExactSpeed(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    const bool has_dir = j.contains("direction"), has_gamma = j.contains("gamma"), has_rap = j.contains("rapidity");
+    if (r.failed() || !(has_dir || has_gamma || has_rap)) return;
+    if (j.contains("velocity")) {
+        r.fail(path + ".velocity", "give either velocity or direction with gamma or rapidity, not both");
+        return;
+    }
+    if (!has_dir || has_gamma == has_rap) {
+        r.fail(path + (has_dir ? ".gamma" : ".direction"), "an exact speed needs direction and exactly one of gamma, rapidity");
+        return;
+    }
+    Vec3 d;
+    r.vec3(j, "direction", path, &d);
+    if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(path + ".direction", "must be non-zero");
+    if (!r.failed()) obj->direction = d / mesh4d::norm(d);
+    if (has_gamma) {
+        r.number(j, "gamma", path, &obj->gamma);
+        // gamma^2 must stay finite with room to spare (1 - b^2 = 1/gamma^2).
+        if (!r.failed() && !(obj->gamma >= 1 && obj->gamma <= 1e15)) r.fail(path + ".gamma", "must be in [1, 1e15]");
+        obj->speed = ObjectSpec::Speed::Gamma;
+        obj->rapidity = std::acosh(obj->gamma);
+    } else {
+        r.number(j, "rapidity", path, &obj->rapidity);
+        if (!r.failed() && !(obj->rapidity >= 0 && obj->rapidity <= 35))
+            r.fail(path + ".rapidity", "must be in [0, 35] (gamma up to about 8e14)");
+        obj->speed = ObjectSpec::Speed::Rapidity;
+        obj->gamma = std::cosh(obj->rapidity);
+    }
+    if (!r.failed()) obj->velocity = obj->direction * std::tanh(obj->rapidity);
+}
+
+void readRotation(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.vec3(j, "rotation_deg", path, &obj->rotation_deg);
+}
+
+void readScale(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    auto it = j.find("scale");
+    if (it == j.end()) return;
+    if (it->is_array()) {
+        r.vec3(j, "scale", path, &obj->scale);
+    } else {
+        double s = 1;
+        r.readNumber(*it, path + ".scale", &s);
+        obj->scale = {s, s, s};
+    }
+    for (int i = 0; i < 3 && !r.failed(); ++i)
+        if (!(obj->scale[i] != 0)) r.fail(path + ".scale", "must be non-zero");
+}
+
+// Read after the speed: a mirror must be at rest.
+void readMirror(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    auto it = j.find("mirror");
+    if (it == j.end()) return;
+    if (!it->is_boolean()) r.fail(path + ".mirror", "expected true or false, got " + FieldReader::describe(*it));
+    else obj->mirror = it->get<bool>();
+    // A mirror at rest keeps the reflection a plane reflection of the light paths (docs/DESIGN.md section 8).
+    if (!r.failed() && obj->mirror && (obj->speed != ObjectSpec::Speed::Velocity || mesh4d::norm(obj->velocity) != 0))
+        r.fail(path + ".mirror", "a mirror must be at rest (velocity [0, 0, 0])");
+}
+
+void readExists(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    auto it = j.find("exists");
+    if (it == j.end()) return;
+    const std::string p = path + ".exists";
+    if (!it->is_array() || it->size() != 2) {
+        r.fail(p, "expected [from, to] (proper or lab time since t0), got " + FieldReader::describe(*it));
+        return;
+    }
+    // null stands for "forever" at that end; +-1e30 and beyond are treated the same way.
+    double v[2] = {obj->exists_from, obj->exists_to};
+    for (int i = 0; i < 2; ++i)
+        if (!(*it)[size_t(i)].is_null()) r.readNumber((*it)[size_t(i)], p + "[" + std::to_string(i) + "]", &v[i]);
+    if (!r.failed() && !(v[0] < v[1]))
+        r.fail(p, "from (" + formatNumber(v[0]) + ") must be less than to (" + formatNumber(v[1]) + ")");
+    obj->exists_from = v[0];
+    obj->exists_to = v[1];
+}
+
+}  // namespace
+
+const std::vector<ObjectField>& objectFields() {
+    static const std::vector<ObjectField> table = {
+        {{"name"}, true, &readName},
+        {{"mesh"}, true, &readMeshPath},
+        {{"position"}, true, &readPosition},
+        {{"t0"}, false, &readT0},
+        {{"velocity"}, false, &readVelocity},
+        {{"direction", "gamma", "rapidity"}, false, &readExactSpeed},
+        {{"rotation_deg"}, false, &readRotation},
+        {{"scale"}, false, &readScale},
+        {{"mirror"}, false, &readMirror},
+        {{"exists"}, false, &readExists},
+    };
+    return table;
+}
+
+std::vector<std::string> objectFieldNames() {
+    std::vector<std::string> names;
+    for (const ObjectField& f : objectFields()) names.insert(names.end(), f.keys.begin(), f.keys.end());
+    return names;
+}
+
+std::vector<std::string> objectMarkerKeys() {
+    std::vector<std::string> names;
+    for (const ObjectField& f : objectFields())
+        if (!f.given_by_gltf_node) names.insert(names.end(), f.keys.begin(), f.keys.end());
+    return names;
+}
+
+void readObjectFields(FieldReader& r, const json& j, const std::string& path, const std::filesystem::path& folder,
+                      ObjectSource source, ObjectSpec* obj) {
+    const ObjectContext context{folder};
+    if (source == ObjectSource::JsonScene) {
+        r.checkKeys(j, path, objectFieldNames());
+    } else {
+        // Step: in glTF the node gives name, mesh and position; other keys may be other tools' own.
+        r.warnUnknownKeys(j, path, objectFieldNames());
+        for (const ObjectField& f : objectFields())
+            if (f.given_by_gltf_node)
+                for (const std::string& key : f.keys)
+                    if (j.contains(key))
+                        r.warn(FieldReader::join(path, key),
+                               "ignored: a glTF object's " + key + " is its node's own (" +
+                                   (key == "name" ? "the node name" : key == "mesh" ? "the node's subtree" : "the node's world translation") +
+                                   ")");
+    }
+    for (const ObjectField& f : objectFields()) {
+        if (source == ObjectSource::GltfNode && f.given_by_gltf_node) continue;
+        f.read(r, j, path, context, obj);
+    }
+}
+
+// Step: the scene-level sections.
+
+void readCamera(FieldReader& r, const json& cam, const std::string& path, CameraSpec* camera) {
+    r.checkKeys(cam, path, {"position", "look_at", "up", "fov_deg", "instant_delay"});
+    r.number(cam, "instant_delay", path, &camera->instant_delay);
+    r.vec3(cam, "position", path, &camera->position);
+    r.vec3(cam, "look_at", path, &camera->look_at);
+    r.vec3(cam, "up", path, &camera->up);
+    r.number(cam, "fov_deg", path, &camera->fov_deg);
+    checkCamera(r, path, *camera);
+}
+
+void checkCamera(FieldReader& r, const std::string& path, const CameraSpec& c) {
+    const Vec3 dir = c.look_at - c.position;
+    if (!r.failed() && !(mesh4d::norm(dir) > 0)) r.fail(path + ".look_at", "must differ from camera.position");
+    if (!r.failed() && !(mesh4d::norm(mesh4d::cross(dir, c.up)) > 0))
+        r.fail(path + ".up", "must be non-zero and not parallel to the view direction");
+    if (!r.failed() && !(c.fov_deg > 0 && c.fov_deg < 180)) r.fail(path + ".fov_deg", "must be in (0, 180)");
+}
+
+void readLight(FieldReader& r, const json& parent, const std::string& top, Scene* scene) {
+    // A point light at `position` or a directional one towards `direction`; by default
+    // directional from camera.up, i.e. overhead.
+    scene->light.direction = scene->camera.up / std::max(mesh4d::norm(scene->camera.up), 1e-300);
+    const json* li = nullptr;
+    if (!r.object(parent, "light", top, &li)) return;
+    const std::string lp = FieldReader::join(top, "light");
+    r.checkKeys(*li, lp, {"position", "direction", "ambient"});
+    if (li->contains("position") == li->contains("direction")) {
+        r.fail(lp, "give exactly one of position (a point light) or direction (towards a distant light)");
+    } else if (li->contains("position")) {
+        scene->light.kind = LightSpec::Kind::Point;
+        r.vec3(*li, "position", lp, &scene->light.position);
+    } else {
+        Vec3 d;
+        r.vec3(*li, "direction", lp, &d);
+        if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(lp + ".direction", "must be non-zero");
+        if (!r.failed()) scene->light.direction = d / mesh4d::norm(d);
+    }
+    r.number(*li, "ambient", lp, &scene->light.ambient);
+    if (!r.failed() && !(scene->light.ambient >= 0 && scene->light.ambient <= 1)) r.fail(lp + ".ambient", "must be in [0, 1]");
+}
+
+void readFrames(FieldReader& r, const json& parent, const std::string& top, FrameSpec* frames) {
+    const json* fr = nullptr;
+    if (!r.object(parent, "frames", top, &fr)) return;
+    const std::string fp = FieldReader::join(top, "frames");
+    r.checkKeys(*fr, fp, {"start", "end", "fps"});
+    r.number(*fr, "start", fp, &frames->start);
+    r.number(*fr, "end", fp, &frames->end);
+    r.number(*fr, "fps", fp, &frames->fps);
+    if (!r.failed() && !(frames->fps > 0)) r.fail(fp + ".fps", "must be > 0");
+    if (!r.failed() && !(frames->end > frames->start))
+        r.fail(fp + ".end", "must be greater than frames.start (" + formatNumber(frames->start) + ")");
+    // Very high frame rates late in time: each frame time start + k / fps is a double, so the
+    // frame spacing must stay well above the spacing of doubles there, or frames would collapse
+    // onto the same time (or be unevenly spaced). Ask for 1/1024 of a frame.
+    if (!r.failed()) {
+        const double t_max = std::max(std::fabs(frames->start), std::fabs(frames->end));
+        const double ulp = std::nextafter(t_max, INFINITY) - t_max;
+        if (!(1.0 / frames->fps >= 1024 * ulp))
+            r.fail(fp + ".fps", formatNumber(frames->fps) + " frames per second near time " + formatNumber(t_max) +
+                                    " s are closer than doubles resolve there (" + formatNumber(ulp) +
+                                    " s); shift frames.start and the objects' t0 towards 0");
+    }
+}
+
+void readModelAndTolerance(FieldReader& r, const json& parent, const std::string& top, Scene* scene) {
+    auto at = [&](const std::string& key) { return FieldReader::join(top, key); };
+    if (parent.contains("model")) {
+        std::string name;
+        r.string(parent, "model", top, &name);
+        if (!r.failed() && !parseModel(name, &scene->model))
+            r.fail(at("model"), "unknown model '" + name + "' (instant, finite, relativistic, contracted)");
+    }
+    // tolerance: light-seconds > 0, or "vertex" (0 inside: exact vertices, straight edges).
+    if (auto tol = parent.find("tolerance"); tol != parent.end() && tol->is_string()) {
+        if (tol->get<std::string>() != "vertex") r.fail(at("tolerance"), "expected a number > 0 or \"vertex\"");
+        else scene->tolerance = 0;
+    } else {
+        r.number(parent, "tolerance", top, &scene->tolerance);
+        if (!r.failed() && !(scene->tolerance > 0)) r.fail(at("tolerance"), "must be > 0 (light-seconds) or \"vertex\"");
+    }
+}
+
+}  // namespace apparent
