@@ -1,93 +1,104 @@
 #!/usr/bin/env python3
-"""Turns accuracy_bench's JSON into docs/ACCURACY.md, gnuplot data and a gnuplot script."""
-import json
+"""Turns the trade CSVs of scripts/accuracy_report.sh into docs/ACCURACY.md and a gnuplot script
+for docs/accuracy.png. At each uniform subdivision level whose error lies in 1e-4 .. 1e-2 x size,
+the adaptive rows are interpolated (log-log, between the two tolerances whose errors bracket it)
+to the same error: the ratios of triangles and of time end to end are the comparison."""
+import csv
+import math
+import os
 import sys
 
-data = json.load(open(sys.argv[1]))
-out = sys.argv[2]
-ctx = data["context"]
-rows = {}
-render = {}
-rest = {}
-for b in data["benchmarks"]:
-    name, arg = b["name"].split("/")[:2]
-    if name == "BM_RenderFlanges":
-        render[int(arg)] = b["real_time"]
-        continue
-    if name == "BM_RestAppearing":
-        rest.setdefault(int(b["name"].split("/")[2]), []).append(b)
-        continue
-    rows.setdefault(name, []).append(b)
+trade_dir, docs = sys.argv[1], sys.argv[2]
+SCENES = [
+    ("flanges", "default scene: the paper's flanges (4 triangles each, 0.866c, 18.675 ls), relativistic"),
+    ("box_near", "box of edge 1 passing 2 ls from the camera at 0.9c, relativistic"),
+    ("sphere320", "icosphere of 320 faces, radius 1, passing 4 ls away at 0.9c, relativistic"),
+    ("plate", "flange-like plate (2 x 4 ls, 4 triangles), 18.675 ls away at 0.866c, finite"),
+    ("sphere20480", "icosphere of 20480 faces, radius 1, passing 4 ls away at 0.9c, relativistic"),
+]
 
-scenes = {"BM_Flanges": "flanges (relativistic, frame 100, the default scene's 4 objects, size 4.90 ls)",
-          "BM_Sphere": "sphere (320 faces, radius 1, 0.9c at 4 ls, relativistic, size 2 ls)"}
-md = ["# Accuracy against time", "",
-      "Measured by `scripts/accuracy_report.sh` (Google Benchmark, `benchmarks/accuracy_bench.cpp`) on "
-      f"{ctx['num_cpus']} x {ctx['mhz_per_cpu']} MHz, {ctx['date']}. Time is the cut of one frame (all objects); "
-      "errors are measured after the timed loop with `tests/error_measure.h`: *out* = largest distance from "
-      "sampled output points (12 per triangle) to the exact surface, *in* = largest distance from exact surface "
-      "points (45 per input triangle) to the output. Both are relative to the object size; T is the tolerance.",
-      ""]
-for name, bs in rows.items():
-    bs.sort(key=lambda b: int(b["name"].split("/")[1]))
-    base = bs[0]["real_time"]
-    md += [f"## {scenes[name]}", "",
-           "| mode | T / size | time per frame (us) | x vertex mode | output triangles | error out / size | error in / size |",
-           "|---|---|---|---|---|---|---|"]
-    with open(f"{out}/accuracy_{name[3:].lower()}.dat", "w") as dat:
-        for b in bs:
-            k = int(b["name"].split("/")[1])
-            mode = "vertex" if k == 0 else "refined"
-            tol = "-" if k == 0 else f"1e-{k}"
-            md.append(f"| {mode} | {tol} | {b['real_time']:.2f} | {b['real_time'] / base:.1f} | "
-                      f"{int(b['triangles'])} | {b['err_out_rel']:.3g} | {b['err_in_rel']:.3g} |")
-            dat.write(f"{b['real_time']} {max(b['err_out_rel'], b['err_in_rel'])} {k}\n")
-    md.append("")
-if render:
-    md += ["## End to end", "",
-           "`apparent render data/scenes/flanges.json --frames 90:110 --model relativistic` writing the .glb "
-           "(20 frames):", "",
-           "| tolerance | time (ms) |", "|---|---|",
-           f"| vertex | {render[0]:.2f} |", f"| 1e-3 x size | {render[3]:.2f} |", "",
-           f"Ratio: {render[3] / render[0]:.1f} x.", ""]
-if rest:
-    md += ["## An object at rest appearing", "",
-           "The default scene's backdrop (a 30 x 8 ls quad of two triangles, 23.675 ls from the camera) existing for "
-           "lab time [-16, -10] s, cut alone; size = its diagonal, 31.0 ls. *out* = largest distance of sampled "
-           "output points from the seen region (the quad between two spheres about the camera), *in* = largest "
-           "distance of seen points of a 0.05 ls grid from the output.", ""]
-    titles = {0: "t_c = 9 s: a disc of radius 5.0 ls seen, every corner still unseen",
-              1: "t_c = 12.5 s: the lower corners seen, the upper ones not"}
-    for frame in sorted(rest):
-        bs = sorted(rest[frame], key=lambda b: int(b["name"].split("/")[1]))
-        md += [f"### {titles[frame]}", "",
-               "| mode | T / size | time per frame (us) | output triangles | error out / size | error in / size |",
-               "|---|---|---|---|---|---|"]
-        for b in bs:
-            k = int(b["name"].split("/")[1])
-            err_in = "all of it missing" if b.get("missing", 0) else f"{b['err_in_rel']:.3g}"
-            md.append(f"| {'vertex' if k == 0 else 'refined'} | {'-' if k == 0 else f'1e-{k}'} | "
-                      f"{b['real_time']:.2f} | {int(b['triangles'])} | {b['err_out_rel']:.3g} | {err_in} |")
-        md.append("")
-md += ["## Reading it", "",
-       "- Both measured errors stay below T at every tolerance: the refinement test (edge segments' exact "
-       "midpoints within T/8 of the chord, every other chord's within T/4) bounds the error by 3T/4 for the "
-       "quadratic part of the map, and the measurement shows the true error at about T/4.",
-       "- Triangle count grows about as 1/T (each factor 10 in T costs about 10x the triangles: the chord "
-       "error falls with the square of the segment length), and time follows the triangle count.",
-       "- Vertex mode is the first row: exact vertices, straight edges; its error is what real-time engines "
-       "accept.",
-       "", "![error against time](accuracy.png)", ""]
-open(f"{out}/ACCURACY.md", "w").write("\n".join(md))
-gp = f"""set terminal pngcairo size 900,560 font ",11"
-set output '{out}/accuracy.png'
-set logscale xy
-set xlabel 'time per frame (microseconds)'
-set ylabel 'measured maximum error / object size'
-set grid
-set key top right
-set title 'apparent: accuracy against time (first point of each line: vertex mode)'
-plot '{out}/accuracy_flanges.dat' using 1:2 with linespoints lw 2 pt 7 title 'flanges (relativistic)', \\
-     '{out}/accuracy_sphere.dat' using 1:2 with linespoints lw 2 pt 5 title 'sphere at 0.9c (relativistic)'
-"""
-open(f"{out}/accuracy.gp", "w").write(gp)
+
+def load(name):
+    rows = []
+    with open(os.path.join(trade_dir, name, "trade.csv")) as f:
+        for r in csv.DictReader(f):
+            if r["skipped"] == "1":
+                continue
+            for k in ("parameter", "error_ls", "error_rel", "triangles_per_frame", "cut_seconds_per_frame",
+                      "export_seconds_per_frame", "glb_bytes_per_frame"):
+                r[k] = float(r[k])
+            r["total"] = r["cut_seconds_per_frame"] + r["export_seconds_per_frame"]
+            rows.append(r)
+    return rows
+
+
+def interpolate(adaptive, error, key):
+    """The adaptive rows' `key` at `error`, log-log between the bracketing rows (None outside)."""
+    pts = sorted((r["error_ls"], r[key]) for r in adaptive if r["error_ls"] > 0)
+    for (e0, v0), (e1, v1) in zip(pts, pts[1:]):
+        if e0 <= error <= e1 and e0 < e1:
+            t = (math.log(error) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(v0) + t * (math.log(v1) - math.log(v0)))
+        if error == e0:
+            return v0
+    return None
+
+
+md = ["# Accuracy against cost: the speed-accuracy trade", "",
+      "Measured by `scripts/accuracy_report.sh`: `apparent trade` on each scene (5 frames spread over the "
+      "sequence, one thread), tables in `docs/trade/<scene>/table.txt` and `trade.csv`. Each row: the measured "
+      "two-sided error (`mesh4d/measure.h`: 12 samples of every output triangle against the exact surface, and "
+      "45 exact-surface points of every input triangle against the output; the largest over objects and frames), "
+      "triangles per frame (mean), the cut (refinement included) and the .glb conversion per frame (normals, "
+      "float32: the writer's per-frame work), and .glb bytes per frame. *Uniform k* splits every input triangle "
+      "4-to-1 k times, then vertex mode: what per-vertex engines do. *T* is `--tolerance T`, the adaptive "
+      "refinement (`mesh4d/slice.h`, bound in `mesh4d/chord_error.h`). Size = the largest moving object's "
+      "bounding-box diagonal.", ""]
+summary = ["| scene | uniform level: error / size | uniform triangles | adaptive triangles at that error | "
+           "ratio | time end to end, adaptive / uniform |", "|---|---|---|---|---|---|"]
+gp_lines = []
+for i, (name, about) in enumerate(SCENES):
+    try:
+        rows = load(name)
+    except FileNotFoundError:
+        continue
+    md += [f"## {name}: {about}", ""]
+    with open(os.path.join(trade_dir, name, "table.txt")) as f:
+        md += ["```"] + f.read().rstrip().split("\n") + ["```", ""]
+    adaptive = [r for r in rows if r["family"] == "tolerance"]
+    uniform = [r for r in rows if r["family"] == "uniform"]
+    for u in uniform:
+        rel = u["error_rel"]
+        if not (1e-4 <= rel <= 1e-2):
+            continue
+        n = interpolate(adaptive, u["error_ls"], "triangles_per_frame")
+        t = interpolate(adaptive, u["error_ls"], "total")
+        if n is None:
+            continue
+        summary.append(f"| {name} | {int(u['parameter'])}: {rel:.3g} | {u['triangles_per_frame']:.0f} | {n:.0f} | "
+                       f"{n / u['triangles_per_frame']:.2f} | {t / u['total']:.2f} |")
+    with open(os.path.join(docs, f"accuracy_{name}.dat"), "w") as d:
+        for fam in ("vertex", "uniform", "tolerance"):
+            d.write(f"# {fam}\n")
+            for r in rows:
+                if r["family"] == fam:
+                    d.write(f"{r['triangles_per_frame']} {r['error_rel']}\n")
+            d.write("\n\n")
+    gp_lines.append((name, i))
+
+head = md[:3]
+md = head + ["## At equal error", "",
+             "Adaptive triangles and time end to end (cut + .glb conversion) interpolated to each uniform level's "
+             "measured error (only levels with error 1e-4 .. 1e-2 x size):", ""] + summary + ["",
+             "![error against triangles per frame](accuracy.png)", ""] + md[3:]
+with open(os.path.join(docs, "ACCURACY.md"), "w") as f:
+    f.write("\n".join(md) + "\n")
+with open(os.path.join(docs, "accuracy.gp"), "w") as g:
+    g.write("set terminal pngcairo size 1000,620 font ',11'\nset output 'accuracy.png'\nset logscale xy\n"
+            "set xlabel 'output triangles per frame'\nset ylabel 'measured two-sided error / size'\nset grid\n"
+            "set key outside right\nset title 'apparent: error against triangles (solid: --tolerance, dashed: uniform subdivision)'\n")
+    plots = []
+    for name, i in gp_lines:
+        plots.append(f"'accuracy_{name}.dat' index 2 using 1:2 with linespoints lw 2 pt 7 lc {i + 1} title '{name}: tolerance'")
+        plots.append(f"'accuracy_{name}.dat' index 1 using 1:2 with linespoints lw 1 dt 2 pt 6 lc {i + 1} title '{name}: uniform'")
+    g.write("plot " + ", \\\n     ".join(plots) + "\n")
