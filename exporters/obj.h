@@ -1,13 +1,27 @@
-// Per-frame OBJ, written by OpenMesh with 17 significant digits (positions only: OBJ has no
-// per-vertex scalar; the emission time is in the PLY and glTF outputs).
+// Per-frame OBJ: every object of the frame in one mesh, absolute lab positions written with 17
+// significant digits (a double survives the text round trip exactly), then the triangles
+// (1-based). Positions only: OBJ has no per-vertex scalar; the emission time is in the PLY and
+// glTF outputs. Triangles with a repeated corner are left out.
 #pragma once
 
 #include <string>
+#include <utility>
 
-#include "exporters/frame_mesh.h"
+#include "exporters/frame_files.h"
 
 namespace apparent {
 
 bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error);
+
+// DIR/frame_NNNNN.obj per frame (exporters/frame_files.h).
+class ObjSink : public FrameFileSink {
+public:
+    explicit ObjSink(std::string dir) : FrameFileSink(std::move(dir), "obj") {}
+
+protected:
+    bool writeFrame(const std::string& path, const ExportFrame& frame, std::string* error) const override {
+        return writeObj(path, frame, error);
+    }
+};
 
 }  // namespace apparent

@@ -14,7 +14,7 @@ cd "$root"
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-$(nproc)}
 
-# Step: Debian packages (../shared/notes/dependencies.md section 1). assimp-testmodels holds real
+# Step: Debian packages (docs/DEPENDENCIES.md section 1). assimp-testmodels holds real
 # third-party meshes for import tests; nodejs/npm run the Khronos glTF-Validator.
 packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev

@@ -1,0 +1,58 @@
+// Where the frames of a sequence go: one sink per output format (.glb, PLY, OBJ; README "Adding a
+// format"). The frame loop (pipeline/frame_loop.h) calls, for one model:
+//   begin(info)                 once, before any frame;
+//   prepare(frame)              on worker threads, several frames at once (optional conversion);
+//   leastBytes(frame), add(...) on one thread, frames in order;
+//   finish(...)                 once, after the last frame.
+// Every method that writes returns false with one line naming the file on failure (the command
+// exits with code 3). Sinks write through AtomicOutput (exporters/atomic_file.h): a file appears
+// whole under its final name or not at all. The output budget (--max-output-bytes) is the loop's:
+// a sink only states the least size of what it is about to write and names the files it completed.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "exporters/frame_mesh.h"
+
+namespace apparent {
+
+// A sink's conversion of one frame, made by prepare() on any thread (opaque to the loop).
+struct PreparedFrame {
+    virtual ~PreparedFrame() = default;
+};
+
+// What a sink reports when the sequence is done.
+struct SinkSummary {
+    std::vector<std::string> completed;  // files written by finish() (their sizes count to the budget)
+    std::string text;                    // appended to the model's summary line, e.g. ", out/m.glb (1.2 MiB)"
+    std::vector<std::string> warnings;   // one line each, without "warning: "
+};
+
+class FrameSink {
+public:
+    virtual ~FrameSink() = default;
+    // Before the first frame: what the sequence is (objects, camera, model).
+    virtual bool begin(const SequenceInfo& info, std::string* error) = 0;
+    // The costly, order-independent part of taking `frame` (may run concurrently; const). The
+    // default prepares nothing.
+    virtual std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& /*frame*/) const { return nullptr; }
+    // The least number of bytes this sink will have written, and not yet reported as completed,
+    // once it takes `frame` (called once per frame, just before add()), and the name the budget's
+    // message uses for it.
+    virtual long long leastBytes(const ExportFrame& frame) = 0;
+    virtual std::string budgetName(const ExportFrame& frame) const = 0;
+    // Takes `frame` (frames in order; `prepared` is prepare(frame), possibly null). Files it
+    // completed are appended to `completed`.
+    virtual bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
+                     std::string* error) = 0;
+    // After the last frame.
+    virtual bool finish(SinkSummary* summary, std::string* error) = 0;
+};
+
+// The least size of a frame in any of the formats: 12 bytes per vertex and 12 per triangle
+// (three float32 or uint32 each), the figure the budget checks before writing.
+long long leastFrameBytes(const ExportFrame& frame);
+
+}  // namespace apparent
