@@ -63,6 +63,25 @@ bool parseSize(const std::string& text, int* width, int* height) {
     }
 }
 
+// --model: a comma list of models ("relativistic", "finite,instant", "all"), for every command
+// that takes one; false with the message for an unknown name.
+bool parseModelList(const std::string& text, StageOptions* options, std::string* error) {
+    std::stringstream ss(text);
+    std::string item;
+    while (!text.empty() && std::getline(ss, item, ',')) {
+        Model m;
+        if (item == "all") {
+            options->all_models = true;
+        } else if (parseModel(item, &m)) {
+            options->models.push_back(m);
+        } else {
+            *error = "--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)";
+            return false;
+        }
+    }
+    return true;
+}
+
 }  // namespace
 
 // Runs a command; what it cannot handle itself becomes one line: out of memory (exit 3) or a broken

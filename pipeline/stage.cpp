@@ -1,25 +1,6 @@
 #include "pipeline/stage.h"
 
-#include <sstream>
-
 namespace apparent {
-
-bool parseModelList(const std::string& text, StageOptions* options, std::string* error) {
-    std::stringstream ss(text);
-    std::string item;
-    while (!text.empty() && std::getline(ss, item, ',')) {
-        Model m;
-        if (item == "all") {
-            options->all_models = true;
-        } else if (parseModel(item, &m)) {
-            options->models.push_back(m);
-        } else {
-            *error = "--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)";
-            return false;
-        }
-    }
-    return true;
-}
 
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error) {
     auto fail = [&](const std::string& message) {

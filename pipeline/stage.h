@@ -41,10 +41,6 @@ struct Stage {
     std::vector<MirrorPlane> mirrors;  // the planes of the mirror objects (findMirrors)
 };
 
-// Parses a comma list of models ("relativistic", "finite,instant", "all") into options->models
-// and options->all_models; false with the message for an unknown name.
-bool parseModelList(const std::string& text, StageOptions* options, std::string* error);
-
 // Loads and validates the scene, the models, the frame count (against max_frames) and range, every
 // mesh and the mirrors, in that order. On failure: false, and the one line to print (without
 // "error: ") in `error`; the command exits with kExitBadInput. Mesh warnings go to `log`.
