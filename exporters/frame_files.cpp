@@ -27,8 +27,8 @@ long long leastFrameBytes(const ExportFrame& frame) {
     return 12 * (long long)vertices + 12 * (long long)frame.triangleCount();
 }
 
-FrameFileSink::FrameFileSink(std::string dir, std::string extension)
-    : dir_(std::move(dir)), extension_(std::move(extension)) {}
+FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameWriter write)
+    : dir_(std::move(dir)), extension_(std::move(extension)), write_(write) {}
 
 std::string FrameFileSink::path(long long k) const {
     return (std::filesystem::path(dir_) / (frameName(k) + "." + extension_)).string();
@@ -41,14 +41,12 @@ bool FrameFileSink::begin(const SequenceInfo&, std::string* error) {
     return !ec;
 }
 
-long long FrameFileSink::leastBytes(const ExportFrame& frame) { return leastFrameBytes(frame); }
-
-std::string FrameFileSink::budgetName(const ExportFrame& frame) const { return path(frame.index); }
+PendingOutput FrameFileSink::pending(const ExportFrame& frame) { return {leastFrameBytes(frame), path(frame.index)}; }
 
 bool FrameFileSink::add(const ExportFrame& frame, const PreparedFrame*, std::vector<std::string>* completed,
                         std::string* error) {
     const std::string p = path(frame.index);
-    if (!writeFrame(p, frame, error)) return false;
+    if (!write_(p, frame, error)) return false;
     completed->push_back(p);
     return true;
 }

@@ -10,23 +10,22 @@
 
 namespace apparent {
 
-class FrameFileSink : public FrameSink {
+// Writes `frame` to `path` (through a temporary name); false with a message naming the file.
+using FrameWriter = bool (*)(const std::string& path, const ExportFrame& frame, std::string* error);
+
+class FrameFileSink final : public FrameSink {
 public:
-    FrameFileSink(std::string dir, std::string extension);
+    FrameFileSink(std::string dir, std::string extension, FrameWriter write);
     bool begin(const SequenceInfo& info, std::string* error) override;
-    long long leastBytes(const ExportFrame& frame) override;
-    std::string budgetName(const ExportFrame& frame) const override;
+    PendingOutput pending(const ExportFrame& frame) override;
     bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
              std::string* error) override;
     bool finish(SinkSummary* summary, std::string* error) override;
 
-protected:
-    // Writes `frame` to `path` (through a temporary name); false with a message naming the file.
-    virtual bool writeFrame(const std::string& path, const ExportFrame& frame, std::string* error) const = 0;
-
 private:
     std::string path(long long k) const;
     std::string dir_, extension_;
+    FrameWriter write_;
 };
 
 }  // namespace apparent

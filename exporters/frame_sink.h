@@ -2,7 +2,7 @@
 // format"). The frame loop (pipeline/frame_loop.h) calls, for one model:
 //   begin(info)                 once, before any frame;
 //   prepare(frame)              on worker threads, several frames at once (optional conversion);
-//   leastBytes(frame), add(...) on one thread, frames in order;
+//   pending(frame), add(...)   on one thread, frames in order;
 //   finish(...)                 once, after the last frame.
 // Every method that writes returns false with one line naming the file on failure (the command
 // exits with code 3). Sinks write through AtomicOutput (exporters/atomic_file.h): a file appears
@@ -30,6 +30,12 @@ struct SinkSummary {
     std::vector<std::string> warnings;   // one line each, without "warning: "
 };
 
+// The least size of what a sink holds unwritten, and the name the budget's message gives it.
+struct PendingOutput {
+    long long bytes = 0;
+    std::string name;
+};
+
 class FrameSink {
 public:
     virtual ~FrameSink() = default;
@@ -38,11 +44,9 @@ public:
     // The costly, order-independent part of taking `frame` (may run concurrently; const). The
     // default prepares nothing.
     virtual std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& /*frame*/) const { return nullptr; }
-    // The least number of bytes this sink will have written, and not yet reported as completed,
-    // once it takes `frame` (called once per frame, just before add()), and the name the budget's
-    // message uses for it.
-    virtual long long leastBytes(const ExportFrame& frame) = 0;
-    virtual std::string budgetName(const ExportFrame& frame) const = 0;
+    // What taking `frame` will add to the output before any of it is reported as completed: at
+    // least `bytes` in all under `name` (called once per frame, just before add()).
+    virtual PendingOutput pending(const ExportFrame& frame) = 0;
     // Takes `frame` (frames in order; `prepared` is prepare(frame), possibly null). Files it
     // completed are appended to `completed`.
     virtual bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,

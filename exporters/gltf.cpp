@@ -642,14 +642,13 @@ bool GlbSink::begin(const SequenceInfo& info, std::string*) {
 
 std::shared_ptr<const PreparedFrame> GlbSink::prepare(const ExportFrame& frame) const { return writer_->prepare(frame); }
 
-long long GlbSink::leastBytes(const ExportFrame& frame) {
-    // Without Draco the file holds at least the frame's positions and indices (NORMAL and the
-    // emission time add more); Draco's size is not known before encoding.
+PendingOutput GlbSink::pending(const ExportFrame& frame) {
+    // Without Draco the file holds at least the frames' positions and indices (NORMAL and the
+    // emission time add more); Draco's size is not known before encoding. Nothing of the .glb
+    // counts as written before finish().
     if (!options_.draco) least_ += leastFrameBytes(frame);
-    return least_;
+    return {least_, model_ + ".glb"};
 }
-
-std::string GlbSink::budgetName(const ExportFrame&) const { return model_ + ".glb"; }
 
 bool GlbSink::add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>*,
                   std::string* error) {

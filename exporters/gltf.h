@@ -82,8 +82,7 @@ public:
     ~GlbSink() override;
     bool begin(const SequenceInfo& info, std::string* error) override;
     std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& frame) const override;
-    long long leastBytes(const ExportFrame& frame) override;
-    std::string budgetName(const ExportFrame& frame) const override;
+    PendingOutput pending(const ExportFrame& frame) override;
     bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
              std::string* error) override;
     bool finish(SinkSummary* summary, std::string* error) override;

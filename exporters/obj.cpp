@@ -1,8 +1,10 @@
 #include "exporters/obj.h"
 
 #include <charconv>
+#include <utility>
 
 #include "exporters/atomic_file.h"
+#include "exporters/frame_files.h"
 
 namespace apparent {
 
@@ -39,6 +41,10 @@ bool writeObj(const std::string& path, const ExportFrame& frame, std::string* er
     }
     AtomicOutput out(path);
     return out.commitBytes(text, error);
+}
+
+std::unique_ptr<FrameSink> objSink(std::string dir) {
+    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj);
 }
 
 }  // namespace apparent

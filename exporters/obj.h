@@ -4,24 +4,16 @@
 // glTF outputs. Triangles with a repeated corner are left out.
 #pragma once
 
+#include <memory>
 #include <string>
-#include <utility>
 
-#include "exporters/frame_files.h"
+#include "exporters/frame_sink.h"
 
 namespace apparent {
 
 bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error);
 
-// DIR/frame_NNNNN.obj per frame (exporters/frame_files.h).
-class ObjSink : public FrameFileSink {
-public:
-    explicit ObjSink(std::string dir) : FrameFileSink(std::move(dir), "obj") {}
-
-protected:
-    bool writeFrame(const std::string& path, const ExportFrame& frame, std::string* error) const override {
-        return writeObj(path, frame, error);
-    }
-};
+// The OBJ sink: DIR/frame_NNNNN.obj per frame (exporters/frame_files.h).
+std::unique_ptr<FrameSink> objSink(std::string dir);
 
 }  // namespace apparent

@@ -2,8 +2,10 @@
 
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 #include "exporters/atomic_file.h"
+#include "exporters/frame_files.h"
 
 namespace apparent {
 
@@ -49,6 +51,10 @@ bool writePly(const std::string& path, const ExportFrame& frame, std::string* er
     // Step: written with every write, fsync and close checked, then renamed into place.
     AtomicOutput out(path);
     return out.commitBytes(bytes, error);
+}
+
+std::unique_ptr<FrameSink> plySink(std::string dir) {
+    return std::make_unique<FrameFileSink>(std::move(dir), "ply", writePly);
 }
 
 }  // namespace apparent

@@ -5,25 +5,17 @@
 // `list uchar int vertex_indices`. Triangles with a repeated corner are left out.
 #pragma once
 
+#include <memory>
 #include <string>
-#include <utility>
 
-#include "exporters/frame_files.h"
+#include "exporters/frame_sink.h"
 
 namespace apparent {
 
 // Writes `frame` to `path` through a temporary file. Returns false with a message on failure.
 bool writePly(const std::string& path, const ExportFrame& frame, std::string* error);
 
-// DIR/frame_NNNNN.ply per frame (exporters/frame_files.h).
-class PlySink : public FrameFileSink {
-public:
-    explicit PlySink(std::string dir) : FrameFileSink(std::move(dir), "ply") {}
-
-protected:
-    bool writeFrame(const std::string& path, const ExportFrame& frame, std::string* error) const override {
-        return writePly(path, frame, error);
-    }
-};
+// The PLY sink: DIR/frame_NNNNN.ply per frame (exporters/frame_files.h).
+std::unique_ptr<FrameSink> plySink(std::string dir);
 
 }  // namespace apparent

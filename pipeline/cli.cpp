@@ -82,6 +82,13 @@ bool parseModelList(const std::string& text, StageOptions* options, std::string*
     return true;
 }
 
+// The limits of every command that loads a scene (pipeline/stage.h).
+void addStageLimits(CLI::App* command, StageOptions* stage) {
+    command->add_option("--max-frames", stage->max_frames, "Refuse scenes with more frames")->capture_default_str();
+    command->add_flag("--allow-outside", stage->limits.allow_outside,
+                      "Let scene mesh paths leave the scene's folder and the working folder");
+}
+
 }  // namespace
 
 // Runs a command; what it cannot handle itself becomes one line: out of memory (exit 3) or a broken
@@ -127,7 +134,6 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                          "the files then show only what the camera sees)");
     render_cmd->add_flag("--quiet,-q", rs.quiet, "No progress or summary");
     render_cmd->add_flag("--verbose,-v", rs.verbose, "Mesh topology and export precision");
-    render_cmd->add_option("--max-frames", rs.stage.max_frames, "Refuse scenes with more frames")->capture_default_str();
     render_cmd->add_option("--max-vertices", max_vertices, "Refuse meshes with more vertices")->capture_default_str();
     render_cmd->add_option("--max-faces", max_faces, "Refuse meshes with more faces")->capture_default_str();
     long long max_file_bytes = (long long)rs.stage.limits.max_file_bytes;
@@ -136,8 +142,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->add_option("--max-output-bytes", rs.max_output_bytes,
                            "Stop with exit code 3 before the outputs would exceed this many bytes in all")
         ->capture_default_str();
-    render_cmd->add_flag("--allow-outside", rs.stage.limits.allow_outside,
-                         "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(render_cmd, &rs.stage);
     render_cmd->footer(kRenderFooter);
 
     // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
@@ -151,9 +156,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     raytrace_cmd->add_option("--frames", trace_frames_text, "A:B traces global frames A..B-1");
     raytrace_cmd->add_option("--threads", ts.threads, "Worker threads (0: all cores)")->capture_default_str();
     raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary");
-    raytrace_cmd->add_option("--max-frames", ts.stage.max_frames, "Refuse scenes with more frames")->capture_default_str();
-    raytrace_cmd->add_flag("--allow-outside", ts.stage.limits.allow_outside,
-                           "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(raytrace_cmd, &ts.stage);
     FigureSettings fs;
     std::string figure_size_text;
     CLI::App* figure_cmd = app.add_subcommand(
@@ -165,9 +168,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
     figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary");
-    figure_cmd->add_option("--max-frames", fs.stage.max_frames, "Refuse scenes with more frames")->capture_default_str();
-    figure_cmd->add_flag("--allow-outside", fs.stage.limits.allow_outside,
-                         "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(figure_cmd, &fs.stage);
 
     try {
         app.parse(argc, argv);
@@ -197,6 +198,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.stage.frame_from, &ts.stage.frame_to))
             return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
         if (ts.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         return guarded([&] { return raytrace(ts, out, err); }, err);
     }
     if (figure_cmd->parsed()) {
@@ -204,6 +206,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             return usage("--size: '" + figure_size_text + "' is not WxH with W and H in 1..16384");
         if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
         if (fs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        if (fs.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (!render_cmd->parsed()) return kExitBadInput;

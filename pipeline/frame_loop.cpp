@@ -139,7 +139,8 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
             for (size_t s = 0; s < sinks.size(); ++s) {
                 // Refused before writing beyond the limit; every completed file counted after.
-                if (!budget->fits(sinks[s]->leastBytes(frame), sinks[s]->budgetName(frame), error)) return false;
+                const PendingOutput pending = sinks[s]->pending(frame);
+                if (!budget->fits(pending.bytes, pending.name, error)) return false;
                 std::vector<std::string> completed;
                 if (!sinks[s]->add(frame, prepared[i][s].get(), &completed, error)) return false;
                 for (const std::string& path : completed)

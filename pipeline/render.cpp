@@ -28,10 +28,10 @@ struct OutputFormat {
 const std::vector<OutputFormat>& formatTable() {
     static const std::vector<OutputFormat> table = {
         {"ply", [](const RenderSettings&, const std::string& dir, const std::string&) -> std::unique_ptr<FrameSink> {
-             return std::make_unique<PlySink>(dir);
+             return plySink(dir);
          }},
         {"obj", [](const RenderSettings&, const std::string& dir, const std::string&) -> std::unique_ptr<FrameSink> {
-             return std::make_unique<ObjSink>(dir);
+             return objSink(dir);
          }},
         {"glb", [](const RenderSettings& s, const std::string&, const std::string& stem) -> std::unique_ptr<FrameSink> {
              return std::make_unique<GlbSink>(stem + ".glb", s.glb, s.verbose);

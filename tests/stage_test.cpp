@@ -215,8 +215,7 @@ public:
         p->index = frame.index;
         return p;
     }
-    long long leastBytes(const ExportFrame&) override { return 0; }
-    std::string budgetName(const ExportFrame&) const override { return "recording"; }
+    PendingOutput pending(const ExportFrame&) override { return {0, "recording"}; }
     bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>*,
              std::string*) override {
         order.push_back(frame.index);
