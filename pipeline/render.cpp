@@ -14,27 +14,22 @@ namespace apparent {
 
 namespace {
 
-// One output format: its --format name and how its sink is made for a model. A new format is one
-// more entry here and one sink in exporters/ (README "Adding a format").
+// One output format: its --format name and how its sink is made for a model. `base` is
+// DIR/<model>: the folder of per-frame files and the stem of a file per sequence. A new format is
+// one more entry here and one sink in exporters/ (README "Adding a motion model, a format, a command").
 struct OutputFormat {
     std::string name;
-    // `frame_dir` is DIR/<model>, `stem` DIR/<model> as a file name stem.
-    std::function<std::unique_ptr<FrameSink>(const RenderSettings&, const std::string& frame_dir,
-                                             const std::string& stem)>
-        make;
+    std::function<std::unique_ptr<FrameSink>(const RenderSettings&, const std::string& base)> make;
 };
 
 // In the order the sinks take each frame (the byte budget checks them in this order too).
 const std::vector<OutputFormat>& formatTable() {
     static const std::vector<OutputFormat> table = {
-        {"ply", [](const RenderSettings&, const std::string& dir, const std::string&) -> std::unique_ptr<FrameSink> {
-             return plySink(dir);
-         }},
-        {"obj", [](const RenderSettings&, const std::string& dir, const std::string&) -> std::unique_ptr<FrameSink> {
-             return objSink(dir);
-         }},
-        {"glb", [](const RenderSettings& s, const std::string&, const std::string& stem) -> std::unique_ptr<FrameSink> {
-             return std::make_unique<GlbSink>(stem + ".glb", s.glb, s.verbose);
+        {"ply", [](const RenderSettings&, const std::string& base) { return plySink(base); }},
+        {"obj", [](const RenderSettings&, const std::string& base) { return objSink(base); }},
+        {"glb",
+         [](const RenderSettings& s, const std::string& base) -> std::unique_ptr<FrameSink> {
+             return std::make_unique<GlbSink>(base + ".glb", s.glb, s.verbose);
          }},
     };
     return table;
@@ -84,12 +79,12 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     loop.progress = !settings.quiet;
     for (Model model : stage.models) {
         const std::string name = modelName(model);
-        const std::string stem = (std::filesystem::path(settings.out_dir) / name).string();
+        const std::string base = (std::filesystem::path(settings.out_dir) / name).string();
         std::vector<std::unique_ptr<FrameSink>> owned;
         std::vector<FrameSink*> sinks;
         for (const OutputFormat& f : formatTable()) {
             if (std::find(settings.formats.begin(), settings.formats.end(), f.name) == settings.formats.end()) continue;
-            owned.push_back(f.make(settings, stem, stem));
+            owned.push_back(f.make(settings, base));
             sinks.push_back(owned.back().get());
         }
         FrameLoopResult result;
