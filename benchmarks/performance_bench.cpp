@@ -28,7 +28,8 @@
 #include "exporters/gltf.h"
 #include "exporters/ply.h"
 #include "pipeline/cli.h"
-#include "pipeline/render.h"
+#include "pipeline/stage.h"
+#include "pipeline/worlds.h"
 #include "test_meshes.h"
 
 namespace {
@@ -180,19 +181,25 @@ void BM_Culling(benchmark::State& state) {
     }
     const std::string scene = writeScene("culling", 2000, 20.0, 10.0, objects.str());
     const bool cull = state.range(0) == 1;
-    apparent::Scene sc;
-    apparent::loadScene(scene, &sc);
-    std::vector<apparent::PreparedObject> prepared;
+    apparent::StageOptions options;
+    options.scene_path = scene;
+    options.quiet = true;
+    apparent::Stage stage;
     std::ostringstream log;
-    apparent::prepareObjects(sc, {}, &prepared, log, true);
-    std::vector<mesh4d::World4D> worlds;
-    for (const auto& o : prepared) worlds.push_back(apparent::buildWorld(o, apparent::Model::Relativistic, sc, 0, 199));
+    std::string error;
+    if (!apparent::loadStage(options, &stage, log, &error)) {
+        state.SkipWithError(error.c_str());
+        return;
+    }
+    const apparent::Scene& sc = stage.scene;
+    const std::vector<mesh4d::World4D> worlds =
+        apparent::buildWorlds(stage.objects, apparent::Model::Relativistic, sc, stage.first, stage.last_excl - 1);
     mesh4d::SliceSettings s;
     s.cull = cull;
     size_t shown = 0, cut = 0;
     for (auto _ : state) {
         shown = cut = 0;
-        for (long long k = 0; k < 200; ++k) {
+        for (long long k = stage.first; k < stage.last_excl; ++k) {
             const mesh4d::ViewSurface view = apparent::viewForFrame(sc, apparent::Model::Relativistic, k);
             for (const auto& w : worlds) {
                 if (cull && !apparent::inCameraView(sc.camera, mesh4d::apparentBound(w, view))) continue;

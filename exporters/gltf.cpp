@@ -6,6 +6,7 @@
 #include <cstring>
 #include <memory>
 #include <filesystem>
+#include <iomanip>
 #include <sstream>
 
 #include <draco/compression/decode.h>
@@ -15,6 +16,8 @@
 #include <tiny_gltf.h>
 
 #include "exporters/atomic_file.h"
+#include "mesh4d/angles.h"
+#include "mesh4d/box.h"
 #include "mesh4d/normals.h"
 
 #include <fcntl.h>
@@ -270,7 +273,7 @@ struct SequenceModel {
         scene.name = info.model;
         tinygltf::Camera cam;
         cam.type = "perspective";
-        cam.perspective.yfov = info.camera.fov_deg * 3.14159265358979323846 / 180.0;
+        cam.perspective.yfov = info.camera.fov_deg * mesh4d::kPi / 180.0;
         model.cameras.push_back(cam);
         tinygltf::Node node;
         node.name = "camera";
@@ -481,7 +484,7 @@ GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo
 
 GlbSequenceWriter::~GlbSequenceWriter() = default;
 
-struct GlbFrameData {
+struct GlbFrameData : PreparedFrame {
     double origin[3] = {0, 0, 0};
     std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
     double far = 0, max_extent = 0, max_float_error = 0;
@@ -490,18 +493,19 @@ struct GlbFrameData {
 std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
     auto d = std::make_shared<GlbFrameData>();
     // Step: the frame's origin (the centre of its bounding box) and the far distance.
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    mesh4d::EventBox box;
     for (const auto& o : f.objects)
         for (size_t i = 0; i < o.positions.size(); ++i) {
             const Vec3 p = o.absolutePosition(i);
             d->far = std::max(d->far, mesh4d::norm(p - impl_->info.camera.position));
-            for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+            box.addPoint(p);
         }
-    for (int c = 0; c < 3; ++c) d->origin[c] = 0.5 * (lo[c] + hi[c]);
+    const Vec3 center = box.center();
+    for (int c = 0; c < 3; ++c) d->origin[c] = center[c];
     // Step: each object's float32 data with normals (crease split), relative to the origin.
     d->data.resize(f.objects.size());
     if (f.triangleCount() > 0) {
-        for (int c = 0; c < 3; ++c) d->max_extent = std::max(d->max_extent, hi[c] - lo[c]);
+        d->max_extent = std::max(d->max_extent, box.extent());
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty()) d->data[o] = toPrimitive(f.objects[o], d->origin, &d->max_float_error);
     }
@@ -608,6 +612,73 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
     if (!out.commit(error)) return false;
     m.stats.bytes = size_t(total);
     if (stats) *stats = m.stats;
+    return true;
+}
+
+namespace {
+
+std::string humanBytes(size_t n) {
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(1);
+    if (n >= 1 << 20) os << double(n) / (1 << 20) << " MiB";
+    else if (n >= 1 << 10) os << double(n) / (1 << 10) << " KiB";
+    else os << n << " B";
+    return os.str();
+}
+
+}  // namespace
+
+GlbSink::GlbSink(std::string path, const GlbOptions& options, bool verbose)
+    : path_(std::move(path)), options_(options), verbose_(verbose) {}
+
+GlbSink::~GlbSink() = default;
+
+bool GlbSink::begin(const SequenceInfo& info, std::string*) {
+    model_ = info.model;
+    tolerance_ = info.tolerance;
+    writer_ = std::make_unique<GlbSequenceWriter>(path_, info, options_);
+    return true;  // the spill file's errors surface at the first add()
+}
+
+std::shared_ptr<const PreparedFrame> GlbSink::prepare(const ExportFrame& frame) const { return writer_->prepare(frame); }
+
+PendingOutput GlbSink::pending(const ExportFrame& frame) {
+    // Without Draco the file holds at least the frames' positions and indices (NORMAL and the
+    // emission time add more); Draco's size is not known before encoding. Nothing of the .glb
+    // counts as written before finish().
+    if (!options_.draco) least_ += leastFrameBytes(frame);
+    return {least_, model_ + ".glb"};
+}
+
+bool GlbSink::add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>*,
+                  std::string* error) {
+    if (!prepared) return writer_->add(frame, error);
+    return writer_->add(frame, static_cast<const GlbFrameData&>(*prepared), error);
+}
+
+bool GlbSink::finish(SinkSummary* summary, std::string* error) {
+    GlbStats stats;
+    if (!writer_->finish(&stats, error)) return false;
+    summary->completed.push_back(path_);
+    // Step: ", out/m.glb (1.2 MiB with Draco, 4.5 MiB without); float32 ... ; Draco ..."
+    summary->text = ", " + path_ + " (" + humanBytes(stats.bytes);
+    if (options_.draco) summary->text += " with Draco, " + humanBytes(stats.bytes_without_draco) + " without";
+    summary->text += ")";
+    std::ostringstream os;
+    os << std::setprecision(3);
+    if (verbose_) os << "; float32 position error <= " << stats.max_float_error << " ls";
+    if (options_.draco && verbose_)
+        os << "; Draco " << options_.position_bits << "-bit position error <= " << stats.max_quantization_error << " ls";
+    summary->text += os.str();
+    // Warn when Draco's quantization is coarser than the accuracy asked for (gltfpack warns the
+    // same way about position bits).
+    if (options_.draco && tolerance_ > 0 && stats.max_quantization_error > tolerance_) {
+        std::ostringstream w;
+        w << std::setprecision(3) << path_ << ": Draco position error up to " << stats.max_quantization_error
+          << " ls exceeds the tolerance " << tolerance_ << " ls; consider more bits (--draco-bits "
+          << std::min(30, options_.position_bits + 2) << ")";
+        summary->warnings.push_back(w.str());
+    }
     return true;
 }
 

@@ -14,7 +14,7 @@
 //   and hides them with it) and extras {"mirror": M}. They come after all frame nodes.
 // - one animation "frames" of STEP scale channels: node k is visible (scale 1) during
 //   [k/fps, (k+1)/fps) and hidden (scale 0) otherwise; the last frame stays visible at the final
-//   key n/fps, which closes the sequence (../shared/notes/dependencies.md section 4).
+//   key n/fps, which closes the sequence (docs/DEPENDENCIES.md section 4).
 // - scene extras: model, tolerance, units, fps, first_frame, frame_times, objects, scene_file.
 // With Draco (KHR_draco_mesh_compression, required), every primitive's attributes and indices
 // are Edgebreaker-coded; POSITION is quantized to `position_bits` over the primitive's largest
@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "exporters/frame_mesh.h"
+#include "exporters/frame_sink.h"
 
 namespace apparent {
 
@@ -70,6 +70,31 @@ public:
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
+};
+
+// The .glb as a frame sink: one GlbSequenceWriter per sequence (begin() starts it), frames
+// converted by prepare() on the loop's worker threads. finish() reports the file and its size
+// (with Draco also the size without it); `verbose` adds the float32 and Draco position error
+// bounds to the summary, and a warning says when Draco's bound exceeds the sequence's tolerance.
+class GlbSink : public FrameSink {
+public:
+    GlbSink(std::string path, const GlbOptions& options, bool verbose);
+    ~GlbSink() override;
+    bool begin(const SequenceInfo& info, std::string* error) override;
+    std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& frame) const override;
+    PendingOutput pending(const ExportFrame& frame) override;
+    bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
+             std::string* error) override;
+    bool finish(SinkSummary* summary, std::string* error) override;
+
+private:
+    std::string path_;
+    GlbOptions options_;
+    bool verbose_;
+    std::string model_;
+    double tolerance_ = 0;
+    long long least_ = 0;  // least size of the file so far without Draco (positions and indices alone)
+    std::unique_ptr<GlbSequenceWriter> writer_;
 };
 
 // All frames at once (the same file as GlbSequenceWriter fed `frames`).

@@ -1,27 +1,50 @@
 #include "exporters/obj.h"
 
-#include <sstream>
-
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/System/omstream.hh>
+#include <charconv>
+#include <utility>
 
 #include "exporters/atomic_file.h"
-#include "exporters/openmesh_frame.h"
+#include "exporters/frame_files.h"
 
 namespace apparent {
 
+namespace {
+
+// `value` with 17 significant digits, shortest form of "%.17g" (std::to_chars: no locale).
+void putNumber(std::string* out, double value) {
+    char buffer[32];
+    const auto r = std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::general, 17);
+    out->append(buffer, r.ptr);
+}
+
+}  // namespace
+
 bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error) {
-    FrameTriMesh om;
-    toOpenMesh(frame, &om);
-    omlog().disable();
-    AtomicOutput out(path);
-    // 17 significant digits: a double survives the text round trip exactly.
-    std::ostringstream os;  // in memory, then written with every error checked (see ply.cpp)
-    if (!OpenMesh::IO::write_mesh(om, os, ".obj", OpenMesh::IO::Options(), 17)) {
-        *error = path + ": OpenMesh could not write the OBJ file";
-        return false;
+    const mesh4d::ApparentMesh m = mergeObjects(frame);
+    size_t faces = 0;
+    for (const auto& t : m.triangles) faces += t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
+    // Step: serialized in memory, then written with every error checked (exporters/atomic_file.h).
+    std::string text = "# " + std::to_string(m.positions.size()) + " vertices, " + std::to_string(faces) + " faces\n";
+    text.reserve(text.size() + 60 * m.positions.size() + 24 * faces);
+    for (const mesh4d::Vec3& p : m.positions) {
+        text += "v ";
+        putNumber(&text, p.x);
+        text += ' ';
+        putNumber(&text, p.y);
+        text += ' ';
+        putNumber(&text, p.z);
+        text += '\n';
     }
-    return out.commitBytes(os.str(), error);
+    for (const auto& t : m.triangles) {
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;  // zero area by construction
+        text += "f " + std::to_string(t[0] + 1) + ' ' + std::to_string(t[1] + 1) + ' ' + std::to_string(t[2] + 1) + '\n';
+    }
+    AtomicOutput out(path);
+    return out.commitBytes(text, error);
+}
+
+std::unique_ptr<FrameSink> objSink(std::string dir) {
+    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj);
 }
 
 }  // namespace apparent

@@ -1,4 +1,4 @@
-// The tinygltf implementation, compiled once for the whole program (../shared/notes/dependencies.md
-// section 3: Debian's shared libtinygltf has no Draco and clashes with libdraco's copy).
+// The tinygltf implementation, compiled once for the whole program (docs/DEPENDENCIES.md section 3:
+// Debian's shared libtinygltf has no Draco and clashes with libdraco's copy).
 #define TINYGLTF_IMPLEMENTATION
 #include <tiny_gltf.h>

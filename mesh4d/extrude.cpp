@@ -8,13 +8,6 @@
 
 namespace mesh4d {
 
-void EventBox::add(const Event& e) {
-    t_lo = std::min(t_lo, e.t);
-    t_hi = std::max(t_hi, e.t);
-    lo = {std::min(lo.x, e.x.x), std::min(lo.y, e.x.y), std::min(lo.z, e.x.z)};
-    hi = {std::max(hi.x, e.x.x), std::max(hi.y, e.x.y), std::max(hi.z, e.x.z)};
-}
-
 World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
                 bool cap_a_real, bool cap_b_real) {
     World4D world;

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "boost.h"
+#include "box.h"
 #include "event.h"
 #include "lightcone.h"
 
@@ -37,13 +38,6 @@ struct RestMesh {
 // An undirected mesh edge, lo < hi.
 struct Edge {
     uint32_t lo = 0, hi = 0;
-};
-
-// The 4D bounding box of a set of events.
-struct EventBox {
-    double t_lo = INFINITY, t_hi = -INFINITY;
-    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    void add(const Event& e);
 };
 
 // A run of consecutive triangles with the boxes of their vertices' events on each cap: the

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "angles.h"
+
 namespace mesh4d {
 
 namespace {
@@ -12,7 +14,7 @@ Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
 }  // namespace
 
 CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
-    const double cos_crease = std::cos(crease_deg * 3.14159265358979323846 / 180.0);
+    const double cos_crease = std::cos(crease_deg * kPi / 180.0);
     const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();
 
     // Step: face area vectors and unit normals; faces around each vertex (CSR layout).

@@ -94,18 +94,8 @@ TraceWorld prepareTrace(const World4D& world) {
         p.normal = flatNormal(v);
         p.offset = dot4(p.normal, toVec4(v[0]));
         // Step: bounds of the prism's six events.
-        p.lo = {INFINITY, INFINITY, INFINITY};
-        p.hi = {-INFINITY, -INFINITY, -INFINITY};
-        p.t_lo = INFINITY;
-        p.t_hi = -INFINITY;
         for (uint32_t vi : world.mesh.triangles[f])
-            for (uint32_t cap = 0; cap < 2; ++cap) {
-                const Event& e = world.events[2 * vi + cap];
-                p.lo = {std::min(p.lo.x, e.x.x), std::min(p.lo.y, e.x.y), std::min(p.lo.z, e.x.z)};
-                p.hi = {std::max(p.hi.x, e.x.x), std::max(p.hi.y, e.x.y), std::max(p.hi.z, e.x.z)};
-                p.t_lo = std::min(p.t_lo, e.t);
-                p.t_hi = std::max(p.t_hi, e.t);
-            }
+            for (uint32_t cap = 0; cap < 2; ++cap) p.box.add(world.events[2 * vi + cap]);
     }
     return trace;
 }
@@ -128,10 +118,8 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
         const double slack_s = 1e-9 * (std::fabs(s_flat) + 1);
         if (!(s_flat > -slack_s && s_flat < best_s + slack_s)) continue;
         const Event at = ray.at(s_flat);
-        const double slack = 1e-9 * (norm(p.hi - p.lo) + norm(at.x) + (p.t_hi - p.t_lo) + std::fabs(at.t));
-        if (at.x.x < p.lo.x - slack || at.x.x > p.hi.x + slack || at.x.y < p.lo.y - slack || at.x.y > p.hi.y + slack ||
-            at.x.z < p.lo.z - slack || at.x.z > p.hi.z + slack || at.t < p.t_lo - slack || at.t > p.t_hi + slack)
-            continue;
+        const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
+        if (!p.box.contains(at, slack)) continue;
         // Step: the prism's three tetrahedra by the 4D barycentric method; the nearest hit wins.
         for (size_t j = 0; j < 3; ++j) {
             const auto& t = world.tets[3 * f + j];

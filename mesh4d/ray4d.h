@@ -62,8 +62,7 @@ struct TraceWorld {
     struct Prism {
         std::array<double, 4> normal{};  // 4D normal of the prism's 3-flat
         double offset = 0;               // normal . V for every event V of the prism
-        Vec3 lo, hi;                     // spatial bounding box of the prism's six events
-        double t_lo = 0, t_hi = 0;       // time range of the six events
+        EventBox box;                    // 4D bounds of the prism's six events
     };
     std::vector<Prism> prisms;           // one per input triangle
 };

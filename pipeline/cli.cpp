@@ -1,5 +1,7 @@
 #include "pipeline/cli.h"
 
+#include <algorithm>
+#include <cmath>
 #include <ostream>
 #include <sstream>
 
@@ -62,6 +64,32 @@ bool parseSize(const std::string& text, int* width, int* height) {
     }
 }
 
+// --model: a comma list of models ("relativistic", "finite,instant", "all"), for every command
+// that takes one; false with the message for an unknown name.
+bool parseModelList(const std::string& text, StageOptions* options, std::string* error) {
+    std::stringstream ss(text);
+    std::string item;
+    while (!text.empty() && std::getline(ss, item, ',')) {
+        Model m;
+        if (item == "all") {
+            options->all_models = true;
+        } else if (parseModel(item, &m)) {
+            options->models.push_back(m);
+        } else {
+            *error = "--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)";
+            return false;
+        }
+    }
+    return true;
+}
+
+// The limits of every command that loads a scene (pipeline/stage.h).
+void addStageLimits(CLI::App* command, StageOptions* stage) {
+    command->add_option("--max-frames", stage->max_frames, "Refuse scenes with more frames")->capture_default_str();
+    command->add_flag("--allow-outside", stage->limits.allow_outside,
+                      "Let scene mesh paths leave the scene's folder and the working folder");
+}
+
 }  // namespace
 
 // Runs a command; what it cannot handle itself becomes one line: out of memory (exit 3) or a broken
@@ -86,9 +114,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
 
     RenderSettings rs;
     std::string model_text, format_text = "glb", frames_text, tolerance_text;
-    long long max_vertices = (long long)rs.limits.max_vertices, max_faces = (long long)rs.limits.max_faces;
+    long long max_vertices = (long long)rs.stage.limits.max_vertices, max_faces = (long long)rs.stage.limits.max_faces;
     CLI::App* render_cmd = app.add_subcommand("render", "Render a scene's apparent shapes into DIR");
-    render_cmd->add_option("scene", rs.scene_path, "Scene file (JSON, see README 'Scene format')")->required();
+    render_cmd->add_option("scene", rs.stage.scene_path, "Scene file (JSON, see README 'Scene format')")->required();
     render_cmd->add_option("--out", rs.out_dir, "Output folder (created if missing)")->capture_default_str();
     render_cmd->add_option("--model", model_text,
                            "instant|finite|relativistic|contracted|all, or a comma list (default: the scene's model)");
@@ -107,45 +135,41 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                          "the files then show only what the camera sees)");
     render_cmd->add_flag("--quiet,-q", rs.quiet, "No progress or summary");
     render_cmd->add_flag("--verbose,-v", rs.verbose, "Mesh topology and export precision");
-    render_cmd->add_option("--max-frames", rs.max_frames, "Refuse scenes with more frames")->capture_default_str();
     render_cmd->add_option("--max-vertices", max_vertices, "Refuse meshes with more vertices")->capture_default_str();
     render_cmd->add_option("--max-faces", max_faces, "Refuse meshes with more faces")->capture_default_str();
-    long long max_file_bytes = (long long)rs.limits.max_file_bytes;
+    long long max_file_bytes = (long long)rs.stage.limits.max_file_bytes;
     render_cmd->add_option("--max-file-bytes", max_file_bytes, "Refuse mesh files (and glTF buffers) larger than this")
         ->capture_default_str();
     render_cmd->add_option("--max-output-bytes", rs.max_output_bytes,
                            "Stop with exit code 3 before the outputs would exceed this many bytes in all")
         ->capture_default_str();
-    render_cmd->add_flag("--allow-outside", rs.limits.allow_outside,
-                         "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(render_cmd, &rs.stage);
     render_cmd->footer(kRenderFooter);
 
     // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
     RaytraceSettings ts;
     std::string trace_model_text, trace_size_text, trace_frames_text;
     CLI::App* raytrace_cmd = app.add_subcommand("raytrace", "Ray-trace the 4D histories into PNG frames DIR/<model>/frame_NNNNN.png");
-    raytrace_cmd->add_option("scene", ts.scene_path, "Scene file (JSON or glTF)")->required();
+    raytrace_cmd->add_option("scene", ts.stage.scene_path, "Scene file (JSON or glTF)")->required();
     raytrace_cmd->add_option("--out", ts.out_dir, "Output folder (created if missing)")->capture_default_str();
     raytrace_cmd->add_option("--model", trace_model_text, "instant|finite|relativistic|contracted|all, or a comma list");
     raytrace_cmd->add_option("--size", trace_size_text, "Image size WxH (default 480x270)");
     raytrace_cmd->add_option("--frames", trace_frames_text, "A:B traces global frames A..B-1");
     raytrace_cmd->add_option("--threads", ts.threads, "Worker threads (0: all cores)")->capture_default_str();
     raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary");
-    raytrace_cmd->add_flag("--allow-outside", ts.limits.allow_outside,
-                           "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(raytrace_cmd, &ts.stage);
     FigureSettings fs;
     std::string figure_size_text;
     CLI::App* figure_cmd = app.add_subcommand(
         "figure", "The paper's comparison sheet: rows instant, finite, relativistic; columns sequential frames");
-    figure_cmd->add_option("scene", fs.scene_path, "Scene file (JSON or glTF)")->required();
+    figure_cmd->add_option("scene", fs.stage.scene_path, "Scene file (JSON or glTF)")->required();
     figure_cmd->add_option("--out", fs.out_path, "Output PNG")->capture_default_str();
     figure_cmd->add_option("--columns", fs.columns, "Frames per row, evenly spaced, first and last included")
         ->capture_default_str();
     figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
     figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary");
-    figure_cmd->add_flag("--allow-outside", fs.limits.allow_outside,
-                         "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(figure_cmd, &fs.stage);
 
     // `trade`: the speed-accuracy trade measured on the user's scene (pipeline/trade.h).
     TradeSettings trs;
@@ -193,19 +217,13 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return kExitBadInput;
     };
     if (raytrace_cmd->parsed()) {
-        std::stringstream ss(trace_model_text);
-        std::string item;
-        while (!trace_model_text.empty() && std::getline(ss, item, ',')) {
-            Model m;
-            if (item == "all") ts.all_models = true;
-            else if (parseModel(item, &m)) ts.models.push_back(m);
-            else return usage("--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)");
-        }
+        if (std::string message; !parseModelList(trace_model_text, &ts.stage, &message)) return usage(message);
         if (!trace_size_text.empty() && !parseSize(trace_size_text, &ts.width, &ts.height))
             return usage("--size: '" + trace_size_text + "' is not WxH with W and H in 1..16384");
-        if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.frame_from, &ts.frame_to))
+        if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.stage.frame_from, &ts.stage.frame_to))
             return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
         if (ts.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         return guarded([&] { return raytrace(ts, out, err); }, err);
     }
     if (figure_cmd->parsed()) {
@@ -213,6 +231,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             return usage("--size: '" + figure_size_text + "' is not WxH with W and H in 1..16384");
         if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
         if (fs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        if (fs.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (trade_cmd->parsed()) {
@@ -240,52 +259,45 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return guarded([&] { return trade(trs, out, err); }, err);
     }
     if (!render_cmd->parsed()) return kExitBadInput;
-    if (!model_text.empty()) {
-        std::stringstream ss(model_text);
-        std::string item;
-        while (std::getline(ss, item, ',')) {
-            Model m;
-            if (item == "all") rs.all_models = true;
-            else if (parseModel(item, &m)) rs.models.push_back(m);
-            else return usage("--model: unknown model '" + item + "' (instant, finite, relativistic, contracted, all)");
-        }
-    }
-    rs.write_glb = false;
+    if (std::string message; !parseModelList(model_text, &rs.stage, &message)) return usage(message);
+    rs.formats.clear();
     {
+        const std::vector<std::string>& known = outputFormats();
+        std::string names;  // "ply, obj, glb"
+        for (const std::string& n : known) names += (names.empty() ? "" : ", ") + n;
         std::stringstream ss(format_text);
         std::string item;
         while (std::getline(ss, item, ',')) {
-            if (item == "glb") rs.write_glb = true;
-            else if (item == "ply") rs.write_ply = true;
-            else if (item == "obj") rs.write_obj = true;
-            else return usage("--format: unknown format '" + item + "' (glb, ply, obj)");
+            if (std::find(known.begin(), known.end(), item) == known.end())
+                return usage("--format: unknown format '" + item + "' (" + names + ")");
+            if (std::find(rs.formats.begin(), rs.formats.end(), item) == rs.formats.end()) rs.formats.push_back(item);
         }
-        if (!rs.write_glb && !rs.write_ply && !rs.write_obj) return usage("--format: no format given (glb, ply, obj)");
+        if (rs.formats.empty()) return usage("--format: no format given (" + names + ")");
     }
     if (!tolerance_text.empty()) {
         if (tolerance_text == "vertex") {
-            rs.tolerance = 0;
+            rs.stage.tolerance = 0;
         } else {
             try {
                 size_t used = 0;
-                rs.tolerance = std::stod(tolerance_text, &used);
-                if (used != tolerance_text.size() || !(rs.tolerance > 0) || !std::isfinite(rs.tolerance)) throw 0;
+                rs.stage.tolerance = std::stod(tolerance_text, &used);
+                if (used != tolerance_text.size() || !(rs.stage.tolerance > 0) || !std::isfinite(rs.stage.tolerance)) throw 0;
             } catch (...) {
                 return usage("--tolerance: '" + tolerance_text + "' is neither a positive number of light-seconds nor 'vertex'");
             }
         }
-        rs.has_tolerance = true;
+        rs.stage.has_tolerance = true;
     }
-    if (!frames_text.empty() && !parseFrames(frames_text, &rs.frame_from, &rs.frame_to))
+    if (!frames_text.empty() && !parseFrames(frames_text, &rs.stage.frame_from, &rs.stage.frame_to))
         return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
     if (rs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
-    if (max_vertices <= 0 || max_faces <= 0 || rs.max_frames <= 0 || max_file_bytes <= 0 || rs.max_output_bytes <= 0)
+    if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0 || rs.max_output_bytes <= 0)
         return usage("--max-vertices, --max-faces, --max-frames, --max-file-bytes and --max-output-bytes must be positive");
-    rs.limits.max_vertices = size_t(max_vertices);
-    rs.limits.max_faces = size_t(max_faces);
-    rs.limits.max_file_bytes = size_t(max_file_bytes);
+    rs.stage.limits.max_vertices = size_t(max_vertices);
+    rs.stage.limits.max_faces = size_t(max_faces);
+    rs.stage.limits.max_file_bytes = size_t(max_file_bytes);
     return guarded([&] { return render(rs, out, err); }, err);
 }
 

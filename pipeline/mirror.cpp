@@ -4,7 +4,10 @@
 #include <cstdint>
 #include <cmath>
 #include <sstream>
-#include <stdexcept>
+
+#include "mesh4d/box.h"
+#include "mesh4d/check.h"
+#include "pipeline/worlds.h"
 
 namespace apparent {
 
@@ -34,16 +37,13 @@ Status findMirrors(const std::vector<PreparedObject>& objects, const std::string
         if (!(mesh4d::norm(n) > 0)) return Status::failure(where + "the mesh has no area");
         n = n / mesh4d::norm(n);
         // Step: planarity, to 1e-9 of the mesh's bounding-box diagonal.
-        Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-        for (const Vec3& p : o.rest.positions) {
-            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-        }
+        mesh4d::EventBox box;
+        for (const Vec3& p : o.rest.positions) box.addPoint(p);
         const Vec3 p0 = o.rest.positions[o.rest.triangles[0][0]];  // on the plane through every vertex, if planar
         double worst = 0;
         for (const auto& t : o.rest.triangles)
             for (uint32_t v : t) worst = std::max(worst, std::fabs(mesh4d::dot(o.rest.positions[v] - p0, n)));
-        if (worst > 1e-9 * mesh4d::norm(hi - lo)) {
+        if (worst > 1e-9 * box.diagonal()) {
             std::ostringstream os;
             os << where << "the mesh is not planar (a vertex lies " << worst << " ls off its plane; a mirror must be flat)";
             return Status::failure(os.str());
@@ -212,8 +212,7 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
                                std::vector<mesh4d::ApparentMesh>* objects) const {
     // Step: each mirror as the camera sees it in this frame (its own cut, `exists` included):
     // what is seen through it is clipped to these triangles. Slivers give no pyramid.
-    if (objects->size() < scene_objects_)
-        throw std::logic_error("MirrorReflections::append: the frame's scene objects are missing");
+    APPARENT_CHECK(objects->size(), >=, scene_objects_);  // the frame's scene objects come first
     std::vector<std::vector<std::array<Vec3, 3>>> seen(mirrors_.size());
     for (size_t mi = 0; mi < mirrors_.size(); ++mi) {
         const mesh4d::ApparentMesh& m = (*objects)[mirrors_[mi].object];

@@ -1,5 +1,5 @@
 // Planar mirrors at rest (scene objects with "mirror": true) and the retarded reflections they
-// show (DESIGN.md section 8). Light from event X reaching the camera C by way of the mirror plane
+// show (docs/DESIGN.md section 8). Light from event X reaching the camera C by way of the mirror plane
 // travels |X - M| + |M - C| = |X - C'|, C' the mirror image of C: it lies on the past cone of
 // the image camera (t_c, C'). So the reflection is the apparent surface for C', reflected back
 // through the plane, where the line of sight from C passes through the mirror polygon.
@@ -11,7 +11,7 @@
 #include "mesh4d/event.h"
 #include "mesh4d/slice.h"
 #include "exporters/frame_mesh.h"
-#include "pipeline/render.h"
+#include "pipeline/prepared_object.h"
 
 namespace apparent {
 
@@ -40,7 +40,7 @@ Status findMirrors(const std::vector<PreparedObject>& objects, const std::string
 // Limits: one bounce (mirrors are not seen in mirrors), the clip is exact on the straight output
 // edges (it adds points on them; emission times and rest points of those are interpolated
 // linearly along the edge), and a mirror whose existence begins or ends within view is clipped to
-// its cut's chords of the cap curve (DESIGN.md section 6), not the curve.
+// its cut's chords of the cap curve (docs/DESIGN.md section 6), not the curve.
 class MirrorReflections {
 public:
     MirrorReflections(const Scene& scene, const std::vector<PreparedObject>& objects,

@@ -11,13 +11,15 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "mesh4d/angles.h"
+#include "pipeline/worlds.h"
+
 namespace apparent {
 
 using mesh4d::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Linear RGB of pixels where a ray meets nothing (a dark blue-grey, so black objects still show).
 constexpr std::array<double, 3> kBackground{0.010, 0.012, 0.020};
 // Share of a mirror pixel's colour that is the reflection; the rest is the mirror's own shading.
@@ -62,7 +64,7 @@ Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int
     const Vec3 r = r0 / mesh4d::norm(r0);
     const Vec3 u = mesh4d::cross(r, f);
     // Step: the pixel centre on the image plane at distance 1.
-    const double half_h = std::tan(camera.fov_deg * kPi / 360);
+    const double half_h = std::tan(camera.fov_deg * mesh4d::kPi / 360);
     const double half_w = half_h * double(width) / double(height);
     const double x = (2 * (px + 0.5) / width - 1) * half_w;
     const double y = (1 - 2 * (py + 0.5) / height) * half_h;
@@ -158,62 +160,20 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
     return frame;
 }
 
-namespace {
-
-// Shared by `raytrace` and `figure`: load, validate, prepare objects and mirrors.
-// An empty `models` becomes the scene's model.
-int loadForTracing(const std::string& scene_path, const MeshLimits& limits, std::vector<Model>* models,
-                   bool quiet, Scene* scene, std::vector<PreparedObject>* objects, std::vector<MirrorPlane>* mirrors,
-                   std::ostream& err) {
-    if (Status s = loadScene(scene_path, scene); !s.ok) {
-        err << "error: " << s.message << "\n";
-        return kExitBadInput;
-    }
-    if (models->empty()) *models = {scene->model};
-    for (Model m : *models) {
-        if (Status s = checkSceneForModel(*scene, m); !s.ok) {
-            err << "error: " << s.message << "\n";
-            return kExitBadInput;
-        }
-    }
-    if (frameCount(scene->frames) > kDefaultMaxFrames) {
-        err << "error: " << scene->path << ": frames: more than " << kDefaultMaxFrames << " frames\n";
-        return kExitBadInput;
-    }
-    if (Status s = prepareObjects(*scene, limits, objects, err, quiet); !s.ok) {
-        err << "error: " << s.message << "\n";
-        return kExitBadInput;
-    }
-    if (Status s = findMirrors(*objects, scene->path, mirrors); !s.ok) {
-        err << "error: " << s.message << "\n";
-        return kExitBadInput;
-    }
-    return kExitOk;
-}
-
-}  // namespace
-
 int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err) {
-    // Step: load and validate the scene, its meshes and mirrors.
-    Scene scene;
-    std::vector<PreparedObject> objects;
-    std::vector<MirrorPlane> mirrors;
-    std::vector<Model> models = settings.models;
-    if (settings.all_models) models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};
-    if (int code = loadForTracing(settings.scene_path, settings.limits, &models, settings.quiet, &scene, &objects,
-                                  &mirrors, err);
-        code != kExitOk)
-        return code;
-    const long long total = frameCount(scene.frames);
-    const long long first = settings.frame_from;
-    const long long last_excl = settings.frame_to < 0 ? total : settings.frame_to;
-    if (!(first >= 0 && first < last_excl && last_excl <= total)) {
-        err << "error: --frames: " << first << ":" << last_excl << " is outside the scene's frames 0:" << total << "\n";
+    // Step: the stage: scene, models, frames, meshes, mirrors.
+    Stage stage;
+    StageOptions stage_options = settings.stage;
+    stage_options.quiet = settings.quiet;
+    std::string error;
+    if (!loadStage(stage_options, &stage, err, &error)) {
+        err << "error: " << error << "\n";
         return kExitBadInput;
     }
+    const long long first = stage.first, last_excl = stage.last_excl;
 
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    for (Model model : models) {
+    for (Model model : stage.models) {
         const auto start = std::chrono::steady_clock::now();
         // Step: the folder, then the static worlds once per model, then every frame.
         const std::string dir = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
@@ -223,11 +183,10 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& 
             err << "error: " << dir << ": cannot create output folder: " << ec.message() << "\n";
             return kExitOutputError;
         }
-        const SceneTracer tracer(scene, objects, mirrors, model, first, last_excl - 1);
+        const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
         for (long long k = first; k < last_excl; ++k) {
             TracedFrame frame;
             arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height); });
-            std::string error;
             if (!writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error)) {
                 err << "error: " << error << "\n";
                 return kExitOutputError;
@@ -251,14 +210,21 @@ std::vector<long long> figureFrames(const Scene& scene, int columns) {
 }
 
 int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err) {
-    std::vector<Model> rows{Model::Instant, Model::Finite, Model::Relativistic};
-    Scene scene;
-    std::vector<PreparedObject> objects;
-    std::vector<MirrorPlane> mirrors;
-    if (int code = loadForTracing(settings.scene_path, settings.limits, &rows, settings.quiet, &scene, &objects,
-                                  &mirrors, err);
-        code != kExitOk)
-        return code;
+    // Step: the stage, for the three rows' models and all frames.
+    Stage stage;
+    StageOptions stage_options = settings.stage;
+    stage_options.models = {Model::Instant, Model::Finite, Model::Relativistic};
+    stage_options.all_models = false;
+    stage_options.frame_from = 0;
+    stage_options.frame_to = -1;
+    stage_options.quiet = settings.quiet;
+    std::string error;
+    if (!loadStage(stage_options, &stage, err, &error)) {
+        err << "error: " << error << "\n";
+        return kExitBadInput;
+    }
+    const Scene& scene = stage.scene;
+    const std::vector<Model>& rows = stage.models;
     // Step: lay out the sheet: rows instant, finite, relativistic; columns sequential frames.
     constexpr int kGap = 4;
     constexpr uint8_t kGapGrey = 96;
@@ -268,7 +234,7 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     std::fill(sheet.rgb.begin(), sheet.rgb.end(), kGapGrey);
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     for (size_t r = 0; r < rows.size(); ++r) {
-        const SceneTracer tracer(scene, objects, mirrors, rows[r], frames.front(), frames.back());
+        const SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], frames.front(), frames.back());
         for (size_t c = 0; c < frames.size(); ++c) {
             TracedFrame frame;
             arena.execute([&] { frame = tracer.traceFrame(frames[c], settings.width, settings.height); });
@@ -280,7 +246,6 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     const std::filesystem::path parent = std::filesystem::path(settings.out_path).parent_path();
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-    std::string error;
     if (ec || !writePng(settings.out_path, sheet, &error)) {
         err << "error: " << (ec ? settings.out_path + ": cannot create folder: " + ec.message() : error) << "\n";
         return kExitOutputError;

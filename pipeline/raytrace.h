@@ -16,7 +16,7 @@
 #include "exporters/png.h"
 #include "mesh4d/ray4d.h"
 #include "pipeline/mirror.h"
-#include "pipeline/render.h"
+#include "pipeline/stage.h"
 
 namespace apparent {
 
@@ -65,28 +65,23 @@ private:
 };
 
 struct RaytraceSettings {
-    std::string scene_path;
+    StageOptions stage;            // scene, --model (empty: the scene's), --frames, --max-frames, limits
     std::string out_dir = "out";
-    std::vector<Model> models;     // empty: the scene's model
-    bool all_models = false;
     int width = 480, height = 270;
-    long long frame_from = 0, frame_to = -1;  // --frames A:B, B exclusive; -1: to the end
     int threads = 0;
     bool quiet = false;
-    MeshLimits limits;
 };
 
 // `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame. Exit codes as `render`.
 int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err);
 
 struct FigureSettings {
-    std::string scene_path;
+    StageOptions stage;            // scene, --max-frames, limits (the rows fix the models, the columns the frames)
     std::string out_path = "sheet.png";
     int columns = 6;
     int width = 320, height = 180;  // one panel
     int threads = 0;
     bool quiet = false;
-    MeshLimits limits;
 };
 
 // The frames a figure shows in its columns: evenly spaced over the scene's frames, first and last included.

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # One-command set-up for apparent on Debian 12 (README "Set up").
-#   scripts/setup.sh demo   install packages, build, render the default scene into out/
+#   scripts/setup.sh demo   install packages, build the program only, render the default scene into out/
 #   scripts/setup.sh test   install packages (and the npm validators), build, run the whole test suite
-#   scripts/setup.sh build  install packages and build only
+#   scripts/setup.sh build  install packages and build everything, nothing run
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores), SKIP_APT=1 to skip apt-get.
 set -euo pipefail
 
@@ -14,7 +14,7 @@ cd "$root"
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-$(nproc)}
 
-# Step: Debian packages (../shared/notes/dependencies.md section 1). assimp-testmodels holds real
+# Step: Debian packages (docs/DEPENDENCIES.md section 1). assimp-testmodels holds real
 # third-party meshes for import tests; nodejs/npm run the Khronos glTF-Validator.
 packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
@@ -47,10 +47,14 @@ if [ "$mode" = test ]; then
   npm ci --no-audit --no-fund --loglevel=error
 fi
 
-# Step: build.
+# Step: build: the demo needs the program alone; test and build make everything (tests, benchmarks).
 echo "== building in $build_dir"
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build "$build_dir" -j "$jobs"
+if [ "$mode" = demo ]; then
+  cmake --build "$build_dir" -j "$jobs" --target apparent
+else
+  cmake --build "$build_dir" -j "$jobs"
+fi
 
 case "$mode" in
   demo)

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "pipeline/render.h"
+#include "pipeline/worlds.h"
 
 using namespace apparent;
 
@@ -55,10 +56,9 @@ TEST(Culling, RenderLeavesOnlyWhatIsOutOfViewEmpty) {
         {"name": "behind", "mesh": "flange.obj", "position": [0, 0, 20], "velocity": [0.5, 0, 0]}]})";
     auto run = [&](bool cull, const std::string& out, const std::string& scene) {
         RenderSettings s;
-        s.scene_path = (dir / scene).string();
+        s.stage.scene_path = (dir / scene).string();
         s.out_dir = (dir / out).string();
-        s.write_glb = false;
-        s.write_ply = true;
+        s.formats = {"ply"};
         s.quiet = true;
         s.cull_view = cull;
         std::ostringstream log, err;

@@ -18,7 +18,6 @@
 #include "run_command.h"
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
-#include "pipeline/render.h"
 #include "pipeline/scene.h"
 
 using namespace apparent;

@@ -18,6 +18,7 @@
 #include "pipeline/cli.h"
 #include "pipeline/mirror.h"
 #include "pipeline/raytrace.h"
+#include "pipeline/worlds.h"
 
 using namespace apparent;
 using mesh4d::Vec3;

@@ -1,0 +1,62 @@
+// Where the frames of a sequence go: one sink per output format (.glb, PLY, OBJ; README "Adding a
+// format"). The frame loop (pipeline/frame_loop.h) calls, for one model:
+//   begin(info)                 once, before any frame;
+//   prepare(frame)              on worker threads, several frames at once (optional conversion);
+//   pending(frame), add(...)   on one thread, frames in order;
+//   finish(...)                 once, after the last frame.
+// Every method that writes returns false with one line naming the file on failure (the command
+// exits with code 3). Sinks write through AtomicOutput (exporters/atomic_file.h): a file appears
+// whole under its final name or not at all. The output budget (--max-output-bytes) is the loop's:
+// a sink only states the least size of what it is about to write and names the files it completed.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "exporters/frame_mesh.h"
+
+namespace apparent {
+
+// A sink's conversion of one frame, made by prepare() on any thread (opaque to the loop).
+struct PreparedFrame {
+    virtual ~PreparedFrame() = default;
+};
+
+// What a sink reports when the sequence is done.
+struct SinkSummary {
+    std::vector<std::string> completed;  // files written by finish() (their sizes count to the budget)
+    std::string text;                    // appended to the model's summary line, e.g. ", out/m.glb (1.2 MiB)"
+    std::vector<std::string> warnings;   // one line each, without "warning: "
+};
+
+// The least size of what a sink holds unwritten, and the name the budget's message gives it.
+struct PendingOutput {
+    long long bytes = 0;
+    std::string name;
+};
+
+class FrameSink {
+public:
+    virtual ~FrameSink() = default;
+    // Before the first frame: what the sequence is (objects, camera, model).
+    virtual bool begin(const SequenceInfo& info, std::string* error) = 0;
+    // The costly, order-independent part of taking `frame` (may run concurrently; const). The
+    // default prepares nothing.
+    virtual std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& /*frame*/) const { return nullptr; }
+    // What taking `frame` will add to the output before any of it is reported as completed: at
+    // least `bytes` in all under `name` (called once per frame, just before add()).
+    virtual PendingOutput pending(const ExportFrame& frame) = 0;
+    // Takes `frame` (frames in order; `prepared` is prepare(frame), possibly null). Files it
+    // completed are appended to `completed`.
+    virtual bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
+                     std::string* error) = 0;
+    // After the last frame.
+    virtual bool finish(SinkSummary* summary, std::string* error) = 0;
+};
+
+// The least size of a frame in any of the formats: 12 bytes per vertex and 12 per triangle
+// (three float32 or uint32 each), the figure the budget checks before writing.
+long long leastFrameBytes(const ExportFrame& frame);
+
+}  // namespace apparent

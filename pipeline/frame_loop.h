@@ -1,0 +1,61 @@
+// The frame loop: for one model, the stage's 4D histories (pipeline/worlds.h) and mirror
+// reflections are built once, then frames [first, last_excl) are cut in parallel batches (TBB;
+// objects of a frame in parallel too) and delivered to the sinks in frame order, so outputs are
+// byte-identical for any thread count. Each sink gets begin(), then every frame, then finish()
+// (exporters/frame_sink.h). Before each write the output budget (--max-output-bytes) is checked
+// against the sink's least size, and after it against the real size of every completed file.
+// Progress (frames done, rate, time left) is shown on a terminal.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "exporters/frame_sink.h"
+#include "pipeline/stage.h"
+#include "pipeline/worlds.h"
+
+namespace apparent {
+
+// Bytes written by a run, against --max-output-bytes: files already written stay complete,
+// nothing is written past the limit.
+class OutputBudget {
+public:
+    explicit OutputBudget(long long limit) : limit_(limit) {}
+    // False, with the message, when `more` bytes beyond those written would pass the limit
+    // (more = 0: the total already has).
+    bool fits(long long more, const std::string& what, std::string* error) const;
+    // Counts the size of the written file `path`; false (with the message) once over the limit.
+    bool count(const std::string& path, std::string* error);
+    long long written() const { return written_; }
+
+private:
+    long long limit_;
+    long long written_ = 0;
+};
+
+struct FrameLoopSettings {
+    int threads = 0;         // worker threads; 0: all cores
+    bool cull_view = false;  // --cull-view: objects outside the camera's view stay empty (worlds.h)
+    bool progress = true;    // on a terminal only
+};
+
+struct FrameLoopResult {
+    size_t max_triangles = 0;            // the largest frame's triangle count
+    size_t limited_triangles = 0;        // triangle-frames that reached the refinement limit
+    size_t max_segments = 0;             // that limit
+    std::vector<SinkSummary> summaries;  // per sink, in the order given
+};
+
+// What the sinks are told about the sequence of `model`: objects (then the reflections, see
+// MirrorReflections::describe), camera, fps, tolerance, scene file.
+SequenceInfo sequenceInfo(const Stage& stage, Model model);
+
+// Runs frames [stage.first, stage.last_excl) of `model` into `sinks` (in that order per frame).
+// Returns false with one line (naming the file) when an output cannot be written or the budget is
+// exhausted: the command's exit code 3. Progress goes to `progress_out`.
+bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& settings,
+                  const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
+                  FrameLoopResult* result, std::string* error);
+
+}  // namespace apparent

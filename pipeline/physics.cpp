@@ -1,0 +1,38 @@
+#include "pipeline/physics.h"
+
+namespace apparent {
+
+mesh4d::Kinematics kinematicsOf(Model m) {
+    return (m == Model::Relativistic || m == Model::Contracted) ? mesh4d::Kinematics::Lorentz
+                                                                 : mesh4d::Kinematics::Galilean;
+}
+
+mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
+    const mesh4d::Kinematics kin = kinematicsOf(model);
+    switch (s.speed) {
+        case ObjectSpec::Speed::Gamma:
+            return mesh4d::makeMotionFromGamma(kin, s.t0, s.position, s.direction, s.gamma);
+        case ObjectSpec::Speed::Rapidity:
+            return mesh4d::makeMotionFromRapidity(kin, s.t0, s.position, s.direction, s.rapidity);
+        case ObjectSpec::Speed::Velocity:
+            break;
+    }
+    return mesh4d::makeMotion(kin, s.t0, s.position, s.velocity);
+}
+
+mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
+    return viewAt(scene, model, frameTime(scene.frames, k));
+}
+
+mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c) {
+    mesh4d::ViewSurface view;
+    view.kind = (model == Model::Finite || model == Model::Relativistic) ? mesh4d::ViewKind::PastCone
+                                                                         : mesh4d::ViewKind::Hyperplane;
+    view.t_c = t_c;
+    // The hyperplane models may look back by the stage's light delay (scene camera.instant_delay).
+    if (view.kind == mesh4d::ViewKind::Hyperplane) view.t_c -= scene.camera.instant_delay;
+    view.apex = scene.camera.position;
+    return view;
+}
+
+}  // namespace apparent

@@ -1,0 +1,81 @@
+#include "pipeline/prepared_object.h"
+
+#include <cmath>
+#include <map>
+#include <ostream>
+#include <utility>
+
+#include "mesh4d/angles.h"
+
+namespace apparent {
+
+using mesh4d::kPi;
+using mesh4d::Vec3;
+
+namespace {
+
+// Rotation by Euler angles in degrees, applied about X, then Y, then Z (fixed axes).
+Vec3 rotateXYZ(const Vec3& p, const Vec3& deg) {
+    const double ax = deg.x * kPi / 180, ay = deg.y * kPi / 180, az = deg.z * kPi / 180;
+    Vec3 r = p;
+    r = {r.x, std::cos(ax) * r.y - std::sin(ax) * r.z, std::sin(ax) * r.y + std::cos(ax) * r.z};
+    r = {std::cos(ay) * r.x + std::sin(ay) * r.z, r.y, -std::sin(ay) * r.x + std::cos(ay) * r.z};
+    r = {std::cos(az) * r.x - std::sin(az) * r.y, std::sin(az) * r.x + std::cos(az) * r.y, r.z};
+    return r;
+}
+
+// Distinct base colours for objects without their own (linear RGB, roughly equal lightness).
+constexpr std::array<std::array<double, 4>, 6> kPalette = {{{0.85, 0.45, 0.10, 1.0},
+                                                            {0.10, 0.45, 0.85, 1.0},
+                                                            {0.55, 0.55, 0.55, 1.0},
+                                                            {0.20, 0.70, 0.25, 1.0},
+                                                            {0.75, 0.20, 0.60, 1.0},
+                                                            {0.85, 0.75, 0.15, 1.0}}};
+
+}  // namespace
+
+std::array<double, 4> objectBaseColor(const std::vector<PreparedObject>& objects, size_t i) {
+    return objects[i].has_color ? objects[i].color : kPalette[i % kPalette.size()];
+}
+
+Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<PreparedObject>* objects,
+                      std::ostream& log, bool quiet) {
+    std::map<std::string, LoadedMesh> cache;  // one read per mesh file
+    for (const ObjectSpec& spec : scene.objects) {
+        // Step: the mesh path must stay where the scene may read (README "Hostile input").
+        if (!limits.allow_outside)
+            if (Status s = checkMeshInside(scene.path, spec.field_path + ".mesh",
+                                           spec.mesh_text.empty() ? spec.mesh_path : spec.mesh_text, spec.mesh_path);
+                !s.ok)
+                return s;
+        auto it = cache.find(spec.mesh_path);
+        if (it == cache.end()) {
+            LoadedMesh mesh;
+            MeshWarnings warnings;
+            if (Status s = readMesh(spec.mesh_path, limits, &mesh, &warnings); !s.ok) return s;
+            if (!quiet)
+                for (const std::string& w : warnings.lines()) log << "warning: " << spec.mesh_path << ": " << w << "\n";
+            it = cache.emplace(spec.mesh_path, std::move(mesh)).first;
+        }
+        PreparedObject obj;
+        obj.spec = spec;
+        obj.rest = it->second.mesh;
+        obj.has_color = it->second.has_color;
+        obj.color = it->second.color;
+        const auto& L = spec.linear;  // column-major
+        for (Vec3& p : obj.rest.positions) {
+            const Vec3 r = rotateXYZ({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z}, spec.rotation_deg);
+            p = {L[0] * r.x + L[3] * r.y + L[6] * r.z, L[1] * r.x + L[4] * r.y + L[7] * r.z,
+                 L[2] * r.x + L[5] * r.y + L[8] * r.z};
+        }
+        // A mirroring map (negative determinant) flips the winding: flip triangles back.
+        const double det_linear = L[0] * (L[4] * L[8] - L[7] * L[5]) - L[3] * (L[1] * L[8] - L[7] * L[2]) +
+                                  L[6] * (L[1] * L[5] - L[4] * L[2]);
+        if (spec.scale.x * spec.scale.y * spec.scale.z * det_linear < 0)
+            for (auto& t : obj.rest.triangles) std::swap(t[1], t[2]);
+        objects->push_back(std::move(obj));
+    }
+    return Status::success();
+}
+
+}  // namespace apparent

@@ -1,0 +1,33 @@
+// A scene object ready for the 4D stage: its mesh read once, rotation, scale and the node's
+// linear map applied (pipeline/stage.h loads them; pipeline/worlds.h extrudes them).
+#pragma once
+
+#include <array>
+#include <iosfwd>
+#include <vector>
+
+#include "mesh4d/extrude.h"
+#include "pipeline/mesh_input.h"
+#include "pipeline/scene.h"
+
+namespace apparent {
+
+struct PreparedObject {
+    ObjectSpec spec;
+    mesh4d::RestMesh rest;             // rest-frame mesh with rotation, scale and `linear` applied
+    bool has_color = false;            // the mesh file gave a base colour
+    std::array<double, 4> color{1, 1, 1, 1};
+};
+
+// The base colour object i is drawn with (linear RGBA): its mesh file's, else a palette colour.
+std::array<double, 4> objectBaseColor(const std::vector<PreparedObject>& objects, size_t i);
+
+// Loads every object's mesh (each file once; its path confined as README "Hostile input" says
+// unless limits.allow_outside) and applies scale, then rotation (X, Y, Z about fixed axes), then
+// the spec's linear map; a map with negative determinant flips the triangles back. Counted
+// warnings go to `log` as "warning: FILE: ..." unless `quiet`. On failure the message names the
+// file and the field.
+Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<PreparedObject>* objects,
+                      std::ostream& log, bool quiet);
+
+}  // namespace apparent

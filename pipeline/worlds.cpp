@@ -1,0 +1,63 @@
+#include "pipeline/worlds.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mesh4d/angles.h"
+#include "mesh4d/box.h"
+
+namespace apparent {
+
+using mesh4d::Vec3;
+
+mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
+                           long long last_frame) {
+    const ObjectSpec& s = object.spec;
+    const mesh4d::Motion motion = motionOf(s, model);
+    // Step: the proper-time span the requested frames can see, padded by the object's own light
+    // crossing time so that rounding in the vertex crossings never reaches an artificial cap.
+    const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(object.rest, motion, viewForFrame(scene, model, first_frame),
+                                                         viewForFrame(scene, model, last_frame));
+    mesh4d::EventBox box;
+    for (const Vec3& p : object.rest.positions) box.addPoint(p);
+    // Interior points of a triangle can emit up to diag (1 + b) / (1 - b^2) = diag / (1 - b) later or
+    // earlier than its vertices (the crossing time's slope along the surface is at most 1/(1 - b)).
+    const double diag = box.diagonal();
+    const double pad = diag * (1 + motion.beta) / motion.one_minus_beta2 +
+                       1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
+    const double open_a = seen.lo - pad, open_b = seen.hi + pad;
+    // Step: clip the span to the object's existence; only those ends are real caps.
+    const bool cap_a_real = s.exists_from > open_a;
+    const bool cap_b_real = s.exists_to < open_b;
+    const double tau_a = cap_a_real ? s.exists_from : open_a;
+    const double tau_b = cap_b_real ? s.exists_to : open_b;
+    if (!(tau_a < tau_b)) {
+        mesh4d::World4D empty;
+        empty.motion = motion;
+        return empty;
+    }
+    return mesh4d::extrude(object.rest, motion, tau_a, tau_b, cap_a_real, cap_b_real);
+}
+
+std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
+                                         long long first_frame, long long last_frame) {
+    std::vector<mesh4d::World4D> worlds;
+    worlds.reserve(objects.size());
+    for (const PreparedObject& o : objects) worlds.push_back(buildWorld(o, model, scene, first_frame, last_frame));
+    return worlds;
+}
+
+bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound) {
+    const Vec3 d = bound.center - camera.position;
+    const double dist = mesh4d::norm(d);
+    if (!(dist > bound.radius)) return true;  // the camera is inside the sphere (or NaN: keep it)
+    const Vec3 f = camera.look_at - camera.position;
+    const double cos_angle = std::clamp(mesh4d::dot(d, f) / (dist * mesh4d::norm(f)), -1.0, 1.0);
+    const double angle = std::acos(cos_angle);                  // centre off the view axis
+    const double angular_radius = std::asin(bound.radius / dist);
+    const double half_fov = 0.5 * camera.fov_deg * mesh4d::kPi / 180.0;
+    const double half_diagonal = std::atan(std::tan(half_fov) * std::sqrt(1 + kCullAspect * kCullAspect));
+    return angle - angular_radius <= half_diagonal;
+}
+
+}  // namespace apparent

@@ -1,0 +1,34 @@
+// The 4D histories of a scene's objects for one model (Black et al. 2007, section III): each
+// object's rest mesh extruded along its worldlines over the proper-time span the requested frames
+// can see, clipped to the object's existence (docs/DESIGN.md section 7); and the view cull
+// (--cull-view) that leaves an object outside the camera's view uncut in a frame.
+#pragma once
+
+#include <vector>
+
+#include "mesh4d/extrude.h"
+#include "mesh4d/slice.h"
+#include "pipeline/physics.h"
+#include "pipeline/prepared_object.h"
+
+namespace apparent {
+
+// The 4D history of one object for `model`, extruded over the proper-time span that frames
+// [first_frame, last_frame] (global numbers, both included) can see from the scene's camera,
+// padded by the object's light-crossing time; only ends of the object's existence are real caps.
+// Empty (motion set, no tetrahedra) when the object does not exist within that span.
+mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
+                           long long last_frame);
+
+// buildWorld for every object, in scene order.
+std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
+                                         long long first_frame, long long last_frame);
+
+// View culling (--cull-view): whether a sphere may show in the camera's view, a circular cone
+// around the view axis whose half-angle reaches the corners of a kCullAspect:1 frame with the
+// camera's vertical field of view (wider than 16:9 and 21:9 screens; a 32:9 screen at the same
+// vertical field of view could miss parts at its far left and right).
+constexpr double kCullAspect = 2.4;
+bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound);
+
+}  // namespace apparent
