@@ -16,7 +16,8 @@
 
 #include "mesh4d/measure.h"
 #include "pipeline/cli.h"
-#include "pipeline/render.h"
+#include "pipeline/prepared_object.h"
+#include "pipeline/worlds.h"
 #include "test_meshes.h"
 
 namespace {

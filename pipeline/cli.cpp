@@ -176,19 +176,18 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     std::string trade_model_text, trade_frames_text, trade_tolerances_text;
     CLI::App* trade_cmd = app.add_subcommand(
         "trade", "Measure error against time and size on a scene: vertex mode, uniform subdivision, a ladder of tolerances");
-    trade_cmd->add_option("scene", trs.scene_path, "Scene file (JSON or glTF)")->required();
+    trade_cmd->add_option("scene", trs.stage.scene_path, "Scene file (JSON or glTF)")->required();
     trade_cmd->add_option("--out", trs.out_dir, "Folder for trade.csv, trade.png and trade.gp (created if missing)")
         ->capture_default_str();
     trade_cmd->add_option("--model", trade_model_text, "finite|relativistic (default: the scene's model)");
     trade_cmd->add_option("--frames", trade_frames_text, "A:B measures frames A..B-1 (default: 5 frames spread over the scene)");
     trade_cmd->add_option("--levels", trs.levels, "Uniform subdivision levels 1..N to compare")->capture_default_str();
     trade_cmd->add_option("--tolerances", trade_tolerances_text,
-                          "Comma list of tolerances relative to the largest object size (default 1e-1,3e-2,...,1e-4)");
+                          "Comma list of tolerances relative to the largest moving object's size (default 1e-1,3e-2,...,1e-4)");
     trade_cmd->add_option("--max-triangles", trs.max_triangles, "Skip rows with more output triangles per frame")
         ->capture_default_str();
     trade_cmd->add_flag("--quiet,-q", trs.quiet, "Only the table");
-    trade_cmd->add_flag("--allow-outside", trs.limits.allow_outside,
-                        "Let scene mesh paths leave the scene's folder and the working folder");
+    addStageLimits(trade_cmd, &trs.stage);
     trade_cmd->footer(
         "Prints, for each row: the measured two-sided error to the exact apparent surface (sampled as the tests do),\n"
         "output triangles per frame, cut time per frame (one thread) and .glb bytes per frame; writes DIR/trade.csv\n"
@@ -235,11 +234,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (trade_cmd->parsed()) {
-        if (!trade_model_text.empty() && !parseModel(trade_model_text, &trs.model))
-            return usage("--model: unknown model '" + trade_model_text + "' (instant, finite, relativistic, contracted)");
-        trs.has_model = !trade_model_text.empty();
-        if (!trade_frames_text.empty() && !parseFrames(trade_frames_text, &trs.frame_from, &trs.frame_to))
+        if (std::string message; !parseModelList(trade_model_text, &trs.stage, &message)) return usage(message);
+        if (!trade_frames_text.empty() && !parseFrames(trade_frames_text, &trs.stage.frame_from, &trs.stage.frame_to))
             return usage("--frames: '" + trade_frames_text + "' is not A:B with 0 <= A < B");
+        trs.has_frames = !trade_frames_text.empty();
+        trs.stage.quiet = trs.quiet;
         if (trs.levels < 0 || trs.levels > 8) return usage("--levels: must be in 0..8");
         if (trs.max_triangles <= 0) return usage("--max-triangles: must be positive");
         std::stringstream ss(trade_tolerances_text);

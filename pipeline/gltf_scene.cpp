@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
+#include "mesh4d/angles.h"
 #include "pipeline/gltf_document.h"
 #include "pipeline/gltf_nodes.h"
 #include "pipeline/scene_fields.h"
@@ -96,7 +97,7 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         c.look_at = pos + ahead / mesh4d::norm(ahead);
         c.up = up;
         const auto& cam = model.cameras[size_t(node.camera)];
-        if (cam.type == "perspective") c.fov_deg = cam.perspective.yfov * 180.0 / 3.14159265358979323846;
+        if (cam.type == "perspective") c.fov_deg = cam.perspective.yfov * 180.0 / mesh4d::kPi;
         if (const json& cx = doc->node_extras[size_t(camera_node)]; cx.is_object() && !is_object[size_t(camera_node)]) {
             r.warnUnknownKeys(cx, where + ".extras", {"instant_delay"});
             r.number(cx, "instant_delay", where + ".extras", &c.instant_delay);

@@ -1,5 +1,7 @@
 #include "pipeline/stage.h"
 
+#include <ostream>
+
 namespace apparent {
 
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error) {
@@ -10,6 +12,9 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     // Step: the scene, the tolerance override and the models it must be valid for.
     Scene& scene = stage->scene;
     if (Status s = loadScene(options.scene_path, &scene); !s.ok) return fail(s.message);
+    // Properties the scene reader kept but did not use (a misspelt field in glTF extras): said once.
+    if (!options.quiet)
+        for (const std::string& w : scene.warnings) log << "warning: " << w << "\n";
     if (options.has_tolerance) scene.tolerance = options.tolerance;
     stage->models = options.models;
     if (options.all_models) stage->models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};

@@ -15,7 +15,9 @@
 #include "exporters/gltf.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/subdivide.h"
-#include "pipeline/render.h"
+#include "pipeline/frame_loop.h"
+#include "pipeline/physics.h"
+#include "pipeline/worlds.h"
 
 namespace apparent {
 
@@ -41,9 +43,10 @@ std::string formatG(double x, int digits = 3) {
 
 // Measures one configuration: `objects` (already subdivided for the uniform family) at
 // `tolerance` over `frames`.
-TradeRow measure(const std::vector<PreparedObject>& objects, const Scene& scene, Model model,
+TradeRow measure(const Stage& stage, const std::vector<PreparedObject>& objects, Model model,
                  const std::vector<long long>& frames, double tolerance, long long max_triangles,
                  const std::string& glb_path, bool* too_large) {
+    const Scene& scene = stage.scene;
     TradeRow row;
     const long long first = frames.front(), last = frames.back();
     std::vector<mesh4d::World4D> worlds;
@@ -82,17 +85,8 @@ TradeRow measure(const std::vector<PreparedObject>& objects, const Scene& scene,
         exported.push_back(std::move(frame));
     }
     // The .glb of these frames, written by the real writer (its size is what a viewer downloads).
-    SequenceInfo info;
-    info.model = modelName(model);
+    SequenceInfo info = sequenceInfo(stage, model);
     info.tolerance = tolerance;
-    info.fps = scene.frames.fps;
-    info.scene_path = scene.path;
-    for (size_t i = 0; i < objects.size(); ++i) {
-        ExportObject o;
-        o.name = objects[i].spec.name;
-        o.base_color = objectBaseColor(objects, i);
-        info.objects.push_back(o);
-    }
     // Export time: the per-frame conversion (crease split, normals, float32: GlbSequenceWriter::prepare),
     // timed like the cut; the file's fixed costs (open, sync, rename) are left out.
     GlbSequenceWriter writer(glb_path, info, GlbOptions{});
@@ -168,45 +162,32 @@ const TradeRow* cheapestWithin(const std::vector<TradeRow>& rows, double error) 
 }
 
 int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
-    // Step: the scene, its model and frames, and the objects' meshes.
-    Scene scene;
-    if (Status s = loadScene(settings.scene_path, &scene); !s.ok) {
-        err << "error: " << s.message << "\n";
+    // Step: the scene, its model and frames, and the objects' meshes (the stage every command loads).
+    Stage stage;
+    if (std::string error; !loadStage(settings.stage, &stage, err, &error)) {
+        err << "error: " << error << "\n";
         return kExitBadInput;
     }
-    const Model model = settings.has_model ? settings.model : scene.model;
-    if (Status s = checkSceneForModel(scene, model); !s.ok) {
-        err << "error: " << s.message << "\n";
+    if (stage.models.size() != 1) {
+        err << "error: --model: trade measures one model at a time\n";
         return kExitBadInput;
     }
-    const long long total = frameCount(scene.frames);
-    if (total > settings.max_frames) {
-        err << "error: " << scene.path << ": frames: " << total << " frames requested, more than the limit of "
-            << settings.max_frames << " (raise it with --max-frames)\n";
-        return kExitBadInput;
-    }
+    const Model model = stage.models.front();
+    const Scene& scene = stage.scene;
     std::vector<long long> frames;
-    if (settings.frame_from >= 0) {
-        const long long to = settings.frame_to < 0 ? total : settings.frame_to;
-        if (!(settings.frame_from < to && to <= total)) {
-            err << "error: --frames: " << settings.frame_from << ":" << to << " is outside the scene's frames 0:" << total << "\n";
-            return kExitBadInput;
-        }
-        for (long long k = settings.frame_from; k < to; ++k) frames.push_back(k);
+    if (settings.has_frames) {
+        for (long long k = stage.first; k < stage.last_excl; ++k) frames.push_back(k);
     } else {
+        const long long total = stage.last_excl - stage.first;
         const long long n = std::min<long long>(5, total);
-        for (long long i = 0; i < n; ++i) frames.push_back(n == 1 ? 0 : i * (total - 1) / (n - 1));
+        for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
     }
     if (model == Model::Instant || model == Model::Contracted) {
         out << "The " << modelName(model) << " model cuts the histories with a hyperplane: the map from the rest "
             << "mesh is affine, so vertex mode is exact (error 0) and no tolerance or subdivision changes it.\n";
         return kExitOk;
     }
-    std::vector<PreparedObject> objects;
-    if (Status s = prepareObjects(scene, settings.limits, &objects, err, settings.quiet); !s.ok) {
-        err << "error: " << s.message << "\n";
-        return kExitBadInput;
-    }
+    const std::vector<PreparedObject>& objects = stage.objects;
     // The size tolerances are relative to: the largest moving object (objects at rest map affinely
     // and are never refined), or the largest object when none moves.
     double size = 0, size_any = 0;
@@ -227,7 +208,7 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
     std::vector<TradeRow> rows;
     auto run = [&](const std::string& family, double parameter, const std::vector<PreparedObject>& objs, double tolerance) {
         bool too_large = false;
-        TradeRow r = measure(objs, scene, model, frames, tolerance, settings.max_triangles, glb_tmp, &too_large);
+        TradeRow r = measure(stage, objs, model, frames, tolerance, settings.max_triangles, glb_tmp, &too_large);
         r.family = family;
         r.parameter = parameter;
         r.skipped = too_large;

@@ -29,24 +29,18 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/mesh_input.h"
-#include "pipeline/scene.h"
+#include "pipeline/stage.h"
 
 namespace apparent {
 
 struct TradeSettings {
-    std::string scene_path;
+    StageOptions stage;        // scene, --model (one model; default the scene's), --frames, limits
+    bool has_frames = false;   // --frames A:B given; otherwise five frames spread over the scene
     std::string out_dir = "out";
-    bool has_model = false;    // --model, else the scene's
-    Model model = Model::Relativistic;
-    long long frame_from = -1;  // --frames A:B (B exclusive); -1: five frames spread over the scene
-    long long frame_to = -1;
     int levels = 4;                       // uniform subdivision levels 1..levels
     std::vector<double> tolerances_rel;   // empty: 1e-1, 3e-2, ... 1e-4 x size
     long long max_triangles = 4'000'000;  // per frame; larger rows are skipped
     bool quiet = false;
-    long long max_frames = kDefaultMaxFrames;
-    MeshLimits limits;
 };
 
 // One measured row of the table.

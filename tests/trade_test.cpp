@@ -1,0 +1,83 @@
+// `apparent trade` end to end (pipeline/trade.h): the table, trade.csv and the plot files on a
+// shipped trade scene; every tolerance row within its tolerance and the uniform rows' errors
+// falling about fourfold per level (the chord error of a halved edge: second order); bad options
+// refused with one line; the affine models said to need nothing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "run_command.h"
+
+namespace fs = std::filesystem;
+using testcli::apparentRun;
+using testcli::source;
+
+namespace {
+std::vector<std::map<std::string, std::string>> readCsv(const fs::path& path) {
+    std::ifstream f(path);
+    std::string line;
+    std::getline(f, line);
+    std::vector<std::string> names;
+    std::stringstream header(line);
+    for (std::string n; std::getline(header, n, ',');) names.push_back(n);
+    std::vector<std::map<std::string, std::string>> rows;
+    while (std::getline(f, line)) {
+        std::stringstream ss(line);
+        std::map<std::string, std::string> row;
+        for (size_t i = 0; i < names.size(); ++i) std::getline(ss, row[names[i]], ',');
+        rows.push_back(row);
+    }
+    return rows;
+}
+}  // namespace
+
+TEST(Trade, TableCsvAndPlotOnTheBoxScene) {
+    const fs::path dir = fs::temp_directory_path() / ("apparent_trade_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const auto r = apparentRun({"trade", source("data/scenes/trade/box_near.json"), "--out", dir.string(), "--levels",
+                                "3", "--tolerances", "1e-2,1e-3", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("uniform level 3"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("For vertex mode's error"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("For a tenth of it"), std::string::npos) << r.out;
+    const auto rows = readCsv(dir / "trade.csv");
+    ASSERT_EQ(rows.size(), 1u + 3u + 2u);
+    EXPECT_EQ(rows[0].at("family"), "vertex");
+    double previous_uniform = std::stod(rows[0].at("error_ls"));
+    for (const auto& row : rows) {
+        const double error = std::stod(row.at("error_ls")), parameter = std::stod(row.at("parameter"));
+        EXPECT_GT(std::stod(row.at("triangles_per_frame")), 0);
+        EXPECT_GT(std::stod(row.at("glb_bytes_per_frame")), 0);
+        if (row.at("family") == "tolerance") {
+            EXPECT_LE(error, parameter) << "T " << parameter;
+            EXPECT_GE(error, 0.5 * parameter) << "T " << parameter;
+        }
+        if (row.at("family") == "uniform") {
+            EXPECT_NEAR(previous_uniform / error, 4.0, 1.0) << "level " << parameter;
+            previous_uniform = error;
+        }
+    }
+    EXPECT_TRUE(fs::exists(dir / "trade.gp"));
+    EXPECT_TRUE(fs::exists(dir / "trade.dat"));
+    fs::remove_all(dir);
+}
+
+TEST(Trade, AffineModelsAndBadOptions) {
+    const auto inst = apparentRun({"trade", source("data/scenes/trade/plate.json"), "--model", "instant", "--out",
+                                   (fs::temp_directory_path() / "apparent_trade_inst").string()});
+    EXPECT_EQ(inst.code, 0);
+    EXPECT_NE(inst.out.find("vertex mode is exact"), std::string::npos) << inst.out;
+    const auto bad = apparentRun({"trade", source("data/scenes/trade/plate.json"), "--tolerances", "1e-3,x"});
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("--tolerances: 'x'"), std::string::npos) << bad.err;
+    const auto two = apparentRun({"trade", source("data/scenes/trade/plate.json"), "--model", "finite,relativistic"});
+    EXPECT_EQ(two.code, 2);
+    EXPECT_NE(two.err.find("one model at a time"), std::string::npos) << two.err;
+    const auto help = apparentRun({"trade", "--help"});
+    EXPECT_EQ(help.code, 0);
+    EXPECT_NE(help.out.find("--tolerances"), std::string::npos);
+}
