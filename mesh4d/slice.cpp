@@ -308,6 +308,7 @@ struct FrameBuilder {
     std::deque<RTri> r_kids;   // ids >= r_nt (a deque: growing never moves the records)
     std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
     uint32_t r_max_depth = 0;
+    size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
     std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
 
     RTri& tri(uint32_t id) { return id < r_nt ? r_base[id] : r_kids[id - r_nt]; }
@@ -458,6 +459,7 @@ struct FrameBuilder {
             (a == lo ? hi_half : lo_half).push_back(3 * B + 0);
             tri(u).child[0] = A;
             tri(u).child[1] = B;
+            ++r_leaves;  // one piece became two
             if (u < r_nt) ++out.refined_triangles;
             stack.push_back(B);
             stack.push_back(A);
@@ -486,6 +488,11 @@ struct FrameBuilder {
             if (tri(id).depth >= r_max_depth) {
                 r_limited[tri(id).src] = 1;
                 continue;
+            }
+            if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
+                out.over_budget = true;
+                stack.clear();
+                return;
             }
             splitLongestPath(id, stack);
             if (tri(id).child[0] == kUnset) stack.push_back(id);  // a coarser neighbour went first
@@ -685,6 +692,7 @@ struct FrameBuilder {
             r_base.resize(r_nt);  // records made on first touch (ensureBase)
             r_init.assign(r_nt, 0);
             r_limited.assign(r_nt, 0);
+            r_leaves = r_nt;
             std::vector<uint32_t> stack;
             for (uint32_t f : failing) {
                 ensureBase(f);

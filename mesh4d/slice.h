@@ -71,6 +71,7 @@ struct ApparentMesh {
     size_t refined_triangles = 0;         // input triangles split by the tolerance
     size_t limited_triangles = 0;         // input triangles whose refinement reached max_segments first
     size_t culled_triangles = 0;          // input triangles skipped by the 4D-box cull (SliceSettings::cull)
+    bool over_budget = false;             // the refinement stopped at SliceSettings::max_triangles
 
     Vec3 absolutePosition(size_t i) const { return origin + positions[i]; }
     double absoluteTime(size_t i) const { return time_origin + emission_times[i]; }
@@ -85,6 +86,10 @@ struct SliceSettings {
     // ApparentMesh::limited_triangles. The rest clip splits at most to 1/max_segments of a triangle.
     // Values below 2 count as 2.
     int max_segments = 256;
+    // Most output triangles the refinement may make for one object in one frame (0: no limit): a
+    // refinement that would pass it stops splitting and sets ApparentMesh::over_budget, so that a
+    // tolerance far too fine for the scene ends with a message instead of exhausting memory.
+    size_t max_triangles = 0;
     // Skip runs of triangles (World4D::chunks) whose cap events all lie on one side of the view
     // surface: before a real cap a (not yet existing) or after a real cap b (gone), decided from
     // the runs' 4D boxes with a margin above rounding, so a skipped run never holds a visible

@@ -411,3 +411,19 @@ TEST(Refine, RefinedSphereStaysClosedGenusZero) {
         EXPECT_FALSE(tc.closed);
     }
 }
+
+// A budget stops a refinement that would be too large (a tolerance far too fine for the scene):
+// the output stays within it (plus the few pieces clipping adds) and says so.
+TEST(Refine, TriangleBudgetStopsTheRefinement) {
+    const TradeScene sc = sphereMid();
+    const World4D w = extrude(sc.mesh, sc.motion, -100, 100, false, false);
+    SliceSettings s;
+    s.tolerance = 1e-9 * sc.size;
+    s.max_triangles = 5000;
+    const ApparentMesh out = sliceWorld(w, sc.view, s);
+    EXPECT_TRUE(out.over_budget);
+    EXPECT_LE(out.triangles.size(), s.max_triangles);
+    EXPECT_GT(out.triangles.size(), sc.mesh.triangles.size());
+    s.tolerance = 1e-3 * sc.size;
+    EXPECT_FALSE(sliceWorld(w, sc.view, s).over_budget);
+}
