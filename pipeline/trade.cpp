@@ -129,7 +129,7 @@ bool plot(const std::string& dir, const std::vector<TradeRow>& rows, double size
     }
     {
         std::ofstream g(gp);
-        g << "set terminal pngcairo size 900,560 font ',11'\n"
+        g << "set terminal pngcairo size 900,560 font ',11' noenhanced\n"
           << "set output 'trade.png'\n"
           << "set logscale xy\n"
           << "set xlabel 'time per frame, cut and .glb export, one thread (milliseconds)'\n"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The speed-accuracy trade of docs/ACCURACY.md: `apparent trade` on the five trade scenes (the
 # default flanges, data/scenes/trade/*.json), then scripts/accuracy_report.py turns their CSVs into
-# docs/ACCURACY.md (with the adaptive / uniform ratios at equal error) and docs/accuracy.png.
+# docs/ACCURACY.md (with the adaptive / uniform ratios at equal error) and docs/accuracy.png;
+# scripts/trade_end_to_end.py times whole renders at equal error (docs/trade/end_to_end.md).
 # Usage: scripts/accuracy_report.sh [BUILD_DIR]      needs: python3, gnuplot (apt gnuplot-nox)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -14,9 +15,16 @@ cd "$root"
 for scene in data/scenes/flanges.json data/scenes/trade/box_near.json data/scenes/trade/sphere320.json \
              data/scenes/trade/plate.json data/scenes/trade/sphere20480.json; do
   name=$(basename "$scene" .json)
+  mkdir -p "$out/$name"
   echo "== apparent trade $scene"
   "$build/apparent" trade "$scene" --out "$out/$name" --quiet | tee "$out/$name/table.txt"
 done
+echo "== where nothing needs refining: the cut at T = 1e-3 x size against vertex mode (performance_bench)"
+cmake --build "$build" --target performance_bench -j "$(nproc)" >/dev/null
+"$build/benchmarks/performance_bench" --benchmark_filter='BM_Cut(VertexMode|Tolerance)/' --benchmark_min_time=0.3 \
+  --benchmark_format=json > "$out/cheap_path.json"
+echo "== end to end at equal error (apparent render, every frame)"
+python3 "$root/scripts/trade_end_to_end.py" "$build" | tee "$out/end_to_end.md"
 python3 "$root/scripts/accuracy_report.py" "$out" "$root/docs"
 (cd "$root/docs" && gnuplot accuracy.gp)
 echo "wrote docs/ACCURACY.md, docs/accuracy.png and docs/trade/"
