@@ -21,6 +21,15 @@ double normM(const Vec3& u, const Motion& m) {
     const double uv = dot(u, m.velocity);
     return std::sqrt(uv * uv + m.one_minus_beta2 * norm2(u));
 }
+// The corners' shape offsets (into s) and the least |x_i|_M.
+double cornerTerms(const ViewAnchor& anchor, const Motion& m, const Event corner[3], Vec3 s[3]) {
+    double xm_min = INFINITY;
+    for (int i = 0; i < 3; ++i) {
+        s[i] = shapeOfEvent(m, corner[i]);
+        xm_min = std::min(xm_min, normMOfEvent(anchor, m, corner[i]));
+    }
+    return xm_min;
+}
 }  // namespace
 
 ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
@@ -42,12 +51,7 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
     }
     // Shape offsets s = y + v delta, their centroid, the M-radius r_M and |x_i|_M.
     Vec3 s[3];
-    double xm_min = INFINITY;
-    for (int i = 0; i < 3; ++i) {
-        const double delta = -corner[i].t;
-        s[i] = corner[i].x + m.velocity * delta;
-        xm_min = std::min(xm_min, anchor.S + dot(corner[i].x, m.velocity) + delta);
-    }
+    const double xm_min = cornerTerms(anchor, m, corner, s);
     const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
     double rM = 0;
     for (int i = 0; i < 3; ++i) rM = std::max(rM, normM(s[i] - centre, m));
@@ -61,12 +65,7 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
 double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Event corner[3]) {
     if (m.beta == 0) return 0;
     Vec3 s[3];
-    double xm_min = INFINITY;
-    for (int i = 0; i < 3; ++i) {
-        const double delta = -corner[i].t;
-        s[i] = corner[i].x + m.velocity * delta;
-        xm_min = std::min(xm_min, anchor.S + dot(corner[i].x, m.velocity) + delta);
-    }
+    const double xm_min = cornerTerms(anchor, m, corner, s);
     double d2 = 0;  // d_M^2
     for (int i = 0; i < 3; ++i) {
         const Vec3 u = s[(i + 1) % 3] - s[i];
@@ -80,11 +79,9 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
 }
 
 double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid) {
-    const double da = -a.t, db = -b.t;
-    const double c = 4 * std::fabs(-mid.t - 0.5 * (da + db));
-    const Vec3 sa = a.x + m.velocity * da, sb = b.x + m.velocity * db;
-    const double l = normM(sb - sa, m);
-    const double xm = std::min(anchor.S + dot(a.x, m.velocity) + da, anchor.S + dot(b.x, m.velocity) + db) - l;
+    const double c = 4 * std::fabs(-mid.t + 0.5 * (a.t + b.t));
+    const double l = normM(shapeOfEvent(m, b) - shapeOfEvent(m, a), m);
+    const double xm = std::min(normMOfEvent(anchor, m, a), normMOfEvent(anchor, m, b)) - l;
     // m is floored at l: finite near the camera, where halving an edge must still shorten it
     // (longest-edge bisection ends only if the halves and medians are shorter than their edge).
     const double mf = std::max(xm, l);

@@ -52,6 +52,13 @@
 
 namespace mesh4d {
 
+// Per point, from its exact local event e (t = -delta, x = y): the shape offset s = y + v delta,
+// and |x|_M = S + y.v + delta (see above).
+inline Vec3 shapeOfEvent(const Motion& m, const Event& e) { return e.x - m.velocity * e.t; }
+inline double normMOfEvent(const ViewAnchor& anchor, const Motion& m, const Event& e) {
+    return anchor.S + dot(e.x, m.velocity) - e.t;
+}
+
 // The largest value over the triangle (l0, l1, l2 >= 0, sum 1) of
 //     c01 l0 l1 + c12 l1 l2 + c20 l2 l0,   every c >= 0:
 // on an edge c/4 at its middle; inside, where the gradient is parallel to (1, 1, 1), at

@@ -621,9 +621,9 @@ struct FrameBuilder {
         std::vector<Vec3> shape(r_nv);  // y + v delta
         std::vector<double> xm(r_nv);   // |x|_M
         for (size_t i = 0; i < r_nv; ++i) {
-            const double delta = -r_time[i];
-            shape[i] = r_pos[i] + world.motion.velocity * delta;
-            xm[i] = anchor.S + dot(r_pos[i], world.motion.velocity) + delta;
+            const Event e{r_time[i], r_pos[i]};
+            shape[i] = shapeOfEvent(world.motion, e);
+            xm[i] = normMOfEvent(anchor, world.motion, e);
         }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
