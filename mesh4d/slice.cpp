@@ -628,6 +628,7 @@ struct FrameBuilder {
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             const auto& t = world.mesh.triangles[f];
+            if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
             const Side s0 = side[t[0]];
             if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;

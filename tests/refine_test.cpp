@@ -427,3 +427,20 @@ TEST(Refine, TriangleBudgetStopsTheRefinement) {
     s.tolerance = 1e-3 * sc.size;
     EXPECT_FALSE(sliceWorld(w, sc.view, s).over_budget);
 }
+
+// A triangle that repeats a vertex (no area) is never split: the refined sphere with one added is
+// the same closed surface, with the same triangles, as without it.
+TEST(Refine, TriangleWithoutAreaIsLeftAlone) {
+    const TradeScene sc = sphereMid();
+    RestMesh with = sc.mesh;
+    const auto t0 = with.triangles[0];
+    with.triangles.push_back({t0[0], t0[1], t0[0]});
+    SliceSettings s;
+    s.tolerance = 1e-4 * sc.size;
+    const ApparentMesh a = testmesh::sliceAbsolute(extrude(sc.mesh, sc.motion, -100, 100, false, false), sc.view, s);
+    const ApparentMesh b = testmesh::sliceAbsolute(extrude(with, sc.motion, -100, 100, false, false), sc.view, s);
+    EXPECT_EQ(a.triangles.size(), b.triangles.size());
+    const apparent::Topology t = apparent::analyzeTopology(b.positions, b.triangles);
+    EXPECT_TRUE(t.closed);
+    EXPECT_EQ(t.genus, 0);
+}
