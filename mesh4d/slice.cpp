@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -305,7 +304,7 @@ struct FrameBuilder {
     };
     std::vector<RTri> r_base;  // ids < r_nt, valid where r_init is set
     std::vector<uint8_t> r_init;
-    std::deque<RTri> r_kids;   // ids >= r_nt (a deque: growing never moves the records)
+    std::vector<RTri> r_kids;  // ids >= r_nt
     std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
     uint32_t r_max_depth = 0;
     size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
