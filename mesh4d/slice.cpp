@@ -134,17 +134,25 @@ struct FrameBuilder {
             const Event& p0 = world.events[2 * e.lo + cap];
             const Event& p1 = world.events[2 * e.hi + cap];
             const double s = cutSegment(view, p0, p1);
-            // The cap passes exactly through a visible end (a frame at the instant the object
-            // begins or ends): the clip point is that vertex, not a copy of it.
-            if (s == 0 && side[e.lo] == Side::Inside) return slot = vertexPoint(e.lo);
-            if (s == 1 && side[e.hi] == Side::Inside) return slot = vertexPoint(e.hi);
-            const Vec3 rest = world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s;
-            // The crossing event lies on the worldline of `rest` (a worldline meets the view surface
-            // once), so its image is the anchored cut of that rest point: relative accuracy however
-            // far the object is; only the parameter s carries the absolute events' rounding.
-            slot = emit(cutRestLocal(anchor, world.motion, rest), rest);
+            slot = crossingAt(
+                s, side[e.lo], side[e.hi], [&](int end) { return vertexPoint(end == 0 ? e.lo : e.hi); },
+                [&] { return world.mesh.positions[e.lo] * (1 - s) + world.mesh.positions[e.hi] * s; });
         }
         return slot;
+    }
+
+    // The output point of a cap crossing at parameter s along a segment whose ends lie on sides
+    // s0 and s1. The cap passing exactly through a visible end (a frame at the instant the object
+    // begins or ends) gives that end itself (end(0) or end(1)), not a copy of it. Otherwise the
+    // crossing event lies on the worldline of the rest point at s (a worldline meets the view
+    // surface once), so its image is the anchored cut of that point, rest(): relative accuracy
+    // however far the object is; only the parameter s carries the absolute events' rounding.
+    template <class End, class Rest>
+    uint32_t crossingAt(double s, Side s0, Side s1, End end, Rest rest) {
+        if (s == 0 && s0 == Side::Inside) return end(0);
+        if (s == 1 && s1 == Side::Inside) return end(1);
+        const Vec3 q = rest();
+        return emit(cutRestLocal(anchor, world.motion, q), q);
     }
 
     // The exact image of vertex i (local coordinates), without emitting it.
@@ -575,10 +583,9 @@ struct FrameBuilder {
         auto [it, inserted] = r_crossings[cap].try_emplace((uint64_t(lo) << 32) | hi, kUnset);
         if (!inserted) return it->second;
         const double s = cutSegment(view, capOfId(lo, cap), capOfId(hi, cap));
-        if (s == 0 && side[lo] == Side::Inside) return it->second = outId(lo);
-        if (s == 1 && side[hi] == Side::Inside) return it->second = outId(hi);
-        const Vec3 rest = restOfId(lo) * (1 - s) + restOfId(hi) * s;
-        const uint32_t id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+        const uint32_t id = crossingAt(
+            s, side[lo], side[hi], [&](int end) { return outId(end == 0 ? lo : hi); },
+            [&] { return restOfId(lo) * (1 - s) + restOfId(hi) * s; });
         return it->second = id;
     }
 
@@ -980,13 +987,14 @@ struct FrameBuilder {
         barycentrics(from, l0);
         barycentrics(to, l1);
         const double s = cutSegment(view, capAt(v, l0, cap), capAt(v, l1, cap));
-        // The cap passes exactly through a visible end: the crossing is that point (as crossingPoint).
-        if (s == 0 && sfrom == Side::Inside) return *id = restPoint(v, from, points);
-        if (s == 1 && sto == Side::Inside) return *id = restPoint(v, to, points);
-        double lm[3];
-        for (int c = 0; c < 3; ++c) lm[c] = l0[c] * (1 - s) + l1[c] * s;
-        const Vec3 rest = restAt(v, lm);
-        return *id = emit(cutRestLocal(anchor, world.motion, rest), rest);
+        const uint32_t out_id = crossingAt(
+            s, sfrom, sto, [&](int end) { return restPoint(v, end == 0 ? from : to, points); },
+            [&] {
+                double lm[3];
+                for (int c = 0; c < 3; ++c) lm[c] = l0[c] * (1 - s) + l1[c] * s;
+                return restAt(v, lm);
+            });
+        return *id = out_id;
     }
 
     // One leaf polygon (convex, possibly with straight runs of corners) clipped to the span and
