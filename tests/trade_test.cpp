@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -63,6 +64,12 @@ TEST(Trade, TableCsvAndPlotOnTheBoxScene) {
     }
     EXPECT_TRUE(fs::exists(dir / "trade.gp"));
     EXPECT_TRUE(fs::exists(dir / "trade.dat"));
+    if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {  // scripts/setup.sh installs it
+        std::ifstream png(dir / "trade.png", std::ios::binary);
+        char magic[8] = {};
+        png.read(magic, 8);
+        EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "trade.png is not a PNG";
+    }
     fs::remove_all(dir);
 }
 
