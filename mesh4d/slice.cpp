@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 #include <unordered_map>
 
@@ -308,9 +309,11 @@ struct FrameBuilder {
         uint32_t child[2];
         uint32_t src;      // the mesh triangle it lies on
         uint32_t depth;    // bisections since the mesh triangle
-        int longest = -1;  // the slot of its longest edge, once known
+        int longest;       // the slot of its longest edge once known, else -1
     };
-    std::vector<RTri> r_base;  // ids < r_nt, valid where r_init is set
+    // ids < r_nt, valid where r_init is set. Left uninitialised (RTri is trivial): a large mesh of
+    // which few triangles need refining touches only their pages.
+    std::unique_ptr<RTri[]> r_base;
     std::vector<uint8_t> r_init;
     std::vector<RTri> r_kids;  // ids >= r_nt
     std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
@@ -696,7 +699,7 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_base.resize(r_nt);  // records made on first touch (ensureBase)
+            r_base.reset(new RTri[r_nt]);  // records made on first touch (ensureBase)
             r_init.assign(r_nt, 0);
             r_limited.assign(r_nt, 0);
             r_leaves = r_nt;
