@@ -52,9 +52,8 @@ TradeRow measure(const Stage& stage, const std::vector<PreparedObject>& objects,
     std::vector<mesh4d::World4D> worlds;
     worlds.reserve(objects.size());
     for (const auto& o : objects) worlds.push_back(buildWorld(o, model, scene, first, last));
-    mesh4d::SliceSettings settings;
+    mesh4d::SliceSettings settings;  // as `apparent render` cuts (frame_loop.cpp)
     settings.tolerance = tolerance;
-    settings.max_segments = 4096;
     std::vector<ExportFrame> exported;
     double seconds = 0, triangles = 0;
     *too_large = false;
