@@ -627,6 +627,7 @@ struct FrameBuilder {
         // Step: the corners' bound (no midpoint needed) passes most triangles that need no
         // refinement; the others get the full bound, from their edges' midpoints cut in batches.
         std::vector<uint32_t> candidates, failing;
+        double expected_pieces = 0;
         std::vector<Vec3> shape(r_nv);  // y + v delta
         std::vector<double> xm(r_nv);   // |x|_M
         for (size_t i = 0; i < r_nv; ++i) {
@@ -682,7 +683,12 @@ struct FrameBuilder {
                     corner[c] = {r_time[v], r_pos[v]};
                     mid[c] = {e_time[e], e_pos[e]};
                 }
-                if (chordError(anchor, world.motion, corner, mid, settings.tolerance).bound > settings.tolerance) failing.push_back(f);
+                const double bound = chordError(anchor, world.motion, corner, mid, settings.tolerance).bound;
+                if (bound > settings.tolerance) {
+                    failing.push_back(f);
+                    // About bound / T pieces once halved down to T (the error falls about as the area).
+                    expected_pieces += std::min(bound / settings.tolerance, 1e6);
+                }
             }
         }
         // Nothing to refine on a simple mesh that exists throughout: vertex mode's output.
@@ -700,6 +706,18 @@ struct FrameBuilder {
         // Step: split until every piece passes.
         if (!failing.empty()) {
             r_base.reset(new RTri[r_nt]);  // records made on first touch (ensureBase)
+            // Room for the pieces and points the refinement is expected to make (growth would copy them).
+            // At most a million: reserving is only a saving, never a bound (max_triangles is).
+            size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
+            if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
+            r_kids.reserve(2 * expect);
+            for (auto* v : {&r_pos, &r_rest}) v->reserve(v->size() + expect);
+            r_time.reserve(r_time.size() + expect);
+            out.positions.reserve(out.positions.size() + expect);
+            out.emission_times.reserve(out.emission_times.size() + expect);
+            out.rest_points.reserve(out.rest_points.size() + expect);
+            out.triangles.reserve(out.triangles.size() + expect);
+            out.source_triangles.reserve(out.source_triangles.size() + expect);
             r_init.assign(r_nt, 0);
             r_limited.assign(r_nt, 0);
             r_leaves = r_nt;
