@@ -428,10 +428,6 @@ struct FrameBuilder {
         setNext(p, to);
     }
 
-    uint32_t newTri() {
-        r_kids.push_back(RTri{});
-        return r_nt + uint32_t(r_kids.size() - 1);
-    }
 
     // Halves the edge of slot c of triangle id at its midpoint, in every triangle around the edge:
     // each becomes (a, m, o) and (m, b, o). The halves' new slots on the edge form two new cycles.
@@ -456,13 +452,11 @@ struct FrameBuilder {
             ensureBase(u);
             const RTri old = tri(u);
             const uint32_t a = old.v[cu], b = old.v[(cu + 1) % 3], o = old.v[(cu + 2) % 3];
-            const uint32_t A = newTri(), B = newTri();
-            RTri& ta = tri(A);
-            ta = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
-                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1};
-            RTri& tb = tri(B);
-            tb = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {kUnset, kUnset, kUnset}, {kUnset, kUnset, kUnset},
-                      {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1};
+            const uint32_t A = r_nt + uint32_t(r_kids.size()), B = A + 1;
+            r_kids.push_back(RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {kUnset, kUnset, kUnset},
+                                  {kUnset, kUnset, kUnset}, {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1});
+            r_kids.push_back(RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {kUnset, kUnset, kUnset},
+                                  {kUnset, kUnset, kUnset}, {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1});
             moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2, old);
             moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1, old);
             (a == lo ? lo_half : hi_half).push_back(3 * A + 0);
