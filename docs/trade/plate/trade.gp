@@ -1,4 +1,4 @@
-set terminal pngcairo size 900,560 font ',11'
+set terminal pngcairo size 900,560 font ',11' noenhanced
 set output 'trade.png'
 set logscale xy
 set xlabel 'time per frame, cut and .glb export, one thread (milliseconds)'
