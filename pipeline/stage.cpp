@@ -2,11 +2,13 @@
 
 #include <ostream>
 
+#include "pipeline/json_limits.h"
+
 namespace apparent {
 
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error) {
     auto fail = [&](const std::string& message) {
-        *error = message;
+        *error = printable(message, 4096);  // one line, whatever a file or key holds
         return false;
     };
     // Step: the scene, the tolerance override and the models it must be valid for.
