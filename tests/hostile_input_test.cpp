@@ -10,12 +10,14 @@
 #include <sstream>
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "exporters/atomic_file.h"
 #include "exporters/ply.h"
 #include "pipeline/cli.h"
 #include "run_command.h"
+#include "pipeline/json_limits.h"
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
 #include "pipeline/scene.h"
@@ -211,4 +213,178 @@ TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
     EXPECT_NE(error.find("frame_00000.ply: cannot write (4096 of "), std::string::npos) << error;
     EXPECT_EQ(slurp(path), previous);
     EXPECT_EQ(filesUnder(box / "out").size(), 1u);
+}
+
+namespace {
+
+// A one-object scene in `dir` whose mesh is `mesh` (relative to the scene).
+std::string writeScene(const fs::path& dir, const std::string& mesh, const std::string& extra_object_fields = "") {
+    const fs::path scene = dir / ("scene_" + std::to_string(std::hash<std::string>{}(mesh + extra_object_fields)) + ".json");
+    std::ofstream(scene) << R"({ "frames": { "start": 10, "end": 10.2, "fps": 10 }, "objects": [ { "name": "t", "mesh": ")"
+                         << mesh << R"(", "position": [0, 0, -10])" << extra_object_fields << " } ] }";
+    return scene.string();
+}
+
+size_t lineCount(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
+
+// A minimal glTF (one triangle, buffer inlined) whose `extras` text is given.
+std::string gltfWithExtras(const std::string& extras) {
+    // Three float32 VEC3 positions: (0,0,0), (1,0,0), (0,1,0), base64 of 36 bytes.
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0],"extras":)" + extras +
+           R"(}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+           R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+           R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+}
+
+}  // namespace
+
+// Issue 15, item 1: an OBJ's material library is never opened (nothing uses materials), wherever
+// it points; a FIFO or a device given as any input is refused before it is read (no hang).
+TEST(HostileInput, MaterialLibrariesAreNeverReadAndOnlyRegularFilesAre) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    ::mkfifo((box / "s/pipe.mtl").c_str(), 0600);  // opening it for reading would block forever
+    std::ofstream(box / "s/m.obj") << "mtllib ../../../../../../../../dev/zero\nmtllib pipe.mtl\nmtllib /etc/passwd\n"
+                                   << slurp(source("data/fixtures/tetra.obj"));
+    const std::string scene = writeScene(box / "s", "m.obj");
+    fs::current_path(box / "s");
+    CommandResult r = apparentRun({"render", scene, "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("m.obj: 3 mtllib lines ignored (material libraries are not read)"), std::string::npos) << r.err;
+
+    // Non-regular inputs: a FIFO mesh, a device mesh (outside allowed), a FIFO scene, a folder.
+    ::mkfifo((box / "s/f.obj").c_str(), 0600);
+    ::mkfifo((box / "s/f.json").c_str(), 0600);
+    fs::create_directories(box / "s/d.ply");
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", writeScene(box / "s", "f.obj")}, "f.obj: is a FIFO, not a regular file (refused)"},
+        {{"render", writeScene(box / "s", "/dev/zero.obj"), "--allow-outside"}, "cannot open"},
+        {{"render", writeScene(box / "s", "d.ply")}, "d.ply: is a folder, not a regular file (refused)"},
+        {{"render", (box / "s/f.json").string()}, "f.json: is a FIFO, not a regular file (refused)"},
+    };
+    for (const auto& [args, expected] : cases) {
+        std::vector<std::string> a = args;
+        a.insert(a.end(), {"--out", (box / "out2").string()});
+        r = apparentRun(a);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    // A device reached through a symlink is refused as what it resolves to.
+    fs::create_symlink("/dev/zero", box / "s/z.obj");
+    r = apparentRun({"render", writeScene(box / "s", "z.obj"), "--out", (box / "out2").string(), "--allow-outside"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("z.obj: is a character device, not a regular file (refused)"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out2"));
+}
+
+// Issue 15, item 2: nesting deeper than kMaxJsonDepth is refused before any recursive parse or
+// dump (a 100 000-deep array crashed json::dump in the error message; deep glTF extras crashed
+// tinygltf), as a scene, as a glTF mesh and as a glTF scene; keys print escaped on one line.
+TEST(HostileInput, DeepNestingAndControlCharactersGiveOneLine) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    const size_t deep = 100000;
+    const std::string nested = std::string(deep, '[') + std::string(deep, ']');
+    std::ofstream(box / "s/deep.json") << R"({ "frames": { "start": 10, "end": 10.2, "fps": 10 }, "objects": [ { "mesh": "tetra.obj", "position": )"
+                                       << nested << " } ] }";
+    const std::string deep_extras = "{\"a\":" + std::string(deep, '[') + std::string(deep, ']') + "}";
+    std::ofstream(box / "s/deep.gltf") << gltfWithExtras(deep_extras);
+    std::ofstream(box / "s/ok.gltf") << gltfWithExtras("{\"frames\":{\"start\":0,\"end\":0.2,\"fps\":10}}");
+    fs::current_path(box / "s");
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", (box / "s/deep.json").string()}, "deep.json: JSON nested deeper than 128 levels at byte "},
+        {{"render", writeScene(box / "s", "deep.gltf")}, "deep.gltf: JSON nested deeper than 128 levels at byte "},
+        {{"render", (box / "s/deep.gltf").string()}, "deep.gltf: JSON nested deeper than 128 levels at byte "},
+    };
+    for (const auto& [args, expected] : cases) {
+        std::vector<std::string> a = args;
+        a.insert(a.end(), {"--out", (box / "out").string()});
+        const CommandResult r = apparentRun(a);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    // The depth bound is what decides: 128 levels pass the check, 129 do not.
+    EXPECT_TRUE(checkJsonDepth("x", std::string(128, '[') + std::string(128, ']')).ok);
+    EXPECT_FALSE(checkJsonDepth("x", std::string(129, '{') + std::string(129, '}')).ok);
+    EXPECT_TRUE(checkJsonDepth("x", "[\"" + std::string(500, '[') + "\"]").ok);         // brackets in a string
+    EXPECT_TRUE(checkJsonDepth("x", "[\"\\\"" + std::string(500, '[') + "\"]").ok);     // after an escaped quote
+    EXPECT_TRUE(checkJsonDepth("x", "[ // " + std::string(500, '[') + "\n]", true).ok);  // in a comment
+
+    // A key with newlines that imitate a success line, and a value with a control character:
+    // printed escaped, one line.
+    std::ofstream(box / "s/key.json")
+        << "{ \"frames\": { \"start\": 10, \"end\": 10.2, \"fps\": 10 }, \"objects\": [ { \"mesh\": \"tetra.obj\", "
+           "\"position\": [0,0,-10], \"pos\\nrelativistic: 2 frames written\": 1 } ] }";
+    CommandResult r = apparentRun({"render", (box / "s/key.json").string(), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("objects[0].pos\\nrelativistic: 2 frames written: unknown field"), std::string::npos) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    std::ofstream(box / "s/value.json")
+        << "{ \"frames\": { \"start\": 10, \"end\": 10.2, \"fps\": 10 }, \"objects\": [ { \"mesh\": \"tetra.obj\", "
+           "\"position\": \"a\\u0007\\nb" << std::string(5000, 'x') << "\" } ] }";
+    r = apparentRun({"render", (box / "s/value.json").string(), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("objects[0].position: expected an array of 3 numbers, got string \"a\\u0007\\nb"), std::string::npos) << r.err;
+    EXPECT_LT(r.err.size(), 300u) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out"));
+    EXPECT_EQ(printable("a\xff\n\x1b", 100), "a\\xFF\\n\\u001B");
+}
+
+// Issue 15, item 5: temporaries are created exclusively under unguessable names: a symlink
+// planted at the old predictable name (".NAME.tmp-PID.EXT") or anywhere else is never written
+// through, the final name never becomes a link, and the .glb's spill file has no name at all.
+TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
+    Sandbox box;
+    fs::create_directories(box / "out/relativistic");
+    std::ofstream(box / "victim.txt") << "precious";
+    const std::string pid = std::to_string(::getpid());
+    for (const std::string name : {".relativistic.tmp-" + pid + ".glb", ".relativistic.glb.tmp-" + pid + ".bin",
+                                   "relativistic/.frame_00000.tmp-" + pid + ".ply",
+                                   "relativistic/.frame_00000.tmp-" + pid + ".obj"})
+        fs::create_symlink(box / "victim.txt", box / "out" / name);
+    const CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out",
+                                         (box / "out").string(), "--format", "glb,ply,obj", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(slurp(box / "victim.txt"), "precious");
+    EXPECT_FALSE(fs::is_symlink(box / "out/relativistic.glb"));
+    EXPECT_TRUE(fs::is_regular_file(box / "out/relativistic.glb"));
+    // Only the planted links and the outputs: no temporary file, no spill file left.
+    for (const auto& e : fs::recursive_directory_iterator(box / "out")) {
+        const std::string name = e.path().filename().string();
+        if (fs::is_symlink(e.path())) continue;
+        EXPECT_EQ(name.find(".tmp-"), std::string::npos) << e.path();
+    }
+
+    // The rename checks that the temporary name is still the file created: a symlink swapped in
+    // while writing is not renamed into place.
+    {
+        AtomicOutput out((box / "out/swap.ply").string());
+        ASSERT_GE(out.fd(), 0) << out.openError();
+        EXPECT_NE(out.tempPath().find("/.swap.tmp-" + pid + "-"), std::string::npos) << out.tempPath();
+        fs::remove(out.tempPath());
+        fs::create_symlink(box / "victim.txt", out.tempPath());
+        std::string error;
+        EXPECT_FALSE(out.commitBytes("overwritten", &error));
+        EXPECT_NE(error.find("was replaced while writing (not renamed into place)"), std::string::npos) << error;
+        fs::remove(out.tempPath());
+    }
+    EXPECT_FALSE(fs::exists(box / "out/swap.ply"));
+    EXPECT_EQ(slurp(box / "victim.txt"), "precious");
+    // Two outputs to one final name get two temporary names.
+    AtomicOutput a((box / "out/x.png").string()), b((box / "out/x.png").string());
+    EXPECT_NE(a.tempPath(), b.tempPath());
+    // The spill file: open, writable, and without a name in its folder.
+    std::string error;
+    const int fd = openAnonymousFile((box / "out").string(), &error);
+    ASSERT_GE(fd, 0) << error;
+    EXPECT_EQ(::write(fd, "abc", 3), 3);
+    struct stat st {};
+    ASSERT_EQ(::fstat(fd, &st), 0);
+    EXPECT_EQ(st.st_nlink, 0u);
+    ::close(fd);
 }
