@@ -54,8 +54,17 @@ struct Confinement {
 bool insideRoot(const Confinement& c, const std::string& filepath) { return resolvesInside(filepath, c.root.string()); }
 
 bool confinedExists(const std::string& abs_filename, void* user) {
-    // tinygltf also probes candidates outside the folder (such as "./name"): those just do not exist.
-    if (!insideRoot(*static_cast<Confinement*>(user), abs_filename)) return false;
+    auto* c = static_cast<Confinement*>(user);
+    // tinygltf also probes candidates outside the folder (such as "./name"): those just do not
+    // exist. A name inside the folder that resolves out of it (a symlink) is a violation.
+    if (!insideRoot(*c, abs_filename)) {
+        const fs::path lexical = fs::absolute(fs::path(abs_filename)).lexically_normal();
+        std::error_code ec;
+        if (c->violation.empty() && fs::exists(lexical, ec) &&
+            lexical.string().rfind(c->root.string() + "/", 0) == 0)
+            c->violation = abs_filename;
+        return false;
+    }
     std::error_code ec;
     return fs::is_regular_file(abs_filename, ec);
 }

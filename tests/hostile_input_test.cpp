@@ -388,3 +388,43 @@ TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
     EXPECT_EQ(st.st_nlink, 0u);
     ::close(fd);
 }
+
+// Issue 15, item 6: confinement is decided on resolved paths everywhere a file is opened: a
+// buffer named inside the glTF's folder that is a symlink to a file outside is refused, by the
+// Draco pre-check (which read it and printed its size) and by tinygltf's file callbacks alike.
+TEST(HostileInput, SymlinkedBuffersOutsideTheGltfFolderAreRefused) {
+    Sandbox box;
+    fs::create_directories(box / "g");
+    fs::create_directories(box / "secret");
+    std::ofstream(box / "secret/data.bin") << std::string(1234, 's');
+    fs::create_symlink(box / "secret/data.bin", box / "g/buf.bin");
+    const std::string draco =
+        R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],)"
+        R"("scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},)"
+        R"("extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],)"
+        R"("accessors":[{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":1234}],"buffers":[{"byteLength":1234,"uri":"buf.bin"}]})";
+    const std::string plain =
+        R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":1234,"uri":"buf.bin"}]})";
+    std::ofstream(box / "g/draco.gltf") << draco;
+    std::ofstream(box / "g/plain.gltf") << plain;
+    for (const char* name : {"draco.gltf", "plain.gltf"}) {
+        LoadedMesh mesh;
+        MeshWarnings w;
+        const Status st = readMesh((box / "g" / name).string(), {}, &mesh, &w);
+        EXPECT_FALSE(st.ok) << name;
+        EXPECT_NE(st.message.find("is outside the glTF file's folder (refused)"), std::string::npos) << st.message;
+        EXPECT_EQ(st.message.find("1234"), std::string::npos) << st.message;
+        EXPECT_EQ(st.message.find('\n'), std::string::npos) << st.message;
+    }
+    // The same buffer as a regular file inside the folder is read (and, short, refused for that).
+    fs::remove(box / "g/buf.bin");
+    fs::copy_file(box / "secret/data.bin", box / "g/buf.bin");
+    LoadedMesh mesh;
+    MeshWarnings w;
+    const Status st = readMesh((box / "g/plain.gltf").string(), {}, &mesh, &w);
+    EXPECT_EQ(st.message.find("outside"), std::string::npos) << st.message;
+}
