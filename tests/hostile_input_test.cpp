@@ -4,13 +4,16 @@
 // disk) leaving the previous file untouched and no temporary file behind.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <csignal>
+#include <iostream>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "exporters/atomic_file.h"
@@ -427,4 +430,152 @@ TEST(HostileInput, SymlinkedBuffersOutsideTheGltfFolderAreRefused) {
     MeshWarnings w;
     const Status st = readMesh((box / "g/plain.gltf").string(), {}, &mesh, &w);
     EXPECT_EQ(st.message.find("outside"), std::string::npos) << st.message;
+}
+
+namespace {
+
+// Runs `apparent ARGS` in a child process: its exit code, stderr, peak RSS (getrusage of the
+// child, bytes) and wall time, so that a refused input is shown to stay small and quick.
+struct Measured {
+    int code = -1;
+    std::string err;
+    long long peak_rss = 0;
+    double seconds = 0;
+};
+
+Measured runMeasured(const std::vector<std::string>& args) {
+    int pipe_fd[2];
+    EXPECT_EQ(::pipe(pipe_fd), 0);
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::close(pipe_fd[0]);
+        const CommandResult r = apparentRun(args);
+        const ssize_t ignored = ::write(pipe_fd[1], r.err.data(), r.err.size());
+        (void)ignored;
+        ::_exit(r.code);
+    }
+    ::close(pipe_fd[1]);
+    Measured m;
+    char buf[4096];
+    for (ssize_t n; (n = ::read(pipe_fd[0], buf, sizeof buf)) > 0;) m.err.append(buf, size_t(n));
+    ::close(pipe_fd[0]);
+    int status = 0;
+    rusage usage{};
+    ::wait4(pid, &status, 0, &usage);
+    m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    m.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    m.peak_rss = (long long)usage.ru_maxrss * 1024;
+    return m;
+}
+
+void expectRefusedSmall(const Measured& m, int code, const std::string& expected) {
+    EXPECT_EQ(m.code, code) << m.err;
+    EXPECT_NE(m.err.find(expected), std::string::npos) << m.err;
+    EXPECT_EQ(lineCount(m.err), 1u) << m.err;
+    EXPECT_LT(m.peak_rss, 500LL << 20) << expected;
+    EXPECT_LT(m.seconds, 30.0) << expected;
+    std::cout << "  refused in " << m.seconds << " s, peak RSS " << (m.peak_rss >> 20) << " MB: " << m.err;
+}
+
+std::string base64Zeros(size_t bytes) { return std::string(bytes / 3 * 4, 'A'); }  // bytes: a multiple of 3
+
+}  // namespace
+
+// Issue 15, item 3: small inputs that would exhaust memory are refused before the work, each
+// with one line naming the file, the field and the limit, within 500 MB of peak RSS.
+TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    fs::current_path(box / "s");
+    const std::string out = (box / "out").string();
+
+    // A DAG of nodes, each listing the next twice: 2^19 instances of a 100-triangle mesh (52M
+    // triangles) from a file of a few KB; counted on the accessors before anything is read.
+    {
+        std::string nodes;
+        const int levels = 19;
+        for (int i = 0; i < levels; ++i)
+            nodes += (i ? "," : "") + std::string("{\"mesh\":0,\"children\":[") + std::to_string(i + 1) + "," +
+                     std::to_string(i + 1) + "]}";
+        nodes += ",{\"mesh\":0}";
+        std::ofstream(box / "s/dag.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[)" << nodes
+            << R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":300,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
+               R"("bufferViews":[{"buffer":0,"byteLength":3600}],"buffers":[{"byteLength":3600,"uri":"data:application/octet-stream;base64,)"
+            << base64Zeros(3600) << "\"}]}";
+        EXPECT_LT(fs::file_size(box / "s/dag.gltf"), 10000u);
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "dag.gltf"), "--out", out}), 2,
+                           "dag.gltf: nodes: 166667 mesh instances hold more than 50000000 vertices after node expansion "
+                           "(raise with --max-vertices)");
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "dag.gltf"), "--out", out, "--max-vertices", "200000000"}),
+                           2, "dag.gltf: nodes: 500001 mesh instances hold more than 50000000 triangles after node expansion "
+                              "(raise with --max-faces)");
+    }
+    // 50M elements declared without a bufferView in a few hundred bytes: refused before allocating.
+    {
+        std::ofstream(box / "s/declared.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}]})";
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "declared.gltf"), "--out", out}), 2,
+                           "declared.gltf: accessors[0].count: 49999998 elements without a bufferView, more than the 0 "
+                           "bytes of the file's buffers (refused)");
+    }
+    // A tolerance below the floor (1e-6 of the object's size) is refused up front.
+    expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj"), "--out", out, "--tolerance", "1e-300"}), 2,
+                       "tolerance (or --tolerance): 1e-300 light-seconds is below the floor of 3.4641016151377543e-06");
+    // The per-frame triangle budget: a fine tolerance within the floor stops at --max-triangles.
+    expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj", R"(, "velocity": [0.9, 0, 0])"), "--out",
+                                    out, "--tolerance", "1e-5", "--max-triangles", "2000"}),
+                       2, "makes more than 2000 triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles");
+    // 10 000 objects x 200 frames: refused before any mesh is cut.
+    {
+        std::ofstream scene(box / "s/many.json");
+        scene << R"({ "frames": { "start": 0, "end": 20, "fps": 10 }, "objects": [)";
+        for (int i = 0; i < 10000; ++i) scene << (i ? "," : "") << R"({ "mesh": "tetra.obj", "position": [0, 0, -10] })";
+        scene << "] }";
+    }
+    expectRefusedSmall(runMeasured({"render", (box / "s/many.json").string(), "--out", out}), 2,
+                       "many.json: objects: 10000 objects x 1 (themselves and 0 mirrors' reflections) x 200 frames exceed "
+                       "the limit of 1000000 object-frames (raise it with --max-object-frames)");
+    EXPECT_TRUE(filesUnder(out).empty());
+}
+
+// Issue 15, item 7: derived quantities are checked, not only the inputs: a scale or rotation
+// that sends vertices beyond range, a glTF node scale that overflows, a look-back beyond range.
+TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    fs::current_path(box / "s");
+    std::ofstream(box / "s/scaled.gltf") << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+                                            R"("nodes":[{"mesh":0,"scale":[3e38,3e38,3e38],"children":[1]},{"mesh":0,"scale":[3e38,3e38,3e38]}],)"
+                                            R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+                                            R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+                                            R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                                            R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {R"(, "scale": 1e300)", "objects[0]: vertex 0 after scale, rotation_deg and position is not finite or beyond 1000000000000"},
+        {R"(, "scale": [1e308, 1e308, 1e308])", "after scale, rotation_deg and position is not finite or beyond"},
+        {R"(, "rotation_deg": [1e300, 0, 0])", "objects[0].rotation_deg: beyond 1e9 degrees (no precision left)"},
+    };
+    for (const auto& [fields, expected] : cases) {
+        const CommandResult r = apparentRun({"render", writeScene(box / "s", "tetra.obj", fields), "--out", (box / "out").string()});
+        EXPECT_EQ(r.code, 2) << fields << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    CommandResult r = apparentRun({"render", writeScene(box / "s", "scaled.gltf"), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("is not finite or beyond"), std::string::npos) << r.err;
+    std::ofstream(box / "s/delay.json") << R"({ "camera": { "instant_delay": 1e308 }, "model": "instant", "frames": { "start": 10, "end": 10.2, "fps": 10 },
+        "objects": [ { "mesh": "tetra.obj", "position": [0, 0, -10] } ] })";
+    r = apparentRun({"render", (box / "s/delay.json").string(), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("delay.json: frames, camera.instant_delay: the viewed time of frame 0 is not finite or beyond"),
+              std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out"));
 }
