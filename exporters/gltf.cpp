@@ -544,7 +544,7 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     return true;
 }
 
-bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
+bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameSink::OutputCheck& check) {
     Impl& m = *impl_;
     if (m.model.frames == 0) {
         *error = m.path + ": no frames to write";
@@ -566,6 +566,9 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
                  " bytes, more than a .glb can hold (4 GiB); render fewer frames at once (--frames) or add --draco";
         return false;
     }
+
+    // The whole file against the output limit before any of it is written.
+    if (check && !check((long long)total, m.path, error)) return false;
 
     // Step: header, JSON chunk, BIN chunk copied from the spill file; through a temporary name,
     // every write checked and synced before the rename.
@@ -657,7 +660,7 @@ bool GlbSink::add(const ExportFrame& frame, const PreparedFrame* prepared, std::
 
 bool GlbSink::finish(SinkSummary* summary, std::string* error) {
     GlbStats stats;
-    if (!writer_->finish(&stats, error)) return false;
+    if (!writer_->finish(&stats, error, check_)) return false;
     summary->completed.push_back(path_);
     // Step: ", out/m.glb (1.2 MiB with Draco, 4.5 MiB without); float32 ... ; Draco ..."
     summary->text = ", " + path_ + " (" + humanBytes(stats.bytes);

@@ -165,6 +165,9 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     // Step: what needs the whole sequence (the .glb is assembled here).
     result->summaries.assign(sinks.size(), {});
     for (size_t s = 0; s < sinks.size(); ++s) {
+        sinks[s]->setFinishCheck([budget](long long bytes, const std::string& name, std::string* e) {
+            return budget->fits(bytes, name, e);
+        });
         if (!sinks[s]->finish(&result->summaries[s], error)) return false;
         for (const std::string& path : result->summaries[s].completed)
             if (!budget->count(path, error)) return false;

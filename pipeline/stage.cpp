@@ -15,6 +15,10 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
         *error = printable(message, 4096);  // one line, whatever a file or key holds
         return false;
     };
+    // Step: the scene's file name goes into the outputs (the .glb's extras are JSON, UTF-8 only):
+    // checked before any work, printed escaped.
+    if (!isValidUtf8(options.scene_path))
+        return fail(options.scene_path + ": the file name is not valid UTF-8 (it is written into the outputs; rename the file)");
     // Step: the scene, the tolerance override and the models it must be valid for.
     Scene& scene = stage->scene;
     if (Status s = loadScene(options.scene_path, &scene); !s.ok) return fail(s.message);

@@ -579,3 +579,36 @@ TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
               std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(box / "out"));
 }
+
+// Issue 15, item 8: a scene file name that is not UTF-8 is refused up front (it rendered every
+// frame, then failed in the .glb's JSON); --max-output-bytes counts the .glb's JSON side before
+// writing it.
+TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    fs::current_path(box / "s");
+    const std::string good = writeScene(box / "s", "tetra.obj");
+    const std::string bad = (box / "s/sc\xff\xfe\ne.json").string();
+    fs::copy_file(good, bad);
+    CommandResult r = apparentRun({"render", bad, "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("sc\\xFF\\xFE\\ne.json: the file name is not valid UTF-8"), std::string::npos) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out"));
+
+    // Many frames of a tiny mesh: the JSON side dominates the .glb; the limit lies between the
+    // least size of the frames (what was counted before) and the real file.
+    std::ofstream(box / "s/long.json")
+        << R"({ "frames": { "start": 10, "end": 60, "fps": 10 }, "objects": [ { "mesh": "tetra.obj", "position": [0, 0, -10] } ] })";
+    r = apparentRun({"render", (box / "s/long.json").string(), "--out", (box / "full").string(), "--tolerance", "vertex", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto full = fs::file_size(box / "full/relativistic.glb");
+    r = apparentRun({"render", (box / "s/long.json").string(), "--out", (box / "out").string(), "--tolerance", "vertex",
+                     "--max-output-bytes", std::to_string(full / 2)});
+    EXPECT_EQ(r.code, 3) << r.err;
+    EXPECT_NE(r.err.find("--max-output-bytes: " + (box / "out/relativistic.glb").string() + " would bring the output to " +
+                         std::to_string(full) + " bytes"),
+              std::string::npos) << r.err;
+    EXPECT_TRUE(filesUnder(box / "out").empty());
+}
