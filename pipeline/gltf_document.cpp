@@ -269,10 +269,20 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
             return false;
         }
         const json& buffer = j["buffers"][size_t(buf)];
-        auto num = [](const json& o, const char* key) {  // a missing or non-number field counts as 0
-            return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
+        // A missing field counts as 0; present, it must be an integer in 0..2^53 (a float such as
+        // 1e300 would overflow the size_t conversions below: undefined behaviour).
+        bool integral = true;
+        auto num = [&](const json& o, const char* key) {
+            if (!o.is_object() || !o.contains(key)) return 0.0;
+            if (!o[key].is_number_unsigned() || o[key].get<uint64_t>() > (uint64_t(1) << 53)) integral = false;
+            return integral ? o[key].get<double>() : 0.0;
         };
         const double len = num(view, "byteLength"), off = num(view, "byteOffset"), blen = num(buffer, "byteLength");
+        if (!integral) {
+            *problem = "bufferViews[" + std::to_string(bv) + "] or buffers[" + std::to_string(buf) +
+                       "]: byteOffset and byteLength must be integers from 0 to 2^53";
+            return false;
+        }
         if (!(off >= 0 && len >= 0 && off + len <= blen)) {
             *problem = "bufferViews[" + std::to_string(bv) + "]: byteOffset + byteLength exceeds buffers[" + std::to_string(buf) + "].byteLength";
             return false;

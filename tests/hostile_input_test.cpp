@@ -577,6 +577,19 @@ TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("delay.json: frames, camera.instant_delay: the viewed time of frame 0 is not finite or beyond"),
               std::string::npos) << r.err;
+    // Draco view offsets as huge floats (a float-to-size_t overflow, UBSan): refused on the JSON.
+    std::ofstream(box / "s/draco_huge.gltf")
+        << R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"scene":0,"scenes":[{"nodes":[0]}],)"
+           R"("nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},)"
+           R"("extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],)"
+           R"("accessors":[{"componentType":5126,"count":3,"type":"VEC3"}],)"
+           R"("bufferViews":[{"buffer":0,"byteOffset":1e300,"byteLength":4}],"buffers":[{"byteLength":1e301,"uri":"data:,"}]})";
+    LoadedMesh mesh;
+    MeshWarnings w;
+    const Status st = readMesh((box / "s/draco_huge.gltf").string(), {}, &mesh, &w);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("bufferViews[0] or buffers[0]: byteOffset and byteLength must be integers from 0 to 2^53"),
+              std::string::npos) << st.message;
     EXPECT_FALSE(fs::exists(box / "out"));
 }
 
