@@ -624,4 +624,8 @@ TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
                          std::to_string(full) + " bytes"),
               std::string::npos) << r.err;
     EXPECT_TRUE(filesUnder(box / "out").empty());
+    // --threads is bounded (10 000 000 crashed TBB).
+    r = apparentRun({"render", good, "--out", (box / "out").string(), "--threads", "10000000"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--threads: 10000000 is outside 0 (all cores) .. 1024"), std::string::npos) << r.err;
 }
