@@ -85,7 +85,6 @@ private:
         if (a.bufferView < 0 && a.count > buffer_bytes_ + 1)
             return fail(aw + ".count", std::to_string(a.count) + " elements without a bufferView, more than the " +
                                            std::to_string(buffer_bytes_) + " bytes of the file's buffers (refused)");
-        values->assign(a.count * size_t(components), 0.0);
 
         auto decode = [&](const uint8_t* p, double* dst) {
             for (int c = 0; c < components; ++c) {
@@ -127,8 +126,11 @@ private:
                 a.byteOffset + (a.count - 1) * stride + elem > length)
                 return fail(aw, "count " + std::to_string(a.count) + " with byteOffset " + std::to_string(a.byteOffset) +
                                     " reaches past bufferViews[" + std::to_string(a.bufferView) + "] (" + std::to_string(length) + " bytes)");
+            // Allocated only now that the view holds every element.
+            values->assign(a.count * size_t(components), 0.0);
             for (size_t i = 0; i < a.count; ++i) decode(base + a.byteOffset + i * stride, values->data() + i * size_t(components));
         }
+        if (a.bufferView < 0) values->assign(a.count * size_t(components), 0.0);  // bounded above
         // Step: sparse substitutions.
         if (a.sparse.isSparse) {
             const auto& sp = a.sparse;

@@ -37,8 +37,11 @@ Status checkRegularFile(const std::string& path) {
 
 Status readRegularFile(const std::string& path, size_t max_bytes, std::string* out, const char* what) {
     out->clear();
+    // The resolved path's type first (stat follows symlinks): a device is never even opened.
+    struct stat before {};
+    if (::stat(path.c_str(), &before) == 0 && !S_ISREG(before.st_mode)) return notRegular(path, before.st_mode);
     // Non-blocking: opening a FIFO without a writer returns at once instead of waiting; the
-    // descriptor's own type is then checked, so a file swapped after a path check is caught too.
+    // descriptor's own type is then checked, so a file swapped after the path check is caught too.
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
     if (fd < 0) return Status::failure(path + ": cannot open " + what + ": " + std::strerror(errno));
     struct stat st {};

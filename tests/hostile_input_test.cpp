@@ -524,6 +524,17 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
                            "declared.gltf: accessors[0].count: 49999998 elements without a bufferView, more than the 0 "
                            "bytes of the file's buffers (refused)");
     }
+    // The same count in an accessor whose bufferView holds 36 bytes: checked before allocating.
+    {
+        std::ofstream(box / "s/short_view.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
+               R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)"
+            << base64Zeros(36) << ""}]}";
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "short_view.gltf"), "--out", out}), 2,
+                           "short_view.gltf: accessors[0]: count 49999998 with byteOffset 0 reaches past bufferViews[0] (36 bytes)");
+    }
     // A tolerance below the floor (1e-6 of the object's size) is refused up front.
     expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj"), "--out", out, "--tolerance", "1e-300"}), 2,
                        "tolerance (or --tolerance): 1e-300 light-seconds is below the floor of 3.4641016151377543e-06");
