@@ -208,7 +208,11 @@ public:
             for (size_t i = 0; i < nv; ++i) {
                 const Vec3 v{pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
                 if (!mesh4d::isFinite(v)) return fail(where + ".attributes.POSITION", "vertex " + std::to_string(i) + " is not finite");
-                out_->mesh.positions.push_back(world.apply(v));
+                // Derived, not only read: a finite node scale can still overflow the product.
+                const Vec3 placed = world.apply(v);
+                if (!mesh4d::isFinite(placed))
+                    return fail(where + ".attributes.POSITION", "vertex " + std::to_string(i) + " is not finite after the node transforms");
+                out_->mesh.positions.push_back(placed);
             }
 
             // Step: indices, or 0..n-1 for non-indexed primitives.

@@ -46,6 +46,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
         return fail(s.message);
     if (Status s = findMirrors(stage->objects, scene.path, &stage->mirrors); !s.ok) return fail(s.message);
     // Step: what the inputs derive, before any work: finite and in range, bounded in number.
+    if (options.max_object_frames <= 0) return fail("--max-object-frames: must be positive");
     const long long frames = stage->last_excl - stage->first;
     const long long slices_per_frame = (long long)stage->objects.size() * (1 + (long long)stage->mirrors.size());
     if (slices_per_frame > options.max_object_frames / frames)

@@ -531,7 +531,7 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
                R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
                R"("accessors":[{"bufferView":0,"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
                R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)"
-            << base64Zeros(36) << ""}]}";
+            << base64Zeros(36) << "\"}]}";
         expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "short_view.gltf"), "--out", out}), 2,
                            "short_view.gltf: accessors[0]: count 49999998 with byteOffset 0 reaches past bufferViews[0] (36 bytes)");
     }
@@ -582,6 +582,23 @@ TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
     CommandResult r = apparentRun({"render", writeScene(box / "s", "scaled.gltf"), "--out", (box / "out").string()});
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("is not finite or beyond"), std::string::npos) << r.err;
+    // A finite node scale (1e300) times a float vertex (3e38) overflows double itself: refused by
+    // the reader (the glTF fuzzer's harness requires finite positions of every mesh read).
+    {
+        const float vertices[9] = {0, 0, 0, 3e38f, 0, 0, 0, 1, 0};
+        std::ofstream(box / "s/big.bin", std::ios::binary).write(reinterpret_cast<const char*>(vertices), sizeof vertices);
+        std::ofstream(box / "s/overflow.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0,"scale":[1e300,1e300,1e300]}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[3e38,1,0]}],)"
+               R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"big.bin"}]})";
+        LoadedMesh mesh;
+        MeshWarnings w;
+        const Status st = readMesh((box / "s/overflow.gltf").string(), {}, &mesh, &w);
+        EXPECT_FALSE(st.ok);
+        EXPECT_NE(st.message.find("overflow.gltf: meshes[0].primitives[0].attributes.POSITION: vertex 1 is not finite after the node transforms"),
+                  std::string::npos) << st.message;
+    }
     std::ofstream(box / "s/delay.json") << R"({ "camera": { "instant_delay": 1e308 }, "model": "instant", "frames": { "start": 10, "end": 10.2, "fps": 10 },
         "objects": [ { "mesh": "tetra.obj", "position": [0, 0, -10] } ] })";
     r = apparentRun({"render", (box / "s/delay.json").string(), "--out", (box / "out").string()});
