@@ -45,7 +45,8 @@ struct GlbStats {
 };
 
 // The .glb of a sequence written as frames arrive: each frame's binary data goes at once to a
-// spill file next to the output (".NAME.glb.tmp-PID.bin", removed when done), only the JSON-side
+// spill file in the output's folder that has no name (openAnonymousFile, atomic_file.h: nothing
+// is left behind whatever ends the process), only the JSON-side
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
 // under a temporary name and renames it into place. Memory does not grow with the frame data;
 // the disk briefly holds the binary data twice.
