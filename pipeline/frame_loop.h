@@ -35,7 +35,7 @@ private:
 };
 
 // Triangles one frame may hold (objects and reflections together) unless --max-triangles says
-// otherwise: about 1.5 GB of frame mesh in memory.
+// otherwise.
 constexpr long long kDefaultMaxFrameTriangles = 20'000'000;
 
 struct FrameLoopSettings {
