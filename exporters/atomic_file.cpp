@@ -6,6 +6,10 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
+#include <random>
+
+#include <sys/stat.h>
 
 #include <fcntl.h>
 #include <pthread.h>
@@ -49,28 +53,88 @@ void onInterrupt(int sig) {
     }
     for (int i = 0; i < kSlots; ++i)
         if (g_slot_used[i].load() && g_temp_paths[i][0] != '\0') ::unlink(g_temp_paths[i]);
-    const char* msg = sig == SIGINT ? "apparent: interrupted (SIGINT): temporary files removed, written files are complete\n"
-                                    : "apparent: terminated (SIGTERM): temporary files removed, written files are complete\n";
+    const char* msg = sig == SIGINT   ? "apparent: interrupted (SIGINT): temporary files removed, written files are complete\n"
+                      : sig == SIGHUP ? "apparent: hung up (SIGHUP): temporary files removed, written files are complete\n"
+                                      : "apparent: terminated (SIGTERM): temporary files removed, written files are complete\n";
     ssize_t ignored = ::write(2, msg, std::strlen(msg));
     (void)ignored;
     ::_exit(128 + sig);
+}
+
+// 12 characters of [a-z0-9] from the kernel's random source: not guessable from the PID or time.
+std::string randomSuffix() {
+    static const char alphabet[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+    std::random_device rd;  // /dev/urandom (getrandom) with libstdc++
+    std::string s;
+    for (int i = 0; i < 12; ++i) s += alphabet[rd() % 36];
+    return s;
+}
+
+// Creates `path_for(random)` exclusively, never following a symlink; retries on a name taken.
+int createExclusive(const std::function<std::string(const std::string&)>& path_for, mode_t mode, std::string* path,
+                    int* err) {
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        *path = path_for(randomSuffix());
+        const int fd = ::open(path->c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, mode);
+        if (fd >= 0) return fd;
+        *err = errno;
+        if (errno != EEXIST) return -1;
+    }
+    return -1;
 }
 
 }  // namespace
 
 AtomicOutput::AtomicOutput(std::string final_path) : final_(std::move(final_path)) {
     const std::filesystem::path p(final_);
-    const std::string name = "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + p.extension().string();
-    temp_ = (p.parent_path() / name).string();
-    slot_ = registerTemp(temp_);
+    const std::string prefix = "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-";
+    const std::string ext = p.extension().string();
+    int err = 0;
+    // The interrupt signals wait while the file is created and its name registered: a handler
+    // running in between would miss a file that exists under a name not yet registered.
+    sigset_t block, previous;
+    sigemptyset(&block);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&block, sig);
+    pthread_sigmask(SIG_BLOCK, &block, &previous);
+    fd_ = createExclusive([&](const std::string& r) { return (p.parent_path() / (prefix + r + ext)).string(); }, 0644,
+                          &temp_, &err);
+    if (fd_ >= 0) slot_ = registerTemp(temp_);
+    pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    struct stat st {};
+    if (fd_ < 0) {
+        open_error_ = final_ + ": cannot create " + temp_ + ": " + std::strerror(err);
+        temp_.clear();
+    } else if (::fstat(fd_, &st) == 0) {
+        dev_ = st.st_dev;
+        ino_ = st.st_ino;
+    }
 }
 
 AtomicOutput::~AtomicOutput() {
-    if (!committed_) std::remove(temp_.c_str());
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_ && !temp_.empty()) std::remove(temp_.c_str());
     unregisterTemp(slot_);
 }
 
 bool AtomicOutput::commit(std::string* error) {
+    if (fd_ < 0 && !open_error_.empty()) {
+        *error = open_error_;
+        return false;
+    }
+    if (fd_ >= 0) {
+        const int fd = fd_;
+        fd_ = -1;
+        if (::close(fd) != 0) {
+            *error = final_ + ": cannot write: " + std::strerror(errno);
+            return false;
+        }
+    }
+    // The name must still be the file created: not replaced (by a symlink or anything else).
+    struct stat st {};
+    if (::lstat(temp_.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_dev != dev_ || st.st_ino != ino_) {
+        *error = final_ + ": the temporary file " + temp_ + " was replaced while writing (not renamed into place)";
+        return false;
+    }
     // Unregistered after the rename: an interrupt in between unlinks a name that no longer exists.
     if (std::rename(temp_.c_str(), final_.c_str()) != 0) {
         *error = final_ + ": cannot rename from " + temp_ + ": " + std::strerror(errno);
@@ -83,27 +147,38 @@ bool AtomicOutput::commit(std::string* error) {
 }
 
 bool AtomicOutput::commitBytes(const std::string& bytes, std::string* error) {
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        *error = final_ + ": cannot create " + temp_ + ": " + std::strerror(errno);
+    if (fd_ < 0) {
+        *error = open_error_.empty() ? final_ + ": already committed" : open_error_;
         return false;
     }
     size_t done = 0;
     std::string why;
-    if (!writeAll(fd, bytes.data(), bytes.size(), &why, &done)) {
+    if (!writeAll(fd_, bytes.data(), bytes.size(), &why, &done)) {
         *error = final_ + ": cannot write (" + std::to_string(done) + " of " + std::to_string(bytes.size()) +
                  " bytes written): " + why;
-        ::close(fd);
         return false;
     }
-    // Always close, keeping the first failure's errno.
-    int failed = ::fsync(fd) != 0 ? errno : 0;
-    if (::close(fd) != 0 && failed == 0) failed = errno;
-    if (failed != 0) {
-        *error = final_ + ": cannot write: " + std::strerror(failed);
+    if (::fsync(fd_) != 0) {
+        *error = final_ + ": cannot write: " + std::strerror(errno);
         return false;
     }
     return commit(error);
+}
+
+int openAnonymousFile(const std::string& dir, std::string* error) {
+    const std::string folder = dir.empty() ? "." : dir;
+    int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_EXCL | O_CLOEXEC, 0600);
+    if (fd >= 0) return fd;
+    // No O_TMPFILE here (some file systems): a random name, unlinked as soon as it exists.
+    std::string path;
+    int err = errno;
+    fd = createExclusive([&](const std::string& r) { return folder + "/.apparent-spill.tmp-" + r; }, 0600, &path, &err);
+    if (fd < 0) {
+        *error = "cannot create a scratch file in " + folder + ": " + std::strerror(err);
+        return -1;
+    }
+    ::unlink(path.c_str());
+    return fd;
 }
 
 bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* written) {
@@ -130,6 +205,9 @@ void installInterruptCleanup() {
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = 0;
     ::sigaction(SIGTERM, &sa, nullptr);
+    // A closed terminal or a lost SSH session: the same as SIGTERM (a nohup'ed run keeps SIG_IGN).
+    struct sigaction old_hup {};
+    if (::sigaction(SIGHUP, nullptr, &old_hup) == 0 && old_hup.sa_handler != SIG_IGN) ::sigaction(SIGHUP, &sa, nullptr);
     // A file size limit (ulimit -f) would kill the process mid-write with SIGXFSZ: ignored, the
     // write fails with EFBIG instead and is reported like a full disk (exit 3, temporary removed).
     struct sigaction ignore {};

@@ -8,18 +8,30 @@
 
 namespace apparent {
 
+//
+// The temporary file is created by the constructor, exclusively (O_CREAT | O_EXCL | O_NOFOLLOW)
+// under an unguessable name: a file or symlink planted at any name in the folder is never opened,
+// written through or truncated (a new random name is drawn while the name exists). Before the
+// rename, the name is checked to still be the file created (same device and inode, lstat: not a
+// symlink put in its place), so the final name never becomes a planted link.
 class AtomicOutput {
 public:
     // `final_path` is where the file should end up. The temporary name is hidden and keeps the
-    // extension, so leftovers are easy to find and tell apart: "dir/.name.tmp-PID.ext".
+    // extension, so leftovers are easy to find and tell apart: "dir/.name.tmp-PID-RANDOM.ext"
+    // (RANDOM: 12 characters from /dev/urandom).
     explicit AtomicOutput(std::string final_path);
-    ~AtomicOutput();  // removes the temporary file unless commit() succeeded
+    ~AtomicOutput();  // closes and removes the temporary file unless commit() succeeded
     AtomicOutput(const AtomicOutput&) = delete;
     AtomicOutput& operator=(const AtomicOutput&) = delete;
 
     const std::string& tempPath() const { return temp_; }
     const std::string& finalPath() const { return final_; }
-    // Renames the temporary file into place. Returns false (and keeps errno's message in `error`) on failure.
+    // The temporary file, open for reading and writing; -1 when it could not be created (then
+    // openError() says why, starting with the final path). Owned: closed by commit() or the destructor.
+    int fd() const { return fd_; }
+    const std::string& openError() const { return open_error_; }
+    // Closes the temporary file (a failed close is an error), checks that its name is still the
+    // file created and renames it into place. Returns false with a message on failure.
     bool commit(std::string* error);
     // Writes `bytes` to the temporary file, checking every write, fsync and close (a full disk or a
     // file size limit fails here, not later), then commits. Returns false with a message on failure;
@@ -29,6 +41,9 @@ public:
 private:
     std::string final_;
     std::string temp_;
+    std::string open_error_;
+    int fd_ = -1;
+    unsigned long long dev_ = 0, ino_ = 0;  // identity of the file created
     bool committed_ = false;
     int slot_ = -1;  // entry in the registry of temporary files the interrupt handler removes
 };
@@ -37,9 +52,14 @@ private:
 // message in `error` and the bytes written so far in `*written` (when given).
 bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* written = nullptr);
 
-// Installs handlers for SIGINT and SIGTERM (SIGINT only when it is not ignored) that remove every
-// temporary file of a live AtomicOutput, print one line and exit with 128 + the signal number
-// (130, 143). Files already renamed into place are complete and stay. SIGXFSZ is ignored, so a
+// A file for scratch data in `dir` that has no name from the start (O_TMPFILE; where the file
+// system lacks it, created exclusively under a random name and unlinked at once): nothing is left
+// behind whatever ends the process, SIGKILL and the OOM killer included. -1 with a message on failure.
+int openAnonymousFile(const std::string& dir, std::string* error);
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP (SIGINT and SIGHUP only when not ignored) that
+// remove every temporary file of a live AtomicOutput, print one line and exit with 128 + the
+// signal number (130, 143, 129). Files already renamed into place are complete and stay. SIGXFSZ is ignored, so a
 // file size limit fails the write (exit 3) instead of killing the process. SIGKILL cannot be caught:
 // it can leave one temporary file per writer, named ".NAME.tmp-PID.EXT", never a truncated final file.
 void installInterruptCleanup();

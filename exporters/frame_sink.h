@@ -10,6 +10,7 @@
 // a sink only states the least size of what it is about to write and names the files it completed.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -53,6 +54,11 @@ public:
                      std::string* error) = 0;
     // After the last frame.
     virtual bool finish(SinkSummary* summary, std::string* error) = 0;
+    // Whether `bytes` more under `name` still fit the output limit (false with the message).
+    using OutputCheck = std::function<bool(long long bytes, const std::string& name, std::string* error)>;
+    // Set before finish(): a sink that writes a file there checks its whole size with `check`
+    // before writing any of it (the default writes nothing in finish()).
+    virtual void setFinishCheck(OutputCheck /*check*/) {}
 };
 
 // The least size of a frame in any of the formats: 12 bytes per vertex and 12 per triangle

@@ -455,9 +455,10 @@ size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
 
 struct GlbSequenceWriter::Impl {
     Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
-        : path(p), info(i), options(o), spill(p + ".bin"), model(info, options, &sink) {
-        sink.fd = ::open(spill.tempPath().c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-        if (sink.fd < 0) sink.error = std::string("cannot create ") + spill.tempPath() + ": " + std::strerror(errno);
+        : path(p), info(i), options(o), model(info, options, &sink) {
+        // The spill file has no name (atomic_file.h): nothing is left behind, even after SIGKILL.
+        const std::string dir = std::filesystem::path(p).parent_path().string();
+        sink.fd = openAnonymousFile(dir, &sink.error);
         if (options.draco) {
             GlbOptions plain_options = options;
             plain_options.draco = false;
@@ -471,7 +472,6 @@ struct GlbSequenceWriter::Impl {
     std::string path;
     SequenceInfo info;
     GlbOptions options;
-    AtomicOutput spill;  // never committed: removed when done (or on an interrupt)
     BinSink sink, count_only;
     SequenceModel model;
     std::unique_ptr<SequenceModel> plain;  // with Draco: the same sequence without it, counted
@@ -532,7 +532,7 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
         return false;
     }
     if (!m.sink.error.empty()) {
-        *error = m.spill.tempPath() + ": " + m.sink.error;
+        *error = m.path + ": spill file: " + m.sink.error;
         return false;
     }
     // A .glb's length field is 32 bits: stop as soon as the frame data alone passes 4 GiB.
@@ -544,7 +544,7 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     return true;
 }
 
-bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
+bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameSink::OutputCheck& check) {
     Impl& m = *impl_;
     if (m.model.frames == 0) {
         *error = m.path + ": no frames to write";
@@ -552,7 +552,7 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
     }
     const std::string json = m.model.finish(m.far);
     if (!m.sink.error.empty()) {
-        *error = m.spill.tempPath() + ": " + m.sink.error;
+        *error = m.path + ": spill file: " + m.sink.error;
         return false;
     }
     const size_t bin = m.sink.size;
@@ -567,12 +567,15 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
         return false;
     }
 
+    // The whole file against the output limit before any of it is written.
+    if (check && !check((long long)total, m.path, error)) return false;
+
     // Step: header, JSON chunk, BIN chunk copied from the spill file; through a temporary name,
     // every write checked and synced before the rename.
     AtomicOutput out(m.path);
-    const int fd = ::open(out.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const int fd = out.fd();
     if (fd < 0) {
-        *error = m.path + ": cannot create " + out.tempPath() + ": " + std::strerror(errno);
+        *error = out.openError();
         return false;
     }
     auto put32 = [](std::string* s, uint32_t v) {
@@ -594,7 +597,7 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
         const ssize_t r = ::pread(m.sink.fd, chunk.data(), std::min(chunk.size(), bin - off), off_t(off));
         if (r < 0 && errno == EINTR) continue;
         if (r <= 0) {
-            werr = std::string("cannot read back ") + m.spill.tempPath() + ": " + std::strerror(r < 0 ? errno : EIO);
+            werr = std::string("cannot read back the spill file: ") + std::strerror(r < 0 ? errno : EIO);
             ok = false;
             break;
         }
@@ -604,7 +607,6 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error) {
     static const char zeros[4] = {0, 0, 0, 0};
     if (ok) ok = writeAll(fd, zeros, padded4(bin) - bin, &werr);
     if (ok && ::fsync(fd) != 0) { werr = std::strerror(errno); ok = false; }
-    if (::close(fd) != 0 && ok) { werr = std::strerror(errno); ok = false; }
     if (!ok) {
         *error = m.path + ": cannot write: " + werr;
         return false;
@@ -658,7 +660,7 @@ bool GlbSink::add(const ExportFrame& frame, const PreparedFrame* prepared, std::
 
 bool GlbSink::finish(SinkSummary* summary, std::string* error) {
     GlbStats stats;
-    if (!writer_->finish(&stats, error)) return false;
+    if (!writer_->finish(&stats, error, check_)) return false;
     summary->completed.push_back(path_);
     // Step: ", out/m.glb (1.2 MiB with Draco, 4.5 MiB without); float32 ... ; Draco ..."
     summary->text = ", " + path_ + " (" + humanBytes(stats.bytes);

@@ -45,7 +45,8 @@ struct GlbStats {
 };
 
 // The .glb of a sequence written as frames arrive: each frame's binary data goes at once to a
-// spill file next to the output (".NAME.glb.tmp-PID.bin", removed when done), only the JSON-side
+// spill file in the output's folder that has no name (openAnonymousFile, atomic_file.h: nothing
+// is left behind whatever ends the process), only the JSON-side
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
 // under a temporary name and renames it into place. Memory does not grow with the frame data;
 // the disk briefly holds the binary data twice.
@@ -64,8 +65,9 @@ public:
     // order. The file is the same either way.
     std::shared_ptr<GlbFrameData> prepare(const ExportFrame& frame) const;  // shared: GlbFrameData is opaque here
     bool add(const ExportFrame& frame, const GlbFrameData& prepared, std::string* error);
-    // Writes the file; a .glb cannot exceed 4 GiB (refused with a message).
-    bool finish(GlbStats* stats, std::string* error);
+    // Writes the file; a .glb cannot exceed 4 GiB (refused with a message). With `check`, the
+    // file's whole size (JSON chunk included) is checked with it before anything is written.
+    bool finish(GlbStats* stats, std::string* error, const FrameSink::OutputCheck& check = nullptr);
 
 private:
     struct Impl;
@@ -86,6 +88,7 @@ public:
     bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
              std::string* error) override;
     bool finish(SinkSummary* summary, std::string* error) override;
+    void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
 
 private:
     std::string path_;
@@ -93,6 +96,7 @@ private:
     bool verbose_;
     std::string model_;
     double tolerance_ = 0;
+    OutputCheck check_;
     long long least_ = 0;  // least size of the file so far without Draco (positions and indices alone)
     std::unique_ptr<GlbSequenceWriter> writer_;
 };

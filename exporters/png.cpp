@@ -35,8 +35,17 @@ void onPngWarning(png_structp, png_const_charp) {}
 // changed after it, so a longjmp back leaves them valid.
 class PngSession {
 public:
-    PngSession(const std::string& file_path, bool writing) : writing_(writing) {
-        file = std::fopen(file_path.c_str(), writing ? "wb" : "rb");
+    // Reading opens `file_path`; writing writes to a copy of `write_fd` (an AtomicOutput's file,
+    // created exclusively), never to a name opened again.
+    PngSession(const std::string& file_path, bool writing, int write_fd = -1) : writing_(writing) {
+        if (writing) {
+            const int copy = write_fd >= 0 ? ::dup(write_fd) : -1;
+            file = copy >= 0 ? ::fdopen(copy, "wb") : nullptr;
+            if (copy >= 0 && !file) ::close(copy);
+            if (write_fd < 0) errno = EBADF;
+        } else {
+            file = std::fopen(file_path.c_str(), "rb");
+        }
         if (!file) {
             open_errno_ = errno;
             return;
@@ -87,7 +96,11 @@ bool writePng(const std::string& path, const RgbImage& image, std::string* error
         return false;
     }
     AtomicOutput out(path);
-    PngSession session(out.tempPath(), /*writing=*/true);
+    if (out.fd() < 0) {
+        *error = out.openError();
+        return false;
+    }
+    PngSession session(out.tempPath(), /*writing=*/true, out.fd());
     if (!session.started(path, error)) return false;
     png_structp png = session.png;
     png_infop info = session.info;

@@ -86,8 +86,18 @@ bool parseModelList(const std::string& text, StageOptions* options, std::string*
 // The limits of every command that loads a scene (pipeline/stage.h).
 void addStageLimits(CLI::App* command, StageOptions* stage) {
     command->add_option("--max-frames", stage->max_frames, "Refuse scenes with more frames")->capture_default_str();
+    command->add_option("--max-object-frames", stage->max_object_frames,
+                        "Refuse runs whose objects (mirror reflections included) times frames exceed this")
+        ->capture_default_str();
     command->add_flag("--allow-outside", stage->limits.allow_outside,
                       "Let scene mesh paths leave the scene's folder and the working folder");
+}
+
+// Worker threads a command may ask for: TBB fails on far more (10 000 000 crashed it).
+constexpr int kMaxThreads = 1024;
+
+std::string threadsProblem(long long n) {
+    return "--threads: " + std::to_string(n) + " is outside 0 (all cores) .. " + std::to_string(kMaxThreads);
 }
 
 }  // namespace
@@ -139,6 +149,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->add_option("--max-faces", max_faces, "Refuse meshes with more faces")->capture_default_str();
     long long max_file_bytes = (long long)rs.stage.limits.max_file_bytes;
     render_cmd->add_option("--max-file-bytes", max_file_bytes, "Refuse mesh files (and glTF buffers) larger than this")
+        ->capture_default_str();
+    render_cmd->add_option("--max-triangles", rs.max_frame_triangles,
+                           "Stop with exit code 2 when one frame's refinement would make more triangles than this "
+                           "(a --tolerance too fine for the scene)")
         ->capture_default_str();
     render_cmd->add_option("--max-output-bytes", rs.max_output_bytes,
                            "Stop with exit code 3 before the outputs would exceed this many bytes in all")
@@ -221,7 +235,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             return usage("--size: '" + trace_size_text + "' is not WxH with W and H in 1..16384");
         if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.stage.frame_from, &ts.stage.frame_to))
             return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
-        if (ts.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        if (ts.threads < 0 || ts.threads > kMaxThreads) return usage(threadsProblem(ts.threads));
         if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         return guarded([&] { return raytrace(ts, out, err); }, err);
     }
@@ -229,7 +243,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!figure_size_text.empty() && !parseSize(figure_size_text, &fs.width, &fs.height))
             return usage("--size: '" + figure_size_text + "' is not WxH with W and H in 1..16384");
         if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
-        if (fs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+        if (fs.threads < 0 || fs.threads > kMaxThreads) return usage(threadsProblem(fs.threads));
         if (fs.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         return guarded([&] { return figure(fs, out, err); }, err);
     }
@@ -291,7 +305,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
-    if (rs.threads < 0) return usage("--threads: must be 0 (all cores) or positive");
+    if (rs.threads < 0 || rs.threads > kMaxThreads) return usage(threadsProblem(rs.threads));
+    if (rs.max_frame_triangles <= 0) return usage("--max-triangles: must be positive");
     if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0 || rs.max_output_bytes <= 0)
         return usage("--max-vertices, --max-faces, --max-frames, --max-file-bytes and --max-output-bytes must be positive");
     rs.stage.limits.max_vertices = size_t(max_vertices);

@@ -1,5 +1,7 @@
 #include "pipeline/frame_loop.h"
 
+#include "pipeline/scene_fields.h"
+
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -101,6 +103,7 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     // Step: per frame, cut every world with the view surface (refined to the tolerance), then deliver.
     mesh4d::SliceSettings slice_settings;
     slice_settings.tolerance = scene.tolerance;
+    slice_settings.max_triangles = size_t(settings.max_frame_triangles);
     result->max_segments = slice_settings.max_segments;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     Progress progress(progress_out, settings.progress, info.model, last_excl - first);
@@ -135,6 +138,15 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
         });
         for (size_t i = 0; i < cut.size(); ++i) {
             const ExportFrame& frame = cut[i];
+            const bool stopped = std::any_of(frame.objects.begin(), frame.objects.end(),
+                                             [](const mesh4d::ApparentMesh& o) { return o.over_budget; });
+            if (stopped || frame.triangleCount() > size_t(settings.max_frame_triangles)) {
+                result->over_budget = true;
+                *error = scene.path + ": frame " + std::to_string(frame.index) + ": tolerance " +
+                         formatNumber(scene.tolerance) + " makes more than " + std::to_string(settings.max_frame_triangles) +
+                         " triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles";
+                return false;
+            }
             result->max_triangles = std::max(result->max_triangles, frame.triangleCount());
             for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
             for (size_t s = 0; s < sinks.size(); ++s) {
@@ -153,6 +165,9 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     // Step: what needs the whole sequence (the .glb is assembled here).
     result->summaries.assign(sinks.size(), {});
     for (size_t s = 0; s < sinks.size(); ++s) {
+        sinks[s]->setFinishCheck([budget](long long bytes, const std::string& name, std::string* e) {
+            return budget->fits(bytes, name, e);
+        });
         if (!sinks[s]->finish(&result->summaries[s], error)) return false;
         for (const std::string& path : result->summaries[s].completed)
             if (!budget->count(path, error)) return false;

@@ -34,8 +34,16 @@ private:
     long long written_ = 0;
 };
 
+// Triangles one frame may hold (objects and reflections together) unless --max-triangles says
+// otherwise.
+constexpr long long kDefaultMaxFrameTriangles = 20'000'000;
+
 struct FrameLoopSettings {
     int threads = 0;         // worker threads; 0: all cores
+    // Triangles per frame: each object's refinement stops at this many
+    // (mesh4d::SliceSettings::max_triangles) and a frame that reaches it, or holds more in all,
+    // ends the loop with a message naming --tolerance and --max-triangles (bad input: exit 2).
+    long long max_frame_triangles = kDefaultMaxFrameTriangles;
     bool cull_view = false;  // --cull-view: objects outside the camera's view stay empty (worlds.h)
     bool progress = true;    // on a terminal only
 };
@@ -45,6 +53,7 @@ struct FrameLoopResult {
     size_t limited_triangles = 0;        // triangle-frames that reached the refinement limit
     size_t max_segments = 0;             // that limit
     std::vector<SinkSummary> summaries;  // per sink, in the order given
+    bool over_budget = false;            // stopped at max_frame_triangles: the error is bad input
 };
 
 // What the sinks are told about the sequence of `model`: objects (then the reflections, see
@@ -53,7 +62,8 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model);
 
 // Runs frames [stage.first, stage.last_excl) of `model` into `sinks` (in that order per frame).
 // Returns false with one line (naming the file) when an output cannot be written or the budget is
-// exhausted: the command's exit code 3. Progress goes to `progress_out`.
+// exhausted: the command's exit code 3; or when a frame passes max_frame_triangles
+// (result->over_budget: exit code 2). Progress goes to `progress_out`.
 bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& settings,
                   const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
                   FrameLoopResult* result, std::string* error);

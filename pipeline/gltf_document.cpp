@@ -12,6 +12,9 @@
 #include <draco/compression/decode.h>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/input_file.h"
+#include "pipeline/json_limits.h"
+
 namespace apparent {
 
 namespace fs = std::filesystem;
@@ -30,14 +33,12 @@ uint64_t hashBytes(const std::vector<unsigned char>& bytes) {
     return std::hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
-// Reads a whole file of at most max_bytes; false if it cannot be read or is larger.
+// Reads a whole regular file of at most max_bytes (input_file.h); false if it cannot be read.
 bool readFile(const fs::path& path, size_t max_bytes, std::vector<unsigned char>* bytes) {
-    std::error_code ec;
-    const auto size = fs::file_size(path, ec);
-    if (ec || size > max_bytes) return false;
-    bytes->assign(size_t(size), 0);
-    std::ifstream in(path, std::ios::binary);
-    return in && (size == 0 || bool(in.read(reinterpret_cast<char*>(bytes->data()), std::streamsize(size))));
+    std::string text;
+    if (!readRegularFile(path.string(), max_bytes, &text).ok) return false;
+    bytes->assign(text.begin(), text.end());
+    return true;
 }
 
 // File access for tinygltf, confined to the glTF file's folder and to a size limit.
@@ -46,18 +47,24 @@ struct Confinement {
     size_t max_bytes;
     std::string violation;         // first refused path, for our own message
     std::vector<FileStamp> read;   // every file read through the callbacks (external buffers)
+    std::string scratch;           // the bytes of the file being read
 };
 
-bool insideRoot(const Confinement& c, const std::string& filepath) {
-    std::error_code ec;
-    const std::string p = fs::weakly_canonical(fs::path(filepath), ec).string();
-    const std::string root = c.root.string();
-    return !ec && p.compare(0, root.size(), root) == 0 && (p.size() == root.size() || p[root.size()] == '/');
-}
+// Decided on the resolved path: a symlink inside the folder that points out of it is outside.
+bool insideRoot(const Confinement& c, const std::string& filepath) { return resolvesInside(filepath, c.root.string()); }
 
 bool confinedExists(const std::string& abs_filename, void* user) {
-    // tinygltf also probes candidates outside the folder (such as "./name"): those just do not exist.
-    if (!insideRoot(*static_cast<Confinement*>(user), abs_filename)) return false;
+    auto* c = static_cast<Confinement*>(user);
+    // tinygltf also probes candidates outside the folder (such as "./name"): those just do not
+    // exist. A name inside the folder that resolves out of it (a symlink) is a violation.
+    if (!insideRoot(*c, abs_filename)) {
+        const fs::path lexical = fs::absolute(fs::path(abs_filename)).lexically_normal();
+        std::error_code ec;
+        if (c->violation.empty() && fs::exists(lexical, ec) &&
+            lexical.string().rfind(c->root.string() + "/", 0) == 0)
+            c->violation = abs_filename;
+        return false;
+    }
     std::error_code ec;
     return fs::is_regular_file(abs_filename, ec);
 }
@@ -73,21 +80,13 @@ bool confinedRead(std::vector<unsigned char>* out, std::string* err, const std::
         if (err) *err += "refused: " + filepath + " is outside the glTF file's folder\n";
         return false;
     }
-    const auto size = fs::file_size(p, ec);
-    if (ec) {
-        if (err) *err += "cannot read " + filepath + "\n";
+    // Only regular files, size-limited (a FIFO or device is refused before it is read).
+    if (Status s = readRegularFile(p.string(), c->max_bytes, &c->scratch); !s.ok) {
+        if (err) *err += s.message + "\n";
         return false;
     }
-    if (size > c->max_bytes) {
-        if (err) *err += filepath + " is larger than the limit of " + std::to_string(c->max_bytes) + " bytes (raise with --max-file-bytes)\n";
-        return false;
-    }
-    std::ifstream in(p, std::ios::binary);
-    out->resize(size_t(size));
-    if (size && !in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size))) {
-        if (err) *err += "cannot read " + filepath + "\n";
-        return false;
-    }
+    out->assign(c->scratch.begin(), c->scratch.end());
+    c->scratch = {};
     c->read.push_back({p.string(), out->size(), hashBytes(*out)});
     return true;
 }
@@ -215,14 +214,11 @@ bool bufferBytes(const nlohmann::json& j, size_t index, const std::vector<unsign
         const auto comma = uri.find(";base64,");
         return comma != std::string::npos && decodeBase64(uri.substr(comma + 8), out);
     }
-    // Relative file (checkBufferUris has refused escapes already).
-    std::error_code ec;
+    // Relative file (checkBufferUris has refused textual escapes): confined after resolving
+    // symlinks too, and only a regular file (else left to tinygltf's confined callbacks to refuse).
     const fs::path p = root / uri;
-    const auto size = fs::file_size(p, ec);
-    if (ec || size > max_bytes) return false;
-    std::ifstream in(p, std::ios::binary);
-    out->resize(size_t(size));
-    return size == 0 || bool(in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size)));
+    if (!resolvesInside(p.string(), root.string())) return false;
+    return readFile(p, max_bytes, out);
 }
 
 // Calls fn(primitive, draco_extension, "meshes[m].primitives[p]") for every primitive with a
@@ -273,10 +269,20 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
             return false;
         }
         const json& buffer = j["buffers"][size_t(buf)];
-        auto num = [](const json& o, const char* key) {  // a missing or non-number field counts as 0
-            return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
+        // A missing field counts as 0; present, it must be an integer in 0..2^53 (a float such as
+        // 1e300 would overflow the size_t conversions below: undefined behaviour).
+        bool integral = true;
+        auto num = [&](const json& o, const char* key) {
+            if (!o.is_object() || !o.contains(key)) return 0.0;
+            if (!o[key].is_number_unsigned() || o[key].get<uint64_t>() > (uint64_t(1) << 53)) integral = false;
+            return integral ? o[key].get<double>() : 0.0;
         };
         const double len = num(view, "byteLength"), off = num(view, "byteOffset"), blen = num(buffer, "byteLength");
+        if (!integral) {
+            *problem = "bufferViews[" + std::to_string(bv) + "] or buffers[" + std::to_string(buf) +
+                       "]: byteOffset and byteLength must be integers from 0 to 2^53";
+            return false;
+        }
         if (!(off >= 0 && len >= 0 && off + len <= blen)) {
             *problem = "bufferViews[" + std::to_string(bv) + "]: byteOffset + byteLength exceeds buffers[" + std::to_string(buf) + "].byteLength";
             return false;
@@ -344,7 +350,7 @@ bool checkDracoPayloads(const nlohmann::json& j, const std::vector<unsigned char
         for (auto it = (*dr)["attributes"].begin(); it != (*dr)["attributes"].end(); ++it) {
             const draco::PointAttribute* a = dm->GetAttributeByUniqueId(uint32_t(it.value().get<long long>()));
             if (!a) {
-                *problem = where + ".attributes." + it.key() + ": Draco attribute id " + it.value().dump() + " is not in the payload";
+                *problem = where + ".attributes." + it.key() + ": Draco attribute id " + jsonForMessage(it.value()) + " is not in the payload";
                 return false;
             }
             if (a->num_components() < 1 || a->num_components() > 4) {
@@ -364,6 +370,8 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     std::string json_text, problem;
     if (!extractJson(path, bytes, binary, &json_text, &problem)) return Status::failure(path + ": " + problem);
+    // Before any recursive parse (nlohmann's dump, tinygltf's parser): a bounded nesting depth.
+    if (Status s = checkJsonDepth(path, json_text); !s.ok) return s;
     nlohmann::json j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) return Status::failure(path + ": invalid JSON");
     if (!j.is_object()) return Status::failure(path + ": the glTF JSON is not an object");
@@ -440,13 +448,11 @@ void dropEntry(Cache& c, std::map<std::string, CacheEntry>::iterator it) {
 Status openGltf(const std::string& path, const MeshLimits& limits, std::shared_ptr<const GltfDocument>* out) {
     out->reset();
     // Step: read the file ourselves (size-limited); its bytes key the cache entry.
+    std::string text;
+    if (Status s = readRegularFile(path, limits.max_file_bytes, &text); !s.ok) return s;
+    std::vector<unsigned char> bytes(text.begin(), text.end());
+    text = {};
     std::error_code ec;
-    const auto size = fs::file_size(path, ec);
-    if (ec) return Status::failure(path + ": cannot open file");
-    if (size > limits.max_file_bytes)
-        return Status::failure(path + ": larger than the limit of " + std::to_string(limits.max_file_bytes) + " bytes (raise with --max-file-bytes)");
-    std::vector<unsigned char> bytes;
-    if (!readFile(path, limits.max_file_bytes, &bytes)) return Status::failure(path + ": cannot read file");
     const fs::path canonical = fs::weakly_canonical(fs::absolute(path, ec), ec);
     if (ec) return Status::failure(path + ": cannot resolve the path: " + ec.message());
 

@@ -51,6 +51,11 @@ private:
     MeshLimits limits_;
     LoadedMesh* out_;
     MeshWarnings* warnings_;
+    size_t buffer_bytes_ = [this] {
+        size_t n = 0;
+        for (const auto& b : model_.buffers) n += b.data.size();
+        return n;
+    }();
 
     // Reads accessor `index` as `components` doubles per element, with every range checked and
     // sparse substitutions applied.
@@ -74,7 +79,12 @@ private:
             return fail(aw + ".count", std::to_string(a.count) + " exceeds the limit of " + std::to_string(count_limit) +
                                            (integer ? " (raise with --max-faces)" : " (raise with --max-vertices)"));
         const size_t elem = size_t(csize) * size_t(components);
-        values->assign(a.count * size_t(components), 0.0);
+        // Before allocating: elements without a bufferView are zeros plus sparse substitutions;
+        // they may not outnumber the bytes of the file's buffers (any vertex a triangle uses is
+        // named by at least one index byte), so a few hundred bytes cannot declare 50M elements.
+        if (a.bufferView < 0 && a.count > buffer_bytes_ + 1)
+            return fail(aw + ".count", std::to_string(a.count) + " elements without a bufferView, more than the " +
+                                           std::to_string(buffer_bytes_) + " bytes of the file's buffers (refused)");
 
         auto decode = [&](const uint8_t* p, double* dst) {
             for (int c = 0; c < components; ++c) {
@@ -116,8 +126,11 @@ private:
                 a.byteOffset + (a.count - 1) * stride + elem > length)
                 return fail(aw, "count " + std::to_string(a.count) + " with byteOffset " + std::to_string(a.byteOffset) +
                                     " reaches past bufferViews[" + std::to_string(a.bufferView) + "] (" + std::to_string(length) + " bytes)");
+            // Allocated only now that the view holds every element.
+            values->assign(a.count * size_t(components), 0.0);
             for (size_t i = 0; i < a.count; ++i) decode(base + a.byteOffset + i * stride, values->data() + i * size_t(components));
         }
+        if (a.bufferView < 0) values->assign(a.count * size_t(components), 0.0);  // bounded above
         // Step: sparse substitutions.
         if (a.sparse.isSparse) {
             const auto& sp = a.sparse;
@@ -148,6 +161,23 @@ private:
     }
 
 public:
+    // The vertices and triangles mesh `mesh_index` adds per instance, from the accessors' counts
+    // alone (nothing read); out-of-range references count 0 (addMesh refuses them).
+    void countMesh(int mesh_index, size_t* vertices, size_t* triangles) const {
+        *vertices = *triangles = 0;
+        if (mesh_index < 0 || size_t(mesh_index) >= model_.meshes.size()) return;
+        auto count = [&](int accessor) -> size_t {
+            return accessor >= 0 && size_t(accessor) < model_.accessors.size() ? model_.accessors[size_t(accessor)].count : 0;
+        };
+        for (const tinygltf::Primitive& prim : model_.meshes[size_t(mesh_index)].primitives) {
+            auto pos = prim.attributes.find("POSITION");
+            if (pos == prim.attributes.end() || (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP)) continue;
+            const size_t nv = count(pos->second), n = prim.indices >= 0 ? count(prim.indices) : nv;
+            *vertices += nv;
+            *triangles += prim.mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : (n >= 2 ? n - 2 : 0);
+        }
+    }
+
     // Adds the triangles of mesh `mesh_index` placed by `world` (a node's world transform).
     bool addMesh(int mesh_index, const Affine& world) {
         if (size_t(mesh_index) >= model_.meshes.size())
@@ -178,7 +208,11 @@ public:
             for (size_t i = 0; i < nv; ++i) {
                 const Vec3 v{pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
                 if (!mesh4d::isFinite(v)) return fail(where + ".attributes.POSITION", "vertex " + std::to_string(i) + " is not finite");
-                out_->mesh.positions.push_back(world.apply(v));
+                // Derived, not only read: a finite node scale can still overflow the product.
+                const Vec3 placed = world.apply(v);
+                if (!mesh4d::isFinite(placed))
+                    return fail(where + ".attributes.POSITION", "vertex " + std::to_string(i) + " is not finite after the node transforms");
+                out_->mesh.positions.push_back(placed);
             }
 
             // Step: indices, or 0..n-1 for non-indexed primitives.
@@ -252,6 +286,25 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
         roots = rootNodes(model);
     }
     Reader reader(path, model, limits, out, warnings);
+    // Step: count what the node instances add before reading any of it: a small file whose nodes
+    // share children (a DAG) multiplies its meshes; the sum is what the limits bound.
+    size_t instances = 0, total_vertices = 0, total_triangles = 0;
+    const Status counted = walkNodes(path, model, roots, own_transform, [&](int node, const Affine&, const std::vector<int>&) {
+        size_t nv = 0, nt = 0;
+        reader.countMesh(model.nodes[size_t(node)].mesh, &nv, &nt);
+        if (nt) ++instances;
+        total_vertices += nv;
+        total_triangles += nt;
+        // One instance over a limit is refused by its accessor's count (readAccessor), naming it.
+        if (instances > 1 && total_triangles > limits.max_faces)
+            return Status::failure(path + ": nodes: " + std::to_string(instances) + " mesh instances hold more than " +
+                                   std::to_string(limits.max_faces) + " triangles after node expansion (raise with --max-faces)");
+        if (instances > 1 && total_vertices > limits.max_vertices)
+            return Status::failure(path + ": nodes: " + std::to_string(instances) + " mesh instances hold more than " +
+                                   std::to_string(limits.max_vertices) + " vertices after node expansion (raise with --max-vertices)");
+        return Status::success();
+    });
+    if (!counted.ok) return counted;
     const Status walked = walkNodes(path, model, roots, own_transform, [&](int node, const Affine& world, const std::vector<int>&) {
         const int mesh = model.nodes[size_t(node)].mesh;
         if (mesh >= 0 && !reader.addMesh(mesh, world)) return reader.status;

@@ -12,6 +12,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include "pipeline/input_file.h"
 #include "pipeline/mesh_check.h"
 #include "pipeline/openmesh_input.h"
 
@@ -36,25 +37,33 @@ bool parseFinite(const std::string& token, double* out) {
     return true;
 }
 
-// Scans the OBJ text for what OpenMesh would drop without a word.
-Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* scan) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return Status::failure(path + ": cannot open mesh file");
-    std::error_code ec;
-    if (const auto size = std::filesystem::file_size(path, ec); !ec && size > limits.max_file_bytes)
-        return Status::failure(path + ": " + std::to_string(size) + " bytes, larger than the limit of " +
-                               std::to_string(limits.max_file_bytes) + " bytes (raise with --max-file-bytes)");
+// Scans the OBJ text for what OpenMesh would drop without a word. Material libraries are never
+// read (nothing uses materials): each `mtllib` line is turned into a comment in `text`, so
+// OpenMesh cannot open the file it names (a device, a FIFO, a file outside every folder).
+Status scanObj(const std::string& path, std::string& text, const MeshLimits& limits, ScanResult* scan,
+               MeshWarnings* warnings) {
+    size_t mtllibs = 0;
     std::string line;
     size_t line_no = 0;
     auto fail = [&](const std::string& problem) {
         return Status::failure(path + ":" + std::to_string(line_no) + ": " + problem);
     };
-    while (std::getline(in, line)) {
+    for (size_t at = 0; at < text.size();) {
+        size_t end = text.find('\n', at);
+        if (end == std::string::npos) end = text.size();
+        const size_t line_start = at;
+        line.assign(text, at, end - at);
+        at = end + 1;
         ++line_no;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         std::istringstream ls(line);
         std::string key;
         if (!(ls >> key) || key[0] == '#') continue;
+        if (key == "mtllib") {
+            text[line_start + line.find_first_not_of(" \t")] = '#';
+            ++mtllibs;
+            continue;
+        }
         if (key == "v") {
             std::string tok;
             double xyz[3];
@@ -93,6 +102,9 @@ Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* sc
                 return fail("f: more than " + std::to_string(limits.max_faces) + " faces (raise with --max-faces)");
         }
     }
+    if (mtllibs)
+        warnings->other.push_back(std::to_string(mtllibs) +
+                                  " mtllib lines ignored (material libraries are not read)");
     if (scan->vertices == 0) return Status::failure(path + ": no vertices ('v' lines)");
     if (scan->faces == 0) return Status::failure(path + ": no usable faces ('f' lines)");
     return Status::success();
@@ -102,15 +114,19 @@ Status scanObj(const std::string& path, const MeshLimits& limits, ScanResult* sc
 
 Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
     // Step: scan for what the library would drop silently.
+    std::string text;
+    if (Status s = readRegularFile(path, limits.max_file_bytes, &text, "mesh file"); !s.ok) return s;
     ScanResult scan;
-    if (Status s = scanObj(path, limits, &scan); !s.ok) return s;
+    if (Status s = scanObj(path, text, limits, &scan, warnings); !s.ok) return s;
 
     // Step: read with OpenMesh; its own log lines become our counts.
     omerr().disable();
     omlog().disable();
     ObjMesh om;
     OpenMesh::IO::Options opt;
-    if (!OpenMesh::IO::read_mesh(om, path, opt)) return Status::failure(path + ": OpenMesh could not read the OBJ file");
+    MemoryBuffer buffer(text);
+    std::istream in(&buffer);
+    if (!OpenMesh::IO::read_mesh(om, in, ".obj", opt)) return Status::failure(path + ": OpenMesh could not read the OBJ file");
 
     return takeOpenMeshResult(om, scan, path, mesh, warnings);
 }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <streambuf>
 #include <string>
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
@@ -13,6 +14,25 @@
 #include "pipeline/mesh_input.h"
 
 namespace apparent {
+
+// An istream over bytes in memory, without copying them: OpenMesh reads the bytes our scan
+// checked, never the path a second time.
+// Seekable: OpenMesh's OBJ reader reads the text twice (vertices, then faces).
+struct MemoryBuffer : std::streambuf {
+    explicit MemoryBuffer(std::string& text) { setg(&text[0], &text[0], &text[0] + text.size()); }
+
+protected:
+    pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
+        const off_type base = dir == std::ios_base::beg ? 0 : dir == std::ios_base::cur ? gptr() - eback() : egptr() - eback();
+        const off_type to = base + off;
+        if (to < 0 || to > egptr() - eback()) return pos_type(off_type(-1));
+        setg(eback(), eback() + to, egptr());
+        return pos_type(to);
+    }
+    pos_type seekpos(pos_type pos, std::ios_base::openmode mode) override {
+        return seekoff(off_type(pos), std::ios_base::beg, mode);
+    }
+};
 
 struct OpenMeshDoubleTraits : OpenMesh::DefaultTraits {
     typedef OpenMesh::Vec3d Point;

@@ -16,6 +16,7 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "pipeline/mesh_check.h"
+#include "pipeline/input_file.h"
 #include "pipeline/openmesh_input.h"
 
 namespace apparent {
@@ -96,7 +97,7 @@ std::vector<std::string> splitWords(const std::string& line) {
 }
 
 // Parses the header lines up to `end_header`.
-bool parseHeader(const std::vector<char>& bytes, PlyHeader* h, std::string* problem) {
+bool parseHeader(const std::string& bytes, PlyHeader* h, std::string* problem) {
     size_t pos = 0, line_no = 0;
     bool has_format = false;
     for (;;) {
@@ -194,7 +195,7 @@ bool parseHeader(const std::vector<char>& bytes, PlyHeader* h, std::string* prob
 // Reads the values of the body, ascii or binary, one at a time.
 class BodyCursor {
 public:
-    BodyCursor(const std::vector<char>& bytes, size_t offset, PlyFormat format)
+    BodyCursor(const std::string& bytes, size_t offset, PlyFormat format)
         : p_(bytes.data() + offset), end_(bytes.data() + bytes.size()), format_(format) {}
 
     size_t remaining() const { return size_t(end_ - p_); }
@@ -277,7 +278,7 @@ private:
 typedef ScannedCounts ScanResult;  // what the scan counts (openmesh_input.h)
 
 // Checks the header and every value of the body before OpenMesh sees the file.
-Status scanPly(const std::string& path, const std::vector<char>& bytes, const MeshLimits& limits, ScanResult* scan) {
+Status scanPly(const std::string& path, const std::string& bytes, const MeshLimits& limits, ScanResult* scan) {
     PlyHeader h;
     std::string problem;
     if (!parseHeader(bytes, &h, &problem)) return Status::failure(path + ": " + problem);
@@ -384,27 +385,20 @@ Status scanPly(const std::string& path, const std::vector<char>& bytes, const Me
 
 Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
     // Step: read the whole file (size-limited) and scan it.
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec) return Status::failure(path + ": cannot open mesh file");
-    if (size > limits.max_file_bytes)
-        return Status::failure(path + ": " + std::to_string(size) + " bytes, larger than the limit of " +
-                               std::to_string(limits.max_file_bytes) + " bytes (raise with --max-file-bytes)");
-    std::vector<char> bytes(size_t(size), 0);
-    {
-        std::ifstream in(path, std::ios::binary);
-        if (!in || (size && !in.read(bytes.data(), std::streamsize(size)))) return Status::failure(path + ": cannot read mesh file");
-    }
+    std::string text;
+    if (Status s = readRegularFile(path, limits.max_file_bytes, &text, "mesh file"); !s.ok) return s;
     ScanResult scan;
-    if (Status s = scanPly(path, bytes, limits, &scan); !s.ok) return s;
-    bytes = {};
+    if (Status s = scanPly(path, text, limits, &scan); !s.ok) return s;
 
     // Step: read with OpenMesh; its own log lines become our counts.
     omerr().disable();
     omlog().disable();
     PlyMesh om;
     OpenMesh::IO::Options opt;
-    if (!OpenMesh::IO::read_mesh(om, path, opt)) return Status::failure(path + ": OpenMesh could not read the PLY file");
+    // From the bytes scanned, not the path again: the file cannot be swapped in between.
+    MemoryBuffer buffer(text);
+    std::istream in(&buffer);
+    if (!OpenMesh::IO::read_mesh(om, in, ".ply", opt)) return Status::failure(path + ": OpenMesh could not read the PLY file");
     if (om.n_vertices() < scan.vertices)
         return Status::failure(path + ": OpenMesh read " + std::to_string(om.n_vertices()) + " of " +
                                std::to_string(scan.vertices) + " vertices");

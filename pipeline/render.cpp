@@ -75,6 +75,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     OutputBudget budget(settings.max_output_bytes);
     FrameLoopSettings loop;
     loop.threads = settings.threads;
+    loop.max_frame_triangles = settings.max_frame_triangles;
     loop.cull_view = settings.cull_view;
     loop.progress = !settings.quiet;
     for (Model model : stage.models) {
@@ -90,7 +91,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         FrameLoopResult result;
         if (!runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error)) {
             err << "error: " << error << "\n";
-            return kExitOutputError;
+            return result.over_budget ? kExitBadInput : kExitOutputError;
         }
         // Step: the summary: the sinks' warnings and files, and the refinement limit if reached.
         std::string summary;

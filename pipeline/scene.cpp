@@ -13,6 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/input_file.h"
+#include "pipeline/mesh_input.h"
+#include "pipeline/json_limits.h"
+
 namespace apparent {
 
 using nlohmann::json;
@@ -93,15 +97,16 @@ Status readJsonScene(const json& root, const std::string& path, Scene* scene) {
 
 Status loadScene(const std::string& path, Scene* scene) {
     if (isGltfPath(path)) return loadGltfScene(path, scene);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        *scene = Scene{};
-        scene->path = path;
-        return Status::failure(path + ": cannot open scene file");
-    }
+    *scene = Scene{};
+    scene->path = path;
+    // Only a regular file, within the size limit of any input file, and nested shallowly enough
+    // for nlohmann's recursive dump (json_limits.h).
+    std::string text;
+    if (Status s = readRegularFile(path, MeshLimits{}.max_file_bytes, &text, "scene file"); !s.ok) return s;
+    if (Status s = checkJsonDepth(path, text, /*comments=*/true); !s.ok) return s;
     json root;
     try {
-        root = json::parse(in, nullptr, true, /*ignore_comments=*/true);
+        root = json::parse(text, nullptr, true, /*ignore_comments=*/true);
     } catch (const json::parse_error& e) {
         // nlohmann's message reads "[json.exception.parse_error.101] parse error at line 3, column 5: ...";
         // keep it from "line".

@@ -6,17 +6,20 @@
 #include <set>
 #include <sstream>
 
+#include "pipeline/json_limits.h"
+
 namespace apparent {
 
 using nlohmann::json;
 using mesh4d::Vec3;
 
 void FieldReader::fail(const std::string& path, const std::string& problem) {
-    if (status_->ok) *status_ = Status::failure(file_ + ": " + path + ": " + problem);
+    // Keys come from the file: printed escaped and cut, so the message stays one line.
+    if (status_->ok) *status_ = Status::failure(printable(file_, 4096) + ": " + printable(path) + ": " + printable(problem, 4096));
 }
 
 void FieldReader::warn(const std::string& path, const std::string& problem) {
-    warnings_.push_back(file_ + ": " + path + ": " + problem);
+    warnings_.push_back(printable(file_, 4096) + ": " + printable(path) + ": " + printable(problem, 4096));
 }
 
 std::string fieldList(const std::vector<std::string>& keys) {
@@ -106,9 +109,7 @@ void FieldReader::readNumber(const json& j, const std::string& path, double* out
 }
 
 std::string FieldReader::describe(const json& j) {
-    std::string s = j.dump();
-    if (s.size() > 40) s = s.substr(0, 37) + "...";
-    return std::string(j.type_name()) + " " + s;
+    return std::string(j.type_name()) + " " + jsonForMessage(j, 37);
 }
 
 std::string formatNumber(double v) {

@@ -1,14 +1,24 @@
 #include "pipeline/stage.h"
 
+#include <algorithm>
+#include <cmath>
 #include <ostream>
+
+#include "pipeline/scene_fields.h"
+
+#include "pipeline/json_limits.h"
 
 namespace apparent {
 
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error) {
     auto fail = [&](const std::string& message) {
-        *error = message;
+        *error = printable(message, 4096);  // one line, whatever a file or key holds
         return false;
     };
+    // Step: the scene's file name goes into the outputs (the .glb's extras are JSON, UTF-8 only):
+    // checked before any work, printed escaped.
+    if (!isValidUtf8(options.scene_path))
+        return fail(options.scene_path + ": the file name is not valid UTF-8 (it is written into the outputs; rename the file)");
     // Step: the scene, the tolerance override and the models it must be valid for.
     Scene& scene = stage->scene;
     if (Status s = loadScene(options.scene_path, &scene); !s.ok) return fail(s.message);
@@ -35,6 +45,44 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     if (Status s = prepareObjects(scene, options.limits, &stage->objects, log, options.quiet); !s.ok)
         return fail(s.message);
     if (Status s = findMirrors(stage->objects, scene.path, &stage->mirrors); !s.ok) return fail(s.message);
+    // Step: what the inputs derive, before any work: finite and in range, bounded in number.
+    if (options.max_object_frames <= 0) return fail("--max-object-frames: must be positive");
+    const long long frames = stage->last_excl - stage->first;
+    const long long slices_per_frame = (long long)stage->objects.size() * (1 + (long long)stage->mirrors.size());
+    if (slices_per_frame > options.max_object_frames / frames)
+        return fail(scene.path + ": objects: " + std::to_string(stage->objects.size()) + " objects x " +
+                    std::to_string(1 + stage->mirrors.size()) + " (themselves and " + std::to_string(stage->mirrors.size()) +
+                    " mirrors' reflections) x " + std::to_string(frames) + " frames exceed the limit of " +
+                    std::to_string(options.max_object_frames) + " object-frames (raise it with --max-object-frames)");
+    auto outOfRange = [](double v) { return !(std::fabs(v) <= kMaxCoordinate); };
+    for (const long long k : {stage->first, stage->last_excl - 1})
+        if (outOfRange(frameTime(scene.frames, k)) || outOfRange(frameTime(scene.frames, k) - scene.camera.instant_delay))
+            return fail(scene.path + ": frames, camera.instant_delay: the viewed time of frame " + std::to_string(k) +
+                        " is not finite or beyond " + formatNumber(kMaxCoordinate) + " s");
+    double largest = 0;
+    for (const PreparedObject& o : stage->objects) {
+        // Beyond 1e9 degrees an angle has no fractional degree left in a double.
+        const mesh4d::Vec3& r = o.spec.rotation_deg;
+        if (!(std::fabs(r.x) <= 1e9 && std::fabs(r.y) <= 1e9 && std::fabs(r.z) <= 1e9))
+            return fail(scene.path + ": " + o.spec.field_path + ".rotation_deg: beyond 1e9 degrees (no precision left)");
+        mesh4d::Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+        for (size_t i = 0; i < o.rest.positions.size(); ++i) {
+            const mesh4d::Vec3& p = o.rest.positions[i];
+            if (outOfRange(p.x) || outOfRange(p.y) || outOfRange(p.z) || outOfRange(p.x + o.spec.position.x) ||
+                outOfRange(p.y + o.spec.position.y) || outOfRange(p.z + o.spec.position.z))
+                return fail(scene.path + ": " + o.spec.field_path + ": vertex " + std::to_string(i) +
+                            " after scale, rotation_deg and position is not finite or beyond " + formatNumber(kMaxCoordinate) +
+                            " light-seconds");
+            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+        if (!o.rest.positions.empty()) largest = std::max(largest, mesh4d::norm(hi - lo));
+    }
+    const double floor = kToleranceFloorRelative * largest;
+    if (scene.tolerance > 0 && scene.tolerance < floor)
+        return fail(scene.path + ": tolerance (or --tolerance): " + formatNumber(scene.tolerance) + " light-seconds is below the floor of " +
+                    formatNumber(floor) + " (1e-6 of the largest object's size, " + formatNumber(largest) +
+                    "; float32 output cannot show finer): use a coarser --tolerance, or 'vertex'");
     return true;
 }
 

@@ -15,6 +15,16 @@
 
 namespace apparent {
 
+constexpr long long kDefaultMaxObjectFrames = 1'000'000;
+// Coordinates and times a scene may reach after every transform, light-seconds (about 32 000
+// years): beyond, squares and differences lose all digits a frame needs. Derived quantities
+// (scaled and rotated vertices, positions at the frame times, the camera's look-back) are checked.
+constexpr double kMaxCoordinate = 1e12;
+// --tolerance may not be finer than this fraction of the largest object's size: float32 output
+// (relative to a local origin) resolves about 6e-8 of it, and a finer tolerance only multiplies
+// triangles (1e-300 made 69M triangles for one frame).
+constexpr double kToleranceFloorRelative = 1e-6;
+
 // Exit codes of every command.
 constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;
@@ -30,6 +40,9 @@ struct StageOptions {
     long long frame_to = -1;           // -1: to the last frame of the scene
     long long max_frames = kDefaultMaxFrames;  // --max-frames: scenes with more frames are refused
     MeshLimits limits;                 // --max-vertices, --max-faces, --max-file-bytes, --allow-outside
+    // --max-object-frames: objects (each mirror's reflections of them included) times frames in
+    // the range; every one is a cut per frame and a primitive of the .glb.
+    long long max_object_frames = kDefaultMaxObjectFrames;
     bool quiet = false;                // no mesh warnings
 };
 
@@ -42,7 +55,10 @@ struct Stage {
 };
 
 // Loads and validates the scene, the models, the frame count (against max_frames) and range, every
-// mesh and the mirrors, in that order. On failure: false, and the one line to print (without
+// mesh and the mirrors, in that order; then what they derive: every transformed vertex finite and
+// within kMaxCoordinate, the camera's look-back and frame times within it, the tolerance not
+// below kToleranceFloorRelative of the largest object, objects x (1 + mirrors) x frames within
+// max_object_frames. On failure: false, and the one line to print (without
 // "error: ") in `error`; the command exits with kExitBadInput. Mesh warnings go to `log`.
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error);
 

@@ -19,6 +19,10 @@ targets=("$@")
 # Inputs per target: sized so that build plus all runs take about 6 minutes on 2 cores (the glTF
 # harnesses run about 5 times slower than the others: tinygltf and Draco per input).
 declare -A runs=([scene]=300000 [obj]=200000 [ply]=300000 [gltf]=50000 [glb]=60000)
+# The JSON readers take inputs up to 1 MiB (deep nesting needs room: 100 000 levels are 200 KB)
+# with a dictionary of nesting tokens; the mesh text formats up to 64 KiB.
+declare -A max_len=([scene]=1048576 [obj]=65536 [ply]=65536 [gltf]=1048576 [glb]=1048576)
+declare -A dict=([scene]=json_nesting.dict [gltf]=json_nesting.dict [glb]=json_nesting.dict)
 
 # Debian 12's clang-14 (the package installs clang++-14; the `clang` package adds the clang++ link).
 cxx=$(command -v clang++-14 || command -v clang++ || true)
@@ -43,9 +47,11 @@ for t in "${targets[@]}"; do
   mkdir -p "$build/fuzz-work/$t" "$build/fuzz-artifacts/$t"
   log="$build/fuzz-$t.log"
   start=$(date +%s)
-  # -max_len: inputs up to 64 KiB; -timeout: one input may take 10 s; -rss_limit_mb and
+  # -max_len: see max_len above; -timeout: one input may take 10 s; -rss_limit_mb and
   # -malloc_limit_mb: a reader that allocates what a header asks for is reported as a bug.
-  if "$build/tests/fuzz/fuzz_$t" -runs="$n" -seed="$seed" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+  dict_arg=()
+  [ -z "${dict[$t]:-}" ] || dict_arg=(-dict="tests/fuzz/${dict[$t]}")
+  if "$build/tests/fuzz/fuzz_$t" -runs="$n" -seed="$seed" -max_len="${max_len[$t]}" "${dict_arg[@]}" -timeout=10 -rss_limit_mb=2048 \
        -malloc_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$build/fuzz-artifacts/$t/" \
        "$build/fuzz-work/$t" "$build/fuzz-seeds/$t" >"$log" 2>&1; then
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")

@@ -377,11 +377,16 @@ TEST(Cli, OutputIsIdenticalForAnyThreadCount) {
     }
 }
 
-// An absurdly fine tolerance stops at the refinement limit with a warning, not a crash.
+// An absurdly fine tolerance is refused up front (below 1e-6 of the object's size, issue 15); one
+// just above that floor stops at the refinement limit with a warning, not a crash.
 TEST(Cli, AbsurdToleranceHitsTheLimitWithAWarning) {
     TempDir dir;
-    const CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(),
-                                         "--frames", "0:1", "--tolerance", "1e-20"});
+    CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(),
+                                   "--frames", "0:1", "--tolerance", "1e-20"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("light-seconds is below the floor of"), std::string::npos) << r.err;
+    r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(), "--frames", "0:1",
+                     "--tolerance", "4e-6"});
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("reached the refinement limit"), std::string::npos) << r.err;
 }

@@ -4,18 +4,23 @@
 // disk) leaving the previous file untouched and no temporary file behind.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <csignal>
+#include <iostream>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "exporters/atomic_file.h"
 #include "exporters/ply.h"
 #include "pipeline/cli.h"
 #include "run_command.h"
+#include "pipeline/json_limits.h"
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
 #include "pipeline/scene.h"
@@ -211,4 +216,444 @@ TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
     EXPECT_NE(error.find("frame_00000.ply: cannot write (4096 of "), std::string::npos) << error;
     EXPECT_EQ(slurp(path), previous);
     EXPECT_EQ(filesUnder(box / "out").size(), 1u);
+}
+
+namespace {
+
+// A one-object scene in `dir` whose mesh is `mesh` (relative to the scene).
+std::string writeScene(const fs::path& dir, const std::string& mesh, const std::string& extra_object_fields = "") {
+    const fs::path scene = dir / ("scene_" + std::to_string(std::hash<std::string>{}(mesh + extra_object_fields)) + ".json");
+    std::ofstream(scene) << R"({ "frames": { "start": 10, "end": 10.2, "fps": 10 }, "objects": [ { "name": "t", "mesh": ")"
+                         << mesh << R"(", "position": [0, 0, -10])" << extra_object_fields << " } ] }";
+    return scene.string();
+}
+
+size_t lineCount(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
+
+// A minimal glTF (one triangle, buffer inlined) whose `extras` text is given.
+std::string gltfWithExtras(const std::string& extras) {
+    // Three float32 VEC3 positions: (0,0,0), (1,0,0), (0,1,0), base64 of 36 bytes.
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0],"extras":)" + extras +
+           R"(}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+           R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+           R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+}
+
+}  // namespace
+
+// Issue 15, item 1: an OBJ's material library is never opened (nothing uses materials), wherever
+// it points; a FIFO or a device given as any input is refused before it is read (no hang).
+TEST(HostileInput, MaterialLibrariesAreNeverReadAndOnlyRegularFilesAre) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    ::mkfifo((box / "s/pipe.mtl").c_str(), 0600);  // opening it for reading would block forever
+    std::ofstream(box / "s/m.obj") << "mtllib ../../../../../../../../dev/zero\nmtllib pipe.mtl\nmtllib /etc/passwd\n"
+                                   << slurp(source("data/fixtures/tetra.obj"));
+    const std::string scene = writeScene(box / "s", "m.obj");
+    fs::current_path(box / "s");
+    CommandResult r = apparentRun({"render", scene, "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("m.obj: 3 mtllib lines ignored (material libraries are not read)"), std::string::npos) << r.err;
+
+    // Non-regular inputs: a FIFO mesh, a device mesh (outside allowed), a FIFO scene, a folder.
+    ::mkfifo((box / "s/f.obj").c_str(), 0600);
+    ::mkfifo((box / "s/f.json").c_str(), 0600);
+    fs::create_directories(box / "s/d.ply");
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", writeScene(box / "s", "f.obj")}, "f.obj: is a FIFO, not a regular file (refused)"},
+        {{"render", writeScene(box / "s", "/dev/zero.obj"), "--allow-outside"}, "cannot open"},
+        {{"render", writeScene(box / "s", "d.ply")}, "d.ply: is a folder, not a regular file (refused)"},
+        {{"render", (box / "s/f.json").string()}, "f.json: is a FIFO, not a regular file (refused)"},
+    };
+    for (const auto& [args, expected] : cases) {
+        std::vector<std::string> a = args;
+        a.insert(a.end(), {"--out", (box / "out2").string()});
+        r = apparentRun(a);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    // A device reached through a symlink is refused as what it resolves to.
+    fs::create_symlink("/dev/zero", box / "s/z.obj");
+    r = apparentRun({"render", writeScene(box / "s", "z.obj"), "--out", (box / "out2").string(), "--allow-outside"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("z.obj: is a character device, not a regular file (refused)"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out2"));
+}
+
+// Issue 15, item 2: nesting deeper than kMaxJsonDepth is refused before any recursive parse or
+// dump (a 100 000-deep array crashed json::dump in the error message; deep glTF extras crashed
+// tinygltf), as a scene, as a glTF mesh and as a glTF scene; keys print escaped on one line.
+TEST(HostileInput, DeepNestingAndControlCharactersGiveOneLine) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    const size_t deep = 100000;
+    const std::string nested = std::string(deep, '[') + std::string(deep, ']');
+    std::ofstream(box / "s/deep.json") << R"({ "frames": { "start": 10, "end": 10.2, "fps": 10 }, "objects": [ { "mesh": "tetra.obj", "position": )"
+                                       << nested << " } ] }";
+    const std::string deep_extras = "{\"a\":" + std::string(deep, '[') + std::string(deep, ']') + "}";
+    std::ofstream(box / "s/deep.gltf") << gltfWithExtras(deep_extras);
+    std::ofstream(box / "s/ok.gltf") << gltfWithExtras("{\"frames\":{\"start\":0,\"end\":0.2,\"fps\":10}}");
+    fs::current_path(box / "s");
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", (box / "s/deep.json").string()}, "deep.json: JSON nested deeper than 128 levels at byte "},
+        {{"render", writeScene(box / "s", "deep.gltf")}, "deep.gltf: JSON nested deeper than 128 levels at byte "},
+        {{"render", (box / "s/deep.gltf").string()}, "deep.gltf: JSON nested deeper than 128 levels at byte "},
+    };
+    for (const auto& [args, expected] : cases) {
+        std::vector<std::string> a = args;
+        a.insert(a.end(), {"--out", (box / "out").string()});
+        const CommandResult r = apparentRun(a);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    // The depth bound is what decides: 128 levels pass the check, 129 do not.
+    EXPECT_TRUE(checkJsonDepth("x", std::string(128, '[') + std::string(128, ']')).ok);
+    EXPECT_FALSE(checkJsonDepth("x", std::string(129, '{') + std::string(129, '}')).ok);
+    EXPECT_TRUE(checkJsonDepth("x", "[\"" + std::string(500, '[') + "\"]").ok);         // brackets in a string
+    EXPECT_TRUE(checkJsonDepth("x", "[\"\\\"" + std::string(500, '[') + "\"]").ok);     // after an escaped quote
+    EXPECT_TRUE(checkJsonDepth("x", "[ // " + std::string(500, '[') + "\n]", true).ok);  // in a comment
+
+    // A key with newlines that imitate a success line, and a value with a control character:
+    // printed escaped, one line.
+    std::ofstream(box / "s/key.json")
+        << "{ \"frames\": { \"start\": 10, \"end\": 10.2, \"fps\": 10 }, \"objects\": [ { \"mesh\": \"tetra.obj\", "
+           "\"position\": [0,0,-10], \"pos\\nrelativistic: 2 frames written\": 1 } ] }";
+    CommandResult r = apparentRun({"render", (box / "s/key.json").string(), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("objects[0].pos\\nrelativistic: 2 frames written: unknown field"), std::string::npos) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    std::ofstream(box / "s/value.json")
+        << "{ \"frames\": { \"start\": 10, \"end\": 10.2, \"fps\": 10 }, \"objects\": [ { \"mesh\": \"tetra.obj\", "
+           "\"position\": \"a\\u0007\\nb" << std::string(5000, 'x') << "\" } ] }";
+    r = apparentRun({"render", (box / "s/value.json").string(), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("objects[0].position: expected an array of 3 numbers, got string \"a\\u0007\\nb"), std::string::npos) << r.err;
+    EXPECT_LT(r.err.size(), 300u) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out"));
+    EXPECT_EQ(printable("a\xff\n\x1b", 100), "a\\xFF\\n\\u001B");
+}
+
+// Issue 15, item 5: temporaries are created exclusively under unguessable names: a symlink
+// planted at the old predictable name (".NAME.tmp-PID.EXT") or anywhere else is never written
+// through, the final name never becomes a link, and the .glb's spill file has no name at all.
+TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
+    Sandbox box;
+    fs::create_directories(box / "out/relativistic");
+    std::ofstream(box / "victim.txt") << "precious";
+    const std::string pid = std::to_string(::getpid());
+    for (const std::string name : {".relativistic.tmp-" + pid + ".glb", ".relativistic.glb.tmp-" + pid + ".bin",
+                                   "relativistic/.frame_00000.tmp-" + pid + ".ply",
+                                   "relativistic/.frame_00000.tmp-" + pid + ".obj"})
+        fs::create_symlink(box / "victim.txt", box / "out" / name);
+    const CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out",
+                                         (box / "out").string(), "--format", "glb,ply,obj", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(slurp(box / "victim.txt"), "precious");
+    EXPECT_FALSE(fs::is_symlink(box / "out/relativistic.glb"));
+    EXPECT_TRUE(fs::is_regular_file(box / "out/relativistic.glb"));
+    // Only the planted links and the outputs: no temporary file, no spill file left.
+    for (const auto& e : fs::recursive_directory_iterator(box / "out")) {
+        const std::string name = e.path().filename().string();
+        if (fs::is_symlink(e.path())) continue;
+        EXPECT_EQ(name.find(".tmp-"), std::string::npos) << e.path();
+    }
+
+    // The rename checks that the temporary name is still the file created: a symlink swapped in
+    // while writing is not renamed into place.
+    {
+        AtomicOutput out((box / "out/swap.ply").string());
+        ASSERT_GE(out.fd(), 0) << out.openError();
+        EXPECT_NE(out.tempPath().find("/.swap.tmp-" + pid + "-"), std::string::npos) << out.tempPath();
+        fs::remove(out.tempPath());
+        fs::create_symlink(box / "victim.txt", out.tempPath());
+        std::string error;
+        EXPECT_FALSE(out.commitBytes("overwritten", &error));
+        EXPECT_NE(error.find("was replaced while writing (not renamed into place)"), std::string::npos) << error;
+        fs::remove(out.tempPath());
+    }
+    EXPECT_FALSE(fs::exists(box / "out/swap.ply"));
+    EXPECT_EQ(slurp(box / "victim.txt"), "precious");
+    // Two outputs to one final name get two temporary names.
+    AtomicOutput a((box / "out/x.png").string()), b((box / "out/x.png").string());
+    EXPECT_NE(a.tempPath(), b.tempPath());
+    // The spill file: open, writable, and without a name in its folder.
+    std::string error;
+    const int fd = openAnonymousFile((box / "out").string(), &error);
+    ASSERT_GE(fd, 0) << error;
+    EXPECT_EQ(::write(fd, "abc", 3), 3);
+    struct stat st {};
+    ASSERT_EQ(::fstat(fd, &st), 0);
+    EXPECT_EQ(st.st_nlink, 0u);
+    ::close(fd);
+}
+
+// Issue 15, item 6: confinement is decided on resolved paths everywhere a file is opened: a
+// buffer named inside the glTF's folder that is a symlink to a file outside is refused, by the
+// Draco pre-check (which read it and printed its size) and by tinygltf's file callbacks alike.
+TEST(HostileInput, SymlinkedBuffersOutsideTheGltfFolderAreRefused) {
+    Sandbox box;
+    fs::create_directories(box / "g");
+    fs::create_directories(box / "secret");
+    std::ofstream(box / "secret/data.bin") << std::string(1234, 's');
+    fs::create_symlink(box / "secret/data.bin", box / "g/buf.bin");
+    const std::string draco =
+        R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],)"
+        R"("scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},)"
+        R"("extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],)"
+        R"("accessors":[{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":1234}],"buffers":[{"byteLength":1234,"uri":"buf.bin"}]})";
+    const std::string plain =
+        R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":1234,"uri":"buf.bin"}]})";
+    std::ofstream(box / "g/draco.gltf") << draco;
+    std::ofstream(box / "g/plain.gltf") << plain;
+    for (const char* name : {"draco.gltf", "plain.gltf"}) {
+        LoadedMesh mesh;
+        MeshWarnings w;
+        const Status st = readMesh((box / "g" / name).string(), {}, &mesh, &w);
+        EXPECT_FALSE(st.ok) << name;
+        EXPECT_NE(st.message.find("is outside the glTF file's folder (refused)"), std::string::npos) << st.message;
+        EXPECT_EQ(st.message.find("1234"), std::string::npos) << st.message;
+        EXPECT_EQ(st.message.find('\n'), std::string::npos) << st.message;
+    }
+    // The same buffer as a regular file inside the folder is read (and, short, refused for that).
+    fs::remove(box / "g/buf.bin");
+    fs::copy_file(box / "secret/data.bin", box / "g/buf.bin");
+    LoadedMesh mesh;
+    MeshWarnings w;
+    const Status st = readMesh((box / "g/plain.gltf").string(), {}, &mesh, &w);
+    EXPECT_EQ(st.message.find("outside"), std::string::npos) << st.message;
+}
+
+namespace {
+
+// Runs `apparent ARGS` in a child process: its exit code, stderr, peak RSS (getrusage of the
+// child, bytes) and wall time, so that a refused input is shown to stay small and quick.
+struct Measured {
+    int code = -1;
+    std::string err;
+    long long peak_rss = 0;
+    double seconds = 0;
+};
+
+Measured runMeasured(const std::vector<std::string>& args) {
+    int pipe_fd[2];
+    EXPECT_EQ(::pipe(pipe_fd), 0);
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::close(pipe_fd[0]);
+        const CommandResult r = apparentRun(args);
+        const ssize_t ignored = ::write(pipe_fd[1], r.err.data(), r.err.size());
+        (void)ignored;
+        ::_exit(r.code);
+    }
+    ::close(pipe_fd[1]);
+    Measured m;
+    char buf[4096];
+    for (ssize_t n; (n = ::read(pipe_fd[0], buf, sizeof buf)) > 0;) m.err.append(buf, size_t(n));
+    ::close(pipe_fd[0]);
+    int status = 0;
+    rusage usage{};
+    ::wait4(pid, &status, 0, &usage);
+    m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    m.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    m.peak_rss = (long long)usage.ru_maxrss * 1024;
+    return m;
+}
+
+void expectRefusedSmall(const Measured& m, int code, const std::string& expected) {
+    EXPECT_EQ(m.code, code) << m.err;
+    EXPECT_NE(m.err.find(expected), std::string::npos) << m.err;
+    EXPECT_EQ(lineCount(m.err), 1u) << m.err;
+    EXPECT_LT(m.peak_rss, 500LL << 20) << expected;
+    EXPECT_LT(m.seconds, 30.0) << expected;
+    std::cout << "  refused in " << m.seconds << " s, peak RSS " << (m.peak_rss >> 20) << " MB: " << m.err;
+}
+
+std::string base64Zeros(size_t bytes) { return std::string(bytes / 3 * 4, 'A'); }  // bytes: a multiple of 3
+
+}  // namespace
+
+// Issue 15, item 3: small inputs that would exhaust memory are refused before the work, each
+// with one line naming the file, the field and the limit, within 500 MB of peak RSS.
+TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    fs::current_path(box / "s");
+    const std::string out = (box / "out").string();
+
+    // A DAG of nodes, each listing the next twice: 2^19 instances of a 100-triangle mesh (52M
+    // triangles) from a file of a few KB; counted on the accessors before anything is read.
+    {
+        std::string nodes;
+        const int levels = 19;
+        for (int i = 0; i < levels; ++i)
+            nodes += (i ? "," : "") + std::string("{\"mesh\":0,\"children\":[") + std::to_string(i + 1) + "," +
+                     std::to_string(i + 1) + "]}";
+        nodes += ",{\"mesh\":0}";
+        std::ofstream(box / "s/dag.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[)" << nodes
+            << R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":300,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
+               R"("bufferViews":[{"buffer":0,"byteLength":3600}],"buffers":[{"byteLength":3600,"uri":"data:application/octet-stream;base64,)"
+            << base64Zeros(3600) << "\"}]}";
+        EXPECT_LT(fs::file_size(box / "s/dag.gltf"), 10000u);
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "dag.gltf"), "--out", out}), 2,
+                           "dag.gltf: nodes: 166667 mesh instances hold more than 50000000 vertices after node expansion "
+                           "(raise with --max-vertices)");
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "dag.gltf"), "--out", out, "--max-vertices", "200000000"}),
+                           2, "dag.gltf: nodes: 500001 mesh instances hold more than 50000000 triangles after node expansion "
+                              "(raise with --max-faces)");
+    }
+    // 50M elements declared without a bufferView in a few hundred bytes: refused before allocating.
+    {
+        std::ofstream(box / "s/declared.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}]})";
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "declared.gltf"), "--out", out}), 2,
+                           "declared.gltf: accessors[0].count: 49999998 elements without a bufferView, more than the 0 "
+                           "bytes of the file's buffers (refused)");
+    }
+    // The same count in an accessor whose bufferView holds 36 bytes: checked before allocating.
+    {
+        std::ofstream(box / "s/short_view.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
+               R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)"
+            << base64Zeros(36) << "\"}]}";
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "short_view.gltf"), "--out", out}), 2,
+                           "short_view.gltf: accessors[0]: count 49999998 with byteOffset 0 reaches past bufferViews[0] (36 bytes)");
+    }
+    // A tolerance below the floor (1e-6 of the object's size) is refused up front.
+    expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj"), "--out", out, "--tolerance", "1e-300"}), 2,
+                       "tolerance (or --tolerance): 1e-300 light-seconds is below the floor of 3.4641016151377543e-06");
+    // The per-frame triangle budget: a fine tolerance within the floor stops at --max-triangles.
+    expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj", R"(, "velocity": [0.9, 0, 0])"), "--out",
+                                    out, "--tolerance", "1e-5", "--max-triangles", "2000"}),
+                       2, "makes more than 2000 triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles");
+    // 10 000 objects x 200 frames: refused before any mesh is cut.
+    {
+        std::ofstream scene(box / "s/many.json");
+        scene << R"({ "frames": { "start": 0, "end": 20, "fps": 10 }, "objects": [)";
+        for (int i = 0; i < 10000; ++i) scene << (i ? "," : "") << R"({ "mesh": "tetra.obj", "position": [0, 0, -10] })";
+        scene << "] }";
+    }
+    expectRefusedSmall(runMeasured({"render", (box / "s/many.json").string(), "--out", out}), 2,
+                       "many.json: objects: 10000 objects x 1 (themselves and 0 mirrors' reflections) x 200 frames exceed "
+                       "the limit of 1000000 object-frames (raise it with --max-object-frames)");
+    EXPECT_TRUE(filesUnder(out).empty());
+}
+
+// Issue 15, item 7: derived quantities are checked, not only the inputs: a scale or rotation
+// that sends vertices beyond range, a glTF node scale that overflows, a look-back beyond range.
+TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    fs::current_path(box / "s");
+    std::ofstream(box / "s/scaled.gltf") << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+                                            R"("nodes":[{"mesh":0,"scale":[3e38,3e38,3e38],"children":[1]},{"mesh":0,"scale":[3e38,3e38,3e38]}],)"
+                                            R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+                                            R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+                                            R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                                            R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {R"(, "scale": 1e300)", "objects[0]: vertex 0 after scale, rotation_deg and position is not finite or beyond 1000000000000"},
+        {R"(, "scale": [1e308, 1e308, 1e308])", "after scale, rotation_deg and position is not finite or beyond"},
+        {R"(, "rotation_deg": [1e300, 0, 0])", "objects[0].rotation_deg: beyond 1e9 degrees (no precision left)"},
+    };
+    for (const auto& [fields, expected] : cases) {
+        const CommandResult r = apparentRun({"render", writeScene(box / "s", "tetra.obj", fields), "--out", (box / "out").string()});
+        EXPECT_EQ(r.code, 2) << fields << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    CommandResult r = apparentRun({"render", writeScene(box / "s", "scaled.gltf"), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("is not finite or beyond"), std::string::npos) << r.err;
+    // A finite node scale (1e300) times a float vertex (3e38) overflows double itself: refused by
+    // the reader (the glTF fuzzer's harness requires finite positions of every mesh read).
+    {
+        const float vertices[9] = {0, 0, 0, 3e38f, 0, 0, 0, 1, 0};
+        std::ofstream(box / "s/big.bin", std::ios::binary).write(reinterpret_cast<const char*>(vertices), sizeof vertices);
+        std::ofstream(box / "s/overflow.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0,"scale":[1e300,1e300,1e300]}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[3e38,1,0]}],)"
+               R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"big.bin"}]})";
+        LoadedMesh mesh;
+        MeshWarnings w;
+        const Status st = readMesh((box / "s/overflow.gltf").string(), {}, &mesh, &w);
+        EXPECT_FALSE(st.ok);
+        EXPECT_NE(st.message.find("overflow.gltf: meshes[0].primitives[0].attributes.POSITION: vertex 1 is not finite after the node transforms"),
+                  std::string::npos) << st.message;
+    }
+    std::ofstream(box / "s/delay.json") << R"({ "camera": { "instant_delay": 1e308 }, "model": "instant", "frames": { "start": 10, "end": 10.2, "fps": 10 },
+        "objects": [ { "mesh": "tetra.obj", "position": [0, 0, -10] } ] })";
+    r = apparentRun({"render", (box / "s/delay.json").string(), "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("delay.json: frames, camera.instant_delay: the viewed time of frame 0 is not finite or beyond"),
+              std::string::npos) << r.err;
+    // Draco view offsets as huge floats (a float-to-size_t overflow, UBSan): refused on the JSON.
+    std::ofstream(box / "s/draco_huge.gltf")
+        << R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"scene":0,"scenes":[{"nodes":[0]}],)"
+           R"("nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},)"
+           R"("extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],)"
+           R"("accessors":[{"componentType":5126,"count":3,"type":"VEC3"}],)"
+           R"("bufferViews":[{"buffer":0,"byteOffset":1e300,"byteLength":4}],"buffers":[{"byteLength":1e301,"uri":"data:,"}]})";
+    LoadedMesh mesh;
+    MeshWarnings w;
+    const Status st = readMesh((box / "s/draco_huge.gltf").string(), {}, &mesh, &w);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("bufferViews[0] or buffers[0]: byteOffset and byteLength must be integers from 0 to 2^53"),
+              std::string::npos) << st.message;
+    EXPECT_FALSE(fs::exists(box / "out"));
+}
+
+// Issue 15, item 8: a scene file name that is not UTF-8 is refused up front (it rendered every
+// frame, then failed in the .glb's JSON); --max-output-bytes counts the .glb's JSON side before
+// writing it.
+TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    fs::copy_file(source("data/fixtures/tetra.obj"), box / "s/tetra.obj");
+    fs::current_path(box / "s");
+    const std::string good = writeScene(box / "s", "tetra.obj");
+    const std::string bad = (box / "s/sc\xff\xfe\ne.json").string();
+    fs::copy_file(good, bad);
+    CommandResult r = apparentRun({"render", bad, "--out", (box / "out").string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("sc\\xFF\\xFE\\ne.json: the file name is not valid UTF-8"), std::string::npos) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(box / "out"));
+
+    // Many frames of a tiny mesh: the JSON side dominates the .glb; the limit lies between the
+    // least size of the frames (what was counted before) and the real file.
+    std::ofstream(box / "s/long.json")
+        << R"({ "frames": { "start": 10, "end": 60, "fps": 10 }, "objects": [ { "mesh": "tetra.obj", "position": [0, 0, -10] } ] })";
+    r = apparentRun({"render", (box / "s/long.json").string(), "--out", (box / "full").string(), "--tolerance", "vertex", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto full = fs::file_size(box / "full/relativistic.glb");
+    r = apparentRun({"render", (box / "s/long.json").string(), "--out", (box / "out").string(), "--tolerance", "vertex",
+                     "--max-output-bytes", std::to_string(full / 2)});
+    EXPECT_EQ(r.code, 3) << r.err;
+    EXPECT_NE(r.err.find("--max-output-bytes: " + (box / "out/relativistic.glb").string() + " would bring the output to " +
+                         std::to_string(full) + " bytes"),
+              std::string::npos) << r.err;
+    EXPECT_TRUE(filesUnder(box / "out").empty());
+    // --threads is bounded (10 000 000 crashed TBB).
+    r = apparentRun({"render", good, "--out", (box / "out").string(), "--threads", "10000000"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--threads: 10000000 is outside 0 (all cores) .. 1024"), std::string::npos) << r.err;
 }

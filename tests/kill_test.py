@@ -6,10 +6,10 @@
    some but not all frame files were replaced. Every file under a final name must be complete:
    each PLY walks from its header to exactly its last byte, the .glb's header length equals its
    size and its chunks parse, and the .glb is still the first run's (it is written last).
-   Leftovers may only be temporary files named ".frame_NNNNN.tmp-PID.ply", ".MODEL.tmp-PID.glb"
-   or ".MODEL.glb.tmp-PID.bin" (the .glb writer's spill file of frame data).
-3. The same run stopped by SIGTERM and by SIGINT: exit 143 and 130 with a one-line message,
-   no temporary file left, every file complete.
+   Leftovers may only be temporary files named ".frame_NNNNN.tmp-PID-RANDOM.ply" or
+   ".MODEL.tmp-PID-RANDOM.glb" (the .glb writer's spill file of frame data has no name: never left).
+3. The same run stopped by SIGTERM, SIGINT and SIGHUP: exit 143, 130 and 129 with a one-line
+   message, no temporary file left, every file complete.
 4. The same run under a file size limit (RLIMIT_FSIZE, as a full disk): exit 3 with a one-line
    error, no temporary file left, every file complete.
 Usage: kill_test.py APPARENT SOURCE_DIR
@@ -30,8 +30,8 @@ import time
 APPARENT, SRC = sys.argv[1], sys.argv[2]
 SCENE = os.path.join(SRC, "data", "scenes", "flanges.json")
 FINAL = re.compile(r"^(frame_\d{5}\.ply|[a-z]+\.glb)$")
-# AtomicOutput's temporary names: ".STEM.tmp-PID.EXT" (frames, the .glb, the .glb writer's spill file).
-TEMP = re.compile(r"^\.(frame_\d{5}|[a-z]+|[a-z]+\.glb)\.tmp-\d+\.(ply|glb|bin)$")
+# AtomicOutput's temporary names: ".STEM.tmp-PID-RANDOM.EXT" (frames, the .glb).
+TEMP = re.compile(r"^\.(frame_\d{5}|[a-z]+)\.tmp-\d+-[a-z0-9]{12}\.(ply|glb)$")
 PLY_TYPES = {"char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h",
              "ushort": "H", "uint16": "H", "int": "i", "int32": "i", "uint": "I", "uint32": "I",
              "float": "f", "float32": "f", "double": "d", "float64": "d"}
@@ -165,8 +165,9 @@ def main():
         for t in temps:
             os.remove(t)
 
-        # Step 3: SIGTERM and SIGINT clean up after themselves.
-        for sig, want, word in ((signal.SIGTERM, 143, "terminated (SIGTERM)"), (signal.SIGINT, 130, "interrupted (SIGINT)")):
+        # Step 3: SIGTERM, SIGINT and SIGHUP clean up after themselves.
+        for sig, want, word in ((signal.SIGTERM, 143, "terminated (SIGTERM)"), (signal.SIGINT, 130, "interrupted (SIGINT)"),
+                                (signal.SIGHUP, 129, "hung up (SIGHUP)")):
             label = signal.Signals(sig).name
             code, err = interrupted_run(out, sig, label)
             check(code == want, "%s: exit %s, want %d" % (label, code, want))

@@ -97,6 +97,16 @@ def main():
                 with open(os.path.join(out, "glb", hashlib.sha1(glb).hexdigest()), "wb") as f:
                     f.write(glb)
         print("%s: %d of %d files (<= %d bytes), %d seeds in all" % (target, kept, len(paths), max_bytes, len(os.listdir(folder))))
+    # Generated nesting seeds (issue 15): just under and over the depth limit (128), and deep.
+    for depth in (127, 129, 5000):
+        nested = "[" * depth + "]" * depth
+        scene = ('{"frames": {"start": 0, "end": 1, "fps": 2}, "objects": [{"mesh": "m.obj", "position": %s}]}' % nested)
+        gltf = ('{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0], "extras": {"a": %s}}], "nodes": [{"extras": %s}]}'
+                % (nested, nested))
+        for target, text in (("scene", scene), ("gltf", gltf)):
+            data = text.encode()
+            with open(os.path.join(out, target, hashlib.sha1(data).hexdigest()), "wb") as f:
+                f.write(data)
 
 
 if __name__ == "__main__":
