@@ -6,12 +6,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <ostream>
 #include <sstream>
 #include <unistd.h>
 
+#include "exporters/atomic_file.h"
 #include "exporters/gltf.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/subdivide.h"
@@ -113,21 +113,31 @@ TradeRow measure(const Stage& stage, const std::vector<PreparedObject>& objects,
     return row;
 }
 
-// Writes DIR/trade.gp and runs gnuplot on it, when gnuplot is installed.
+// A whole file written under a temporary name and renamed into place (exporters/atomic_file.h).
+bool writeFile(const std::string& path, const std::string& bytes, std::ostream& err) {
+    AtomicOutput file(path);
+    std::string error;
+    if (file.fd() < 0) error = file.openError();
+    else if (file.commitBytes(bytes, &error)) return true;
+    err << "error: " << error << "\n";
+    return false;
+}
+
+// Writes DIR/trade.dat and DIR/trade.gp and runs gnuplot on them, when gnuplot is installed.
 bool plot(const std::string& dir, const std::vector<TradeRow>& rows, double size, std::ostream& err) {
     const std::string dat = dir + "/trade.dat", gp = dir + "/trade.gp", png = dir + "/trade.png";
     {
-        std::ofstream d(dat);
+        std::ostringstream d;
         for (const char* family : {"vertex", "uniform", "tolerance"}) {
             d << "# " << family << "\n";
             for (const auto& r : rows)
                 if (r.family == family && !r.skipped) d << r.total() * 1e3 << " " << r.error / size << "\n";
             d << "\n\n";
         }
-        if (!d) return false;
+        if (!writeFile(dat, d.str(), err)) return false;
     }
     {
-        std::ofstream g(gp);
+        std::ostringstream g;
         g << "set terminal pngcairo size 900,560 font ',11' noenhanced\n"
           << "set output 'trade.png'\n"
           << "set logscale xy\n"
@@ -138,7 +148,7 @@ bool plot(const std::string& dir, const std::vector<TradeRow>& rows, double size
           << "plot 'trade.dat' index 0 using 1:2 with points pt 7 ps 2 title 'vertex mode', \\\n"
           << "     'trade.dat' index 1 using 1:2 with linespoints lw 2 pt 5 title 'uniform subdivision (levels 1..k)', \\\n"
           << "     'trade.dat' index 2 using 1:2 with linespoints lw 2 pt 9 title '--tolerance T (adaptive)'\n";
-        if (!g) return false;
+        if (!writeFile(gp, g.str(), err)) return false;
     }
     const std::string cmd = "cd '" + dir + "' && gnuplot trade.gp 2>&1";
     if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
@@ -279,17 +289,7 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
     }
     out << table.str();
     const std::string csv_path = settings.out_dir + "/trade.csv";
-    std::ofstream f(csv_path);
-    f << csv.str();
-    f.close();
-    if (!f) {
-        err << "error: " << csv_path << ": cannot write\n";
-        return kExitOutputError;
-    }
-    if (!plot(settings.out_dir, rows, size, err)) {
-        err << "error: " << settings.out_dir << ": cannot write the plot files\n";
-        return kExitOutputError;
-    }
+    if (!writeFile(csv_path, csv.str(), err) || !plot(settings.out_dir, rows, size, err)) return kExitOutputError;
     if (!settings.quiet) err << "wrote " << csv_path << " and " << settings.out_dir << "/trade.png\n";
     return kExitOk;
 }
