@@ -4,6 +4,7 @@
 #include <cmath>
 #include <ostream>
 
+#include "mesh4d/box.h"
 #include "pipeline/scene_fields.h"
 
 #include "pipeline/json_limits.h"
@@ -65,7 +66,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
         const mesh4d::Vec3& r = o.spec.rotation_deg;
         if (!(std::fabs(r.x) <= 1e9 && std::fabs(r.y) <= 1e9 && std::fabs(r.z) <= 1e9))
             return fail(scene.path + ": " + o.spec.field_path + ".rotation_deg: beyond 1e9 degrees (no precision left)");
-        mesh4d::Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+        mesh4d::EventBox box;
         for (size_t i = 0; i < o.rest.positions.size(); ++i) {
             const mesh4d::Vec3& p = o.rest.positions[i];
             if (outOfRange(p.x) || outOfRange(p.y) || outOfRange(p.z) || outOfRange(p.x + o.spec.position.x) ||
@@ -73,10 +74,9 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
                 return fail(scene.path + ": " + o.spec.field_path + ": vertex " + std::to_string(i) +
                             " after scale, rotation_deg and position is not finite or beyond " + formatNumber(kMaxCoordinate) +
                             " light-seconds");
-            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+            box.addPoint(p);
         }
-        if (!o.rest.positions.empty()) largest = std::max(largest, mesh4d::norm(hi - lo));
+        if (!o.rest.positions.empty()) largest = std::max(largest, box.diagonal());
     }
     const double floor = kToleranceFloorRelative * largest;
     if (scene.tolerance > 0 && scene.tolerance < floor)

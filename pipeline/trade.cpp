@@ -13,6 +13,7 @@
 
 #include "exporters/atomic_file.h"
 #include "exporters/gltf.h"
+#include "mesh4d/box.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/subdivide.h"
 #include "pipeline/frame_loop.h"
@@ -27,12 +28,9 @@ using Clock = std::chrono::steady_clock;
 
 // The bounding-box diagonal of a rest mesh.
 double restSize(const mesh4d::RestMesh& m) {
-    mesh4d::Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    for (const auto& p : m.positions) {
-        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
-    return m.positions.empty() ? 0.0 : mesh4d::norm(hi - lo);
+    mesh4d::EventBox box;
+    for (const auto& p : m.positions) box.addPoint(p);
+    return m.positions.empty() ? 0.0 : box.diagonal();
 }
 
 std::string formatG(double x, int digits = 3) {
