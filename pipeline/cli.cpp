@@ -152,8 +152,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         ->capture_default_str();
     render_cmd->add_option("--max-triangles", rs.max_frame_triangles,
                            "Stop with exit code 2 when one frame's refinement would make more triangles than this "
-                           "(a --tolerance too fine for the scene)")
-        ->capture_default_str();
+                           "(a --tolerance too fine for the scene); default: 4 x the scene's input triangles "
+                           "(objects x (1 + mirrors)), at least " + std::to_string(kMinFrameTriangleBudget));
     render_cmd->add_option("--max-output-bytes", rs.max_output_bytes,
                            "Stop with exit code 3 before the outputs would exceed this many bytes in all")
         ->capture_default_str();
@@ -306,7 +306,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
     if (rs.threads < 0 || rs.threads > kMaxThreads) return usage(threadsProblem(rs.threads));
-    if (rs.max_frame_triangles <= 0) return usage("--max-triangles: must be positive");
+    if (rs.max_frame_triangles < 0) return usage("--max-triangles: must be positive");
     if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0 || rs.max_output_bytes <= 0)
         return usage("--max-vertices, --max-faces, --max-frames, --max-file-bytes and --max-output-bytes must be positive");
     rs.stage.limits.max_vertices = size_t(max_vertices);

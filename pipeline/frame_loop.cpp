@@ -3,6 +3,7 @@
 #include "pipeline/scene_fields.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -13,6 +14,7 @@
 #include <unistd.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
 #include "mesh4d/check.h"
@@ -20,6 +22,14 @@
 namespace apparent {
 
 namespace {
+
+// A frame over the per-frame budget: an object's refinement stopped at it, or all the frame's
+// objects together hold more.
+bool overBudget(const ExportFrame& frame, long long max_frame_triangles) {
+    return frame.triangleCount() > size_t(max_frame_triangles) ||
+           std::any_of(frame.objects.begin(), frame.objects.end(),
+                       [](const mesh4d::ApparentMesh& o) { return o.over_budget; });
+}
 
 // Progress on a terminal: frames done, rate, time left. Silent when stderr is not a terminal.
 class Progress {
@@ -67,6 +77,13 @@ bool OutputBudget::count(const std::string& path, std::string* error) {
     return fits(0, path, error);
 }
 
+long long defaultFrameTriangleBudget(const Stage& stage) {
+    long long input = 0;
+    for (const PreparedObject& o : stage.objects) input += (long long)o.rest.triangles.size();
+    input *= 1 + (long long)stage.mirrors.size();
+    return std::max(kMinFrameTriangleBudget, 4 * input);
+}
+
 SequenceInfo sequenceInfo(const Stage& stage, Model model) {
     const Scene& scene = stage.scene;
     SequenceInfo info;
@@ -107,60 +124,86 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     result->max_segments = slice_settings.max_segments;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     Progress progress(progress_out, settings.progress, info.model, last_excl - first);
-    // Frames are independent given the static worlds: cut a batch in parallel (TBB), then deliver
-    // it in frame order, so files are byte-identical whatever the thread count.
-    const long long batch = std::max<long long>(1, 4 * (long long)arena.max_concurrency());
-    for (long long b0 = first; b0 < last_excl; b0 += batch) {
-        const long long b1 = std::min(last_excl, b0 + batch);
-        std::vector<ExportFrame> cut(size_t(b1 - b0));
-        // prepared[frame][sink]: each sink's conversion of the frame, made on the worker too.
-        std::vector<std::vector<std::shared_ptr<const PreparedFrame>>> prepared(size_t(b1 - b0));
-        arena.execute([&] {
-            tbb::parallel_for(b0, b1, [&](long long k) {
-                ExportFrame& frame = cut[size_t(k - b0)];
-                frame.index = k;
-                frame.t_c = frameTime(scene.frames, k);
-                const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-                // Objects in parallel too (a short range of frames of a many-object scene), each
-                // into its own slot: the result does not depend on the scheduling.
-                frame.objects.resize(worlds.size());
-                tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
-                    const mesh4d::World4D& w = worlds[o];
-                    // --cull-view: an object wholly outside the camera's view is left empty.
-                    if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(w, view))) return;
-                    frame.objects[o] = mesh4d::sliceWorld(w, view, slice_settings);
-                });
-                // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-                reflections.append(view, slice_settings, &frame.objects);
-                APPARENT_CHECK(frame.objects.size(), ==, info.objects.size());
-                for (const FrameSink* sink : sinks) prepared[size_t(k - b0)].push_back(sink->prepare(frame));
-            });
-        });
-        for (size_t i = 0; i < cut.size(); ++i) {
-            const ExportFrame& frame = cut[i];
-            const bool stopped = std::any_of(frame.objects.begin(), frame.objects.end(),
-                                             [](const mesh4d::ApparentMesh& o) { return o.over_budget; });
-            if (stopped || frame.triangleCount() > size_t(settings.max_frame_triangles)) {
-                result->over_budget = true;
-                *error = scene.path + ": frame " + std::to_string(frame.index) + ": tolerance " +
-                         formatNumber(scene.tolerance) + " makes more than " + std::to_string(settings.max_frame_triangles) +
-                         " triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles";
-                return false;
-            }
-            result->max_triangles = std::max(result->max_triangles, frame.triangleCount());
-            for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
-            for (size_t s = 0; s < sinks.size(); ++s) {
-                // Refused before writing beyond the limit; every completed file counted after.
-                const PendingOutput pending = sinks[s]->pending(frame);
-                if (!budget->fits(pending.bytes, pending.name, error)) return false;
-                std::vector<std::string> completed;
-                if (!sinks[s]->add(frame, prepared[i][s].get(), &completed, error)) return false;
-                for (const std::string& path : completed)
-                    if (!budget->count(path, error)) return false;
-            }
-            progress.update(frame.index - first + 1);
+    // Frames are independent given the static worlds: a TBB pipeline cuts them in parallel and
+    // delivers them in frame order, so files are byte-identical whatever the thread count. At most
+    // `tokens` frames (cut meshes and the sinks' conversions) are held at once, so the memory of a
+    // run is bounded by about tokens x the per-frame budget, also for a run the budget stops.
+    struct Work {
+        ExportFrame frame;
+        std::vector<std::shared_ptr<const PreparedFrame>> prepared;  // per sink, made on the worker
+    };
+    using WorkPtr = std::shared_ptr<Work>;
+    const size_t tokens = size_t(arena.max_concurrency()) + 1;
+    long long next = first;
+    std::atomic<bool> stop{false};  // set by the in-order stage on an error: later frames are skipped
+
+    // Source, in order: the next frame number.
+    auto source = [&](tbb::flow_control& fc) -> WorkPtr {
+        if (stop || next >= last_excl) {
+            fc.stop();
+            return nullptr;
         }
-    }
+        auto w = std::make_shared<Work>();
+        w->frame.index = next++;
+        return w;
+    };
+    // In parallel: cut every world with the frame's view surface, then each sink's conversion.
+    auto cutFrame = [&](WorkPtr w) -> WorkPtr {
+        if (stop) return w;
+        ExportFrame& frame = w->frame;
+        const long long k = frame.index;
+        frame.t_c = frameTime(scene.frames, k);
+        const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
+        // Objects in parallel too (a short range of frames of a many-object scene), each into its
+        // own slot: the result does not depend on the scheduling.
+        frame.objects.resize(worlds.size());
+        tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
+            const mesh4d::World4D& world = worlds[o];
+            // --cull-view: an object wholly outside the camera's view is left empty.
+            if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(world, view))) return;
+            frame.objects[o] = mesh4d::sliceWorld(world, view, slice_settings);
+        });
+        // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
+        reflections.append(view, slice_settings, &frame.objects);
+        APPARENT_CHECK(frame.objects.size(), ==, info.objects.size());
+        if (!overBudget(frame, settings.max_frame_triangles))
+            for (const FrameSink* sink : sinks) w->prepared.push_back(sink->prepare(frame));
+        return w;
+    };
+    // Sink, in order: the budget checks, then every sink gets the frame.
+    auto deliver = [&](WorkPtr w) {
+        if (stop) return;
+        const ExportFrame& frame = w->frame;
+        if (overBudget(frame, settings.max_frame_triangles)) {
+            result->over_budget = true;
+            *error = scene.path + ": frame " + std::to_string(frame.index) + ": tolerance " +
+                     formatNumber(scene.tolerance) + " makes more than " + std::to_string(settings.max_frame_triangles) +
+                     " triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles";
+            stop = true;
+            return;
+        }
+        result->max_triangles = std::max(result->max_triangles, frame.triangleCount());
+        for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
+        for (size_t s = 0; s < sinks.size(); ++s) {
+            // Refused before writing beyond the limit; every completed file counted after.
+            const PendingOutput pending = sinks[s]->pending(frame);
+            std::vector<std::string> completed;
+            bool done = budget->fits(pending.bytes, pending.name, error) &&
+                        sinks[s]->add(frame, w->prepared[s].get(), &completed, error);
+            for (size_t c = 0; done && c < completed.size(); ++c) done = budget->count(completed[c], error);
+            if (!done) {
+                stop = true;
+                return;
+            }
+        }
+        progress.update(frame.index - first + 1);
+    };
+    arena.execute([&] {
+        tbb::parallel_pipeline(tokens, tbb::make_filter<void, WorkPtr>(tbb::filter_mode::serial_in_order, source) &
+                                           tbb::make_filter<WorkPtr, WorkPtr>(tbb::filter_mode::parallel, cutFrame) &
+                                           tbb::make_filter<WorkPtr, void>(tbb::filter_mode::serial_in_order, deliver));
+    });
+    if (stop) return false;
 
     // Step: what needs the whole sequence (the .glb is assembled here).
     result->summaries.assign(sinks.size(), {});

@@ -35,15 +35,22 @@ private:
 };
 
 // Triangles one frame may hold (objects and reflections together) unless --max-triangles says
-// otherwise.
-constexpr long long kDefaultMaxFrameTriangles = 20'000'000;
+// otherwise: 4 x the scene's input triangles (objects x (1 + mirrors); vertex mode's frame holds at
+// most the input plus the pieces of clipped triangles, which this covers), and never less than
+// kMinFrameTriangleBudget, so that refinement has room. The budget bounds memory: the frame loop
+// holds at most threads + 1 frames, and a refined frame costs a few hundred bytes per
+// output triangle at its peak (measured: `/usr/bin/time -f %M` on a budget-stopped run, README
+// "Hostile input"), so a run the default budget stops on a small input stays under 500 MB on the
+// 2-core machine the README's figures come from.
+constexpr long long kMinFrameTriangleBudget = 600'000;
+long long defaultFrameTriangleBudget(const Stage& stage);
 
 struct FrameLoopSettings {
     int threads = 0;         // worker threads; 0: all cores
     // Triangles per frame: each object's refinement stops at this many
     // (mesh4d::SliceSettings::max_triangles) and a frame that reaches it, or holds more in all,
     // ends the loop with a message naming --tolerance and --max-triangles (bad input: exit 2).
-    long long max_frame_triangles = kDefaultMaxFrameTriangles;
+    long long max_frame_triangles = kMinFrameTriangleBudget;
     bool cull_view = false;  // --cull-view: objects outside the camera's view stay empty (worlds.h)
     bool progress = true;    // on a terminal only
 };

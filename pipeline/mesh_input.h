@@ -21,8 +21,8 @@ struct MeshWarnings {
 };
 
 struct MeshLimits {
-    size_t max_vertices = 50'000'000;
-    size_t max_faces = 50'000'000;
+    size_t max_vertices = 10'000'000;
+    size_t max_faces = 10'000'000;
     size_t max_file_bytes = size_t(2) << 30;  // any one file a mesh reads (glTF buffers included)
     // Scene mesh paths must resolve (".." and symlinks followed) inside the scene file's folder or
     // the current working folder, unless this is set (--allow-outside). glTF buffer URIs stay

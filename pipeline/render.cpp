@@ -75,7 +75,8 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     OutputBudget budget(settings.max_output_bytes);
     FrameLoopSettings loop;
     loop.threads = settings.threads;
-    loop.max_frame_triangles = settings.max_frame_triangles;
+    loop.max_frame_triangles =
+        settings.max_frame_triangles > 0 ? settings.max_frame_triangles : defaultFrameTriangleBudget(stage);
     loop.cull_view = settings.cull_view;
     loop.progress = !settings.quiet;
     for (Model model : stage.models) {

@@ -23,7 +23,7 @@ struct RenderSettings {
     bool quiet = false;
     bool verbose = false;
     long long max_output_bytes = 20LL << 30;  // --max-output-bytes: all files of the run together
-    long long max_frame_triangles = kDefaultMaxFrameTriangles;  // --max-triangles: per frame
+    long long max_frame_triangles = 0;  // --max-triangles: per frame; 0: defaultFrameTriangleBudget
 };
 
 // The names --format accepts, in the order their sinks take each frame: "ply", "obj", "glb".

@@ -480,6 +480,17 @@ void expectRefusedSmall(const Measured& m, int code, const std::string& expected
 
 std::string base64Zeros(size_t bytes) { return std::string(bytes / 3 * 4, 'A'); }  // bytes: a multiple of 3
 
+// RFC 4648 base64 of `bytes` (a multiple of 3 long: no padding needed).
+std::string base64(const std::string& bytes) {
+    static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i + 2 < bytes.size(); i += 3) {
+        const uint32_t v = uint32_t(uint8_t(bytes[i])) << 16 | uint32_t(uint8_t(bytes[i + 1])) << 8 | uint8_t(bytes[i + 2]);
+        for (int k = 3; k >= 0; --k) out.push_back(kAlphabet[(v >> (6 * k)) & 63]);
+    }
+    return out;
+}
+
 }  // namespace
 
 // Issue 15, item 3: small inputs that would exhaust memory are refused before the work, each
@@ -508,19 +519,58 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
             << base64Zeros(3600) << "\"}]}";
         EXPECT_LT(fs::file_size(box / "s/dag.gltf"), 10000u);
         expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "dag.gltf"), "--out", out}), 2,
-                           "dag.gltf: nodes: 166667 mesh instances hold more than 50000000 vertices after node expansion "
+                           "dag.gltf: nodes: 33334 mesh instances hold more than 10000000 vertices after node expansion "
                            "(raise with --max-vertices)");
         expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "dag.gltf"), "--out", out, "--max-vertices", "200000000"}),
-                           2, "dag.gltf: nodes: 500001 mesh instances hold more than 50000000 triangles after node expansion "
+                           2, "dag.gltf: nodes: 100001 mesh instances hold more than 10000000 triangles after node expansion "
                               "(raise with --max-faces)");
     }
-    // 50M elements declared without a bufferView in a few hundred bytes: refused before allocating.
+    // The tester's case: an indexed 200-triangle grid in a DAG of 16 levels, 2^17 - 1 instances:
+    // 26M triangles and 16M vertices from 6 KB, within the limits of the time (50M each); it took
+    // 108 s and 8.8 GB before the frame budget stopped it. The default limits (10M) refuse it on
+    // the accessors' counts before anything is expanded.
+    {
+        const int n = 10;  // grid cells per side
+        std::vector<float> pos;
+        std::vector<uint32_t> idx;
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) pos.insert(pos.end(), {float(i) / n, float(j) / n, 0.f});
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n) + 1, d = c + 1;
+                idx.insert(idx.end(), {a, b, d, a, d, c});
+            }
+        std::string bytes(reinterpret_cast<const char*>(pos.data()), pos.size() * 4);
+        bytes.append(reinterpret_cast<const char*>(idx.data()), idx.size() * 4);
+        while (bytes.size() % 3) bytes.push_back('\0');
+        std::string nodes;
+        const int levels = 16;
+        for (int i = 0; i < levels; ++i)
+            nodes += (i ? "," : "") + std::string("{\"mesh\":0,\"children\":[") + std::to_string(i + 1) + "," +
+                     std::to_string(i + 1) + "]}";
+        nodes += ",{\"mesh\":0}";
+        std::ofstream(box / "s/grid_dag.gltf")
+            << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[)" << nodes
+            << R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"accessors":[)"
+            << R"({"bufferView":0,"componentType":5126,"count":)" << pos.size() / 3
+            << R"(,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},{"bufferView":1,"componentType":5125,"count":)"
+            << idx.size() << R"(,"type":"SCALAR"}],"bufferViews":[{"buffer":0,"byteLength":)" << pos.size() * 4
+            << R"(},{"buffer":0,"byteOffset":)" << pos.size() * 4 << R"(,"byteLength":)" << idx.size() * 4
+            << R"(}],"buffers":[{"byteLength":)" << bytes.size()
+            << R"(,"uri":"data:application/octet-stream;base64,)" << base64(bytes) << "\"}]}";
+        EXPECT_LT(fs::file_size(box / "s/grid_dag.gltf"), 8000u);
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "grid_dag.gltf"), "--out", out, "--tolerance", "vertex"}),
+                           2, "grid_dag.gltf: nodes: 50001 mesh instances hold more than 10000000 triangles after node "
+                              "expansion (raise with --max-faces)");
+    }
+    // 50M elements declared without a bufferView in a few hundred bytes: refused before allocating
+    // (the default limit of 10M refuses it first; raised here to reach the check on the buffers).
     {
         std::ofstream(box / "s/declared.gltf")
             << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
                R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
                R"("accessors":[{"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}]})";
-        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "declared.gltf"), "--out", out}), 2,
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "declared.gltf"), "--out", out, "--max-vertices", "100000000"}), 2,
                            "declared.gltf: accessors[0].count: 49999998 elements without a bufferView, more than the 0 "
                            "bytes of the file's buffers (refused)");
     }
@@ -532,7 +582,7 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
                R"("accessors":[{"bufferView":0,"componentType":5126,"count":49999998,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
                R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)"
             << base64Zeros(36) << "\"}]}";
-        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "short_view.gltf"), "--out", out}), 2,
+        expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "short_view.gltf"), "--out", out, "--max-vertices", "100000000"}), 2,
                            "short_view.gltf: accessors[0]: count 49999998 with byteOffset 0 reaches past bufferViews[0] (36 bytes)");
     }
     // A tolerance below the floor (1e-6 of the object's size) is refused up front.
@@ -542,6 +592,22 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
     expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj", R"(, "velocity": [0.9, 0, 0])"), "--out",
                                     out, "--tolerance", "1e-5", "--max-triangles", "2000"}),
                        2, "makes more than 2000 triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles");
+    // The default per-frame budget (4 x the input triangles, at least 600 000): a 320-triangle
+    // sphere at a tolerance just above the floor would make 1.2M triangles per frame; the run stops
+    // at the budget, holding at most threads + 1 frames (2 threads, as on the README's machine).
+    fs::copy_file(source("data/meshes/icosphere320.obj"), box / "s/sphere.obj");
+    {
+        std::ofstream(box / "s/sphere.json") << R"({ "frames": { "start": 0, "end": 2, "fps": 10 }, "objects": [ )"
+                                                R"({ "mesh": "sphere.obj", "position": [0, 0, -2.5], "velocity": [0.9, 0, 0] } ] })";
+        const Measured m =
+            runMeasured({"render", (box / "s/sphere.json").string(), "--out", out, "--tolerance", "3.5e-6", "--threads", "2"});
+#ifdef APPARENT_SANITIZED
+        EXPECT_EQ(m.code, 2) << m.err;  // ASan's shadow memory and quarantine: no RSS bound
+#else
+        expectRefusedSmall(m, 2, "makes more than 600000 triangles (--max-triangles); use a coarser --tolerance or raise "
+                                 "--max-triangles");
+#endif
+    }
     // 10 000 objects x 200 frames: refused before any mesh is cut.
     {
         std::ofstream scene(box / "s/many.json");

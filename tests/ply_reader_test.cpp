@@ -105,7 +105,7 @@ TEST(PlyReader, MalformedFilesNameTheField) {
     const std::pair<const char*, const char*> cases[] = {
         {"bad_index.ply", "bad_index.ply: face[1].vertex_indices[2]: index 9 is out of range (4 vertices)"},
         {"bad_number.ply", "bad_number.ply: vertex[1].y: 'nan' is not a finite number"},
-        {"huge_count.ply", "huge_count.ply: element vertex: 4000000000 vertices, more than the limit of 50000000"},
+        {"huge_count.ply", "huge_count.ply: element vertex: 4000000000 vertices, more than the limit of 10000000"},
         {"no_z.ply", "no_z.ply: element vertex: no scalar property 'z'"},
         {"no_faces.ply", "no_faces.ply: header: no 'element face'"},
         {"truncated.ply", "truncated.ply: face[3].vertex_indices[1]: the file ends early"},
