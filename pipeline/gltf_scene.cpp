@@ -59,6 +59,9 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
             camera_node = n;
             camera_world = world;
         }
+        // A camera node without a mesh is the camera: its extras are camera fields (velocity,
+        // instant_delay), even where their names are object fields too.
+        if (node.camera >= 0 && node.mesh < 0) return Status::success();
         const json& ex = doc->node_extras[size_t(n)];
         if (!ex.is_object()) return Status::success();
         const bool marked = std::any_of(markers.begin(), markers.end(), [&](const std::string& k) { return ex.contains(k); });
@@ -99,8 +102,9 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         const auto& cam = model.cameras[size_t(node.camera)];
         if (cam.type == "perspective") c.fov_deg = cam.perspective.yfov * 180.0 / mesh4d::kPi;
         if (const json& cx = doc->node_extras[size_t(camera_node)]; cx.is_object() && !is_object[size_t(camera_node)]) {
-            r.warnUnknownKeys(cx, where + ".extras", {"instant_delay"});
+            r.warnUnknownKeys(cx, where + ".extras", {"instant_delay", "velocity"});
             r.number(cx, "instant_delay", where + ".extras", &c.instant_delay);
+            r.vec3(cx, "velocity", where + ".extras", &c.velocity);
         }
         checkCamera(r, where, c);
     }

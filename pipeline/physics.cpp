@@ -20,6 +20,22 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     return mesh4d::makeMotion(kin, s.t0, s.position, s.velocity);
 }
 
+mesh4d::CameraMotion cameraMotionOf(const Scene& scene) {
+    return mesh4d::makeCameraMotion(scene.camera.position, scene.camera.velocity);
+}
+
+mesh4d::MotionInCameraFrame cameraFrameMotionOf(const ObjectSpec& s, Model model, const Scene& scene) {
+    return mesh4d::motionInCameraFrame(motionOf(s, model), cameraMotionOf(scene));
+}
+
+const mesh4d::RestMesh& restInCameraFrame(const mesh4d::RestMesh& rest, const mesh4d::MotionInCameraFrame& m,
+                                          mesh4d::RestMesh* storage) {
+    if (!m.rotated) return rest;
+    *storage = rest;
+    for (mesh4d::Vec3& p : storage->positions) p = mesh4d::apply(m.rotation, p);
+    return *storage;
+}
+
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k) {
     return viewAt(scene, model, frameTime(scene.frames, k));
 }

@@ -6,6 +6,8 @@
 #pragma once
 
 #include "mesh4d/boost.h"
+#include "mesh4d/camera_frame.h"
+#include "mesh4d/extrude.h"
 #include "mesh4d/lightcone.h"
 #include "pipeline/scene.h"
 
@@ -14,8 +16,21 @@ namespace apparent {
 // Lorentz for relativistic and contracted, Galilean for instant and finite.
 mesh4d::Kinematics kinematicsOf(Model model);
 
-// The motion of `object` under `model`. Precondition: the scene passed checkSceneForModel.
+// The motion of `object` under `model` in the lab. Precondition: the scene passed
+// checkSceneForModel.
 mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
+
+// The camera's worldline (scene camera.position and camera.velocity).
+mesh4d::CameraMotion cameraMotionOf(const Scene& scene);
+
+// The motion of `object` in the camera's rest frame, where every output is (camera.velocity:
+// mesh4d/camera_frame.h), with the Thomas-Wigner rotation of its rest points; the lab motion,
+// unchanged, for a camera at rest.
+mesh4d::MotionInCameraFrame cameraFrameMotionOf(const ObjectSpec& object, Model model, const Scene& scene);
+
+// `rest` with the rotation of `m` applied to its points (a copy only when m.rotated).
+const mesh4d::RestMesh& restInCameraFrame(const mesh4d::RestMesh& rest, const mesh4d::MotionInCameraFrame& m,
+                                          mesh4d::RestMesh* storage);
 
 // The view surface at camera time t_c, and at global frame k (t_c = frameTime(scene.frames, k)).
 mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c);

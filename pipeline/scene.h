@@ -26,6 +26,9 @@ struct CameraSpec {
     // t = t_k - instant_delay, so that with the light delay of the stage centre they show the
     // objects where the light-speed models do (Black et al. 2007 advance their camera so).
     double instant_delay = 0;
+    // Lab velocity (fraction of c, |v| < 1): the camera's worldline is position + velocity t, and
+    // the outputs are in its rest frame (mesh4d/camera_frame.h; README "A moving camera").
+    mesh4d::Vec3 velocity{0, 0, 0};
 };
 
 // The light that shades the raytracer's pictures, at rest in the lab (README "Scene format").

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "mesh4d/robust.h"
 #include "pipeline/json_limits.h"
 
 namespace apparent {
@@ -321,8 +322,9 @@ void readObjectFields(FieldReader& r, const json& j, const std::string& path, co
 // Step: the scene-level sections.
 
 void readCamera(FieldReader& r, const json& cam, const std::string& path, CameraSpec* camera) {
-    r.checkKeys(cam, path, {"position", "look_at", "up", "fov_deg", "instant_delay"});
+    r.checkKeys(cam, path, {"position", "look_at", "up", "fov_deg", "instant_delay", "velocity"});
     r.number(cam, "instant_delay", path, &camera->instant_delay);
+    r.vec3(cam, "velocity", path, &camera->velocity);
     r.vec3(cam, "position", path, &camera->position);
     r.vec3(cam, "look_at", path, &camera->look_at);
     r.vec3(cam, "up", path, &camera->up);
@@ -336,6 +338,10 @@ void checkCamera(FieldReader& r, const std::string& path, const CameraSpec& c) {
     if (!r.failed() && !(mesh4d::norm(mesh4d::cross(dir, c.up)) > 0))
         r.fail(path + ".up", "must be non-zero and not parallel to the view direction");
     if (!r.failed() && !(c.fov_deg > 0 && c.fov_deg < 180)) r.fail(path + ".fov_deg", "must be in (0, 180)");
+    // The camera is an observer: slower than light in every model (1 - |v|^2 without cancellation).
+    if (!r.failed() && !(mesh4d::oneMinusNorm2(c.velocity.x, c.velocity.y, c.velocity.z) > 0))
+        r.fail(path + ".velocity", "|velocity| = " + formatNumber(mesh4d::norm(c.velocity)) +
+                                       " must be < 1 (the speed of light): the camera is an observer");
 }
 
 void readLight(FieldReader& r, const json& parent, const std::string& top, Scene* scene) {

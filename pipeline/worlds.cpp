@@ -13,13 +13,17 @@ using mesh4d::Vec3;
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame) {
     const ObjectSpec& s = object.spec;
-    const mesh4d::Motion motion = motionOf(s, model);
+    // In the camera's rest frame (the lab's for a camera at rest): its motion and rest points.
+    const mesh4d::MotionInCameraFrame in_camera = cameraFrameMotionOf(s, model, scene);
+    const mesh4d::Motion& motion = in_camera.motion;
+    mesh4d::RestMesh rotated;
+    const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_camera, &rotated);
     // Step: the proper-time span the requested frames can see, padded by the object's own light
     // crossing time so that rounding in the vertex crossings never reaches an artificial cap.
-    const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(object.rest, motion, viewForFrame(scene, model, first_frame),
+    const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(rest, motion, viewForFrame(scene, model, first_frame),
                                                          viewForFrame(scene, model, last_frame));
     mesh4d::EventBox box;
-    for (const Vec3& p : object.rest.positions) box.addPoint(p);
+    for (const Vec3& p : rest.positions) box.addPoint(p);
     // Interior points of a triangle can emit up to diag (1 + b) / (1 - b^2) = diag / (1 - b) later or
     // earlier than its vertices (the crossing time's slope along the surface is at most 1/(1 - b)).
     const double diag = box.diagonal();
@@ -36,7 +40,7 @@ mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scen
         empty.motion = motion;
         return empty;
     }
-    return mesh4d::extrude(object.rest, motion, tau_a, tau_b, cap_a_real, cap_b_real);
+    return mesh4d::extrude(rest, motion, tau_a, tau_b, cap_a_real, cap_b_real);
 }
 
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,

@@ -354,3 +354,22 @@ TEST(GltfScene, ChangedFilesAreParsedAgain) {
     for (size_t i = 0; i < before.mesh.positions.size(); ++i)
         EXPECT_EQ(after.mesh.positions[i] - after.mesh.positions[0], (before.mesh.positions[i] - before.mesh.positions[0]) * 2.0) << i;
 }
+
+// camera.velocity in a glTF-authored scene: the camera node's extras (glTF's axes, like every
+// vector in extras), read as the JSON scene's camera.velocity; an impossible one is refused.
+TEST(GltfScene, CameraNodeExtrasGiveTheCameraVelocity) {
+    Folder dir;
+    json g = tetraGltf();
+    addNode(&g, "thing", {0, 0, -5}, json{{"velocity", {0.5, 0, 0}}});
+    g["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.1}}}}});
+    g["scenes"][0]["nodes"].push_back(g["nodes"].size());
+    g["nodes"].push_back({{"name", "cam"}, {"camera", 0}, {"extras", {{"velocity", {0, 0.25, -0.5}}}}});
+    Scene scene;
+    Status st = loadScene(dir.write("scene.gltf", g.dump()), &scene);
+    ASSERT_TRUE(st.ok) << st.message;
+    EXPECT_EQ(scene.camera.velocity, (mesh4d::Vec3{0, 0.25, -0.5}));
+    g["nodes"].back()["extras"]["velocity"] = {0, 1.5, 0};
+    st = loadScene(dir.write("scene.gltf", g.dump()), &scene);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find(".velocity: |velocity| = 1.5 must be < 1 (the speed of light)"), std::string::npos) << st.message;
+}
