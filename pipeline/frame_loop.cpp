@@ -52,8 +52,22 @@ private:
 
 }  // namespace
 
+bool OutputBudget::fitsEstimate(double estimate, long long measured, long long total, std::string* error) const {
+    if (limit_ <= 0 || double(written_) + estimate <= double(limit_)) return true;
+    const double whole = double(written_) + estimate;
+    std::ostringstream size;
+    size << std::setprecision(3) << whole / double(1LL << 20) << " MiB";
+    *error = "--max-output-bytes: this run would write about " + std::to_string((long long)whole) + " bytes (" +
+             size.str() + ", estimated from " + std::to_string(measured) + " of " + std::to_string(total) +
+             " frames), more than the limit of " + std::to_string(limit_) + "; " +
+             (written_ ? "nothing more was written (the files written are complete)" : "nothing was written") +
+             ": use a coarser --tolerance (e.g. 1e-2x), fewer --frames, --compress draco, or raise it with "
+             "--max-output-bytes (0: no limit)";
+    return false;
+}
+
 bool OutputBudget::fits(long long more, const std::string& what, std::string* error) const {
-    if (written_ + more <= limit_) return true;
+    if (limit_ <= 0 || written_ + more <= limit_) return true;
     *error = "--max-output-bytes: " + what + (more ? " would bring" : " brought") + " the output to " +
              std::to_string(written_ + more) + " bytes, more than the limit of " + std::to_string(limit_) + " (" +
              std::to_string(written_) + " bytes written, every written file is complete; raise it with --max-output-bytes)";
@@ -128,14 +142,31 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
                     const mesh4d::World4D& w = worlds[o];
                     // --cull-view: an object wholly outside the camera's view is left empty.
                     if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(w, view))) return;
-                    frame.objects[o] = mesh4d::sliceWorld(w, view, slice_settings);
+                    mesh4d::SliceSettings own = slice_settings;
+                    own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
+                    frame.objects[o] = mesh4d::sliceWorld(w, view, own);
                 });
                 // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-                reflections.append(view, slice_settings, &frame.objects);
+                reflections.append(view, slice_settings, &frame.objects, &stage.tolerances);
                 APPARENT_CHECK(frame.objects.size(), ==, info.objects.size());
                 for (const FrameSink* sink : sinks) prepared[size_t(k - b0)].push_back(sink->prepare(frame));
             });
         });
+        // Before the first write: the first batch's estimate, scaled to the whole run.
+        // (A frame past --max-triangles is reported below instead.)
+        if (b0 == first) {
+            double bytes = 0;
+            bool too_many = false;
+            for (const ExportFrame& frame : cut) {
+                too_many = too_many || frame.triangleCount() > size_t(settings.max_frame_triangles) ||
+                           std::any_of(frame.objects.begin(), frame.objects.end(),
+                                       [](const mesh4d::ApparentMesh& o) { return o.over_budget; });
+                for (const FrameSink* sink : sinks) bytes += double(sink->estimate(frame));
+            }
+            if (too_many) bytes = 0;
+            const double whole = bytes / double(cut.size()) * double(last_excl - first) * double(settings.models_left);
+            if (!budget->fitsEstimate(whole, (long long)cut.size(), last_excl - first, error)) return false;
+        }
         for (size_t i = 0; i < cut.size(); ++i) {
             const ExportFrame& frame = cut[i];
             const bool stopped = std::any_of(frame.objects.begin(), frame.objects.end(),

@@ -65,6 +65,8 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         }
     }
     std::error_code ec;
+    // A folder this run creates is removed again when the run stops before writing into it.
+    const bool had_folder = std::filesystem::exists(settings.out_dir, ec);
     std::filesystem::create_directories(settings.out_dir, ec);
     if (ec) {
         err << "error: " << settings.out_dir << ": cannot create output folder: " << ec.message() << "\n";
@@ -78,6 +80,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     loop.max_frame_triangles = settings.max_frame_triangles;
     loop.cull_view = settings.cull_view;
     loop.progress = !settings.quiet;
+    loop.models_left = (long long)stage.models.size();
     for (Model model : stage.models) {
         const std::string name = modelName(model);
         const std::string base = (std::filesystem::path(settings.out_dir) / name).string();
@@ -89,7 +92,11 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
             sinks.push_back(owned.back().get());
         }
         FrameLoopResult result;
-        if (!runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error)) {
+        const bool ran = runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error);
+        --loop.models_left;
+        if (!ran) {
+            owned.clear();  // the sinks remove their temporaries
+            if (!had_folder && budget.written() == 0) std::filesystem::remove(settings.out_dir, ec);  // only if empty
             err << "error: " << error << "\n";
             return result.over_budget ? kExitBadInput : kExitOutputError;
         }

@@ -385,6 +385,28 @@ void readFrames(FieldReader& r, const json& parent, const std::string& top, Fram
     }
 }
 
+bool parseTolerance(const std::string& text, double* absolute, double* relative) {
+    if (text == "vertex") {
+        *absolute = 0;
+        *relative = 0;
+        return true;
+    }
+    const bool is_relative = !text.empty() && text.back() == 'x';
+    const std::string number = is_relative ? text.substr(0, text.size() - 1) : text;
+    double v = 0;
+    try {
+        size_t used = 0;
+        v = std::stod(number, &used);
+        if (used != number.size() || std::isspace((unsigned char)number[0])) return false;
+    } catch (const std::exception&) {
+        return false;
+    }
+    if (!(v > 0) || !std::isfinite(v) || (is_relative && !(v < 1))) return false;
+    *absolute = is_relative ? 0 : v;
+    *relative = is_relative ? v : 0;
+    return true;
+}
+
 void readModelAndTolerance(FieldReader& r, const json& parent, const std::string& top, Scene* scene) {
     auto at = [&](const std::string& key) { return FieldReader::join(top, key); };
     if (parent.contains("model")) {
@@ -393,12 +415,15 @@ void readModelAndTolerance(FieldReader& r, const json& parent, const std::string
         if (!r.failed() && !parseModel(name, &scene->model))
             r.fail(at("model"), "unknown model '" + name + "' (instant, finite, relativistic, contracted)");
     }
-    // tolerance: light-seconds > 0, or "vertex" (0 inside: exact vertices, straight edges).
+    // tolerance: light-seconds > 0, "vertex" (0 inside: exact vertices, straight edges), or
+    // "<f>x": f times each object's bounding-box diagonal. Absent: kDefaultToleranceRelative x.
     if (auto tol = parent.find("tolerance"); tol != parent.end() && tol->is_string()) {
-        if (tol->get<std::string>() != "vertex") r.fail(at("tolerance"), "expected a number > 0 or \"vertex\"");
-        else scene->tolerance = 0;
-    } else {
+        if (!parseTolerance(tol->get<std::string>(), &scene->tolerance, &scene->tolerance_relative))
+            r.fail(at("tolerance"), "expected a number > 0 (light-seconds), \"vertex\" or a fraction of each object's size "
+                                    "such as \"1e-3x\", got \"" + tol->get<std::string>() + "\"");
+    } else if (tol != parent.end()) {
         r.number(parent, "tolerance", top, &scene->tolerance);
+        scene->tolerance_relative = 0;
         if (!r.failed() && !(scene->tolerance > 0)) r.fail(at("tolerance"), "must be > 0 (light-seconds) or \"vertex\"");
     }
 }

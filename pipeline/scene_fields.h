@@ -104,6 +104,10 @@ void checkCamera(FieldReader& r, const std::string& path, const CameraSpec& came
 // The light's default direction follows camera.up: read the camera first.
 void readLight(FieldReader& r, const nlohmann::json& parent, const std::string& top, Scene* scene);
 void readFrames(FieldReader& r, const nlohmann::json& parent, const std::string& top, FrameSpec* frames);
+// A tolerance as the command line and the scene's `tolerance` string write it: "vertex" (both 0),
+// "T" (light-seconds > 0: absolute = T, relative = 0) or "Fx" (0 < F < 1, a fraction of each
+// object's bounding-box diagonal: relative = F, absolute = 0). False, untouched, for anything else.
+bool parseTolerance(const std::string& text, double* absolute, double* relative);
 void readModelAndTolerance(FieldReader& r, const nlohmann::json& parent, const std::string& top, Scene* scene);
 
 }  // namespace apparent
