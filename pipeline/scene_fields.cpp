@@ -81,6 +81,13 @@ void FieldReader::vec3(const json& parent, const char* key, const std::string& p
     *out = {v[0], v[1], v[2]};
 }
 
+void FieldReader::axisVec3(const json& parent, const char* key, const std::string& path, Vec3* out) {
+    Vec3 v = *out;
+    vec3(parent, key, path, &v);
+    if (z_up_ && parent.contains(key)) v = {v.x, v.z, -v.y};
+    *out = v;
+}
+
 void FieldReader::string(const json& parent, const char* key, const std::string& path, std::string* out) {
     auto it = parent.find(key);
     if (it == parent.end()) return;
@@ -182,7 +189,7 @@ void readT0(FieldReader& r, const json& j, const std::string& path, const Object
 }
 
 void readVelocity(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
-    r.vec3(j, "velocity", path, &obj->velocity);
+    r.axisVec3(j, "velocity", path, &obj->velocity);
 }
 
 // An exactly stated speed: a unit direction with gamma or rapidity (README "Scene format").
@@ -198,7 +205,7 @@ void readExactSpeed(FieldReader& r, const json& j, const std::string& path, cons
         return;
     }
     Vec3 d;
-    r.vec3(j, "direction", path, &d);
+    r.axisVec3(j, "direction", path, &d);
     if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(path + ".direction", "must be non-zero");
     if (!r.failed()) obj->direction = d / mesh4d::norm(d);
     if (has_gamma) {
@@ -218,12 +225,16 @@ void readExactSpeed(FieldReader& r, const json& j, const std::string& path, cons
 }
 
 void readRotation(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    if (r.zUp() && j.contains("rotation_deg"))
+        r.fail(path + ".rotation_deg", "not read with the scene's \"up\": \"z\" (no single axis rule); rotate the node itself");
     r.vec3(j, "rotation_deg", path, &obj->rotation_deg);
 }
 
 void readScale(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
     auto it = j.find("scale");
     if (it == j.end()) return;
+    if (r.zUp() && it->is_array())
+        r.fail(path + ".scale", "an array is not read with the scene's \"up\": \"z\" (no single axis rule); scale the node itself");
     if (it->is_array()) {
         r.vec3(j, "scale", path, &obj->scale);
     } else {
@@ -350,10 +361,10 @@ void readLight(FieldReader& r, const json& parent, const std::string& top, Scene
         r.fail(lp, "give exactly one of position (a point light) or direction (towards a distant light)");
     } else if (li->contains("position")) {
         scene->light.kind = LightSpec::Kind::Point;
-        r.vec3(*li, "position", lp, &scene->light.position);
+        r.axisVec3(*li, "position", lp, &scene->light.position);
     } else {
         Vec3 d;
-        r.vec3(*li, "direction", lp, &d);
+        r.axisVec3(*li, "direction", lp, &d);
         if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(lp + ".direction", "must be non-zero");
         if (!r.failed()) scene->light.direction = d / mesh4d::norm(d);
     }
@@ -383,6 +394,15 @@ void readFrames(FieldReader& r, const json& parent, const std::string& top, Fram
                                     " s are closer than doubles resolve there (" + formatNumber(ulp) +
                                     " s); shift frames.start and the objects' t0 towards 0");
     }
+}
+
+void readUpAxis(FieldReader& r, const json& parent, const std::string& top) {
+    if (!parent.contains("up")) return;
+    std::string up;
+    r.string(parent, "up", top, &up);
+    if (r.failed()) return;
+    if (up != "y" && up != "z") r.fail(FieldReader::join(top, "up"), "expected \"y\" (glTF's axes, the default) or \"z\" (Blender's), got \"" + up + "\"");
+    r.setZUp(up == "z");
 }
 
 bool parseTolerance(const std::string& text, double* absolute, double* relative) {
