@@ -81,6 +81,11 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     loop.cull_view = settings.cull_view;
     loop.progress = !settings.quiet;
     loop.models_left = (long long)stage.models.size();
+    std::vector<std::string> created;  // DIR/<model> folders of per-frame files that did not exist
+    for (Model model : stage.models) {
+        const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
+        if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
+    }
     for (Model model : stage.models) {
         const std::string name = modelName(model);
         const std::string base = (std::filesystem::path(settings.out_dir) / name).string();
@@ -96,7 +101,9 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         --loop.models_left;
         if (!ran) {
             owned.clear();  // the sinks remove their temporaries
-            if (!had_folder && budget.written() == 0) std::filesystem::remove(settings.out_dir, ec);  // only if empty
+            // Folders this run created and left empty go too (remove() takes only empty ones).
+            for (const std::string& folder : created) std::filesystem::remove(folder, ec);
+            if (!had_folder) std::filesystem::remove(settings.out_dir, ec);
             err << "error: " << error << "\n";
             return result.over_budget ? kExitBadInput : kExitOutputError;
         }
