@@ -56,7 +56,7 @@ bool OutputBudget::fitsEstimate(double estimate, long long measured, long long t
     if (limit_ <= 0 || double(written_) + estimate <= double(limit_)) return true;
     const double whole = double(written_) + estimate;
     std::ostringstream size;
-    size << std::setprecision(3) << whole / double(1LL << 20) << " MiB";
+    size << std::fixed << std::setprecision(1) << whole / double(1LL << 20) << " MiB";
     *error = "--max-output-bytes: this run would write about " + std::to_string((long long)whole) + " bytes (" +
              size.str() + ", estimated from " + std::to_string(measured) + " of " + std::to_string(total) +
              " frames), more than the limit of " + std::to_string(limit_) + "; " +
