@@ -18,6 +18,7 @@ public:
     FrameFileSink(std::string dir, std::string extension, FrameWriter write);
     bool begin(const SequenceInfo& info, std::string* error) override;
     PendingOutput pending(const ExportFrame& frame) override;
+    long long estimate(const ExportFrame& frame) const override { return leastFrameBytes(frame); }
     bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
              std::string* error) override;
     bool finish(SinkSummary* summary, std::string* error) override;

@@ -48,6 +48,9 @@ public:
     // What taking `frame` will add to the output before any of it is reported as completed: at
     // least `bytes` in all under `name` (called once per frame, just before add()).
     virtual PendingOutput pending(const ExportFrame& frame) = 0;
+    // About how many bytes taking `frame` would add to the outputs, for the estimate the loop makes
+    // from the first frames before anything is written (no side effects; 0: not known, the default).
+    virtual long long estimate(const ExportFrame& /*frame*/) const { return 0; }
     // Takes `frame` (frames in order; `prepared` is prepare(frame), possibly null). Files it
     // completed are appended to `completed`.
     virtual bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,

@@ -85,6 +85,8 @@ public:
     bool begin(const SequenceInfo& info, std::string* error) override;
     std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& frame) const override;
     PendingOutput pending(const ExportFrame& frame) override;
+    // Positions and indices (Draco's size is not known before encoding: 0).
+    long long estimate(const ExportFrame& frame) const override { return options_.draco ? 0 : leastFrameBytes(frame); }
     bool add(const ExportFrame& frame, const PreparedFrame* prepared, std::vector<std::string>* completed,
              std::string* error) override;
     bool finish(SinkSummary* summary, std::string* error) override;

@@ -9,6 +9,7 @@
 
 #include "pipeline/raytrace.h"
 #include "pipeline/render.h"
+#include "pipeline/scene_fields.h"
 #include "pipeline/trade.h"
 
 namespace apparent {
@@ -126,14 +127,18 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     std::string model_text, format_text = "glb", frames_text, tolerance_text;
     long long max_vertices = (long long)rs.stage.limits.max_vertices, max_faces = (long long)rs.stage.limits.max_faces;
     CLI::App* render_cmd = app.add_subcommand("render", "Render a scene's apparent shapes into DIR");
-    render_cmd->add_option("scene", rs.stage.scene_path, "Scene file (JSON, see README 'Scene format')")->required();
+    render_cmd->add_option("scene", rs.stage.scene_path,
+                           "Scene file: JSON (.json, README 'Scene format') or glTF (.gltf or .glb with object "
+                           "fields in node extras, README 'Scenes in glTF')")
+        ->required();
     render_cmd->add_option("--out", rs.out_dir, "Output folder (created if missing)")->capture_default_str();
     render_cmd->add_option("--model", model_text,
                            "instant|finite|relativistic|contracted|all, or a comma list (default: the scene's model)");
     render_cmd->add_option("--format", format_text, "Comma list of glb, ply, obj")->capture_default_str();
     render_cmd->add_option("--tolerance", tolerance_text,
-                           "Largest distance between output and exact apparent surface, light-seconds (overrides "
-                           "the scene's), or 'vertex': exact vertices joined by straight edges, no refinement");
+                           "Largest distance between output and exact apparent surface (overrides the scene's): "
+                           "T light-seconds; Fx, F times each object's bounding-box diagonal (default 1e-3x); "
+                           "or 'vertex': exact vertices joined by straight edges, no refinement");
     render_cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
     render_cmd->add_flag("--draco", rs.glb.draco, "Compress every frame mesh of the .glb with KHR_draco_mesh_compression");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
@@ -155,7 +160,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "(a --tolerance too fine for the scene); default: 4 x the scene's input triangles "
                            "(objects x (1 + mirrors)), at least " + std::to_string(kMinFrameTriangleBudget));
     render_cmd->add_option("--max-output-bytes", rs.max_output_bytes,
-                           "Stop with exit code 3 before the outputs would exceed this many bytes in all")
+                           "Stop with exit code 3 before the outputs would exceed this many bytes in all "
+                           "(estimated from the first frames before writing anything; 0: no limit)")
         ->capture_default_str();
     addStageLimits(render_cmd, &rs.stage);
     render_cmd->footer(kRenderFooter);
@@ -208,6 +214,18 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
         "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
 
+    // An unknown command: CLI11 would say only "A subcommand is required"; name the nearest.
+    if (argc > 1 && argv[1][0] != '-') {
+        std::vector<std::string> names;
+        for (const CLI::App* c : app.get_subcommands({})) names.push_back(c->get_name());
+        if (std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+            const std::string near = nearestField(argv[1], names);
+            err << "error: unknown command '" << argv[1] << "'"
+                << (near.empty() ? "" : "; did you mean " + near + "?") << " (commands: " << fieldList(names)
+                << "; run 'apparent --help')\n";
+            return kExitBadInput;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
@@ -288,17 +306,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (rs.formats.empty()) return usage("--format: no format given (" + names + ")");
     }
     if (!tolerance_text.empty()) {
-        if (tolerance_text == "vertex") {
-            rs.stage.tolerance = 0;
-        } else {
-            try {
-                size_t used = 0;
-                rs.stage.tolerance = std::stod(tolerance_text, &used);
-                if (used != tolerance_text.size() || !(rs.stage.tolerance > 0) || !std::isfinite(rs.stage.tolerance)) throw 0;
-            } catch (...) {
-                return usage("--tolerance: '" + tolerance_text + "' is neither a positive number of light-seconds nor 'vertex'");
-            }
-        }
+        if (!parseTolerance(tolerance_text, &rs.stage.tolerance, &rs.stage.tolerance_relative))
+            return usage("--tolerance: '" + tolerance_text +
+                         "' is neither a positive number of light-seconds, a fraction of each object's size such as "
+                         "1e-3x, nor 'vertex'");
         rs.stage.has_tolerance = true;
     }
     if (!frames_text.empty() && !parseFrames(frames_text, &rs.stage.frame_from, &rs.stage.frame_to))
@@ -306,9 +317,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
     if (rs.threads < 0 || rs.threads > kMaxThreads) return usage(threadsProblem(rs.threads));
-    if (rs.max_frame_triangles < 0) return usage("--max-triangles: must be positive");
-    if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0 || rs.max_output_bytes <= 0)
-        return usage("--max-vertices, --max-faces, --max-frames, --max-file-bytes and --max-output-bytes must be positive");
+    if (rs.max_frame_triangles < 0) return usage("--max-triangles: must be 0 (the default budget) or positive");
+    if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0)
+        return usage("--max-vertices, --max-faces, --max-frames and --max-file-bytes must be positive");
+    if (rs.max_output_bytes < 0) return usage("--max-output-bytes: must be positive, or 0 for no limit");
     rs.stage.limits.max_vertices = size_t(max_vertices);
     rs.stage.limits.max_faces = size_t(max_faces);
     rs.stage.limits.max_file_bytes = size_t(max_file_bytes);

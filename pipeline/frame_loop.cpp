@@ -62,8 +62,22 @@ private:
 
 }  // namespace
 
+bool OutputBudget::fitsEstimate(double estimate, long long measured, long long total, std::string* error) const {
+    if (limit_ <= 0 || double(written_) + estimate <= double(limit_)) return true;
+    const double whole = double(written_) + estimate;
+    std::ostringstream size;
+    size << std::fixed << std::setprecision(1) << whole / double(1LL << 20) << " MiB";
+    *error = "--max-output-bytes: this run would write about " + std::to_string((long long)whole) + " bytes (" +
+             size.str() + ", estimated from " + std::to_string(measured) + " of " + std::to_string(total) +
+             " frames), more than the limit of " + std::to_string(limit_) + "; " +
+             (written_ ? "nothing more was written (the files written are complete)" : "nothing was written") +
+             ": use a coarser --tolerance (e.g. 1e-2x), fewer --frames, --compress draco, or raise it with "
+             "--max-output-bytes (0: no limit)";
+    return false;
+}
+
 bool OutputBudget::fits(long long more, const std::string& what, std::string* error) const {
-    if (written_ + more <= limit_) return true;
+    if (limit_ <= 0 || written_ + more <= limit_) return true;
     *error = "--max-output-bytes: " + what + (more ? " would bring" : " brought") + " the output to " +
              std::to_string(written_ + more) + " bytes, more than the limit of " + std::to_string(limit_) + " (" +
              std::to_string(written_) + " bytes written, every written file is complete; raise it with --max-output-bytes)";
@@ -126,8 +140,9 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     Progress progress(progress_out, settings.progress, info.model, last_excl - first);
     // Frames are independent given the static worlds: a TBB pipeline cuts them in parallel and
     // delivers them in frame order, so files are byte-identical whatever the thread count. At most
-    // `tokens` frames (cut meshes and the sinks' conversions) are held at once, so the memory of a
-    // run is bounded by about tokens x the per-frame budget, also for a run the budget stops.
+    // `tokens` frames (cut meshes and the sinks' conversions) are held at once (and the first
+    // kEstimateFrames, held back for the size estimate below), so the memory of a run is bounded by
+    // about (tokens + kEstimateFrames) x the per-frame budget, also for a run the budget stops.
     struct Work {
         ExportFrame frame;
         std::vector<std::shared_ptr<const PreparedFrame>> prepared;  // per sink, made on the worker
@@ -161,17 +176,19 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             const mesh4d::World4D& world = worlds[o];
             // --cull-view: an object wholly outside the camera's view is left empty.
             if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(world, view))) return;
-            frame.objects[o] = mesh4d::sliceWorld(world, view, slice_settings);
+            mesh4d::SliceSettings own = slice_settings;
+            own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
+            frame.objects[o] = mesh4d::sliceWorld(world, view, own);
         });
         // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-        reflections.append(view, slice_settings, &frame.objects);
+        reflections.append(view, slice_settings, &frame.objects, &stage.tolerances);
         APPARENT_CHECK(frame.objects.size(), ==, info.objects.size());
         if (!overBudget(frame, settings.max_frame_triangles))
             for (const FrameSink* sink : sinks) w->prepared.push_back(sink->prepare(frame));
         return w;
     };
     // Sink, in order: the budget checks, then every sink gets the frame.
-    auto deliver = [&](WorkPtr w) {
+    auto deliverOne = [&](const WorkPtr& w) {
         if (stop) return;
         const ExportFrame& frame = w->frame;
         if (overBudget(frame, settings.max_frame_triangles)) {
@@ -197,6 +214,33 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             }
         }
         progress.update(frame.index - first + 1);
+    };
+    // Before the first write: the output size estimated from the first kEstimateFrames frames
+    // (held back until then), scaled to the whole run. A frame past --max-triangles is reported
+    // by deliverOne instead.
+    constexpr size_t kEstimateFrames = 4;
+    std::vector<WorkPtr> held;
+    bool estimated = false;
+    auto deliver = [&](WorkPtr w) {
+        if (stop) return;
+        if (estimated) return deliverOne(w);
+        held.push_back(std::move(w));
+        if (held.size() < kEstimateFrames && held.back()->frame.index + 1 < last_excl) return;
+        estimated = true;
+        double bytes = 0;
+        bool too_many = false;
+        for (const WorkPtr& h : held) {
+            too_many = too_many || overBudget(h->frame, settings.max_frame_triangles);
+            for (const FrameSink* sink : sinks) bytes += double(sink->estimate(h->frame));
+        }
+        if (too_many) bytes = 0;
+        const double whole = bytes / double(held.size()) * double(last_excl - first) * double(settings.models_left);
+        if (!budget->fitsEstimate(whole, (long long)held.size(), last_excl - first, error)) {
+            stop = true;
+            return;
+        }
+        for (const WorkPtr& h : held) deliverOne(h);
+        held.clear();
     };
     arena.execute([&] {
         tbb::parallel_pipeline(tokens, tbb::make_filter<void, WorkPtr>(tbb::filter_mode::serial_in_order, source) &

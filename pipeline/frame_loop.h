@@ -4,7 +4,9 @@
 // byte-identical for any thread count. Each sink gets begin(), then every frame, then finish()
 // (exporters/frame_sink.h). Before each write the output budget (--max-output-bytes) is checked
 // against the sink's least size, and after it against the real size of every completed file.
-// Progress (frames done, rate, time left) is shown on a terminal.
+// Before the first write, the sinks' estimate of the first batch of frames, scaled to every frame
+// and every model left, is checked against the budget too: a run that would pass it stops with
+// nothing written. Progress (frames done, rate, time left) is shown on a terminal.
 #pragma once
 
 #include <iosfwd>
@@ -18,10 +20,14 @@
 namespace apparent {
 
 // Bytes written by a run, against --max-output-bytes: files already written stay complete,
-// nothing is written past the limit.
+// nothing is written past the limit. A limit of 0 is none.
 class OutputBudget {
 public:
     explicit OutputBudget(long long limit) : limit_(limit) {}
+    // Before anything is written: false, with the one line that names the ways out (--tolerance,
+    // --frames, --compress, --max-output-bytes), when `estimate` bytes for the whole run would pass
+    // the limit. `measured` of `total` frames gave the estimate.
+    bool fitsEstimate(double estimate, long long measured, long long total, std::string* error) const;
     // False, with the message, when `more` bytes beyond those written would pass the limit
     // (more = 0: the total already has).
     bool fits(long long more, const std::string& what, std::string* error) const;
@@ -53,6 +59,9 @@ struct FrameLoopSettings {
     long long max_frame_triangles = kMinFrameTriangleBudget;
     bool cull_view = false;  // --cull-view: objects outside the camera's view stay empty (worlds.h)
     bool progress = true;    // on a terminal only
+    // Models still to run with the same budget, this one included: the estimate made from the
+    // first frames before writing (OutputBudget::fitsEstimate) counts them all.
+    long long models_left = 1;
 };
 
 struct FrameLoopResult {

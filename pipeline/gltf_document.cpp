@@ -375,6 +375,17 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
     nlohmann::json j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) return Status::failure(path + ": invalid JSON");
     if (!j.is_object()) return Status::failure(path + ": the glTF JSON is not an object");
+    // glTF 1.0 (asset.version "1.x", or meshes as a dictionary): tinygltf would read no meshes
+    // from it and the file would seem empty.
+    {
+        const auto asset = j.find("asset");
+        const nlohmann::json version = asset != j.end() && asset->is_object() ? asset->value("version", nlohmann::json()) : nlohmann::json();
+        const bool v1 = (version.is_string() && version.get<std::string>().rfind("1", 0) == 0) ||
+                        (j.contains("meshes") && j["meshes"].is_object());
+        if (v1)
+            return Status::failure(path + ": asset.version: glTF 1.0 is not supported; convert with "
+                                          "'npx gltf-pipeline -i IN -o OUT.glb' (it upgrades 1.0 to 2.0) or re-export as glTF 2.0");
+    }
     if (!checkBufferUris(j, &problem) || !checkDracoReferences(j, &problem) ||
         !checkDracoPayloads(j, bytes, binary, canonical.parent_path(), limits.max_file_bytes, &problem))
         return Status::failure(path + ": " + problem);

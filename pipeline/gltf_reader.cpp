@@ -272,6 +272,10 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
     if (Status s = openGltf(path, limits, &doc); !s.ok) return s;
     warnings->other.insert(warnings->other.end(), doc->warnings.begin(), doc->warnings.end());
     const tinygltf::Model& model = doc->model;
+    // Skins and animations are not read: the meshes are taken as stored (their bind pose).
+    if (!model.skins.empty() || !model.animations.empty())
+        warnings->other.push_back(std::to_string(model.skins.size()) + " skins and " + std::to_string(model.animations.size()) +
+                                  " animations: skin and animation ignored: the bind pose is used");
 
     // Step: choose the roots: one named node (in its own frame), or the whole file's.
     std::vector<int> roots;

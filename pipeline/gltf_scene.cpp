@@ -122,7 +122,8 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
                                                     (key[0] == 'c' ? "camera is the first node with a camera" : "objects are the nodes whose extras hold object fields"));
     sx.erase("camera");
     sx.erase("objects");
-    r.warnUnknownKeys(sx, top, {"frames", "light", "model", "tolerance"});
+    r.warnUnknownKeys(sx, top, {"frames", "light", "model", "tolerance", "up"});
+    readUpAxis(r, sx, top);  // before any vector is read
     readLight(r, sx, top, scene);
     readFrames(r, sx, top, &scene->frames);
     readModelAndTolerance(r, sx, top, scene);

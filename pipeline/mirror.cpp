@@ -209,7 +209,7 @@ MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<Prepa
 }
 
 void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
-                               std::vector<mesh4d::ApparentMesh>* objects) const {
+                               std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances) const {
     // Step: each mirror as the camera sees it in this frame (its own cut, `exists` included):
     // what is seen through it is clipped to these triangles. Slivers give no pyramid.
     APPARENT_CHECK(objects->size(), >=, scene_objects_);  // the frame's scene objects come first
@@ -232,7 +232,9 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         }
         mesh4d::ViewSurface image = view;
         image.apex = reflectPoint(m, view.apex);
-        const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, settings);
+        mesh4d::SliceSettings own = settings;
+        if (object_tolerances) own.tolerance = (*object_tolerances)[target.object];
+        const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
         objects->push_back(reflectAndClip(cut, m, seen[target.mirror], camera_));
     }
 }

@@ -51,8 +51,10 @@ public:
     // order of describe()). `view` is the frame's view for the camera; its apex is replaced.
     // `objects` must already hold the frame's cut of every scene object, in scene order: each
     // mirror's cut is what its reflections are clipped to (empty cut: empty reflections).
+    // `object_tolerances` (one per scene object), when given, replaces settings.tolerance for each
+    // object's reflections (the stage's per-object tolerances).
     void append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
-                std::vector<mesh4d::ApparentMesh>* objects) const;
+                std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances = nullptr) const;
     // Appends the reflections' names and colours (the object's, darkened by the mirror's
     // reflectance) to info->objects, and makes the mirrors themselves translucent so that the
     // reflections behind them show from the camera.

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -48,6 +49,15 @@ Status scanObj(const std::string& path, std::string& text, const MeshLimits& lim
     auto fail = [&](const std::string& problem) {
         return Status::failure(path + ":" + std::to_string(line_no) + ": " + problem);
     };
+    // UTF-16 (a byte-order mark, or NUL bytes among the first characters, as Windows tools write
+    // it): every line would read as garbage and the file as "no vertices".
+    const size_t prefix = std::min<size_t>(text.size(), 64);
+    if ((text.size() >= 2 && (((unsigned char)text[0] == 0xFF && (unsigned char)text[1] == 0xFE) ||
+                              ((unsigned char)text[0] == 0xFE && (unsigned char)text[1] == 0xFF))) ||
+        text.find('\0') < prefix)
+        return Status::failure(path + ": UTF-16 text; save as UTF-8 (OBJ is read as ASCII / UTF-8)");
+    size_t face_no = 0;          // 'f' lines so far
+    std::string first_repeat;    // "face 3 repeats vertex 7 (line 12)": the first face dropped for it
     for (size_t at = 0; at < text.size();) {
         size_t end = text.find('\n', at);
         if (end == std::string::npos) end = text.size();
@@ -90,9 +100,18 @@ Status scanObj(const std::string& path, std::string& text, const MeshLimits& lim
                                 std::to_string(scan->vertices) + " so far, or -1..-" + std::to_string(scan->vertices) + ")");
                 idx.push_back(resolved);
             }
+            ++face_no;
             if (idx.size() < 3) return fail("f: a face needs at least 3 vertices, got " + std::to_string(idx.size()));
             if (std::set<long>(idx.begin(), idx.end()).size() != idx.size()) {
                 ++scan->repeated_index;  // OpenMesh drops it; we count it as degenerate
+                if (first_repeat.empty()) {
+                    std::set<long> seen;
+                    long repeated = 0;
+                    for (long i : idx)
+                        if (!seen.insert(i).second && !repeated) repeated = i;
+                    first_repeat = "face " + std::to_string(face_no) + " repeats vertex " + std::to_string(repeated) +
+                                   " (line " + std::to_string(line_no) + ")";
+                }
                 continue;
             }
             ++scan->faces;
@@ -106,7 +125,15 @@ Status scanObj(const std::string& path, std::string& text, const MeshLimits& lim
         warnings->other.push_back(std::to_string(mtllibs) +
                                   " mtllib lines ignored (material libraries are not read)");
     if (scan->vertices == 0) return Status::failure(path + ": no vertices ('v' lines)");
-    if (scan->faces == 0) return Status::failure(path + ": no usable faces ('f' lines)");
+    if (scan->faces == 0)
+        return Status::failure(path + ": no usable faces ('f' lines)" +
+                               (first_repeat.empty() ? std::string()
+                                                      : ": " + first_repeat +
+                                                            (scan->repeated_index > 1
+                                                                 ? " (and " + std::to_string(scan->repeated_index - 1) + " more faces repeat a vertex)"
+                                                                 : std::string())));
+    if (!first_repeat.empty())
+        warnings->other.push_back(first_repeat + ": dropped (a face may use a vertex once)");
     return Status::success();
 }
 

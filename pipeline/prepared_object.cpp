@@ -1,6 +1,7 @@
 #include "pipeline/prepared_object.h"
 
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <ostream>
 #include <utility>
@@ -50,6 +51,13 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
                 return s;
         auto it = cache.find(spec.mesh_path);
         if (it == cache.end()) {
+            // A misspelt path: name the field that gave it ("cannot open" would not say which).
+            std::error_code ec;
+            std::string file = spec.mesh_path;  // without a glTF "#Node" suffix
+            if (const auto h = file.rfind('#'); h != std::string::npos && isGltfPath(file.substr(0, h))) file.resize(h);
+            if (!std::filesystem::exists(file, ec) && !ec)
+                return Status::failure(scene.path + ": " + spec.field_path + ".mesh: \"" +
+                                       (spec.mesh_text.empty() ? spec.mesh_path : spec.mesh_text) + "\" not found (" + file + ")");
             LoadedMesh mesh;
             MeshWarnings warnings;
             if (Status s = readMesh(spec.mesh_path, limits, &mesh, &warnings); !s.ok) return s;

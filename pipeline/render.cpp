@@ -65,6 +65,8 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         }
     }
     std::error_code ec;
+    // A folder this run creates is removed again when the run stops before writing into it.
+    const bool had_folder = std::filesystem::exists(settings.out_dir, ec);
     std::filesystem::create_directories(settings.out_dir, ec);
     if (ec) {
         err << "error: " << settings.out_dir << ": cannot create output folder: " << ec.message() << "\n";
@@ -79,6 +81,12 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         settings.max_frame_triangles > 0 ? settings.max_frame_triangles : defaultFrameTriangleBudget(stage);
     loop.cull_view = settings.cull_view;
     loop.progress = !settings.quiet;
+    loop.models_left = (long long)stage.models.size();
+    std::vector<std::string> created;  // DIR/<model> folders of per-frame files that did not exist
+    for (Model model : stage.models) {
+        const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
+        if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
+    }
     for (Model model : stage.models) {
         const std::string name = modelName(model);
         const std::string base = (std::filesystem::path(settings.out_dir) / name).string();
@@ -90,7 +98,13 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
             sinks.push_back(owned.back().get());
         }
         FrameLoopResult result;
-        if (!runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error)) {
+        const bool ran = runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error);
+        --loop.models_left;
+        if (!ran) {
+            owned.clear();  // the sinks remove their temporaries
+            // Folders this run created and left empty go too (remove() takes only empty ones).
+            for (const std::string& folder : created) std::filesystem::remove(folder, ec);
+            if (!had_folder) std::filesystem::remove(settings.out_dir, ec);
             err << "error: " << error << "\n";
             return result.over_budget ? kExitBadInput : kExitOutputError;
         }

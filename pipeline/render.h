@@ -13,6 +13,9 @@
 
 namespace apparent {
 
+// The default output budget: 2 GiB on disk.
+constexpr long long kDefaultMaxOutputBytes = 2LL << 30;
+
 struct RenderSettings {
     StageOptions stage;                // scene, --model, --tolerance, --frames, limits
     std::string out_dir = "out";
@@ -22,7 +25,9 @@ struct RenderSettings {
     bool cull_view = false;            // --cull-view: leave objects outside the camera's view empty
     bool quiet = false;
     bool verbose = false;
-    long long max_output_bytes = 20LL << 30;  // --max-output-bytes: all files of the run together
+    // --max-output-bytes: all files of the run together (0: no limit); checked first against an
+    // estimate from the first frames, before anything is written.
+    long long max_output_bytes = kDefaultMaxOutputBytes;
     long long max_frame_triangles = 0;  // --max-triangles: per frame; 0: defaultFrameTriangleBudget
 };
 

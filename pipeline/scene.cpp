@@ -97,6 +97,13 @@ Status readJsonScene(const json& root, const std::string& path, Scene* scene) {
 
 Status loadScene(const std::string& path, Scene* scene) {
     if (isGltfPath(path)) return loadGltfScene(path, scene);
+    // A mesh given where the scene belongs: say so rather than "invalid JSON at line 1".
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower((unsigned char)c));
+    if (ext == ".obj" || ext == ".ply")
+        return Status::failure(path + " is an " + (ext == ".obj" ? std::string("OBJ") : std::string("PLY")) +
+                               " mesh, not a scene: name it in a scene's objects[].mesh (README \"Scene format\"), "
+                               "or open a .json, .gltf or .glb scene");
     *scene = Scene{};
     scene->path = path;
     // Only a regular file, within the size limit of any input file, and nested shallowly enough

@@ -71,13 +71,23 @@ struct ObjectSpec {
     bool mirror = false;
 };
 
+// The default tolerance, as a fraction of each object's bounding-box diagonal: an object that fills
+// a 1000-pixel-wide view is then within about a pixel of its exact apparent surface, and the
+// measured error is 0.85 to 0.99 of it (docs/ACCURACY.md; `apparent trade` rows "T = 0.001 x size").
+constexpr double kDefaultToleranceRelative = 1e-3;
+
 struct Scene {
     std::string path;                  // the scene file, as given
     CameraSpec camera;
     LightSpec light;                   // default: directional, from camera.up (overhead)
     FrameSpec frames;
     Model model = Model::Relativistic;
-    double tolerance = 1e-3;          // light-seconds; 0 = vertex mode
+    // The tolerance: absolute (`tolerance` light-seconds > 0; 0 = vertex mode) when
+    // tolerance_relative is 0, else relative: each object's is tolerance_relative x its
+    // bounding-box diagonal (the default when neither the scene nor --tolerance gives one; the stage
+    // then sets `tolerance` to the smallest object's, for messages and the outputs' extras).
+    double tolerance = 1e-3;
+    double tolerance_relative = kDefaultToleranceRelative;
     std::vector<ObjectSpec> objects;
     // What was read but not used, one line each ("file: field: problem"): in a glTF scene, extras
     // keys that are not scene fields (other tools keep custom properties there), misspelt ones

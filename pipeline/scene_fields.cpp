@@ -82,6 +82,13 @@ void FieldReader::vec3(const json& parent, const char* key, const std::string& p
     *out = {v[0], v[1], v[2]};
 }
 
+void FieldReader::axisVec3(const json& parent, const char* key, const std::string& path, Vec3* out) {
+    Vec3 v = *out;
+    vec3(parent, key, path, &v);
+    if (z_up_ && parent.contains(key)) v = {v.x, v.z, -v.y};
+    *out = v;
+}
+
 void FieldReader::string(const json& parent, const char* key, const std::string& path, std::string* out) {
     auto it = parent.find(key);
     if (it == parent.end()) return;
@@ -183,7 +190,7 @@ void readT0(FieldReader& r, const json& j, const std::string& path, const Object
 }
 
 void readVelocity(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
-    r.vec3(j, "velocity", path, &obj->velocity);
+    r.axisVec3(j, "velocity", path, &obj->velocity);
 }
 
 // An exactly stated speed: a unit direction with gamma or rapidity (README "Scene format").
@@ -199,7 +206,7 @@ void readExactSpeed(FieldReader& r, const json& j, const std::string& path, cons
         return;
     }
     Vec3 d;
-    r.vec3(j, "direction", path, &d);
+    r.axisVec3(j, "direction", path, &d);
     if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(path + ".direction", "must be non-zero");
     if (!r.failed()) obj->direction = d / mesh4d::norm(d);
     if (has_gamma) {
@@ -219,12 +226,16 @@ void readExactSpeed(FieldReader& r, const json& j, const std::string& path, cons
 }
 
 void readRotation(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    if (r.zUp() && j.contains("rotation_deg"))
+        r.fail(path + ".rotation_deg", "not read with the scene's \"up\": \"z\" (no single axis rule); rotate the node itself");
     r.vec3(j, "rotation_deg", path, &obj->rotation_deg);
 }
 
 void readScale(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
     auto it = j.find("scale");
     if (it == j.end()) return;
+    if (r.zUp() && it->is_array())
+        r.fail(path + ".scale", "an array is not read with the scene's \"up\": \"z\" (no single axis rule); scale the node itself");
     if (it->is_array()) {
         r.vec3(j, "scale", path, &obj->scale);
     } else {
@@ -356,10 +367,10 @@ void readLight(FieldReader& r, const json& parent, const std::string& top, Scene
         r.fail(lp, "give exactly one of position (a point light) or direction (towards a distant light)");
     } else if (li->contains("position")) {
         scene->light.kind = LightSpec::Kind::Point;
-        r.vec3(*li, "position", lp, &scene->light.position);
+        r.axisVec3(*li, "position", lp, &scene->light.position);
     } else {
         Vec3 d;
-        r.vec3(*li, "direction", lp, &d);
+        r.axisVec3(*li, "direction", lp, &d);
         if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(lp + ".direction", "must be non-zero");
         if (!r.failed()) scene->light.direction = d / mesh4d::norm(d);
     }
@@ -391,6 +402,37 @@ void readFrames(FieldReader& r, const json& parent, const std::string& top, Fram
     }
 }
 
+void readUpAxis(FieldReader& r, const json& parent, const std::string& top) {
+    if (!parent.contains("up")) return;
+    std::string up;
+    r.string(parent, "up", top, &up);
+    if (r.failed()) return;
+    if (up != "y" && up != "z") r.fail(FieldReader::join(top, "up"), "expected \"y\" (glTF's axes, the default) or \"z\" (Blender's), got \"" + up + "\"");
+    r.setZUp(up == "z");
+}
+
+bool parseTolerance(const std::string& text, double* absolute, double* relative) {
+    if (text == "vertex") {
+        *absolute = 0;
+        *relative = 0;
+        return true;
+    }
+    const bool is_relative = !text.empty() && text.back() == 'x';
+    const std::string number = is_relative ? text.substr(0, text.size() - 1) : text;
+    double v = 0;
+    try {
+        size_t used = 0;
+        v = std::stod(number, &used);
+        if (used != number.size() || std::isspace((unsigned char)number[0])) return false;
+    } catch (const std::exception&) {
+        return false;
+    }
+    if (!(v > 0) || !std::isfinite(v) || (is_relative && !(v < 1))) return false;
+    *absolute = is_relative ? 0 : v;
+    *relative = is_relative ? v : 0;
+    return true;
+}
+
 void readModelAndTolerance(FieldReader& r, const json& parent, const std::string& top, Scene* scene) {
     auto at = [&](const std::string& key) { return FieldReader::join(top, key); };
     if (parent.contains("model")) {
@@ -399,12 +441,15 @@ void readModelAndTolerance(FieldReader& r, const json& parent, const std::string
         if (!r.failed() && !parseModel(name, &scene->model))
             r.fail(at("model"), "unknown model '" + name + "' (instant, finite, relativistic, contracted)");
     }
-    // tolerance: light-seconds > 0, or "vertex" (0 inside: exact vertices, straight edges).
+    // tolerance: light-seconds > 0, "vertex" (0 inside: exact vertices, straight edges), or
+    // "<f>x": f times each object's bounding-box diagonal. Absent: kDefaultToleranceRelative x.
     if (auto tol = parent.find("tolerance"); tol != parent.end() && tol->is_string()) {
-        if (tol->get<std::string>() != "vertex") r.fail(at("tolerance"), "expected a number > 0 or \"vertex\"");
-        else scene->tolerance = 0;
-    } else {
+        if (!parseTolerance(tol->get<std::string>(), &scene->tolerance, &scene->tolerance_relative))
+            r.fail(at("tolerance"), "expected a number > 0 (light-seconds), \"vertex\" or a fraction of each object's size "
+                                    "such as \"1e-3x\", got \"" + tol->get<std::string>() + "\"");
+    } else if (tol != parent.end()) {
         r.number(parent, "tolerance", top, &scene->tolerance);
+        scene->tolerance_relative = 0;
         if (!r.failed() && !(scene->tolerance > 0)) r.fail(at("tolerance"), "must be > 0 (light-seconds) or \"vertex\"");
     }
 }

@@ -39,6 +39,11 @@ public:
     bool object(const nlohmann::json& parent, const char* key, const std::string& path, const nlohmann::json** out);
     void number(const nlohmann::json& parent, const char* key, const std::string& path, double* out);
     void vec3(const nlohmann::json& parent, const char* key, const std::string& path, mesh4d::Vec3* out);
+    // A position or direction in the scene's axes: as vec3, then turned from Z-up to glTF's Y-up,
+    // (x, y, z) -> (x, z, -y), when the source is Z-up (setZUp; see readUpAxis).
+    void axisVec3(const nlohmann::json& parent, const char* key, const std::string& path, mesh4d::Vec3* out);
+    void setZUp(bool z_up) { z_up_ = z_up; }
+    bool zUp() const { return z_up_; }
     void string(const nlohmann::json& parent, const char* key, const std::string& path, std::string* out);
     void readNumber(const nlohmann::json& j, const std::string& path, double* out);
 
@@ -50,6 +55,7 @@ private:
     std::string file_;
     Status* status_;
     std::vector<std::string> warnings_;
+    bool z_up_ = false;
 };
 
 // "a, b, c": field names for messages.
@@ -104,6 +110,17 @@ void checkCamera(FieldReader& r, const std::string& path, const CameraSpec& came
 // The light's default direction follows camera.up: read the camera first.
 void readLight(FieldReader& r, const nlohmann::json& parent, const std::string& top, Scene* scene);
 void readFrames(FieldReader& r, const nlohmann::json& parent, const std::string& top, FrameSpec* frames);
+// A tolerance as the command line and the scene's `tolerance` string write it: "vertex" (both 0),
+// "T" (light-seconds > 0: absolute = T, relative = 0) or "Fx" (0 < F < 1, a fraction of each
+// object's bounding-box diagonal: relative = F, absolute = 0). False, untouched, for anything else.
+bool parseTolerance(const std::string& text, double* absolute, double* relative);
+// The axes of a glTF scene's vectors (its extras "up": "y", the default, or "z"): glTF is Y-up,
+// but a Blender user's custom properties (which Blender's glTF exporter copies into extras
+// unchanged) are in Blender's Z-up axes. With "z", every position and direction of the scene's and
+// nodes' extras (velocity, direction, light.position, light.direction) is turned into glTF's axes
+// as Blender's exporter turns geometry, (x, y, z) -> (x, z, -y); rotation_deg and scale, which
+// have no such single rule, are refused there (use the node's own rotation and scale).
+void readUpAxis(FieldReader& r, const nlohmann::json& parent, const std::string& top);
 void readModelAndTolerance(FieldReader& r, const nlohmann::json& parent, const std::string& top, Scene* scene);
 
 }  // namespace apparent

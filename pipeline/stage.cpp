@@ -27,7 +27,10 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     // Properties the scene reader kept but did not use (a misspelt field in glTF extras): said once.
     if (!options.quiet)
         for (const std::string& w : scene.warnings) log << "warning: " << w << "\n";
-    if (options.has_tolerance) scene.tolerance = options.tolerance;
+    if (options.has_tolerance) {
+        scene.tolerance = options.tolerance;
+        scene.tolerance_relative = options.tolerance_relative;
+    }
     stage->models = options.models;
     if (options.all_models) stage->models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};
     if (stage->models.empty()) stage->models = {scene.model};
@@ -67,6 +70,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
             return fail(scene.path + ": frames, camera.instant_delay: the viewed time of frame " + std::to_string(k) +
                         " is not finite or beyond " + formatNumber(kMaxCoordinate) + " s");
     double largest = 0;
+    std::vector<double> sizes;  // each object's bounding-box diagonal
     for (const PreparedObject& o : stage->objects) {
         // Beyond 1e9 degrees an angle has no fractional degree left in a double.
         const mesh4d::Vec3& r = o.spec.rotation_deg;
@@ -82,10 +86,31 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
                             " light-seconds");
             box.addPoint(p);
         }
-        if (!o.rest.positions.empty()) largest = std::max(largest, box.diagonal());
+        sizes.push_back(o.rest.positions.empty() ? 0.0 : box.diagonal());
+        largest = std::max(largest, sizes.back());
+    }
+    // Step: each object's tolerance; a relative one follows the object's own size, so the same
+    // scene at any scale gives the same triangles.
+    stage->tolerances.assign(stage->objects.size(), scene.tolerance);
+    if (scene.tolerance_relative > 0) {
+        double smallest = 0;
+        for (size_t i = 0; i < sizes.size(); ++i) {
+            // Never below the floor of the largest object (a speck beside a huge backdrop).
+            stage->tolerances[i] = std::max(scene.tolerance_relative * (sizes[i] > 0 ? sizes[i] : largest),
+                                            kToleranceFloorRelative * largest);
+            if (stage->tolerances[i] > 0 && (smallest == 0 || stage->tolerances[i] < smallest)) smallest = stage->tolerances[i];
+        }
+        scene.tolerance = smallest;
+        if (!(smallest > 0))
+            return fail(scene.path + ": tolerance: every object has size 0, so a tolerance relative to the size is 0; "
+                        "give one in light-seconds (--tolerance T) or 'vertex'");
     }
     const double floor = kToleranceFloorRelative * largest;
-    if (scene.tolerance > 0 && scene.tolerance < floor)
+    if (scene.tolerance_relative > 0 && scene.tolerance_relative < kToleranceFloorRelative)
+        return fail(scene.path + ": tolerance (or --tolerance): " + formatNumber(scene.tolerance_relative) +
+                    "x is below the floor of " + formatNumber(kToleranceFloorRelative) +
+                    "x (float32 output cannot show finer): use a coarser --tolerance, or 'vertex'");
+    if (scene.tolerance_relative == 0 && scene.tolerance > 0 && scene.tolerance < floor)
         return fail(scene.path + ": tolerance (or --tolerance): " + formatNumber(scene.tolerance) + " light-seconds is below the floor of " +
                     formatNumber(floor) + " (1e-6 of the largest object's size, " + formatNumber(largest) +
                     "; float32 output cannot show finer): use a coarser --tolerance, or 'vertex'");

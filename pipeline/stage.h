@@ -35,7 +35,8 @@ struct StageOptions {
     std::vector<Model> models;         // --model; empty: the scene's model
     bool all_models = false;           // --model all: instant, finite, relativistic, contracted
     bool has_tolerance = false;        // --tolerance given: overrides the scene's
-    double tolerance = 1e-3;           // light-seconds; 0: vertex mode
+    double tolerance = 1e-3;           // light-seconds; 0: vertex mode (with tolerance_relative 0)
+    double tolerance_relative = 0;     // > 0: --tolerance Fx, this fraction of each object's size
     long long frame_from = 0;          // --frames A:B, global frame numbers, B exclusive
     long long frame_to = -1;           // -1: to the last frame of the scene
     long long max_frames = kDefaultMaxFrames;  // --max-frames: scenes with more frames are refused
@@ -51,13 +52,16 @@ struct Stage {
     std::vector<Model> models;         // what to run, each checked with checkSceneForModel
     long long first = 0, last_excl = 0;  // frames [first, last_excl), 0 <= first < last_excl <= frame count
     std::vector<PreparedObject> objects;
+    // Each object's tolerance, light-seconds (0: vertex mode): the scene's absolute one, or its
+    // relative one times the object's bounding-box diagonal (README "Accuracy").
+    std::vector<double> tolerances;
     std::vector<MirrorPlane> mirrors;  // the planes of the mirror objects (findMirrors)
 };
 
 // Loads and validates the scene, the models, the frame count (against max_frames) and range, every
 // mesh and the mirrors, in that order; then what they derive: every transformed vertex finite and
-// within kMaxCoordinate, the camera's look-back and frame times within it, the tolerance not
-// below kToleranceFloorRelative of the largest object, objects x (1 + mirrors) x frames within
+// within kMaxCoordinate, the camera's look-back and frame times within it, each object's tolerance
+// (set here; scene.tolerance becomes the smallest) not below kToleranceFloorRelative of the largest object, objects x (1 + mirrors) x frames within
 // max_object_frames. On failure: false, and the one line to print (without
 // "error: ") in `error`; the command exits with kExitBadInput. Mesh warnings go to `log`.
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error);

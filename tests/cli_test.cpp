@@ -231,7 +231,7 @@ TEST(Cli, BadInputExitsTwoAndWritesNothing) {
     const std::pair<const char*, const char*> cases[] = {
         {"scene_superluminal.json", "objects[0].velocity"},
         {"scene_malformed.json", "invalid JSON"},
-        {"scene_missing_mesh.json", "does_not_exist.obj: cannot open mesh file"},
+        {"scene_missing_mesh.json", "objects[0].mesh: \"does_not_exist.obj\" not found"},
         {"scene_unknown_field.json", "objects[0].velocty"},
     };
     for (const auto& [file, expected] : cases) {
