@@ -91,7 +91,6 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
 
     // Step: the camera node. glTF cameras look down local -Z with +Y up.
     if (camera_node >= 0) {
-        const std::string where = "nodes[" + std::to_string(camera_node) + "]";
         const tinygltf::Node& node = model.nodes[size_t(camera_node)];
         CameraSpec& c = scene->camera;
         const Vec3 pos = camera_world.apply({0, 0, 0});
@@ -101,12 +100,6 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         c.up = up;
         const auto& cam = model.cameras[size_t(node.camera)];
         if (cam.type == "perspective") c.fov_deg = cam.perspective.yfov * 180.0 / mesh4d::kPi;
-        if (const json& cx = doc->node_extras[size_t(camera_node)]; cx.is_object() && !is_object[size_t(camera_node)]) {
-            r.warnUnknownKeys(cx, where + ".extras", {"instant_delay", "velocity"});
-            r.number(cx, "instant_delay", where + ".extras", &c.instant_delay);
-            r.vec3(cx, "velocity", where + ".extras", &c.velocity);
-        }
-        checkCamera(r, where, c);
     }
 
     // Step: the scene's extras: light, frames, model and tolerance, read as in a JSON scene.
@@ -124,6 +117,16 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
     sx.erase("objects");
     r.warnUnknownKeys(sx, top, {"frames", "light", "model", "tolerance", "up"});
     readUpAxis(r, sx, top);  // before any vector is read
+    // The camera node's extras (its velocity in the scene's axes, like every vector in extras).
+    if (camera_node >= 0) {
+        const std::string where = "nodes[" + std::to_string(camera_node) + "]";
+        if (const json& cx = doc->node_extras[size_t(camera_node)]; cx.is_object() && !is_object[size_t(camera_node)]) {
+            r.warnUnknownKeys(cx, where + ".extras", {"instant_delay", "velocity"});
+            r.number(cx, "instant_delay", where + ".extras", &scene->camera.instant_delay);
+            r.axisVec3(cx, "velocity", where + ".extras", &scene->camera.velocity);
+        }
+        checkCamera(r, where, scene->camera);
+    }
     readLight(r, sx, top, scene);
     readFrames(r, sx, top, &scene->frames);
     readModelAndTolerance(r, sx, top, scene);
