@@ -51,24 +51,93 @@ int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t*
     return k;
 }
 
+struct REdge {
+    uint32_t mid;  // midpoint vertex once made, else kUnset
+    double len;    // edgeLength once known, else NaN
+};
+// Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
+// touched), later ids the halves made by splits, two by two. Each slot c is the edge from v[c]
+// to v[c + 1]; the slots on one edge form a cycle (next), as World4D::slot_next does for the
+// mesh, so that an edge is split in every triangle that has it: no T-junctions, however the
+// splits go.
+struct RTri {
+    uint32_t v[3];
+    uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
+    uint32_t edge[3];  // the edge record of each slot
+    uint32_t child;    // the first of its two halves (the second is child + 1) once split, else kUnset
+    uint32_t src;      // the mesh triangle it lies on
+    uint16_t depth;    // bisections since the mesh triangle
+    int16_t longest;   // the slot of its longest edge once known, else -1
+};
+
+// The refinement's working arrays, kept per thread from frame to frame: a frame reuses the pages the
+// previous one touched instead of faulting fresh ones in (the arrays are several times the size of
+// the output). Cleared, not freed, by each frame; freed after a frame that made them larger than
+// kScratchKeep bytes, so a single huge frame does not hold its memory for the program's life.
+struct RefineScratch {
+    std::vector<Vec3> pos, shape, rest, e_pos;
+    std::vector<double> time, xm, e_time;
+    std::vector<Event> cap;
+    std::vector<uint8_t> e_done, init, limited;
+    std::vector<REdge> edges;
+    std::unique_ptr<RTri[]> tri;
+    size_t tri_cap = 0;
+    std::vector<uint32_t> members, stack;
+    std::vector<Side> side;
+    std::vector<uint32_t> vertex_out;
+
+    size_t bytes() const {
+        return (pos.capacity() + shape.capacity() + rest.capacity() + e_pos.capacity()) * sizeof(Vec3) +
+               (time.capacity() + xm.capacity() + e_time.capacity()) * sizeof(double) + cap.capacity() * sizeof(Event) +
+               edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
+               (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
+               e_done.capacity() + init.capacity() + limited.capacity() + side.capacity();
+    }
+};
+constexpr size_t kScratchKeep = size_t(256) << 20;
+
+RefineScratch& threadScratch() {
+    static thread_local RefineScratch scratch;
+    return scratch;
+}
+
 struct FrameBuilder {
     const World4D& world;
     const ViewSurface& view;
     const SliceSettings& settings;
     const ViewAnchor anchor;  // the frame's local coordinates (positions relative to the object's apparent origin)
     ApparentMesh out;
-    std::vector<Side> side;
-    std::vector<uint32_t> vertex_out;     // rest vertex -> output vertex
+    RefineScratch& scratch;               // this thread's working arrays (threadScratch)
+    std::vector<Side>& side;
+    std::vector<uint32_t>& vertex_out;    // rest vertex -> output vertex
     std::vector<uint32_t> crossing_out;   // 2 * edge + cap -> output vertex
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being clipped (rest clip)
     bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restPlan
     double rest_tolerance = 0;          // the tolerance restPlan keeps (settings.tolerance is 0 at rest)
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
-        : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)) {
+        : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)), scratch(threadScratch()),
+          side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
+          r_shape(scratch.shape), r_xm(scratch.xm), r_rest(scratch.rest), r_cap(scratch.cap), e_pos(scratch.e_pos),
+          e_time(scratch.e_time), e_done(scratch.e_done), scratch_members(scratch.members), r_edges(scratch.edges),
+          r_tri(scratch.tri), r_tri_cap(scratch.tri_cap), r_init(scratch.init), r_limited(scratch.limited) {
+        for (auto* a : {&r_pos, &r_shape, &r_rest, &e_pos}) a->clear();
+        for (auto* a : {&r_time, &r_xm, &e_time}) a->clear();
+        for (auto* a : {&e_done, &r_init, &r_limited}) a->clear();
+        side.clear();
+        vertex_out.clear();
+        r_cap.clear();
+        r_edges.clear();
+        scratch_members.clear();
+        scratch.stack.clear();
         out.origin = anchor.origin;
         out.time_origin = anchor.time_origin;
     }
+    ~FrameBuilder() {
+        if (scratch.bytes() > kScratchKeep) scratch = RefineScratch();
+    }
+    FrameBuilder(const FrameBuilder&) = delete;
+    FrameBuilder& operator=(const FrameBuilder&) = delete;
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
         // A clip point that fell on a visible corner is that corner (see crossingPoint): the
@@ -288,47 +357,31 @@ struct FrameBuilder {
     // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
     // ids edge midpoints made when first needed. `side` and `vertex_out` grow with them.
     uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
-    std::vector<Vec3> r_pos;      // exact local image of every id (mesh vertices: from the batch cut)
-    std::vector<double> r_time;   // its local emission time, -delta
-    std::vector<Vec3> r_shape;    // its shape offset y + v delta (chord_error.h shapeOfEvent)
-    std::vector<double> r_xm;     // its |x|_M (chord_error.h normMOfEvent)
-    std::vector<Vec3> r_rest;     // rest point of ids >= r_nv
-    std::vector<Event> r_cap;     // cap events (2 per id >= r_nv) when a cap is real
+    std::vector<Vec3>& r_pos;     // exact local image of every id (mesh vertices: from the batch cut)
+    std::vector<double>& r_time;  // its local emission time, -delta
+    std::vector<Vec3>& r_shape;   // its shape offset y + v delta (chord_error.h shapeOfEvent)
+    std::vector<double>& r_xm;    // its |x|_M (chord_error.h normMOfEvent)
+    std::vector<Vec3>& r_rest;    // rest point of ids >= r_nv
+    std::vector<Event>& r_cap;    // cap events (2 per id >= r_nv) when a cap is real
     // Midpoints of mesh edges: exact local images (cut in batches before the splits).
-    std::vector<Vec3> e_pos;
-    std::vector<double> e_time;
-    std::vector<uint8_t> e_done;
-    std::vector<uint32_t> scratch_members;
+    std::vector<Vec3>& e_pos;
+    std::vector<double>& e_time;
+    std::vector<uint8_t>& e_done;
+    std::vector<uint32_t>& scratch_members;
 
     // Edges of the refinement: records below r_ne are the mesh's edges, later ones the halves and
     // inner edges that splits make. Every slot on an edge refers to the edge's record, so its
     // midpoint and length are made once and seen from every triangle around it.
-    struct REdge {
-        uint32_t mid;  // midpoint vertex once made, else kUnset
-        double len;    // edgeLength once known, else NaN
-    };
-    std::vector<REdge> r_edges;
+    std::vector<REdge>& r_edges;
 
-    // Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
-    // touched), later ids the halves made by splits, two by two. Each slot c is the edge from v[c]
-    // to v[c + 1]; the slots on one edge form a cycle (next), as World4D::slot_next does for the
-    // mesh, so that an edge is split in every triangle that has it: no T-junctions, however the
-    // splits go.
-    struct RTri {
-        uint32_t v[3];
-        uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
-        uint32_t edge[3];  // the edge record of each slot
-        uint32_t child;    // the first of its two halves (the second is child + 1) once split, else kUnset
-        uint32_t src;      // the mesh triangle it lies on
-        uint16_t depth;    // bisections since the mesh triangle
-        int16_t longest;   // the slot of its longest edge once known, else -1
-    };
-    // One array for all ids, left uninitialised (RTri is trivial): a large mesh of which few
-    // triangles need refining touches only their pages (r_init says which base records are made).
-    std::unique_ptr<RTri[]> r_tri;
-    size_t r_tri_size = 0, r_tri_cap = 0;
-    std::vector<uint8_t> r_init;
-    std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
+    // Triangles (RTri): one array for all ids, left uninitialised (RTri is trivial): a large mesh
+    // of which few triangles need refining touches only their pages (r_init says which base
+    // records are made).
+    std::unique_ptr<RTri[]>& r_tri;
+    size_t& r_tri_cap;
+    size_t r_tri_size = 0;
+    std::vector<uint8_t>& r_init;
+    std::vector<uint8_t>& r_limited;  // per mesh triangle: a piece reached the depth limit first
     uint32_t r_max_depth = 0;
     size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
     std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
@@ -743,7 +796,7 @@ struct FrameBuilder {
             r_init.assign(r_nt, 0);
             r_limited.assign(r_nt, 0);
             r_leaves = r_nt;
-            std::vector<uint32_t> stack;
+            std::vector<uint32_t>& stack = scratch.stack;
             for (uint32_t f : failing) {
                 ensureBase(f);
                 stack.push_back(f);
@@ -753,7 +806,8 @@ struct FrameBuilder {
         }
 
         // Step: the leaves, mesh triangle by mesh triangle, each tree depth first.
-        std::vector<uint32_t> stack;
+        std::vector<uint32_t>& stack = scratch.stack;
+        stack.clear();
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
