@@ -51,6 +51,14 @@ int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t*
     return k;
 }
 
+// The terms of the bound (chord_error.h chordErrorOfTerms) of one point, side by side: what a
+// corner or an edge's end contributes is read from one place.
+struct VTerms {
+    Vec3 s;     // shape offset y + v delta (shapeOfEvent)
+    double xm;  // |x|_M (normMOfEvent)
+    double t;   // local emission time, -delta
+};
+
 struct REdge {
     uint32_t mid;  // midpoint vertex once made, else kUnset
     double len;    // edgeLength once known, else NaN
@@ -75,8 +83,9 @@ struct RTri {
 // the output). Cleared, not freed, by each frame; freed after a frame that made them larger than
 // kScratchKeep bytes, so a single huge frame does not hold its memory for the program's life.
 struct RefineScratch {
-    std::vector<Vec3> pos, shape, rest, e_pos;
-    std::vector<double> time, xm, e_time;
+    std::vector<Vec3> pos, rest, e_pos;
+    std::vector<double> time, e_time;
+    std::vector<VTerms> terms;
     std::vector<Event> cap;
     std::vector<uint8_t> e_done, init, limited;
     std::vector<REdge> edges;
@@ -87,8 +96,9 @@ struct RefineScratch {
     std::vector<uint32_t> vertex_out;
 
     size_t bytes() const {
-        return (pos.capacity() + shape.capacity() + rest.capacity() + e_pos.capacity()) * sizeof(Vec3) +
-               (time.capacity() + xm.capacity() + e_time.capacity()) * sizeof(double) + cap.capacity() * sizeof(Event) +
+        return (pos.capacity() + rest.capacity() + e_pos.capacity()) * sizeof(Vec3) +
+               (time.capacity() + e_time.capacity()) * sizeof(double) + terms.capacity() * sizeof(VTerms) +
+               cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
                e_done.capacity() + init.capacity() + limited.capacity() + side.capacity();
@@ -118,11 +128,12 @@ struct FrameBuilder {
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)), scratch(threadScratch()),
           side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
-          r_shape(scratch.shape), r_xm(scratch.xm), r_rest(scratch.rest), r_cap(scratch.cap), e_pos(scratch.e_pos),
+          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), e_pos(scratch.e_pos),
           e_time(scratch.e_time), e_done(scratch.e_done), scratch_members(scratch.members), r_edges(scratch.edges),
           r_tri(scratch.tri), r_tri_cap(scratch.tri_cap), r_init(scratch.init), r_limited(scratch.limited) {
-        for (auto* a : {&r_pos, &r_shape, &r_rest, &e_pos}) a->clear();
-        for (auto* a : {&r_time, &r_xm, &e_time}) a->clear();
+        for (auto* a : {&r_pos, &r_rest, &e_pos}) a->clear();
+        for (auto* a : {&r_time, &e_time}) a->clear();
+        r_terms.clear();
         for (auto* a : {&e_done, &r_init, &r_limited}) a->clear();
         side.clear();
         vertex_out.clear();
@@ -359,8 +370,7 @@ struct FrameBuilder {
     uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
     std::vector<Vec3>& r_pos;     // exact local image of every id (mesh vertices: from the batch cut)
     std::vector<double>& r_time;  // its local emission time, -delta
-    std::vector<Vec3>& r_shape;   // its shape offset y + v delta (chord_error.h shapeOfEvent)
-    std::vector<double>& r_xm;    // its |x|_M (chord_error.h normMOfEvent)
+    std::vector<VTerms>& r_terms; // its terms of the bound
     std::vector<Vec3>& r_rest;    // rest point of ids >= r_nv
     std::vector<Event>& r_cap;    // cap events (2 per id >= r_nv) when a cap is real
     // Midpoints of mesh edges: exact local images (cut in batches before the splits).
@@ -430,8 +440,7 @@ struct FrameBuilder {
         const uint32_t id = uint32_t(r_pos.size());
         r_pos.push_back(e.x);
         r_time.push_back(e.t);
-        r_shape.push_back(shapeOfEvent(world.motion, e));
-        r_xm.push_back(normMOfEvent(anchor, world.motion, e));
+        r_terms.push_back({shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t});
         r_rest.push_back(rest);
         Side s = Side::Inside;
         if (world.cap_a_real || world.cap_b_real) {
@@ -449,12 +458,20 @@ struct FrameBuilder {
     }
 
     double edgeLengthOf(uint32_t a, uint32_t b, uint32_t mid) const {
-        return edgeLengthOfTerms(world.motion, r_time[a], r_time[b], r_time[mid], r_shape[a], r_shape[b], r_xm[a], r_xm[b]);
+        const VTerms &ta = r_terms[a], &tb = r_terms[b];
+        return edgeLengthOfTerms(world.motion, ta.t, tb.t, r_terms[mid].t, ta.s, tb.s, ta.xm, tb.xm);
     }
 
     // The midpoint vertex of slot c of triangle id (made once per edge): a mesh edge's from the
     // batch cut, any other cut when first needed, with the edge's length.
     uint32_t midVertex(uint32_t id, int c) {
+        if (id >= r_nt || r_init[id]) {  // the frequent case, kept small enough to inline
+            const uint32_t m = r_edges[r_tri[id].edge[c]].mid;
+            if (m != kUnset) return m;
+        }
+        return makeMidVertex(id, c);
+    }
+    [[gnu::noinline]] uint32_t makeMidVertex(uint32_t id, int c) {
         ensureBase(id);
         const uint32_t rec = r_tri[id].edge[c];
         if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
@@ -561,10 +578,11 @@ struct FrameBuilder {
             const Side s0 = side[v[0]];
             if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
             double t_mid[3];
-            for (int c = 0; c < 3; ++c) t_mid[c] = r_time[midVertex(id, c)];
-            const double t_corner[3] = {r_time[v[0]], r_time[v[1]], r_time[v[2]]};
-            const Vec3 s[3] = {r_shape[v[0]], r_shape[v[1]], r_shape[v[2]]};
-            const double xm[3] = {r_xm[v[0]], r_xm[v[1]], r_xm[v[2]]};
+            for (int c = 0; c < 3; ++c) t_mid[c] = r_terms[midVertex(id, c)].t;
+            const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
+            const double t_corner[3] = {k0.t, k1.t, k2.t};
+            const Vec3 s[3] = {k0.s, k1.s, k2.s};
+            const double xm[3] = {k0.xm, k1.xm, k2.xm};
             const ChordError ce = chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
             if (ce.bound <= settings.tolerance) continue;
             if (r_tri[id].depth >= r_max_depth) {
@@ -697,14 +715,10 @@ struct FrameBuilder {
         // refinement; the others get the full bound, from their edges' midpoints cut in batches.
         std::vector<uint32_t> candidates, failing;
         double expected_pieces = 0;
-        std::vector<Vec3>& shape = r_shape;  // y + v delta, once per vertex
-        std::vector<double>& xm = r_xm;      // |x|_M, once per vertex
-        shape.resize(r_nv);
-        xm.resize(r_nv);
+        r_terms.resize(r_nv);  // the bound's terms, once per vertex
         for (size_t i = 0; i < r_nv; ++i) {
             const Event e{r_time[i], r_pos[i]};
-            shape[i] = shapeOfEvent(world.motion, e);
-            xm[i] = normMOfEvent(anchor, world.motion, e);
+            r_terms[i] = {shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t};
         }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
@@ -713,8 +727,8 @@ struct FrameBuilder {
             const Side s0 = side[t[0]];
             if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
-            const Vec3 sc[3] = {shape[t[0]], shape[t[1]], shape[t[2]]};
-            const double xc[3] = {xm[t[0]], xm[t[1]], xm[t[2]]};
+            const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
+            const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
             if (passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
             const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
             if (chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance) candidates.push_back(uint32_t(f));
@@ -752,8 +766,8 @@ struct FrameBuilder {
                     const uint32_t v = world.mesh.triangles[f][c], e = world.triangle_edges[f][c];
                     t_corner[c] = r_time[v];
                     t_mid[c] = e_time[e];
-                    sc[c] = shape[v];
-                    xc[c] = xm[v];
+                    sc[c] = r_terms[v].s;
+                    xc[c] = r_terms[v].xm;
                 }
                 const double bound = chordErrorOfTerms(world.motion, t_corner, t_mid, sc, xc, settings.tolerance).bound;
                 if (bound > settings.tolerance) {
@@ -785,9 +799,9 @@ struct FrameBuilder {
             reserveTris(r_nt + 2 * expect);  // records made on first touch (ensureBase)
             r_tri_size = r_nt;
             r_edges.reserve(ne + 2 * expect);
-            for (auto* v : {&r_pos, &r_rest, &r_shape}) v->reserve(v->size() + expect);
+            for (auto* v : {&r_pos, &r_rest}) v->reserve(v->size() + expect);
+            r_terms.reserve(r_terms.size() + expect);
             r_time.reserve(r_time.size() + expect);
-            r_xm.reserve(r_xm.size() + expect);
             out.positions.reserve(out.positions.size() + expect);
             out.emission_times.reserve(out.emission_times.size() + expect);
             out.rest_points.reserve(out.rest_points.size() + expect);
