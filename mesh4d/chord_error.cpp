@@ -67,8 +67,15 @@ ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const do
     double xm_min = INFINITY;
     for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, xm[i]);
     const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
-    double rM = 0;
-    for (int i = 0; i < 3; ++i) rM = std::max(rM, normM(s[i] - centre, m));
+    // The largest |s_i - centre|_M: one square root of the largest square (sqrt is monotonic and
+    // correctly rounded, so this is the largest of the three roots, bit for bit).
+    double q = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[i] - centre;
+        const double uv = dot(u, m.velocity);
+        q = std::max(q, uv * uv + m.one_minus_beta2 * norm2(u));
+    }
+    const double rM = std::sqrt(q);
     const double mlow = xm_min - 2 * rM;
     const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
     r.bound = m.beta * (Q + R);
