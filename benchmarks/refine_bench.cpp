@@ -6,7 +6,8 @@
 // output's (12 4^j for the box, 320 4^j for the sphere) is cut in vertex mode. Both are timed in
 // the same loop, alternately, by the thread's CPU clock (time the thread waits for a core on a
 // shared machine is not counted: a long cut would otherwise be preempted more often than a short
-// one), and each keeps its best time over the iterations. Counters:
+// one) around blocks of cuts of about 2 ms each, and each keeps its best time per cut over the
+// iterations. Counters:
 //   tol_ns_per_tri     best time of the tolerance cut / its output triangles
 //   vertex_ns_per_tri  best time of the vertex cut of the uniform mesh / its triangles
 //   ratio              tol_ns_per_tri / vertex_ns_per_tri (the target: <= 3)
@@ -57,15 +58,25 @@ double threadSeconds() {
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-// CPU seconds of one cut (the output's release included, as a caller pays it).
-double seconds(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& s, size_t* tris) {
+// CPU seconds of one cut (the output's release included, as a caller pays it), averaged over
+// `repeats` cuts: the thread's CPU clock is read around a block long enough to be above its grain.
+double seconds(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& s, size_t* tris,
+               int repeats) {
     const double t0 = threadSeconds();
-    {
+    for (int r = 0; r < repeats; ++r) {
         const mesh4d::ApparentMesh m = mesh4d::sliceWorld(w, view, s);
         benchmark::DoNotOptimize(m.positions.data());
         *tris = m.triangles.size();
     }
-    return threadSeconds() - t0;
+    return (threadSeconds() - t0) / repeats;
+}
+
+// Cuts per block so that a block takes about 2 ms of CPU.
+int repeatsFor(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& s) {
+    size_t tris = 0;
+    const double one = seconds(w, view, s, &tris, 1);
+    const double more = seconds(w, view, s, &tris, std::max(1, int(2e-3 / std::max(one, 1e-7))));
+    return std::max(1, std::min(100000, int(2e-3 / std::max(more, 1e-9))));
 }
 
 // range(0): 0 = box, 1 = sphere; range(1): k, T = 10^-k x size.
@@ -76,20 +87,22 @@ void BM_PerTriangle(benchmark::State& state) {
     tol.max_segments = 4096;
     tol.tolerance = std::pow(10.0, -double(state.range(1))) * sc.size;
     size_t tris = 0;
-    seconds(w, sc.view, tol, &tris);
+    const int tol_repeats = repeatsFor(w, sc.view, tol);
+    seconds(w, sc.view, tol, &tris, 1);
     // The uniform level whose triangle count is nearest (in ratio) the refined output's.
     int level = 0;
     while (double(sc.mesh.triangles.size()) * std::pow(4.0, level + 0.5) < double(tris)) ++level;
     const mesh4d::World4D uw = mesh4d::extrude(mesh4d::subdivideUniform(sc.mesh, level), sc.motion, -100, 100, false, false);
     const mesh4d::SliceSettings vertex;
+    const int vertex_repeats = repeatsFor(uw, sc.view, vertex);
     double best_tol = INFINITY, best_vertex = INFINITY;
     size_t utris = 0;
     for (auto _ : state) {
-        const double a = seconds(w, sc.view, tol, &tris);
-        const double b = seconds(uw, sc.view, vertex, &utris);
+        const double a = seconds(w, sc.view, tol, &tris, tol_repeats);
+        const double b = seconds(uw, sc.view, vertex, &utris, vertex_repeats);
         best_tol = std::min(best_tol, a);
         best_vertex = std::min(best_vertex, b);
-        state.SetIterationTime(a + b);
+        state.SetIterationTime(a * tol_repeats + b * vertex_repeats);
     }
     const double tol_ns = 1e9 * best_tol / double(std::max<size_t>(tris, 1));
     const double vertex_ns = 1e9 * best_vertex / double(std::max<size_t>(utris, 1));
