@@ -74,7 +74,8 @@ struct RTri {
     uint32_t edge[3];  // the edge record of each slot
     uint32_t child;    // the first of its two halves (the second is child + 1) once split, else kUnset
     uint32_t src;      // the mesh triangle it lies on
-    uint16_t depth;    // bisections since the mesh triangle
+    uint8_t depth;     // bisections since the mesh triangle (at most 2 log2(max_segments) <= 60)
+    uint8_t failed;    // its bound is known to exceed the tolerance (it waits for a neighbour's split)
     int16_t longest;   // the slot of its longest edge once known, else -1
 };
 
@@ -423,6 +424,7 @@ struct FrameBuilder {
         t.child = kUnset;
         t.src = id;
         t.depth = 0;
+        t.failed = 0;
         t.longest = -1;
     }
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
@@ -542,11 +544,11 @@ struct FrameBuilder {
             const uint32_t inner = uint32_t(r_edges.size());
             r_edges.push_back({kUnset, NAN});
             const uint32_t a_half = a == lo ? lo_rec : hi_rec, b_half = a == lo ? hi_rec : lo_rec;
-            const uint16_t depth = uint16_t(old.depth + 1);
+            const uint8_t depth = uint8_t(old.depth + 1);
             r_tri[A] = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {a_half, inner, old.edge[(cu + 2) % 3]}, kUnset,
-                            old.src, depth, -1};
+                            old.src, depth, 0, -1};
             r_tri[B] = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {b_half, old.edge[(cu + 1) % 3], inner}, kUnset,
-                            old.src, depth, -1};
+                            old.src, depth, 0, -1};
             r_tri_size += 2;
             moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2);
             moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1);
@@ -577,14 +579,19 @@ struct FrameBuilder {
             const uint32_t v[3] = {r_tri[id].v[0], r_tri[id].v[1], r_tri[id].v[2]};
             const Side s0 = side[v[0]];
             if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
-            double t_mid[3];
-            for (int c = 0; c < 3; ++c) t_mid[c] = r_terms[midVertex(id, c)].t;
-            const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
-            const double t_corner[3] = {k0.t, k1.t, k2.t};
-            const Vec3 s[3] = {k0.s, k1.s, k2.s};
-            const double xm[3] = {k0.xm, k1.xm, k2.xm};
-            const ChordError ce = chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
-            if (ce.bound <= settings.tolerance) continue;
+            // A piece back on the stack after a neighbour's split has the same corners and
+            // midpoints as when it failed: its bound is not evaluated again.
+            if (!r_tri[id].failed) {
+                double t_mid[3];
+                for (int c = 0; c < 3; ++c) t_mid[c] = r_terms[midVertex(id, c)].t;
+                const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
+                const double t_corner[3] = {k0.t, k1.t, k2.t};
+                const Vec3 s[3] = {k0.s, k1.s, k2.s};
+                const double xm[3] = {k0.xm, k1.xm, k2.xm};
+                const ChordError ce = chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
+                if (ce.bound <= settings.tolerance) continue;
+                r_tri[id].failed = 1;
+            }
             if (r_tri[id].depth >= r_max_depth) {
                 r_limited[r_tri[id].src] = 1;
                 continue;

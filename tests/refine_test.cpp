@@ -157,10 +157,10 @@ double outlineNonCircularity(const ApparentMesh& m, const Vec3& C) {
     if (dot(axis, Vec3{mean.x(), mean.y(), mean.z()}) < 0) axis = -axis;
     double lo = INFINITY, hi = 0, sum = 0;
     for (const auto& d : dirs) {
-        const double a = std::atan2(norm(cross(d, axis)), dot(d, axis));
-        lo = std::min(lo, a);
-        hi = std::max(hi, a);
-        sum += a;
+        const double angle = std::atan2(norm(cross(d, axis)), dot(d, axis));
+        lo = std::min(lo, angle);
+        hi = std::max(hi, angle);
+        sum += angle;
     }
     return (hi - lo) / (sum / double(dirs.size()));
 }
