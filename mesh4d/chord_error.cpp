@@ -34,12 +34,26 @@ double cornerTerms(const ViewAnchor& anchor, const Motion& m, const Event corner
 
 ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
                       double tolerance) {
+    if (m.beta == 0) return {};
+    const double t_corner[3] = {corner[0].t, corner[1].t, corner[2].t};
+    const double t_mid[3] = {mid[0].t, mid[1].t, mid[2].t};
+    Vec3 s[3];
+    double xm[3];
+    for (int i = 0; i < 3; ++i) {
+        s[i] = shapeOfEvent(m, corner[i]);
+        xm[i] = normMOfEvent(anchor, m, corner[i]);
+    }
+    return chordErrorOfTerms(m, t_corner, t_mid, s, xm, tolerance);
+}
+
+ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const double t_mid[3], const Vec3 s[3],
+                             const double xm[3], double tolerance) {
     ChordError r;
     if (m.beta == 0) return r;
     // Delays (delta = -t) and the midpoint bubbles, |beta| (delta is convex: beta <= 0 up to rounding).
     double c[3];
     for (int e = 0; e < 3; ++e) {
-        const double d0 = -corner[e].t, d1 = -corner[(e + 1) % 3].t, dm = -mid[e].t;
+        const double d0 = -t_corner[e], d1 = -t_corner[(e + 1) % 3], dm = -t_mid[e];
         c[e] = 4 * std::fabs(dm - 0.5 * (d0 + d1));
     }
     const double Q = bubbleMax(c[0], c[1], c[2]);
@@ -49,12 +63,19 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
         r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
         return r;
     }
-    // Shape offsets s = y + v delta, their centroid, the M-radius r_M and |x_i|_M.
-    Vec3 s[3];
-    const double xm_min = cornerTerms(anchor, m, corner, s);
+    // The shape offsets' centroid, the M-radius r_M and the least |x_i|_M.
+    double xm_min = INFINITY;
+    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, xm[i]);
     const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
-    double rM = 0;
-    for (int i = 0; i < 3; ++i) rM = std::max(rM, normM(s[i] - centre, m));
+    // The largest |s_i - centre|_M: one square root of the largest square (sqrt is monotonic and
+    // correctly rounded, so this is the largest of the three roots, bit for bit).
+    double q = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[i] - centre;
+        const double uv = dot(u, m.velocity);
+        q = std::max(q, uv * uv + m.one_minus_beta2 * norm2(u));
+    }
+    const double rM = std::sqrt(q);
     const double mlow = xm_min - 2 * rM;
     const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
     r.bound = m.beta * (Q + R);
@@ -79,9 +100,15 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
 }
 
 double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid) {
-    const double c = 4 * std::fabs(-mid.t + 0.5 * (a.t + b.t));
-    const double l = normM(shapeOfEvent(m, b) - shapeOfEvent(m, a), m);
-    const double xm = std::min(normMOfEvent(anchor, m, a), normMOfEvent(anchor, m, b)) - l;
+    return edgeLengthOfTerms(m, a.t, b.t, mid.t, shapeOfEvent(m, a), shapeOfEvent(m, b), normMOfEvent(anchor, m, a),
+                             normMOfEvent(anchor, m, b));
+}
+
+double edgeLengthOfTerms(const Motion& m, double ta, double tb, double tmid, const Vec3& sa, const Vec3& sb, double xma,
+                         double xmb) {
+    const double c = 4 * std::fabs(-tmid + 0.5 * (ta + tb));
+    const double l = normM(sb - sa, m);
+    const double xm = std::min(xma, xmb) - l;
     // m is floored at l: finite near the camera, where halving an edge must still shorten it
     // (longest-edge bisection ends only if the halves and medians are shorter than their edge).
     const double mf = std::max(xm, l);

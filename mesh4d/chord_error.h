@@ -79,6 +79,13 @@ struct ChordError {
 ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
                       double tolerance = INFINITY);
 
+// The same bound from per-point terms, as the refinement keeps them once per point: the local
+// event times t (= -delta) of the corners and of the edge midpoints (t_mid[c] on corners c, c + 1),
+// and the corners' shape offsets s = shapeOfEvent and |x|_M = normMOfEvent. Bit-identical to
+// chordError (which computes these terms and calls it).
+ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const double t_mid[3], const Vec3 s[3],
+                             const double xm[3], double tolerance = INFINITY);
+
 // A bound from the corners alone, for triangles that need no refinement: no midpoint is cut.
 // The Hessian of delta satisfies u^T H u <= |u|_M^2 / ((1 - b^2) |x|_M) (that of a norm is at
 // most M / |x|_M), and the linear interpolant of a function with such a Hessian errs by at most
@@ -113,5 +120,10 @@ inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion&
 // the camera still has a finite length that halving reduces). A property of the edge alone, so
 // both triangles of an edge agree on it.
 double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid);
+
+// edgeLength from per-point terms: the event times of the ends and the midpoint, the ends' shape
+// offsets and |x|_M (see chordErrorOfTerms). Bit-identical to edgeLength.
+double edgeLengthOfTerms(const Motion& m, double ta, double tb, double tmid, const Vec3& sa, const Vec3& sb, double xma,
+                         double xmb);
 
 }  // namespace mesh4d

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <set>
@@ -50,24 +51,105 @@ int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t*
     return k;
 }
 
+// The terms of the bound (chord_error.h chordErrorOfTerms) of one point, side by side: what a
+// corner or an edge's end contributes is read from one place.
+struct VTerms {
+    Vec3 s;     // shape offset y + v delta (shapeOfEvent)
+    double xm;  // |x|_M (normMOfEvent)
+    double t;   // local emission time, -delta
+};
+
+struct REdge {
+    uint32_t mid;  // midpoint vertex once made, else kUnset
+    double len;    // edgeLength once known, else NaN
+};
+// Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
+// touched), later ids the halves made by splits, two by two. Each slot c is the edge from v[c]
+// to v[c + 1]; the slots on one edge form a cycle (next), as World4D::slot_next does for the
+// mesh, so that an edge is split in every triangle that has it: no T-junctions, however the
+// splits go.
+struct RTri {
+    uint32_t v[3];
+    uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
+    uint32_t edge[3];  // the edge record of each slot
+    uint32_t child;    // the first of its two halves (the second is child + 1) once split, else kUnset
+    uint32_t src;      // the mesh triangle it lies on
+    uint8_t depth;     // bisections since the mesh triangle (at most 2 log2(max_segments) <= 60)
+    uint8_t failed;    // its bound is known to exceed the tolerance (it waits for a neighbour's split)
+    int16_t longest;   // the slot of its longest edge once known, else -1
+};
+
+// The refinement's working arrays, kept per thread from frame to frame: a frame reuses the pages the
+// previous one touched instead of faulting fresh ones in (the arrays are several times the size of
+// the output). Cleared, not freed, by each frame; freed after a frame that made them larger than
+// kScratchKeep bytes, so a single huge frame does not hold its memory for the program's life.
+struct RefineScratch {
+    std::vector<Vec3> pos, rest, e_pos;
+    std::vector<double> time, e_time;
+    std::vector<VTerms> terms;
+    std::vector<Event> cap;
+    std::vector<uint8_t> e_done, init, limited;
+    std::vector<REdge> edges;
+    std::unique_ptr<RTri[]> tri;
+    size_t tri_cap = 0;
+    std::vector<uint32_t> members, stack;
+    std::vector<Side> side;
+    std::vector<uint32_t> vertex_out;
+
+    size_t bytes() const {
+        return (pos.capacity() + rest.capacity() + e_pos.capacity()) * sizeof(Vec3) +
+               (time.capacity() + e_time.capacity()) * sizeof(double) + terms.capacity() * sizeof(VTerms) +
+               cap.capacity() * sizeof(Event) +
+               edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
+               (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
+               e_done.capacity() + init.capacity() + limited.capacity() + side.capacity();
+    }
+};
+constexpr size_t kScratchKeep = size_t(256) << 20;
+
+RefineScratch& threadScratch() {
+    static thread_local RefineScratch scratch;
+    return scratch;
+}
+
 struct FrameBuilder {
     const World4D& world;
     const ViewSurface& view;
     const SliceSettings& settings;
     const ViewAnchor anchor;  // the frame's local coordinates (positions relative to the object's apparent origin)
     ApparentMesh out;
-    std::vector<Side> side;
-    std::vector<uint32_t> vertex_out;     // rest vertex -> output vertex
+    RefineScratch& scratch;               // this thread's working arrays (threadScratch)
+    std::vector<Side>& side;
+    std::vector<uint32_t>& vertex_out;    // rest vertex -> output vertex
     std::vector<uint32_t> crossing_out;   // 2 * edge + cap -> output vertex
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being clipped (rest clip)
     bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restPlan
     double rest_tolerance = 0;          // the tolerance restPlan keeps (settings.tolerance is 0 at rest)
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
-        : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)) {
+        : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)), scratch(threadScratch()),
+          side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
+          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), e_pos(scratch.e_pos),
+          e_time(scratch.e_time), e_done(scratch.e_done), scratch_members(scratch.members), r_edges(scratch.edges),
+          r_tri(scratch.tri), r_tri_cap(scratch.tri_cap), r_init(scratch.init), r_limited(scratch.limited) {
+        for (auto* a : {&r_pos, &r_rest, &e_pos}) a->clear();
+        for (auto* a : {&r_time, &e_time}) a->clear();
+        r_terms.clear();
+        for (auto* a : {&e_done, &r_init, &r_limited}) a->clear();
+        side.clear();
+        vertex_out.clear();
+        r_cap.clear();
+        r_edges.clear();
+        scratch_members.clear();
+        scratch.stack.clear();
         out.origin = anchor.origin;
         out.time_origin = anchor.time_origin;
     }
+    ~FrameBuilder() {
+        if (scratch.bytes() > kScratchKeep) scratch = RefineScratch();
+    }
+    FrameBuilder(const FrameBuilder&) = delete;
+    FrameBuilder& operator=(const FrameBuilder&) = delete;
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
         // A clip point that fell on a visible corner is that corner (see crossingPoint): the
@@ -281,82 +363,86 @@ struct FrameBuilder {
 
 
     // ---- Step (refinement, tolerance > 0, moving, past cone): conforming bisection ----
+    // Flat records, no allocation per piece: vertices as arrays indexed by id, edges and pieces as
+    // records in one array each, the midpoints' closed forms once per edge, the bound's per-point
+    // terms once per point.
     // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
     // ids edge midpoints made when first needed. `side` and `vertex_out` grow with them.
-    uint32_t r_nv = 0, r_nt = 0;
-    std::vector<Vec3> r_pos;      // exact local image of every id (mesh vertices: from the batch cut)
-    std::vector<double> r_time;   // its local emission time, -delta
-    std::vector<Vec3> r_rest;     // rest point of ids >= r_nv
-    std::vector<Event> r_cap;     // cap events (2 per id >= r_nv) when a cap is real
-    // Midpoints of mesh edges: exact local images (batch), and their vertex ids once made.
-    std::vector<Vec3> e_pos;
-    std::vector<double> e_time;
-    std::vector<uint8_t> e_done;
-    std::vector<uint32_t> e_id;
-    std::vector<double> e_len;  // edgeLength of mesh edges, NaN until needed
-    std::vector<uint32_t> scratch_members, scratch_lo, scratch_hi;
+    uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
+    std::vector<Vec3>& r_pos;     // exact local image of every id (mesh vertices: from the batch cut)
+    std::vector<double>& r_time;  // its local emission time, -delta
+    std::vector<VTerms>& r_terms; // its terms of the bound
+    std::vector<Vec3>& r_rest;    // rest point of ids >= r_nv
+    std::vector<Event>& r_cap;    // cap events (2 per id >= r_nv) when a cap is real
+    // Midpoints of mesh edges: exact local images (cut in batches before the splits).
+    std::vector<Vec3>& e_pos;
+    std::vector<double>& e_time;
+    std::vector<uint8_t>& e_done;
+    std::vector<uint32_t>& scratch_members;
 
-    // Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
-    // touched), later ids the halves made by splits. Each slot c is the edge from v[c] to v[c + 1];
-    // the slots on one edge form a cycle (next), as World4D::slot_next does for the mesh, so that an
-    // edge is split in every triangle that has it: no T-junctions, however the splits go.
-    struct RTri {
-        uint32_t v[3];
-        uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
-        uint32_t mid[3];   // midpoint vertex of a slot that is not a whole mesh edge, once made
-        uint32_t edge[3];  // the mesh edge while the slot is a whole mesh edge, else kUnset
-        double len[3];     // edgeLength of a slot that is not a whole mesh edge, once known (else NaN)
-        uint32_t child[2];
-        uint32_t src;      // the mesh triangle it lies on
-        uint32_t depth;    // bisections since the mesh triangle
-        int longest;       // the slot of its longest edge once known, else -1
-    };
-    // ids < r_nt, valid where r_init is set. Left uninitialised (RTri is trivial): a large mesh of
-    // which few triangles need refining touches only their pages.
-    std::unique_ptr<RTri[]> r_base;
-    std::vector<uint8_t> r_init;
-    std::vector<RTri> r_kids;  // ids >= r_nt
-    std::vector<uint8_t> r_limited;  // per mesh triangle: a piece reached the depth limit first
+    // Edges of the refinement: records below r_ne are the mesh's edges, later ones the halves and
+    // inner edges that splits make. Every slot on an edge refers to the edge's record, so its
+    // midpoint and length are made once and seen from every triangle around it.
+    std::vector<REdge>& r_edges;
+
+    // Triangles (RTri): one array for all ids, left uninitialised (RTri is trivial): a large mesh
+    // of which few triangles need refining touches only their pages (r_init says which base
+    // records are made).
+    std::unique_ptr<RTri[]>& r_tri;
+    size_t& r_tri_cap;
+    size_t r_tri_size = 0;
+    std::vector<uint8_t>& r_init;
+    std::vector<uint8_t>& r_limited;  // per mesh triangle: a piece reached the depth limit first
     uint32_t r_max_depth = 0;
     size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
     std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
 
-    RTri& tri(uint32_t id) { return id < r_nt ? r_base[id] : r_kids[id - r_nt]; }
+    RTri& tri(uint32_t id) { return r_tri[id]; }
     Vec3 restOfId(uint32_t id) const { return id < r_nv ? world.mesh.positions[id] : r_rest[id - r_nv]; }
     Event capOfId(uint32_t id, int cap) const { return id < r_nv ? world.events[2 * id + cap] : r_cap[2 * (id - r_nv) + cap]; }
     Event eventOfId(uint32_t id) const { return {r_time[id], r_pos[id]}; }
 
+    // Room for n more triangle records (growth copies them: they are trivial).
+    void reserveTris(size_t n) {
+        if (r_tri_size + n <= r_tri_cap) return;
+        const size_t cap = std::max(r_tri_size + n, 2 * r_tri_cap);
+        std::unique_ptr<RTri[]> grown(new RTri[cap]);
+        if (r_tri_size > 0) std::memcpy(static_cast<void*>(grown.get()), r_tri.get(), r_tri_size * sizeof(RTri));
+        r_tri = std::move(grown);
+        r_tri_cap = cap;
+    }
+
     void ensureBase(uint32_t id) {
         if (id >= r_nt || r_init[id]) return;
         r_init[id] = 1;
-        RTri& t = r_base[id];
+        RTri& t = r_tri[id];
         for (int c = 0; c < 3; ++c) {
             t.v[c] = world.mesh.triangles[id][c];
             t.next[c] = world.slot_next[3 * id + c];
-            t.mid[c] = kUnset;
             t.edge[c] = world.triangle_edges[id][c];
-            t.len[c] = NAN;
         }
-        t.child[0] = t.child[1] = kUnset;
+        t.child = kUnset;
         t.src = id;
         t.depth = 0;
+        t.failed = 0;
         t.longest = -1;
     }
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
-    uint32_t nextOf(uint32_t p) {
+    uint32_t nextOf(uint32_t p) const {
         const uint32_t id = p / 3;
         if (id < r_nt && !r_init[id]) return world.slot_next[p];
-        return tri(id).next[p % 3];
+        return r_tri[id].next[p % 3];
     }
     void setNext(uint32_t p, uint32_t to) {
         ensureBase(p / 3);
-        tri(p / 3).next[p % 3] = to;
+        r_tri[p / 3].next[p % 3] = to;
     }
 
     uint32_t newVertex(const Vec3& rest, const Event& e, uint32_t a, uint32_t b) {
         const uint32_t id = uint32_t(r_pos.size());
         r_pos.push_back(e.x);
         r_time.push_back(e.t);
+        r_terms.push_back({shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t});
         r_rest.push_back(rest);
         Side s = Side::Inside;
         if (world.cap_a_real || world.cap_b_real) {
@@ -373,51 +459,47 @@ struct FrameBuilder {
         return id;
     }
 
-    uint32_t edgeMidVertex(uint32_t e) {
-        if (e_id[e] == kUnset) {
-            const Edge& ed = world.edges[e];
-            const Vec3 rest = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
-            if (!e_done[e]) {
-                const Event ev = cutRestLocal(anchor, world.motion, rest);
-                e_pos[e] = ev.x;
-                e_time[e] = ev.t;
-                e_done[e] = 1;
-            }
-            e_id[e] = newVertex(rest, {e_time[e], e_pos[e]}, ed.lo, ed.hi);
-        }
-        return e_id[e];
+    double edgeLengthOf(uint32_t a, uint32_t b, uint32_t mid) const {
+        const VTerms &ta = r_terms[a], &tb = r_terms[b];
+        return edgeLengthOfTerms(world.motion, ta.t, tb.t, r_terms[mid].t, ta.s, tb.s, ta.xm, tb.xm);
     }
 
-    // The midpoint vertex of slot c of triangle id: a mesh edge's from the batch, otherwise made
-    // once and given to every slot on the edge.
+    // The midpoint vertex of slot c of triangle id (made once per edge): a mesh edge's from the
+    // batch cut, any other cut when first needed, with the edge's length.
     uint32_t midVertex(uint32_t id, int c) {
-        {
-            const RTri& t = tri(id);
-            if (t.edge[c] != kUnset) return edgeMidVertex(t.edge[c]);
-            if (t.mid[c] != kUnset) return t.mid[c];
+        if (id >= r_nt || r_init[id]) {  // the frequent case, kept small enough to inline
+            const uint32_t m = r_edges[r_tri[id].edge[c]].mid;
+            if (m != kUnset) return m;
         }
-        const uint32_t a = tri(id).v[c], b = tri(id).v[(c + 1) % 3];
+        return makeMidVertex(id, c);
+    }
+    [[gnu::noinline]] uint32_t makeMidVertex(uint32_t id, int c) {
+        ensureBase(id);
+        const uint32_t rec = r_tri[id].edge[c];
+        if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
+        if (rec < r_ne) {
+            const Edge& ed = world.edges[rec];
+            const Vec3 rest = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
+            if (!e_done[rec]) {
+                const Event ev = cutRestLocal(anchor, world.motion, rest);
+                e_pos[rec] = ev.x;
+                e_time[rec] = ev.t;
+                e_done[rec] = 1;
+            }
+            return r_edges[rec].mid = newVertex(rest, {e_time[rec], e_pos[rec]}, ed.lo, ed.hi);
+        }
+        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
         const Vec3 rest = (restOfId(a) + restOfId(b)) * 0.5;
         const uint32_t m = newVertex(rest, cutRestLocal(anchor, world.motion, rest), a, b);
-        const double len = edgeLength(anchor, world.motion, eventOfId(a), eventOfId(b), eventOfId(m));
-        const uint32_t start = 3 * id + uint32_t(c);
-        uint32_t p = start;
-        do {
-            tri(p / 3).mid[p % 3] = m;
-            tri(p / 3).len[p % 3] = len;
-            p = nextOf(p);
-        } while (p != start);
+        r_edges[rec] = {m, edgeLengthOf(a, b, m)};
         return m;
     }
 
     // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
     // in the edge's cycle.
-    void moveSlot(uint32_t from, uint32_t to, const RTri& old) {
+    void moveSlot(uint32_t from, uint32_t to) {
         const uint32_t nx = nextOf(from);
-        RTri& t = tri(to / 3);
-        t.mid[to % 3] = old.mid[from % 3];
-        t.edge[to % 3] = old.edge[from % 3];
-        t.len[to % 3] = old.len[from % 3];
+        RTri& t = r_tri[to / 3];
         if (nx == from) {
             t.next[to % 3] = to;
             return;
@@ -428,12 +510,12 @@ struct FrameBuilder {
         setNext(p, to);
     }
 
-
     // Halves the edge of slot c of triangle id at its midpoint, in every triangle around the edge:
-    // each becomes (a, m, o) and (m, b, o). The halves' new slots on the edge form two new cycles.
+    // each becomes (a, m, o) and (m, b, o). The halves' slots on the edge form two new cycles, on
+    // two new edge records; each triangle's new inner edge (m, o) gets its own record.
     void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
-        const uint32_t lo = std::min(tri(id).v[c], tri(id).v[(c + 1) % 3]);
+        const uint32_t lo = std::min(r_tri[id].v[c], r_tri[id].v[(c + 1) % 3]);
         std::vector<uint32_t>& members = scratch_members;
         members.clear();
         const uint32_t start = 3 * id + uint32_t(c);
@@ -442,34 +524,49 @@ struct FrameBuilder {
             members.push_back(p);
             p = nextOf(p);
         } while (p != start);
-        std::vector<uint32_t>& lo_half = scratch_lo;
-        std::vector<uint32_t>& hi_half = scratch_hi;
-        lo_half.clear();
-        hi_half.clear();
+        const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
+        r_edges.push_back({kUnset, NAN});
+        r_edges.push_back({kUnset, NAN});
+        reserveTris(2 * members.size());
+        uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
+        auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
+            if (first == kUnset) first = slot;
+            else r_tri[prev / 3].next[prev % 3] = slot;
+            prev = slot;
+        };
         for (uint32_t q : members) {
             const uint32_t u = q / 3;
             const int cu = int(q % 3);
             ensureBase(u);
-            const RTri old = tri(u);
+            const RTri old = r_tri[u];
             const uint32_t a = old.v[cu], b = old.v[(cu + 1) % 3], o = old.v[(cu + 2) % 3];
-            const uint32_t A = r_nt + uint32_t(r_kids.size()), B = A + 1;
-            r_kids.push_back(RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {kUnset, kUnset, kUnset},
-                                  {kUnset, kUnset, kUnset}, {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1});
-            r_kids.push_back(RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {kUnset, kUnset, kUnset},
-                                  {kUnset, kUnset, kUnset}, {NAN, NAN, NAN}, {kUnset, kUnset}, old.src, old.depth + 1, -1});
-            moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2, old);
-            moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1, old);
-            (a == lo ? lo_half : hi_half).push_back(3 * A + 0);
-            (a == lo ? hi_half : lo_half).push_back(3 * B + 0);
-            tri(u).child[0] = A;
-            tri(u).child[1] = B;
+            const uint32_t A = uint32_t(r_tri_size), B = A + 1;
+            const uint32_t inner = uint32_t(r_edges.size());
+            r_edges.push_back({kUnset, NAN});
+            const uint32_t a_half = a == lo ? lo_rec : hi_rec, b_half = a == lo ? hi_rec : lo_rec;
+            const uint8_t depth = uint8_t(old.depth + 1);
+            r_tri[A] = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {a_half, inner, old.edge[(cu + 2) % 3]}, kUnset,
+                            old.src, depth, 0, -1};
+            r_tri[B] = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {b_half, old.edge[(cu + 1) % 3], inner}, kUnset,
+                            old.src, depth, 0, -1};
+            r_tri_size += 2;
+            moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2);
+            moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1);
+            if (a == lo) {
+                link(3 * A, lo_first, lo_prev);
+                link(3 * B, hi_first, hi_prev);
+            } else {
+                link(3 * B, lo_first, lo_prev);
+                link(3 * A, hi_first, hi_prev);
+            }
+            r_tri[u].child = A;
             ++r_leaves;  // one piece became two
             if (u < r_nt) ++out.refined_triangles;
             stack.push_back(B);
             stack.push_back(A);
         }
-        for (const auto* ring : {&lo_half, &hi_half})
-            for (size_t k = 0; k < ring->size(); ++k) tri((*ring)[k] / 3).next[(*ring)[k] % 3] = (*ring)[(k + 1) % ring->size()];
+        r_tri[lo_prev / 3].next[lo_prev % 3] = lo_first;  // close the two cycles
+        r_tri[hi_prev / 3].next[hi_prev % 3] = hi_first;
     }
 
     // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
@@ -478,19 +575,25 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            if (tri(id).child[0] != kUnset) continue;  // split meanwhile, as a neighbour
-            const uint32_t v[3] = {tri(id).v[0], tri(id).v[1], tri(id).v[2]};
+            if (r_tri[id].child != kUnset) continue;  // split meanwhile, as a neighbour
+            const uint32_t v[3] = {r_tri[id].v[0], r_tri[id].v[1], r_tri[id].v[2]};
             const Side s0 = side[v[0]];
             if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
-            Event corner[3], mid[3];
-            for (int c = 0; c < 3; ++c) {
-                corner[c] = eventOfId(v[c]);
-                mid[c] = eventOfId(midVertex(id, c));
+            // A piece back on the stack after a neighbour's split has the same corners and
+            // midpoints as when it failed: its bound is not evaluated again.
+            if (!r_tri[id].failed) {
+                double t_mid[3];
+                for (int c = 0; c < 3; ++c) t_mid[c] = r_terms[midVertex(id, c)].t;
+                const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
+                const double t_corner[3] = {k0.t, k1.t, k2.t};
+                const Vec3 s[3] = {k0.s, k1.s, k2.s};
+                const double xm[3] = {k0.xm, k1.xm, k2.xm};
+                const ChordError ce = chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
+                if (ce.bound <= settings.tolerance) continue;
+                r_tri[id].failed = 1;
             }
-            const ChordError ce = chordError(anchor, world.motion, corner, mid, settings.tolerance);
-            if (ce.bound <= settings.tolerance) continue;
-            if (tri(id).depth >= r_max_depth) {
-                r_limited[tri(id).src] = 1;
+            if (r_tri[id].depth >= r_max_depth) {
+                r_limited[r_tri[id].src] = 1;
                 continue;
             }
             if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
@@ -499,7 +602,7 @@ struct FrameBuilder {
                 return;
             }
             splitLongestPath(id, stack);
-            if (tri(id).child[0] == kUnset) stack.push_back(id);  // a coarser neighbour went first
+            if (r_tri[id].child == kUnset) stack.push_back(id);  // a coarser neighbour went first
         }
     }
 
@@ -514,21 +617,17 @@ struct FrameBuilder {
         }
     };
     Rank rankOf(uint32_t id, int c) {
-        const uint32_t a = tri(id).v[c], b = tri(id).v[(c + 1) % 3];
-        double len;
-        if (tri(id).edge[c] != kUnset) {
-            double& cached = e_len[tri(id).edge[c]];
-            if (cached != cached) cached = edgeLength(anchor, world.motion, eventOfId(a), eventOfId(b), eventOfId(midVertex(id, c)));
-            len = cached;
-        } else {
-            if (tri(id).len[c] != tri(id).len[c]) midVertex(id, c);  // sets len around the edge
-            len = tri(id).len[c];
+        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
+        const uint32_t rec = r_tri[id].edge[c];
+        if (r_edges[rec].len != r_edges[rec].len) {
+            const uint32_t m = midVertex(id, c);  // sets the length of an edge made by a split
+            if (r_edges[rec].len != r_edges[rec].len) r_edges[rec].len = edgeLengthOf(a, b, m);
         }
-        return {len, std::min(a, b), std::max(a, b)};
+        return {r_edges[rec].len, std::min(a, b), std::max(a, b)};
     }
     int longestSlot(uint32_t id) {
         ensureBase(id);
-        if (tri(id).longest >= 0) return tri(id).longest;
+        if (r_tri[id].longest >= 0) return r_tri[id].longest;
         int best = 0;
         Rank r = rankOf(id, 0);
         for (int c = 1; c < 3; ++c) {
@@ -538,7 +637,7 @@ struct FrameBuilder {
                 best = c;
             }
         }
-        tri(id).longest = best;
+        r_tri[id].longest = int16_t(best);
         return best;
     }
 
@@ -605,6 +704,7 @@ struct FrameBuilder {
         r_nv = uint32_t(world.mesh.positions.size());
         r_nt = uint32_t(world.mesh.triangles.size());
         const size_t ne = world.edges.size();
+        r_ne = uint32_t(ne);
         int levels = 1;
         while (levels < 30 && (int64_t(1) << levels) < int64_t(std::max(settings.max_segments, 2))) ++levels;
         r_max_depth = uint32_t(2 * levels);  // about max_segments pieces along each direction of a triangle
@@ -622,12 +722,10 @@ struct FrameBuilder {
         // refinement; the others get the full bound, from their edges' midpoints cut in batches.
         std::vector<uint32_t> candidates, failing;
         double expected_pieces = 0;
-        std::vector<Vec3> shape(r_nv);  // y + v delta
-        std::vector<double> xm(r_nv);   // |x|_M
+        r_terms.resize(r_nv);  // the bound's terms, once per vertex
         for (size_t i = 0; i < r_nv; ++i) {
             const Event e{r_time[i], r_pos[i]};
-            shape[i] = shapeOfEvent(world.motion, e);
-            xm[i] = normMOfEvent(anchor, world.motion, e);
+            r_terms[i] = {shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t};
         }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
@@ -636,18 +734,16 @@ struct FrameBuilder {
             const Side s0 = side[t[0]];
             if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
-            const Vec3 sc[3] = {shape[t[0]], shape[t[1]], shape[t[2]]};
-            const double xc[3] = {xm[t[0]], xm[t[1]], xm[t[2]]};
+            const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
+            const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
             if (passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
             const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
             if (chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance) candidates.push_back(uint32_t(f));
         }
         if (!candidates.empty()) {
-            e_id.assign(ne, kUnset);
             e_done.assign(ne, 0);
             e_pos.resize(ne);
             e_time.resize(ne);
-            e_len.assign(ne, NAN);
             std::vector<uint32_t> which;
             for (uint32_t f : candidates)
                 for (uint32_t e : world.triangle_edges[f])
@@ -671,13 +767,16 @@ struct FrameBuilder {
                 }
             }
             for (uint32_t f : candidates) {
-                Event corner[3], mid[3];
+                double t_corner[3], t_mid[3], xc[3];
+                Vec3 sc[3];
                 for (int c = 0; c < 3; ++c) {
                     const uint32_t v = world.mesh.triangles[f][c], e = world.triangle_edges[f][c];
-                    corner[c] = {r_time[v], r_pos[v]};
-                    mid[c] = {e_time[e], e_pos[e]};
+                    t_corner[c] = r_time[v];
+                    t_mid[c] = e_time[e];
+                    sc[c] = r_terms[v].s;
+                    xc[c] = r_terms[v].xm;
                 }
-                const double bound = chordError(anchor, world.motion, corner, mid, settings.tolerance).bound;
+                const double bound = chordErrorOfTerms(world.motion, t_corner, t_mid, sc, xc, settings.tolerance).bound;
                 if (bound > settings.tolerance) {
                     failing.push_back(f);
                     // About bound / T pieces once halved down to T (the error falls about as the area).
@@ -699,13 +798,16 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_base.reset(new RTri[r_nt]);  // records made on first touch (ensureBase)
+            r_edges.assign(ne, REdge{kUnset, NAN});
             // Room for the pieces and points the refinement is expected to make (growth would copy them).
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
             if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
-            r_kids.reserve(2 * expect);
+            reserveTris(r_nt + 2 * expect);  // records made on first touch (ensureBase)
+            r_tri_size = r_nt;
+            r_edges.reserve(ne + 2 * expect);
             for (auto* v : {&r_pos, &r_rest}) v->reserve(v->size() + expect);
+            r_terms.reserve(r_terms.size() + expect);
             r_time.reserve(r_time.size() + expect);
             out.positions.reserve(out.positions.size() + expect);
             out.emission_times.reserve(out.emission_times.size() + expect);
@@ -715,7 +817,7 @@ struct FrameBuilder {
             r_init.assign(r_nt, 0);
             r_limited.assign(r_nt, 0);
             r_leaves = r_nt;
-            std::vector<uint32_t> stack;
+            std::vector<uint32_t>& stack = scratch.stack;
             for (uint32_t f : failing) {
                 ensureBase(f);
                 stack.push_back(f);
@@ -725,7 +827,8 @@ struct FrameBuilder {
         }
 
         // Step: the leaves, mesh triangle by mesh triangle, each tree depth first.
-        std::vector<uint32_t> stack;
+        std::vector<uint32_t>& stack = scratch.stack;
+        stack.clear();
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
@@ -738,8 +841,8 @@ struct FrameBuilder {
             while (!stack.empty()) {
                 const RTri& t = tri(stack.back());
                 stack.pop_back();
-                if (t.child[0] != kUnset) {
-                    const uint32_t a = t.child[0], b = t.child[1];
+                if (t.child != kUnset) {
+                    const uint32_t a = t.child, b = t.child + 1;
                     stack.push_back(b);
                     stack.push_back(a);
                 } else {

@@ -36,6 +36,11 @@
 // |F - L| bounds both one-sided distances between the output and the exact surface, so the
 // two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
 // no triangle needs refining, identical to vertex mode's.
+// Cost: per output triangle about two midpoint cuts, one and a half bounds and the bookkeeping of
+// the splits (flat records, no allocation per piece: docs/ACCURACY.md, "Cost per output triangle").
+// The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
+// frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
+// grew them past 256 MiB.
 // An object at rest on the past cone is its input (an affine cut), except where a real cap clips
 // it: the cap is one lab time, so the cone meets it in a sphere and the clip curves are circles.
 // With T > 0 such a triangle is split in four, recursively, only where a cap's curve could hide in

@@ -210,7 +210,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     addStageLimits(trade_cmd, &trs.stage);
     trade_cmd->footer(
         "Prints, for each row: the measured two-sided error to the exact apparent surface (sampled as the tests do),\n"
-        "output triangles per frame, cut and .glb-conversion time per frame (one thread) and .glb bytes per frame;\n"
+        "output triangles per frame, cut and .glb-conversion time per frame (one thread, its CPU time) and .glb bytes\n"
+        "per frame; "
         "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
         "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
 

@@ -1,8 +1,8 @@
 #include "pipeline/trade.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -24,7 +24,14 @@ namespace apparent {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// Times are the calling thread's CPU time, not wall time: on a shared machine the wall clock also
+// counts the time the thread waits for a core, which hits a long configuration more often than a
+// short one and so skews the ratios between rows.
+double threadSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 // The bounding-box diagonal of a rest mesh.
 double restSize(const mesh4d::RestMesh& m) {
@@ -65,9 +72,9 @@ TradeRow measure(const Stage& stage, const std::vector<PreparedObject>& objects,
         double spent = 0;
         do {
             frame.objects.clear();
-            const auto t0 = Clock::now();
+            const double t0 = threadSeconds();
             for (const auto& w : worlds) frame.objects.push_back(mesh4d::sliceWorld(w, view, settings));
-            spent += std::chrono::duration<double>(Clock::now() - t0).count();
+            spent += threadSeconds() - t0;
             ++repeats;
         } while (spent < 2e-3 && repeats < 1000);
         seconds += spent / repeats;
@@ -94,9 +101,9 @@ TradeRow measure(const Stage& stage, const std::vector<PreparedObject>& objects,
         double spent = 0;
         std::shared_ptr<GlbFrameData> prepared;
         do {
-            const auto t0 = Clock::now();
+            const double t0 = threadSeconds();
             prepared = writer.prepare(frame);
-            spent += std::chrono::duration<double>(Clock::now() - t0).count();
+            spent += threadSeconds() - t0;
             ++repeats;
         } while (spent < 2e-3 && repeats < 1000);
         row.export_seconds += spent / repeats / double(frames.size());

@@ -12,7 +12,8 @@
 // Each row reports the measured two-sided error (mesh4d/measure.h: sampled output points against
 // the exact surface and exact-surface lattice points against the output, the largest over the
 // objects and frames), output triangles per frame, the time of the cut per frame (all objects,
-// refinement included, repeated until at least 2 ms are timed), the time to convert a frame for
+// refinement included, repeated until at least 2 ms are timed; CPU time of the thread, so that
+// other load on the machine does not count), the time to convert a frame for
 // the .glb (the real writer's per-frame work: crease split, normals, float32; timed the same way,
 // the file's fixed costs left out) and the .glb bytes per frame (the frames written to a temporary
 // file, then removed). End to end is the sum of the two times. It prints the table, writes DIR/trade.csv and, with gnuplot installed,

@@ -47,7 +47,7 @@ def interpolate(adaptive, error, key):
 
 md = ["# Accuracy against cost: the speed-accuracy trade", "",
       "Measured by `scripts/accuracy_report.sh`: `apparent trade` on each scene (5 frames spread over the "
-      "sequence, one thread), tables in `docs/trade/<scene>/table.txt` and `trade.csv`. Each row: the measured "
+      "sequence, one thread, times in CPU time of the thread), tables in `docs/trade/<scene>/table.txt` and `trade.csv`. Each row: the measured "
       "two-sided error (`mesh4d/measure.h`: 12 samples of every output triangle against the exact surface, and "
       "45 exact-surface points of every input triangle against the output; the largest over objects and frames), "
       "triangles per frame (mean), the cut (refinement included) and the .glb conversion per frame (normals, "
@@ -94,25 +94,43 @@ if os.path.exists(cp):
     t = {b["name"]: b for b in bench}
     cheap = ["## Where nothing needs refining", "",
              "`benchmarks/performance_bench.cpp` (BM_CutVertexMode, BM_CutTolerance): a torus of N triangles 10 ls "
-             "away at 0.9c, one frame, one core; at T = 1e-3 x size no triangle needs refining, so the output equals "
+             "away at 0.9c, one frame, one core, CPU time; at T = 1e-3 x size no triangle needs refining, so the output equals "
              "vertex mode's and the cost is the test that decides it (the corners' bound, `chordErrorFromCorners`).", "",
              "| N | vertex mode | T = 1e-3 x size | output triangles at T | ratio |", "|---|---|---|---|---|"]
     for n in ("1000", "10000", "100000", "1000000"):
         v, c = t.get(f"BM_CutVertexMode/{n}"), t.get(f"BM_CutTolerance/{n}")
         if v and c:
             note = "" if c["output_triangles"] == v["output_triangles"] else " (refined: not a no-refinement case)"
-            cheap.append(f"| {n} | {v['real_time']:.3g} {v['time_unit']} | {c['real_time']:.3g} {c['time_unit']} | "
-                         f"{c['output_triangles']:.0f} of {v['output_triangles']:.0f}{note} | {c['real_time'] / v['real_time']:.2f} |")
+            cheap.append(f"| {n} | {v['cpu_time']:.3g} {v['time_unit']} | {c['cpu_time']:.3g} {c['time_unit']} | "
+                         f"{c['output_triangles']:.0f} of {v['output_triangles']:.0f}{note} | {c['cpu_time'] / v['cpu_time']:.2f} |")
     cheap.append("")
+per_tri = []
+pt = os.path.join(trade_dir, "per_triangle.json")
+if os.path.exists(pt):
+    bench = [b for b in json.load(open(pt))["benchmarks"] if b.get("run_type", "iteration") == "iteration"]
+    per_tri = ["## Cost per output triangle", "",
+               "`benchmarks/refine_bench.cpp` (BM_PerTriangle): one frame of the box and the 320-face sphere (closest "
+               "approach, as in tests/refine_test.cpp) cut at T = 10^-k x size, against vertex mode on the uniform "
+               "subdivision of the input with about as many triangles, timed alternately in one loop by the thread's "
+               "CPU clock, best of the iterations (ns per output triangle, the output's release included).", "",
+               "| scene | k | output triangles at T | uniform triangles | tolerance, ns / triangle | "
+               "vertex mode, ns / triangle | ratio |", "|---|---|---|---|---|---|---|"]
+    for b in bench:
+        parts = dict(p.split(":") for p in b["name"].split("/")[1:] if ":" in p)
+        scene = "box" if parts.get("scene") == "0" else "sphere320"
+        per_tri.append(f"| {scene} | {parts.get('k')} | {b['triangles']:.0f} | {b['uniform_triangles']:.0f} | "
+                       f"{b['tol_ns_per_tri']:.0f} | {b['vertex_ns_per_tri']:.1f} | {b['ratio']:.1f} |")
+    per_tri.append("")
 end_to_end = []
 e2e = os.path.join(trade_dir, "end_to_end.md")
 if os.path.exists(e2e):
     end_to_end = ["## End to end at equal error", "",
                   "`scripts/trade_end_to_end.py`: `apparent render` of the whole scene (every frame, one thread, .glb "
                   "written), the input subdivided k times in vertex mode against the original input at --tolerance = "
-                  "uniform level k's measured error; best of 3 wall times (process start and mesh loading included).", ""]
+                  "uniform level k's measured error; best of 7 CPU times of the process (user + system: process start and mesh "
+                  "loading included; time spent waiting for a core on the shared machine left out).", ""]
     end_to_end += open(e2e).read().rstrip().split("\n") + [""]
-end_to_end += cheap
+end_to_end += cheap + per_tri
 head = md[:3] + [""]
 md = head + ["## At equal error", "",
              "Adaptive triangles and time end to end (cut + .glb conversion) interpolated to each uniform level's "

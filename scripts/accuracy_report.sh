@@ -12,17 +12,23 @@ cmake --build "$build" --target apparent -j "$(nproc)" >/dev/null
 out=$root/docs/trade
 mkdir -p "$out"
 cd "$root"
+# A finer ladder than trade's default (about 1.5x apart instead of 3x): the comparison at equal error
+# interpolates between the two tolerances that bracket each uniform level's error.
+ladder=1e-1,5e-2,3e-2,2e-2,1e-2,7e-3,5e-3,3e-3,2e-3,1.4e-3,1e-3,7e-4,5e-4,3e-4,2e-4,1.4e-4,1e-4
 for scene in data/scenes/flanges.json data/scenes/trade/box_near.json data/scenes/trade/sphere320.json \
              data/scenes/trade/plate.json data/scenes/trade/sphere20480.json; do
   name=$(basename "$scene" .json)
   mkdir -p "$out/$name"
   echo "== apparent trade $scene"
-  "$build/apparent" trade "$scene" --out "$out/$name" --quiet | tee "$out/$name/table.txt"
+  "$build/apparent" trade "$scene" --out "$out/$name" --quiet --tolerances "$ladder" | tee "$out/$name/table.txt"
 done
 echo "== where nothing needs refining: the cut at T = 1e-3 x size against vertex mode (performance_bench)"
 cmake --build "$build" --target performance_bench -j "$(nproc)" >/dev/null
 "$build/benchmarks/performance_bench" --benchmark_filter='BM_Cut(VertexMode|Tolerance)/' --benchmark_min_time=0.3 \
   --benchmark_format=json > "$out/cheap_path.json"
+echo "== cost per output triangle: tolerance mode against vertex mode (refine_bench)"
+cmake --build "$build" --target refine_bench -j "$(nproc)" >/dev/null
+"$build/benchmarks/refine_bench" --benchmark_min_time=0.5 --benchmark_format=json > "$out/per_triangle.json"
 echo "== end to end at equal error (apparent render, every frame)"
 python3 "$root/scripts/trade_end_to_end.py" "$build" | tee "$out/end_to_end.md"
 python3 "$root/scripts/accuracy_report.py" "$out" "$root/docs"

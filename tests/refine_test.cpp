@@ -5,10 +5,12 @@
 // (mesh4d/chord_error.h) is checked against brute-force maxima.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
 
 #include <Eigen/Dense>
 #include <random>
+#include <thread>
 
 #include "mesh4d/chord_error.h"
 #include "mesh4d/robust.h"
@@ -155,10 +157,10 @@ double outlineNonCircularity(const ApparentMesh& m, const Vec3& C) {
     if (dot(axis, Vec3{mean.x(), mean.y(), mean.z()}) < 0) axis = -axis;
     double lo = INFINITY, hi = 0, sum = 0;
     for (const auto& d : dirs) {
-        const double a = std::atan2(norm(cross(d, axis)), dot(d, axis));
-        lo = std::min(lo, a);
-        hi = std::max(hi, a);
-        sum += a;
+        const double angle = std::atan2(norm(cross(d, axis)), dot(d, axis));
+        lo = std::min(lo, angle);
+        hi = std::max(hi, angle);
+        sum += angle;
     }
     return (hi - lo) / (sum / double(dirs.size()));
 }
@@ -443,4 +445,48 @@ TEST(Refine, TriangleWithoutAreaIsLeftAlone) {
     const apparent::Topology t = apparent::analyzeTopology(b.positions, b.triangles);
     EXPECT_TRUE(t.closed);
     EXPECT_EQ(t.genus, 0);
+}
+
+// The refinement keeps its working arrays per thread from frame to frame (slice.cpp
+// RefineScratch): a frame's output must not depend on what the thread cut before. Frames of
+// different worlds (refined, clipped by caps, vertex mode, larger then smaller) cut one after the
+// other on one thread give the same bytes as each cut alone on a fresh thread.
+TEST(Refine, FramesDoNotDependOnTheFramesBefore) {
+    const TradeScene sphere = sphereMid(), box = boxNear();
+    const World4D ws = extrude(sphere.mesh, sphere.motion, -100, 100, false, false);
+    const World4D wb = extrude(box.mesh, box.motion, -100, 100, false, false);
+    const RestMesh torus = testmesh::torus(16, 8, 3.0, 1.0);
+    const World4D wt = extrude(torus, makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -12}, {0.8, 0.2, 0}), 0.0, 3.0, true, true);
+    struct Cut {
+        const World4D* world;
+        ViewSurface view;
+        double tolerance;
+    };
+    const std::vector<Cut> cuts = {{&ws, sphere.view, 1e-5 * sphere.size}, {&wb, box.view, 1e-3 * box.size},
+                                   {&wt, {ViewKind::PastCone, 12.0, {}}, 1e-3},  {&ws, sphere.view, 0.0},
+                                   {&wb, box.view, 1e-4 * box.size},             {&wt, {ViewKind::PastCone, 9.0, {}}, 0.0},
+                                   {&ws, sphere.view, 3e-4 * sphere.size}};
+    auto cut = [](const Cut& c) {
+        SliceSettings s;
+        s.tolerance = c.tolerance;
+        return sliceWorld(*c.world, c.view, s);
+    };
+    auto same = [](const ApparentMesh& a, const ApparentMesh& b) {
+        return a.triangles == b.triangles && a.source_triangles == b.source_triangles &&
+               a.positions.size() == b.positions.size() &&
+               std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3)) == 0 &&
+               a.emission_times == b.emission_times && a.refined_triangles == b.refined_triangles &&
+               a.clipped_triangles == b.clipped_triangles;
+    };
+    size_t refined = 0, clipped = 0;
+    for (size_t i = 0; i < cuts.size(); ++i) {
+        const ApparentMesh after = cut(cuts[i]);  // this thread has cut cuts[0 .. i-1] before
+        ApparentMesh alone;
+        std::thread([&] { alone = cut(cuts[i]); }).join();
+        EXPECT_TRUE(same(after, alone)) << "cut " << i;
+        refined += after.refined_triangles > 0;
+        clipped += after.clipped_triangles > 0;
+    }
+    EXPECT_GE(refined, 3u);  // the sequence does exercise the refinement, and its clipping
+    EXPECT_GE(clipped, 1u);
 }

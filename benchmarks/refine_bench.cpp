@@ -1,0 +1,124 @@
+// Cost per output triangle of the tolerance mode's refinement against vertex mode (issue 13: per
+// output triangle at most 3x vertex mode's cost per triangle, at every T).
+//
+// For each scene and tolerance T = 10^-k x size (k = range(1)), one frame is cut with the
+// tolerance, and the uniform subdivision of the input whose triangle count is nearest the refined
+// output's (12 4^j for the box, 320 4^j for the sphere) is cut in vertex mode. Both are timed in
+// the same loop, alternately, by the thread's CPU clock (time the thread waits for a core on a
+// shared machine is not counted: a long cut would otherwise be preempted more often than a short
+// one) around blocks of cuts of about 2 ms each, and each keeps its best time per cut over the
+// iterations. Counters:
+//   tol_ns_per_tri     best time of the tolerance cut / its output triangles
+//   vertex_ns_per_tri  best time of the vertex cut of the uniform mesh / its triangles
+//   ratio              tol_ns_per_tri / vertex_ns_per_tri (the issue's target: <= 3)
+//   triangles, uniform_triangles: the two output sizes.
+//
+//   box:      the unit box passing 2 ls from the camera at 0.9c, seen at closest approach
+//             (docs/ACCURACY.md), size = its diagonal sqrt 3.
+//   sphere:   the 320-face icosphere of radius 1 passing 4 ls away at 0.9c, size = its diameter 2.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+
+#include "mesh4d/slice.h"
+#include "mesh4d/subdivide.h"
+#include "test_meshes.h"
+
+namespace {
+
+struct Scene {
+    mesh4d::RestMesh mesh;
+    mesh4d::Motion motion;
+    mesh4d::ViewSurface view;
+    double size;
+};
+
+Scene boxNear() {
+    mesh4d::RestMesh box;
+    for (int i = 0; i < 8; ++i) box.positions.push_back({i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5});
+    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads) {
+        box.triangles.push_back({q[0], q[1], q[2]});
+        box.triangles.push_back({q[0], q[2], q[3]});
+    }
+    return {box, mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0.0, {0, 0, -2}, {0.9, 0, 0}),
+            {mesh4d::ViewKind::PastCone, 2.0, {0, 0, 0}}, std::sqrt(3.0)};
+}
+
+Scene sphereMid() {
+    return {testmesh::icosphere(2, 1.0), mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0.0, {0, 0, -4}, {0.9, 0, 0}),
+            {mesh4d::ViewKind::PastCone, 4.0, {0, 0, 0}}, 2.0};
+}
+
+double threadSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// CPU seconds of one cut (the output's release included, as a caller pays it), averaged over
+// `repeats` cuts: the thread's CPU clock is read around a block long enough to be above its grain.
+double seconds(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& s, size_t* tris,
+               int repeats) {
+    const double t0 = threadSeconds();
+    for (int r = 0; r < repeats; ++r) {
+        const mesh4d::ApparentMesh m = mesh4d::sliceWorld(w, view, s);
+        benchmark::DoNotOptimize(m.positions.data());
+        *tris = m.triangles.size();
+    }
+    return (threadSeconds() - t0) / repeats;
+}
+
+// Cuts per block so that a block takes about 2 ms of CPU.
+int repeatsFor(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& s) {
+    size_t tris = 0;
+    const double one = seconds(w, view, s, &tris, 1);
+    const double more = seconds(w, view, s, &tris, std::max(1, int(2e-3 / std::max(one, 1e-7))));
+    return std::max(1, std::min(100000, int(2e-3 / std::max(more, 1e-9))));
+}
+
+// range(0): 0 = box, 1 = sphere; range(1): k, T = 10^-k x size.
+void BM_PerTriangle(benchmark::State& state) {
+    const Scene sc = state.range(0) == 0 ? boxNear() : sphereMid();
+    const mesh4d::World4D w = mesh4d::extrude(sc.mesh, sc.motion, -100, 100, false, false);
+    mesh4d::SliceSettings tol;
+    tol.max_segments = 4096;
+    tol.tolerance = std::pow(10.0, -double(state.range(1))) * sc.size;
+    size_t tris = 0;
+    const int tol_repeats = repeatsFor(w, sc.view, tol);
+    seconds(w, sc.view, tol, &tris, 1);
+    // The uniform level whose triangle count is nearest (in ratio) the refined output's.
+    int level = 0;
+    while (double(sc.mesh.triangles.size()) * std::pow(4.0, level + 0.5) < double(tris)) ++level;
+    const mesh4d::World4D uw = mesh4d::extrude(mesh4d::subdivideUniform(sc.mesh, level), sc.motion, -100, 100, false, false);
+    const mesh4d::SliceSettings vertex;
+    const int vertex_repeats = repeatsFor(uw, sc.view, vertex);
+    double best_tol = INFINITY, best_vertex = INFINITY;
+    size_t utris = 0;
+    for (auto _ : state) {
+        const double a = seconds(w, sc.view, tol, &tris, tol_repeats);
+        const double b = seconds(uw, sc.view, vertex, &utris, vertex_repeats);
+        best_tol = std::min(best_tol, a);
+        best_vertex = std::min(best_vertex, b);
+        state.SetIterationTime(a * tol_repeats + b * vertex_repeats);
+    }
+    const double tol_ns = 1e9 * best_tol / double(std::max<size_t>(tris, 1));
+    const double vertex_ns = 1e9 * best_vertex / double(std::max<size_t>(utris, 1));
+    state.counters["tol_ns_per_tri"] = tol_ns;
+    state.counters["vertex_ns_per_tri"] = vertex_ns;
+    state.counters["ratio"] = tol_ns / vertex_ns;
+    state.counters["triangles"] = double(tris);
+    state.counters["uniform_triangles"] = double(utris);
+}
+
+}  // namespace
+
+BENCHMARK(BM_PerTriangle)
+    ->ArgsProduct({{0, 1}, {2, 3, 4, 5}})
+    ->ArgNames({"scene", "k"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
