@@ -223,7 +223,8 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     bool estimated = false;
     auto deliver = [&](WorkPtr w) {
         if (stop) return;
-        if (estimated) return deliverOne(w);
+        // A frame past the budget ends the run at once (nothing held is written).
+        if (estimated || overBudget(w->frame, settings.max_frame_triangles)) return deliverOne(w);
         held.push_back(std::move(w));
         if (held.size() < kEstimateFrames && held.back()->frame.index + 1 < last_excl) return;
         estimated = true;

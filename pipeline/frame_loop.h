@@ -48,7 +48,7 @@ private:
 // output triangle at its peak (measured: `/usr/bin/time -f %M` on a budget-stopped run, README
 // "Hostile input"), so a run the default budget stops on a small input stays under 500 MB on the
 // 2-core machine the README's figures come from.
-constexpr long long kMinFrameTriangleBudget = 600'000;
+constexpr long long kMinFrameTriangleBudget = 500'000;
 long long defaultFrameTriangleBudget(const Stage& stage);
 
 struct FrameLoopSettings {

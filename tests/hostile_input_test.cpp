@@ -592,7 +592,7 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
     expectRefusedSmall(runMeasured({"render", writeScene(box / "s", "tetra.obj", R"(, "velocity": [0.9, 0, 0])"), "--out",
                                     out, "--tolerance", "1e-5", "--max-triangles", "2000"}),
                        2, "makes more than 2000 triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles");
-    // The default per-frame budget (4 x the input triangles, at least 600 000): a 320-triangle
+    // The default per-frame budget (4 x the input triangles, at least 500 000): a 320-triangle
     // sphere at a tolerance just above the floor would make 1.2M triangles per frame; the run stops
     // at the budget, holding at most threads + 1 frames (2 threads, as on the README's machine).
     fs::copy_file(source("data/meshes/icosphere320.obj"), box / "s/sphere.obj");
@@ -604,7 +604,7 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
 #ifdef APPARENT_SANITIZED
         EXPECT_EQ(m.code, 2) << m.err;  // ASan's shadow memory and quarantine: no RSS bound
 #else
-        expectRefusedSmall(m, 2, "makes more than 600000 triangles (--max-triangles); use a coarser --tolerance or raise "
+        expectRefusedSmall(m, 2, "makes more than 500000 triangles (--max-triangles); use a coarser --tolerance or raise "
                                  "--max-triangles");
 #endif
     }
