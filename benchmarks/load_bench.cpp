@@ -11,7 +11,8 @@
 //                          (wall time, ru_maxrss from wait4): counters load_s, gltfpack_s,
 //                          time_ratio, load_peak_MiB, gltfpack_peak_MiB, peak_ratio.
 //   BM_Cut/N               the vertex-mode cone cut of one frame, one core
-//   BM_WritePly/N          that frame written to PLY (pipeline's writer, through the temporary file)
+//   BM_WritePly/N          that frame written to PLY (the sink's writer: temporary file, fsync, rename)
+//   BM_SerializePly/N      the same frame's PLY bytes in memory only (no file)
 //   BM_WriteObj/N          the same to OBJ
 #include <benchmark/benchmark.h>
 
@@ -199,6 +200,16 @@ void write(benchmark::State& state, bool ply) {
     fs::remove_all(dir);
 }
 void BM_WritePly(benchmark::State& state) { write(state, true); }
+// The PLY bytes alone, in memory (no file): what the writer costs before the kernel and the disk.
+void BM_SerializePly(benchmark::State& state) {
+    const Passing& p = passing(state.range(0));
+    std::string bytes;
+    for (auto _ : state) {
+        apparent::serializePly(p.frame, &bytes);
+        benchmark::DoNotOptimize(bytes.data());
+    }
+    state.counters["triangles"] = double(p.world.mesh.triangles.size());
+}
 void BM_WriteObj(benchmark::State& state) { write(state, false); }
 
 }  // namespace
@@ -209,6 +220,7 @@ BENCHMARK(BM_LoadVsGltfpack)
     ->Iterations(3);
 BENCHMARK(BM_Cut)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WritePly)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SerializePly)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WriteObj)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {

@@ -44,7 +44,7 @@ struct FaceBlock {
 
 }  // namespace
 
-bool writePly(const std::string& path, const ExportFrame& frame, std::string* error) {
+void serializePly(const ExportFrame& frame, std::string* out) {
     const bool little = littleEndianHost();
     // Step: counts, per block of triangles (faces with a repeated corner are left out: zero area by
     // construction), so that every block knows where its bytes go.
@@ -70,13 +70,12 @@ bool writePly(const std::string& path, const ExportFrame& frame, std::string* er
     }
 
     // Step: the header, then every vertex (x y z quality, absolute lab values) and face, each
-    // block written in place in parallel: the bytes do not depend on the thread count. The buffer
-    // is kept between frames (no reallocation while frames do not grow).
+    // block written in place in parallel: the bytes do not depend on the thread count.
     const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
                                "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n"
                                "element face " + std::to_string(faces) +
                                "\nproperty list uchar int vertex_indices\nend_header\n";
-    thread_local std::string bytes;
+    std::string& bytes = *out;
     bytes.resize(header.size() + kVertexBytes * vertices + kFaceBytes * faces);
     std::memcpy(&bytes[0], header.data(), header.size());
     char* const vertex_start = &bytes[0] + header.size();
@@ -108,6 +107,11 @@ bool writePly(const std::string& path, const ExportFrame& frame, std::string* er
             for (uint32_t v : t) p = storeLittleEndian(p, int32_t(v + b.vertex_base), little);
         }
     });
+}
+
+bool writePly(const std::string& path, const ExportFrame& frame, std::string* error) {
+    thread_local std::string bytes;  // kept between frames: no reallocation while frames do not grow
+    serializePly(frame, &bytes);
     // Step: written with every write, fsync and close checked, then renamed into place.
     AtomicOutput out(path);
     return out.commitBytes(bytes, error);
