@@ -94,7 +94,7 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             sorted.assign(idx.begin(), idx.end());
             std::sort(sorted.begin(), sorted.end());
             if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
-                ++scan->repeated_index;  // OpenMesh drops it; we count it as degenerate
+                ++scan->repeated_index;  // dropped (as OpenMesh does) and counted as degenerate
                 continue;
             }
             if (++faces > limits.max_faces)

@@ -24,7 +24,7 @@ namespace {
 enum class PlyFormat { Ascii, BinaryLittle, BinaryBig };
 enum class ScalarType { Int8, Uint8, Int16, Uint16, Int32, Uint32, Float32, Float64 };
 
-// The names of PLY 1.0 and the sized names most writers use (both are accepted by OpenMesh).
+// The names of PLY 1.0 and the sized names most writers use (both are accepted).
 bool parseType(const std::string& s, ScalarType* t) {
     static const std::pair<const char*, ScalarType> names[] = {
         {"char", ScalarType::Int8},     {"int8", ScalarType::Int8},       {"uchar", ScalarType::Uint8},
@@ -53,7 +53,7 @@ size_t typeSize(ScalarType t) {
 
 bool isIntegral(ScalarType t) { return t != ScalarType::Float32 && t != ScalarType::Float64; }
 
-// Range of an integral type, to refuse ascii values that would wrap when OpenMesh stores them.
+// Range of an integral type, to refuse ascii values that would wrap in their declared type.
 void integralRange(ScalarType t, double* lo, double* hi) {
     switch (t) {
         case ScalarType::Int8: *lo = -128; *hi = 127; return;
@@ -280,7 +280,7 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
     if (!parseHeader(bytes, &h, &problem)) return Status::failure(path + ": " + problem);
     auto fail = [&](const std::string& field, const std::string& what) { return Status::failure(path + ": " + field + ": " + what); };
 
-    // Step: the elements we need, with the properties OpenMesh reads.
+    // Step: the elements we need, with the properties the mesh needs.
     const PlyElement* vertex = nullptr;
     const PlyElement* face = nullptr;
     for (const PlyElement& e : h.elements) {
