@@ -165,6 +165,7 @@ TEST(MeshLoader, NonManifoldFacesAreGivenTheirOwnVerticesAsOpenMeshDoes) {
         {{0, 1, 2}, {0, 1, 3}},                      // a flipped neighbour (directed edge 0->1 twice)
         {{0, 1, 2}, {0, 6, 7}},                      // a bowtie: two fans meet at vertex 0
         {{0, 1, 5, 2}, {0, 1, 4}, {1, 0, 3}, {2, 8, 5}},  // a quad among them
+        {{0, 1, 2}, {0, 2, 1}},                      // two faces on the same corners, opposite ways
     };
     for (size_t c = 0; c < cases.size(); ++c) {
         writeObj(dir / "n.obj", m, cases[c]);
