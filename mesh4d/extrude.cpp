@@ -11,19 +11,11 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
                 bool cap_a_real, bool cap_b_real) {
     World4D world;
     world.motion = motion;
-    world.mesh = mesh;
     world.tau_a = tau_a;
     world.tau_b = tau_b;
     world.cap_a_real = cap_a_real;
     world.cap_b_real = cap_b_real;
-
-    // Events: both caps of every vertex's worldline.
     const size_t nv = mesh.positions.size();
-    world.events.resize(2 * nv);
-    for (size_t i = 0; i < nv; ++i) {
-        world.events[2 * i + 0] = labFromRest(motion, tau_a, mesh.positions[i]);
-        world.events[2 * i + 1] = labFromRest(motion, tau_b, mesh.positions[i]);
-    }
 
     // Unique edges, numbered in order of first appearance (slot 3 f + c is edge c of triangle f)
     // so that the numbering depends on the mesh alone. The slots are grouped by their edge with a
@@ -94,6 +86,16 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         } else {
             first_slot(slot) = first_slot(first_slot(slot));
         }
+    }
+
+    // The mesh (its one copy) and the events, after the edges' scratch arrays are freed: the peak
+    // memory is the world itself.
+    world.mesh = mesh;
+    // Events: both caps of every vertex's worldline.
+    world.events.resize(2 * nv);
+    for (size_t i = 0; i < nv; ++i) {
+        world.events[2 * i + 0] = labFromRest(motion, tau_a, mesh.positions[i]);
+        world.events[2 * i + 1] = labFromRest(motion, tau_b, mesh.positions[i]);
     }
 
     world.simple = true;
