@@ -1,7 +1,11 @@
 #include "exporters/obj.h"
 
+#include <algorithm>
 #include <charconv>
 #include <utility>
+#include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include "exporters/atomic_file.h"
 #include "exporters/frame_files.h"
@@ -17,30 +21,86 @@ void putNumber(std::string* out, double value) {
     out->append(buffer, r.ptr);
 }
 
+void putIndex(std::string* out, uint64_t value) {
+    char buffer[24];
+    const auto r = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    out->append(buffer, r.ptr);
+}
+
+bool keptFace(const std::array<uint32_t, 3>& t) { return t[0] != t[1] && t[1] != t[2] && t[0] != t[2]; }
+
+constexpr size_t kBlock = size_t(1) << 15;  // vertices or triangles formatted by one task
+
+// A run of one object's vertices or triangles, formatted into its own text.
+struct Block {
+    size_t object = 0, begin = 0, end = 0;
+    bool faces = false;
+    uint64_t vertex_base = 0;  // vertices of the objects before (faces)
+};
+
 }  // namespace
 
 bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error) {
-    const mesh4d::ApparentMesh m = mergeObjects(frame);
-    size_t faces = 0;
-    for (const auto& t : m.triangles) faces += t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
-    // Step: serialized in memory, then written with every error checked (exporters/atomic_file.h).
-    std::string text = "# " + std::to_string(m.positions.size()) + " vertices, " + std::to_string(faces) + " faces\n";
-    text.reserve(text.size() + 60 * m.positions.size() + 24 * faces);
-    for (const mesh4d::Vec3& p : m.positions) {
-        text += "v ";
-        putNumber(&text, p.x);
-        text += ' ';
-        putNumber(&text, p.y);
-        text += ' ';
-        putNumber(&text, p.z);
-        text += '\n';
+    // Step: the blocks, every object's vertices first, then every object's faces, in file order.
+    std::vector<Block> blocks;
+    uint64_t vertices = 0;
+    for (size_t o = 0; o < frame.objects.size(); ++o) {
+        const size_t n = frame.objects[o].positions.size();
+        for (size_t b = 0; b < n; b += kBlock) blocks.push_back({o, b, std::min(n, b + kBlock), false, 0});
     }
-    for (const auto& t : m.triangles) {
-        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;  // zero area by construction
-        text += "f " + std::to_string(t[0] + 1) + ' ' + std::to_string(t[1] + 1) + ' ' + std::to_string(t[2] + 1) + '\n';
+    for (size_t o = 0; o < frame.objects.size(); ++o) {
+        const size_t n = frame.objects[o].triangles.size();
+        for (size_t b = 0; b < n; b += kBlock) blocks.push_back({o, b, std::min(n, b + kBlock), true, vertices});
+        vertices += frame.objects[o].positions.size();
     }
+    // Step: each block formatted in parallel into its own text (kept between frames), then joined
+    // in order: the bytes do not depend on the thread count.
+    thread_local std::vector<std::string> kept_texts;
+    std::vector<std::string>& texts = kept_texts;  // the calling thread's, for every task
+    if (texts.size() < blocks.size()) texts.resize(blocks.size());
+    std::vector<size_t> faces_in(blocks.size(), 0);
+    tbb::parallel_for(size_t(0), blocks.size(), [&](size_t i) {
+        const Block& b = blocks[i];
+        const mesh4d::ApparentMesh& part = frame.objects[b.object];
+        std::string& text = texts[i];
+        text.clear();
+        if (!b.faces) {
+            for (size_t v = b.begin; v < b.end; ++v) {
+                const mesh4d::Vec3 p = part.absolutePosition(v);
+                text += "v ";
+                putNumber(&text, p.x);
+                text += ' ';
+                putNumber(&text, p.y);
+                text += ' ';
+                putNumber(&text, p.z);
+                text += '\n';
+            }
+            return;
+        }
+        for (size_t f = b.begin; f < b.end; ++f) {
+            const auto& t = part.triangles[f];
+            if (!keptFace(t)) continue;  // zero area by construction
+            ++faces_in[i];
+            text += 'f';
+            for (uint32_t v : t) {
+                text += ' ';
+                putIndex(&text, b.vertex_base + v + 1);
+            }
+            text += '\n';
+        }
+    });
+    size_t faces = 0, size = 0;
+    for (size_t i = 0; i < blocks.size(); ++i) {
+        faces += faces_in[i];
+        size += texts[i].size();
+    }
+    thread_local std::string all;
+    all = "# " + std::to_string(vertices) + " vertices, " + std::to_string(faces) + " faces\n";
+    all.reserve(all.size() + size);
+    for (size_t i = 0; i < blocks.size(); ++i) all += texts[i];
+    // Step: written with every error checked (exporters/atomic_file.h).
     AtomicOutput out(path);
-    return out.commitBytes(text, error);
+    return out.commitBytes(all, error);
 }
 
 std::unique_ptr<FrameSink> objSink(std::string dir) {

@@ -1,8 +1,11 @@
 #include "exporters/ply.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <utility>
+
+#include <tbb/parallel_for.h>
 
 #include "exporters/atomic_file.h"
 #include "exporters/frame_files.h"
@@ -11,43 +14,104 @@ namespace apparent {
 
 namespace {
 
-// Little-endian bytes of a value, whatever the host's byte order.
-template <class T>
-void putLittleEndian(std::string* out, T value) {
-    unsigned char bytes[sizeof(T)];
-    std::memcpy(bytes, &value, sizeof(T));
-    uint16_t probe = 1;
+bool littleEndianHost() {
+    const uint16_t probe = 1;
     unsigned char first = 0;
     std::memcpy(&first, &probe, 1);
-    if (first == 1) {
-        out->append(reinterpret_cast<const char*>(bytes), sizeof(T));
-    } else {
-        for (size_t i = sizeof(T); i-- > 0;) out->push_back(char(bytes[i]));
-    }
+    return first == 1;
 }
+
+// Stores the little-endian bytes of `value` at `dst`, whatever the host's byte order.
+template <class T>
+char* storeLittleEndian(char* dst, T value, bool little_host) {
+    std::memcpy(dst, &value, sizeof(T));
+    if (!little_host) std::reverse(dst, dst + sizeof(T));
+    return dst + sizeof(T);
+}
+
+bool keptFace(const std::array<uint32_t, 3>& t) { return t[0] != t[1] && t[1] != t[2] && t[0] != t[2]; }
+
+constexpr size_t kBlock = size_t(1) << 16;  // triangles or vertices serialized by one task
+constexpr size_t kVertexBytes = 32;         // double x y z quality
+constexpr size_t kFaceBytes = 13;           // uchar 3, int i j k
+
+// A run of one object's triangles, with the kept faces before it in the whole frame.
+struct FaceBlock {
+    size_t object = 0, begin = 0, end = 0;
+    size_t faces_before = 0;
+    uint32_t vertex_base = 0;
+};
 
 }  // namespace
 
+void serializePly(const ExportFrame& frame, std::string* out) {
+    const bool little = littleEndianHost();
+    // Step: counts, per block of triangles (faces with a repeated corner are left out: zero area by
+    // construction), so that every block knows where its bytes go.
+    std::vector<FaceBlock> blocks;
+    size_t vertices = 0;
+    for (size_t o = 0; o < frame.objects.size(); ++o) {
+        const auto& tris = frame.objects[o].triangles;
+        for (size_t b = 0; b < tris.size(); b += kBlock)
+            blocks.push_back({o, b, std::min(tris.size(), b + kBlock), 0, uint32_t(vertices)});
+        vertices += frame.objects[o].positions.size();
+    }
+    std::vector<size_t> kept(blocks.size(), 0);
+    tbb::parallel_for(size_t(0), blocks.size(), [&](size_t i) {
+        const auto& tris = frame.objects[blocks[i].object].triangles;
+        size_t n = 0;
+        for (size_t f = blocks[i].begin; f < blocks[i].end; ++f) n += keptFace(tris[f]);
+        kept[i] = n;
+    });
+    size_t faces = 0;
+    for (size_t i = 0; i < blocks.size(); ++i) {
+        blocks[i].faces_before = faces;
+        faces += kept[i];
+    }
+
+    // Step: the header, then every vertex (x y z quality, absolute lab values) and face, each
+    // block written in place in parallel: the bytes do not depend on the thread count.
+    const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
+                               "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n"
+                               "element face " + std::to_string(faces) +
+                               "\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string& bytes = *out;
+    bytes.resize(header.size() + kVertexBytes * vertices + kFaceBytes * faces);
+    std::memcpy(&bytes[0], header.data(), header.size());
+    char* const vertex_start = &bytes[0] + header.size();
+    char* const face_start = vertex_start + kVertexBytes * vertices;
+    size_t base = 0;
+    for (const auto& part : frame.objects) {
+        char* const dst = vertex_start + kVertexBytes * base;
+        tbb::parallel_for(size_t(0), part.positions.size(), kBlock, [&](size_t first) {
+            const size_t last = std::min(part.positions.size(), first + kBlock);
+            char* p = dst + kVertexBytes * first;
+            for (size_t i = first; i < last; ++i) {
+                const mesh4d::Vec3 q = part.absolutePosition(i);
+                p = storeLittleEndian(p, q.x, little);
+                p = storeLittleEndian(p, q.y, little);
+                p = storeLittleEndian(p, q.z, little);
+                p = storeLittleEndian(p, part.absoluteTime(i), little);
+            }
+        });
+        base += part.positions.size();
+    }
+    tbb::parallel_for(size_t(0), blocks.size(), [&](size_t i) {
+        const FaceBlock& b = blocks[i];
+        const auto& tris = frame.objects[b.object].triangles;
+        char* p = face_start + kFaceBytes * b.faces_before;
+        for (size_t f = b.begin; f < b.end; ++f) {
+            const auto& t = tris[f];
+            if (!keptFace(t)) continue;
+            *p++ = char(3);
+            for (uint32_t v : t) p = storeLittleEndian(p, int32_t(v + b.vertex_base), little);
+        }
+    });
+}
+
 bool writePly(const std::string& path, const ExportFrame& frame, std::string* error) {
-    const mesh4d::ApparentMesh m = mergeObjects(frame);
-    std::vector<const std::array<uint32_t, 3>*> faces;  // without a repeated corner (zero area by construction)
-    faces.reserve(m.triangles.size());
-    for (const auto& t : m.triangles)
-        if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) faces.push_back(&t);
-    // Step: the header, then every vertex (x y z quality) and face, serialized in memory.
-    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(m.positions.size()) +
-                        "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n"
-                        "element face " + std::to_string(faces.size()) +
-                        "\nproperty list uchar int vertex_indices\nend_header\n";
-    bytes.reserve(bytes.size() + 32 * m.positions.size() + 13 * faces.size());
-    for (size_t i = 0; i < m.positions.size(); ++i) {
-        for (int c = 0; c < 3; ++c) putLittleEndian(&bytes, m.positions[i][c]);
-        putLittleEndian(&bytes, m.emission_times[i]);
-    }
-    for (const auto* t : faces) {
-        bytes.push_back(char(3));
-        for (uint32_t v : *t) putLittleEndian(&bytes, int32_t(v));
-    }
+    thread_local std::string bytes;  // kept between frames: no reallocation while frames do not grow
+    serializePly(frame, &bytes);
     // Step: written with every write, fsync and close checked, then renamed into place.
     AtomicOutput out(path);
     return out.commitBytes(bytes, error);

@@ -12,6 +12,10 @@
 
 namespace apparent {
 
+// The file's bytes for `frame` into `bytes` (resized; its capacity is reused): serialized in
+// parallel blocks (TBB), the same bytes whatever the thread count.
+void serializePly(const ExportFrame& frame, std::string* bytes);
+
 // Writes `frame` to `path` through a temporary file. Returns false with a message on failure.
 bool writePly(const std::string& path, const ExportFrame& frame, std::string* error);
 

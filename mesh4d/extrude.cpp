@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 #include "robust.h"
 
@@ -12,70 +11,91 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
                 bool cap_a_real, bool cap_b_real) {
     World4D world;
     world.motion = motion;
-    world.mesh = mesh;
     world.tau_a = tau_a;
     world.tau_b = tau_b;
     world.cap_a_real = cap_a_real;
     world.cap_b_real = cap_b_real;
-
-    // Events: both caps of every vertex's worldline.
     const size_t nv = mesh.positions.size();
+
+    // Unique edges, numbered in order of first appearance (slot 3 f + c is edge c of triangle f)
+    // so that the numbering depends on the mesh alone. The slots are grouped by their edge with a
+    // counting sort on the lower vertex and a sort of each small group on (higher vertex, slot):
+    // linear memory, no hash table.
+    const size_t nf = mesh.triangles.size();
+    const size_t slots = 3 * nf;
+    world.vertex_used.assign(nv, 0);
+    std::vector<uint32_t> offset(nv + 1, 0);
+    for (const auto& tri : mesh.triangles)
+        for (int c = 0; c < 3; ++c) {
+            world.vertex_used[tri[c]] = 1;
+            ++offset[std::min(tri[c], tri[(c + 1) % 3]) + 1];
+        }
+    for (size_t v = 0; v < nv; ++v) offset[v + 1] += offset[v];
+    std::vector<uint64_t> by_lo(slots);  // (hi << 32) | slot, grouped by lo
+    {
+        std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
+        for (size_t f = 0; f < nf; ++f)
+            for (int c = 0; c < 3; ++c) {
+                uint32_t a = mesh.triangles[f][c], b = mesh.triangles[f][(c + 1) % 3];
+                if (a > b) std::swap(a, b);
+                by_lo[fill[a]++] = (uint64_t(b) << 32) | uint32_t(3 * f + c);
+            }
+    }
+    // Each group of equal (lo, hi), its slots in triangle order: the first slot stands for the
+    // edge (stored in triangle_edges until numbered), and the cycle of slot_next links the slots
+    // of non-degenerate triangles (World4D::slot_next).
+    world.triangle_edges.resize(nf);
+    auto first_slot = [&](uint32_t slot) -> uint32_t& { return world.triangle_edges[slot / 3][slot % 3]; };
+    world.slot_next.resize(slots);
+    auto degenerate = [&](uint32_t slot) {
+        const auto& t = mesh.triangles[slot / 3];
+        return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
+    };
+    for (size_t v = 0; v < nv; ++v) {
+        uint64_t* g = by_lo.data() + offset[v];
+        uint64_t* const g_end = by_lo.data() + offset[v + 1];
+        std::sort(g, g_end);
+        while (g < g_end) {
+            uint64_t* e = g;
+            while (e < g_end && (*e >> 32) == (*g >> 32)) ++e;
+            const uint32_t first = uint32_t(*g);
+            uint32_t cycle_first = UINT32_MAX, cycle_last = UINT32_MAX;
+            for (uint64_t* it = g; it < e; ++it) {
+                const uint32_t slot = uint32_t(*it);
+                first_slot(slot) = first;
+                world.slot_next[slot] = slot;
+                if (degenerate(slot)) continue;
+                if (cycle_first == UINT32_MAX) cycle_first = slot;
+                else world.slot_next[cycle_last] = slot;
+                cycle_last = slot;
+            }
+            if (cycle_last != UINT32_MAX) world.slot_next[cycle_last] = cycle_first;
+            g = e;
+        }
+    }
+    std::vector<uint64_t>().swap(by_lo);
+    std::vector<uint32_t>().swap(offset);
+    // Numbering in slot order: a slot's first slot is never after it, so it is numbered already.
+    for (uint32_t slot = 0; slot < slots; ++slot) {
+        if (first_slot(slot) == slot) {
+            const auto& t = mesh.triangles[slot / 3];
+            uint32_t a = t[slot % 3], b = t[(slot % 3 + 1) % 3];
+            if (a > b) std::swap(a, b);
+            first_slot(slot) = uint32_t(world.edges.size());
+            world.edges.push_back({a, b});
+        } else {
+            first_slot(slot) = first_slot(first_slot(slot));
+        }
+    }
+
+    // The mesh (its one copy) and the events, after the edges' scratch arrays are freed: the peak
+    // memory is the world itself.
+    world.mesh = mesh;
+    // Events: both caps of every vertex's worldline.
     world.events.resize(2 * nv);
     for (size_t i = 0; i < nv; ++i) {
         world.events[2 * i + 0] = labFromRest(motion, tau_a, mesh.positions[i]);
         world.events[2 * i + 1] = labFromRest(motion, tau_b, mesh.positions[i]);
-    }
-
-    // Unique edges, keyed by (lo, hi), numbered in order of first appearance so that the
-    // numbering depends on the mesh alone.
-    std::unordered_map<uint64_t, uint32_t> edge_index;
-    edge_index.reserve(mesh.triangles.size() * 2);
-    world.triangle_edges.resize(mesh.triangles.size());
-    world.vertex_used.assign(nv, 0);
-    for (size_t f = 0; f < mesh.triangles.size(); ++f) {
-        const auto& tri = mesh.triangles[f];
-        for (int c = 0; c < 3; ++c) {
-            world.vertex_used[tri[c]] = 1;
-            uint32_t a = tri[c], b = tri[(c + 1) % 3];
-            if (a > b) std::swap(a, b);
-            const uint64_t key = (uint64_t(a) << 32) | b;
-            auto [it, inserted] = edge_index.emplace(key, uint32_t(world.edges.size()));
-            if (inserted) world.edges.push_back({a, b});
-            world.triangle_edges[f][c] = it->second;
-        }
-    }
-
-    // The cycle of slots around each edge (World4D::slot_next).
-    {
-        const uint32_t unset = 0xffffffffu;
-        std::vector<uint32_t> first(world.edges.size(), unset), last(world.edges.size(), unset);
-        world.slot_next.resize(3 * mesh.triangles.size());
-        for (size_t f = 0; f < mesh.triangles.size(); ++f) {
-            const auto& t = mesh.triangles[f];
-            const bool degenerate = t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
-            for (int c = 0; c < 3; ++c) {
-                const uint32_t slot = uint32_t(3 * f + c);
-                world.slot_next[slot] = slot;
-                if (degenerate) continue;
-                const uint32_t e = world.triangle_edges[f][c];
-                if (first[e] == unset) first[e] = slot;
-                else world.slot_next[last[e]] = slot;
-                last[e] = slot;
-            }
-        }
-        for (size_t e = 0; e < world.edges.size(); ++e)
-            if (last[e] != unset) world.slot_next[last[e]] = first[e];
-    }
-
-    // Three tetrahedra per prism, staircase split over the vertices sorted by id.
-    world.tets.reserve(3 * mesh.triangles.size());
-    for (const auto& tri : mesh.triangles) {
-        std::array<uint32_t, 3> s = tri;
-        std::sort(s.begin(), s.end());
-        const uint32_t ia = 2 * s[0], ib = ia + 1, ja = 2 * s[1], jb = ja + 1, ka = 2 * s[2], kb = ka + 1;
-        world.tets.push_back({ia, ja, ka, kb});
-        world.tets.push_back({ia, ja, jb, kb});
-        world.tets.push_back({ia, ib, jb, kb});
     }
 
     world.simple = true;

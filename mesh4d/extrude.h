@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cmath>
+#include <utility>
 #include <cstdint>
 #include <vector>
 
@@ -56,7 +57,6 @@ struct World4D {
     bool cap_a_real = false;         // the object begins existing at tau_a
     bool cap_b_real = false;         // the object ends existing at tau_b
     std::vector<Event> events;       // 2 per rest vertex: index 2 i + 0 (cap a), 2 i + 1 (cap b)
-    std::vector<std::array<uint32_t, 4>> tets;  // 3 per triangle, indices into events
     std::vector<Edge> edges;                    // unique undirected edges of the mesh
     std::vector<std::array<uint32_t, 3>> triangle_edges;  // edge of (v0,v1), (v1,v2), (v2,v0)
     // The triangles around each edge as a cycle of slots: slot 3 f + c (edge c of triangle f) ->
@@ -70,7 +70,26 @@ struct World4D {
     double shape_radius = 0;                    // max |q| over the used rest vertices
     bool simple = false;  // every vertex used and no triangle repeats an index (the vertex-mode fast path)
     bool empty() const { return mesh.triangles.empty() || !(tau_a < tau_b); }
+    // The tetrahedra are implicit (computed from the triangles, not stored): 3 per triangle,
+    // tetrahedron 3 f + k is prismTet(mesh.triangles[f], k).
+    size_t tetCount() const { return 3 * mesh.triangles.size(); }
+    std::array<uint32_t, 4> tet(size_t i) const;
 };
+
+// Tetrahedron k (0, 1, 2) of the prism over triangle `tri`, as indices into World4D::events: the
+// staircase split over its vertices sorted by id (i < j < k): {ia, ja, ka, kb}, {ia, ja, jb, kb},
+// {ia, ib, jb, kb}.
+inline std::array<uint32_t, 4> prismTet(const std::array<uint32_t, 3>& tri, int k) {
+    uint32_t s0 = tri[0], s1 = tri[1], s2 = tri[2];
+    if (s0 > s1) std::swap(s0, s1);
+    if (s1 > s2) std::swap(s1, s2);
+    if (s0 > s1) std::swap(s0, s1);
+    const uint32_t ia = 2 * s0, ja = 2 * s1, ka = 2 * s2;
+    if (k == 0) return {ia, ja, ka, ka + 1};
+    if (k == 1) return {ia, ja, ja + 1, ka + 1};
+    return {ia, ia + 1, ja + 1, ka + 1};
+}
+inline std::array<uint32_t, 4> World4D::tet(size_t i) const { return prismTet(mesh.triangles[i / 3], int(i % 3)); }
 
 // Builds the 4D history of `mesh` under `motion` over proper times [tau_a, tau_b].
 // Preconditions: tau_a < tau_b, every triangle index < mesh.positions.size().

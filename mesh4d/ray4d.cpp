@@ -89,7 +89,7 @@ TraceWorld prepareTrace(const World4D& world) {
         TraceWorld::Prism& p = trace.prisms[f];
         // Step: the 3-flat, from the first tetrahedron of the prism (all three share it: the prism
         // is the affine image of triangle x interval).
-        const auto& t = world.tets[3 * f];
+        const auto t = world.tet(3 * f);
         const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
         p.normal = flatNormal(v);
         p.offset = dot4(p.normal, toVec4(v[0]));
@@ -122,7 +122,7 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
         if (!p.box.contains(at, slack)) continue;
         // Step: the prism's three tetrahedra by the 4D barycentric method; the nearest hit wins.
         for (size_t j = 0; j < 3; ++j) {
-            const auto& t = world.tets[3 * f + j];
+            const auto t = world.tet(3 * f + j);
             const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
             const std::optional<TetHit> hit = intersectTet(ray, v, best_s);
             if (!hit) continue;

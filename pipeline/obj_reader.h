@@ -1,12 +1,14 @@
-// Wavefront OBJ meshes, read with OpenMesh and converted to our types.
+// Wavefront OBJ meshes, read by our own single-pass scanner (std::from_chars, no iostreams) into
+// double positions, made into a mesh as OpenMesh's importer would (pipeline/polygon_input.h).
 //
-// OpenMesh's reader is lenient: it silently skips faces with out-of-range or repeated indices and
-// vertices with unparsable coordinates. So the file is first scanned line by line, and anything
-// OpenMesh would drop unannounced becomes either a one-line error naming the line (bad numbers,
-// indices out of range, faces of fewer than 3 vertices) or a counted warning (degenerate faces
-// with a repeated index). Polygons are triangulated by OpenMesh (a fan), counted as a warning.
-// Limit: OpenMesh's OBJ reader parses coordinates as float, so rest-frame positions carry a
-// relative rounding of about 6e-8 of their magnitude; everything after the read is double.
+// Everything a lenient reader would drop unannounced becomes either a one-line error naming the
+// line (bad numbers, indices out of range, faces of fewer than 3 vertices) or a counted warning
+// (degenerate faces with a repeated index). Polygons are triangulated as a fan about their first
+// corner, counted as a warning. Only `v` and `f` lines are read (the first three numbers of a
+// `v`, the position index of each `f` corner: "i", "i/t", "i//n", "i/t/n", negatives counting
+// back); material libraries are never opened (`mtllib` lines are counted as ignored), other
+// keywords skipped. Coordinates must lie within float range (|x| <= 3e38), since every export
+// is float32.
 #pragma once
 
 #include <string>

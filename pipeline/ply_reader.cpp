@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -10,25 +11,20 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Core/System/omstream.hh>
-
-#include "pipeline/mesh_check.h"
 #include "pipeline/input_file.h"
-#include "pipeline/openmesh_input.h"
+#include "pipeline/polygon_input.h"
 
 namespace apparent {
 
 namespace {
 
-typedef InputTriMesh PlyMesh;
 
 enum class PlyFormat { Ascii, BinaryLittle, BinaryBig };
 enum class ScalarType { Int8, Uint8, Int16, Uint16, Int32, Uint32, Float32, Float64 };
 
-// The names of PLY 1.0 and the sized names most writers use (both are accepted by OpenMesh).
+// The names of PLY 1.0 and the sized names most writers use (both are accepted).
 bool parseType(const std::string& s, ScalarType* t) {
     static const std::pair<const char*, ScalarType> names[] = {
         {"char", ScalarType::Int8},     {"int8", ScalarType::Int8},       {"uchar", ScalarType::Uint8},
@@ -57,7 +53,7 @@ size_t typeSize(ScalarType t) {
 
 bool isIntegral(ScalarType t) { return t != ScalarType::Float32 && t != ScalarType::Float64; }
 
-// Range of an integral type, to refuse ascii values that would wrap when OpenMesh stores them.
+// Range of an integral type, to refuse ascii values that would wrap in their declared type.
 void integralRange(ScalarType t, double* lo, double* hi) {
     switch (t) {
         case ScalarType::Int8: *lo = -128; *hi = 127; return;
@@ -241,50 +237,50 @@ private:
             *problem = "the file ends early";
             return false;
         }
-        const std::string token(start, size_t(p_ - start));
+        std::string_view token(start, size_t(p_ - start));
         if (token.size() > 64) {
             *problem = "value too long";
             return false;
         }
-        char* e = nullptr;
-        errno = 0;
+        const std::string_view shown = token;
+        if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+        const char* const token_end = token.data() + token.size();
         if (isIntegral(t)) {
-            const long long x = std::strtoll(token.c_str(), &e, 10);
+            long long x = 0;
+            const auto r = std::from_chars(token.data(), token_end, x);
             double lo, hi;
             integralRange(t, &lo, &hi);
-            if (*e != '\0' || errno == ERANGE || double(x) < lo || double(x) > hi) {
-                *problem = "'" + token + "' is not an integer in [" + std::to_string((long long)lo) + ", " +
+            if (r.ec != std::errc() || r.ptr != token_end || double(x) < lo || double(x) > hi) {
+                *problem = "'" + std::string(shown) + "' is not an integer in [" + std::to_string((long long)lo) + ", " +
                            std::to_string((long long)hi) + "]";
                 return false;
             }
             *v = double(x);
         } else {
-            const double x = std::strtod(token.c_str(), &e);
-            // OpenMesh parses with operator>>, which stops at "nan" or "inf": refuse them here.
-            if (*e != '\0' || !std::isfinite(x) || (t == ScalarType::Float32 && std::fabs(x) > 3.4e38)) {
-                *problem = "'" + token + "' is not a finite number";
+            double x = 0;
+            const auto r = std::from_chars(token.data(), token_end, x);
+            if (r.ec != std::errc() || r.ptr != token_end || !std::isfinite(x) ||
+                (t == ScalarType::Float32 && std::fabs(x) > 3.4e38)) {
+                *problem = "'" + std::string(shown) + "' is not a finite number";
                 return false;
             }
             *v = x;
         }
         return true;
     }
-
     const char* p_;
     const char* end_;
     PlyFormat format_;
 };
 
-typedef ScannedCounts ScanResult;  // what the scan counts (openmesh_input.h)
-
-// Checks the header and every value of the body before OpenMesh sees the file.
-Status scanPly(const std::string& path, const std::string& bytes, const MeshLimits& limits, ScanResult* scan) {
+// Checks the header and every value of the body, keeping the vertices and faces.
+Status scanPly(const std::string& path, const std::string& bytes, const MeshLimits& limits, ScannedMesh* scan) {
     PlyHeader h;
     std::string problem;
     if (!parseHeader(bytes, &h, &problem)) return Status::failure(path + ": " + problem);
     auto fail = [&](const std::string& field, const std::string& what) { return Status::failure(path + ": " + field + ": " + what); };
 
-    // Step: the elements we need, with the properties OpenMesh reads.
+    // Step: the elements we need, with the properties the mesh needs.
     const PlyElement* vertex = nullptr;
     const PlyElement* face = nullptr;
     for (const PlyElement& e : h.elements) {
@@ -327,83 +323,82 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
                                                  std::to_string(body) + " bytes after the header)");
         needed += e.count * row;
     }
-    scan->vertices = vertex->count;
-
-    // Step: every value of the body, in file order.
+    // Step: every value of the body, in file order, the vertices and faces kept as read.
+    auto& positions = scan->mesh.positions;
+    auto& triangles = scan->mesh.triangles;
+    positions.resize(size_t(vertex->count));  // bounded by the file size above
+    std::vector<int> vertex_axis(vertex->props.size(), -1);  // 0, 1, 2 for x, y, z; -1 for other properties
+    for (size_t pi = 0; pi < vertex->props.size(); ++pi)
+        for (int a = 0; a < 3; ++a)
+            if (!vertex->props[pi].list && vertex->props[pi].name == "xyz"[a] + std::string()) vertex_axis[pi] = a;
     BodyCursor cur(bytes, h.body_offset, h.format);
-    std::vector<double> face_indices;
+    std::vector<uint32_t> face_indices, sorted;
     for (const PlyElement& e : h.elements) {
         const bool is_vertex = &e == vertex, is_face = &e == face;
         for (uint64_t row = 0; row < e.count; ++row) {
             for (size_t pi = 0; pi < e.props.size(); ++pi) {
                 const PlyProperty& p = e.props[pi];
-                const std::string field = e.name + "[" + std::to_string(row) + "]." + p.name;
+                // Built only for a message: "face[3].vertex_indices".
+                auto field = [&] { return e.name + "[" + std::to_string(row) + "]." + p.name; };
                 double v = 0;
-                if (!cur.read(p.list ? p.count_type : p.type, &v, &problem)) return fail(field, problem);
+                if (!cur.read(p.list ? p.count_type : p.type, &v, &problem)) return fail(field(), problem);
                 if (!p.list) {
-                    if (is_vertex && (p.name == "x" || p.name == "y" || p.name == "z") &&
-                        !(std::isfinite(v) && std::fabs(v) <= 3.0e38))
-                        return fail(field, "not a finite number within float range (|x| <= 3e38)");
+                    if (is_vertex && vertex_axis[pi] >= 0) {
+                        if (!(std::isfinite(v) && std::fabs(v) <= 3.0e38))
+                            return fail(field(), "not a finite number within float range (|x| <= 3e38)");
+                        mesh4d::Vec3& q = positions[size_t(row)];
+                        (vertex_axis[pi] == 0 ? q.x : vertex_axis[pi] == 1 ? q.y : q.z) = v;
+                    }
                     continue;
                 }
                 // A list: its count, then its items (each item takes at least one byte).
-                if (v < 0 || v > double(cur.remaining())) return fail(field, "list count " + std::to_string((long long)v) + " is negative or longer than the rest of the file");
+                if (v < 0 || v > double(cur.remaining()))
+                    return fail(field(), "list count " + std::to_string((long long)v) +
+                                             " is negative or longer than the rest of the file");
                 const size_t n = size_t(v);
                 const bool indices = is_face && int(pi) == index_prop;
-                if (indices) face_indices.assign(n, 0);
+                if (indices) face_indices.clear();
                 for (size_t k = 0; k < n; ++k) {
                     double item = 0;
-                    if (!cur.read(p.type, &item, &problem)) return fail(field + "[" + std::to_string(k) + "]", problem);
-                    if (indices) face_indices[k] = item;
+                    if (!cur.read(p.type, &item, &problem)) return fail(field() + "[" + std::to_string(k) + "]", problem);
+                    if (!indices) continue;
+                    if (!(item >= 0 && item < double(vertex->count)))
+                        return fail(field() + "[" + std::to_string(k) + "]", "index " + std::to_string((long long)item) +
+                                                                           " is out of range (" + std::to_string(vertex->count) + " vertices)");
+                    face_indices.push_back(uint32_t(item));
                 }
                 if (!indices) continue;
-                // Step: the face itself, as OpenMesh will take it.
-                if (n < 3) return fail(field, "a face needs at least 3 vertices, got " + std::to_string(n));
-                for (size_t k = 0; k < n; ++k)
-                    if (!(face_indices[k] >= 0 && face_indices[k] < double(vertex->count)))
-                        return fail(field + "[" + std::to_string(k) + "]", "index " + std::to_string((long long)face_indices[k]) +
-                                                                         " is out of range (" + std::to_string(vertex->count) + " vertices)");
-                std::vector<double> sorted(face_indices);
+                // Step: the face itself, as OpenMesh would take it.
+                if (n < 3) return fail(field(), "a face needs at least 3 vertices, got " + std::to_string(n));
+                sorted.assign(face_indices.begin(), face_indices.end());
                 std::sort(sorted.begin(), sorted.end());
                 if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
                     ++scan->repeated_index;
                     continue;
                 }
-                scan->triangles += n - 2;
-                if (n > 3) ++scan->polygons;
-                if (scan->triangles > limits.max_faces)
-                    return fail(field, "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
+                if (triangles.size() + n - 2 > limits.max_faces)
+                    return fail(field(), "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
+                if (n > 3) scan->polygons.emplace_back(uint32_t(triangles.size()), uint32_t(n));
+                for (size_t k = 1; k + 1 < n; ++k)
+                    triangles.push_back({face_indices[0], face_indices[k], face_indices[k + 1]});
             }
         }
     }
     if (vertex->count == 0) return fail("element vertex", "no vertices");
-    if (scan->triangles == 0) return fail("element face", "no usable faces");
+    if (triangles.empty()) return fail("element face", "no usable faces");
     return Status::success();
 }
 
 }  // namespace
 
 Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
-    // Step: read the whole file (size-limited) and scan it.
+    // Step: read the whole file (size-limited) and scan it: the bytes are read once.
     std::string text;
     if (Status s = readRegularFile(path, limits.max_file_bytes, &text, "mesh file"); !s.ok) return s;
-    ScanResult scan;
+    ScannedMesh scan;
     if (Status s = scanPly(path, text, limits, &scan); !s.ok) return s;
-
-    // Step: read with OpenMesh; its own log lines become our counts.
-    omerr().disable();
-    omlog().disable();
-    PlyMesh om;
-    OpenMesh::IO::Options opt;
-    // From the bytes scanned, not the path again: the file cannot be swapped in between.
-    MemoryBuffer buffer(text);
-    std::istream in(&buffer);
-    if (!OpenMesh::IO::read_mesh(om, in, ".ply", opt)) return Status::failure(path + ": OpenMesh could not read the PLY file");
-    if (om.n_vertices() < scan.vertices)
-        return Status::failure(path + ": OpenMesh read " + std::to_string(om.n_vertices()) + " of " +
-                               std::to_string(scan.vertices) + " vertices");
-
-    return takeOpenMeshResult(om, scan, path, mesh, warnings);
+    std::string().swap(text);
+    return finishScannedMesh(std::move(scan), path, mesh, warnings);
 }
 
 }  // namespace apparent

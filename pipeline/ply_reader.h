@@ -1,8 +1,9 @@
-// Stanford PLY meshes (ascii, binary little- and big-endian), read with OpenMesh and converted to
-// our types.
+// Stanford PLY meshes (ascii, binary little- and big-endian), read by our own single-pass scan
+// into double positions and made into a mesh as OpenMesh's importer would
+// (pipeline/polygon_input.h).
 //
-// OpenMesh's PLY reader trusts the header: it sizes its arrays from the element counts and drops
-// faces with bad indices with a log line only. So the file is first checked by our own scan: the
+// A lenient reader trusts the header (sizing its arrays from the element counts) and drops faces
+// with bad indices with a log line only. Our scan checks everything as it reads: the
 // header (the `ply` magic, one `format` line, known property types, `element vertex` with scalar
 // x, y and z, `element face` with a `vertex_indices` or `vertex_index` list), the element counts
 // against the limits and against the file size (each row needs a minimum number of bytes, so a

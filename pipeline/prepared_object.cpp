@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "mesh4d/angles.h"
+#include "pipeline/gltf_document.h"
 
 namespace apparent {
 
@@ -15,15 +16,21 @@ using mesh4d::Vec3;
 
 namespace {
 
-// Rotation by Euler angles in degrees, applied about X, then Y, then Z (fixed axes).
-Vec3 rotateXYZ(const Vec3& p, const Vec3& deg) {
-    const double ax = deg.x * kPi / 180, ay = deg.y * kPi / 180, az = deg.z * kPi / 180;
-    Vec3 r = p;
-    r = {r.x, std::cos(ax) * r.y - std::sin(ax) * r.z, std::sin(ax) * r.y + std::cos(ax) * r.z};
-    r = {std::cos(ay) * r.x + std::sin(ay) * r.z, r.y, -std::sin(ay) * r.x + std::cos(ay) * r.z};
-    r = {std::cos(az) * r.x - std::sin(az) * r.y, std::sin(az) * r.x + std::cos(az) * r.y, r.z};
-    return r;
-}
+// Rotation by Euler angles in degrees, applied about X, then Y, then Z (fixed axes); the sines
+// and cosines computed once per object.
+struct RotationXYZ {
+    double cx, sx, cy, sy, cz, sz;
+    explicit RotationXYZ(const Vec3& deg)
+        : cx(std::cos(deg.x * kPi / 180)), sx(std::sin(deg.x * kPi / 180)), cy(std::cos(deg.y * kPi / 180)),
+          sy(std::sin(deg.y * kPi / 180)), cz(std::cos(deg.z * kPi / 180)), sz(std::sin(deg.z * kPi / 180)) {}
+    Vec3 operator()(const Vec3& p) const {
+        Vec3 r = p;
+        r = {r.x, cx * r.y - sx * r.z, sx * r.y + cx * r.z};
+        r = {cy * r.x + sy * r.z, r.y, -sy * r.x + cy * r.z};
+        r = {cz * r.x - sz * r.y, sz * r.x + cz * r.y, r.z};
+        return r;
+    }
+};
 
 // Distinct base colours for objects without their own (linear RGB, roughly equal lightness).
 constexpr std::array<std::array<double, 4>, 6> kPalette = {{{0.85, 0.45, 0.10, 1.0},
@@ -71,8 +78,9 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
         obj.has_color = it->second.has_color;
         obj.color = it->second.color;
         const auto& L = spec.linear;  // column-major
+        const RotationXYZ rotate(spec.rotation_deg);
         for (Vec3& p : obj.rest.positions) {
-            const Vec3 r = rotateXYZ({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z}, spec.rotation_deg);
+            const Vec3 r = rotate({p.x * spec.scale.x, p.y * spec.scale.y, p.z * spec.scale.z});
             p = {L[0] * r.x + L[3] * r.y + L[6] * r.z, L[1] * r.x + L[4] * r.y + L[7] * r.z,
                  L[2] * r.x + L[5] * r.y + L[8] * r.z};
         }
@@ -83,6 +91,7 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
             for (auto& t : obj.rest.triangles) std::swap(t[1], t[2]);
         objects->push_back(std::move(obj));
     }
+    clearGltfCache();  // the meshes are read: parsed glTF documents are not needed any more
     return Status::success();
 }
 

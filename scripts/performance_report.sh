@@ -9,4 +9,5 @@ cmake --build "$build" --target performance_bench apparent -j "$(nproc)" >/dev/n
 "$build/benchmarks/performance_bench" --benchmark_format=json \
   --benchmark_out="$root/docs/performance.json" --benchmark_out_format=json >/dev/null
 python3 "$root/scripts/performance_report.py" "$root/docs/performance.json" "$build/apparent" "$root/docs/PERFORMANCE.md"
+"$root/scripts/load_report.sh" "$build"  # its own section, appended to the file just written
 echo "wrote docs/PERFORMANCE.md, docs/performance.json"

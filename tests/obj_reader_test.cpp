@@ -1,4 +1,4 @@
-// OBJ reading through OpenMesh: good meshes load, polygons and degenerate faces are counted,
+// OBJ reading by our own scanner: good meshes load, polygons and degenerate faces are counted,
 // malformed files fail with the line number, and no truncated prefix of a file crashes.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// PLY reading through OpenMesh after our own scan: ascii and binary files load, our exporter's
+// PLY reading by our own scan: ascii and binary files load, our exporter's
 // per-frame PLY reads back, third-party files load or are refused with one line, malformed files
 // name the element, row and property, and no truncated prefix crashes.
 #include <gtest/gtest.h>

@@ -111,7 +111,7 @@ TEST(Ray4D, LabNormalIsTheTriangleAtOneLabInstant) {
     for (const auto kin : {mesh4d::Kinematics::Galilean, mesh4d::Kinematics::Lorentz}) {
         const mesh4d::Motion m = mesh4d::makeMotion(kin, 0, {0, 0, -5}, {0.6, 0, 0.5});
         const mesh4d::World4D w = mesh4d::extrude(tri, m, -10, 10, false, false);
-        const auto& t = w.tets[0];
+        const auto t = w.tet(0);
         const auto n4 = mesh4d::flatNormal({w.events[t[0]], w.events[t[1]], w.events[t[2]], w.events[t[3]]});
         Vec3 n{n4[1], n4[2], n4[3]};
         n = n / mesh4d::norm(n);

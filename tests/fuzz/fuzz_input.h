@@ -1,4 +1,4 @@
-// Shared by the libFuzzer harnesses: the readers take paths (OpenMesh and tinygltf read files), so
+// Shared by the libFuzzer harnesses: the readers take paths (tinygltf reads files), so
 // each input is written to one file in a per-process folder on tmpfs (/dev/shm when present,
 // else the temporary folder) and read back from there. The folder holds nothing else, so a glTF
 // buffer URI can only name the input itself or fail.
