@@ -131,9 +131,13 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             w.s = hit->s;
             w.event = ray.at(hit->s);
             w.triangle = uint32_t(f);
+            // The side the ray arrives from is a 4D question: it meets the 3-flat coming from
+            // where N . (R(s) - V) has the sign of -N . D. The spatial test n . d alone flips the
+            // normal across a moving face wherever aberration makes d graze it (issue 20).
             const Vec3 n{p.normal[1], p.normal[2], p.normal[3]};
             const double len = norm(n);
-            w.lab_normal = len > 0 ? n / len : Vec3{0, 0, 0};
+            const double facing = nd > 0 ? -1.0 : 1.0;
+            w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
             best = w;
         }
     }

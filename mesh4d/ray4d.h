@@ -74,7 +74,9 @@ struct WorldHit {
     double s = 0;           // ray parameter of the hit
     Event event;            // the hit event: emission time and lab position
     uint32_t triangle = 0;  // input triangle (prism) hit
-    Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant (unoriented)
+    Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant, turned
+                            // towards the side the ray arrives from in 4D (N . D < 0, D = dR/ds): the
+                            // outward normal wherever a closed surface is seen from outside
 };
 
 // The nearest hit of `ray` with any tetrahedron of `trace`, s in (0, s_max). Empty for a miss.

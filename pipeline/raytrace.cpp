@@ -100,11 +100,10 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     return best;
 }
 
-std::array<double, 3> SceneTracer::shade(const Hit& h, const Vec3& ray_dir) const {
-    // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), n turned towards the incoming ray
-    // (the surfaces are two-sided, as in the exported glTF).
-    Vec3 n = h.hit.lab_normal;
-    if (mesh4d::dot(n, ray_dir) > 0) n = -n;
+std::array<double, 3> SceneTracer::shade(const Hit& h) const {
+    // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), n already turned towards the side
+    // the ray arrives from (the surfaces are two-sided, as in the exported glTF).
+    const Vec3 n = h.hit.lab_normal;
     const LightSpec& light = scene_.light;
     Vec3 l = light.direction;
     if (light.kind == LightSpec::Kind::Point) {
@@ -135,7 +134,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
                 frame.object[idx] = hit.object;
-                color = shade(hit, ray.direction);
+                color = shade(hit);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,
@@ -147,7 +146,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
                     std::array<double, 3> reflected = kBackground;
                     if (second.object >= 0) {
                         frame.reflected[idx] = second.object;
-                        reflected = shade(second, bounce.direction);
+                        reflected = shade(second);
                     }
                     for (int c = 0; c < 3; ++c)
                         color[size_t(c)] = (1 - kMirrorReflectance) * color[size_t(c)] + kMirrorReflectance * reflected[size_t(c)];

@@ -53,7 +53,7 @@ private:
         mesh4d::WorldHit hit;
     };
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
-    std::array<double, 3> shade(const Hit& h, const mesh4d::Vec3& ray_dir) const;
+    std::array<double, 3> shade(const Hit& h) const;
 
     Scene scene_;
     Model model_;

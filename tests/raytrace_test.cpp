@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -456,4 +457,100 @@ TEST(RaytraceCrossCheck, ReflectionsFollowTheMirrorsExistence) {
         }
         std::cout << "[mirror exists] " << modelName(model) << ": reflections in " << present << " of 20 frames\n";
     }
+}
+
+namespace {
+
+// Linear value of an 8-bit sRGB level (IEC 61966-2-1), and back, independent of raytrace.cpp.
+double srgbToLinear(uint8_t v) {
+    const double s = v / 255.0;
+    return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+}
+int linearToSrgb8(double c) {
+    c = std::clamp(c, 0.0, 1.0);
+    return int(std::lround(255 * (c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055)));
+}
+
+// Writes a unit cube whose six faces are separate objects (one quad each), rotated by
+// `rotation_deg`, at [0, 0, -5] at t = 0 moving at 0.9c along x, lit by a distant light.
+std::string writeFacesScene(const std::filesystem::path& dir, const std::string& rotation_deg) {
+    std::filesystem::create_directories(dir);
+    const char* faces[6][4] = {{"0.5 -0.5 -0.5", "0.5 0.5 -0.5", "0.5 0.5 0.5", "0.5 -0.5 0.5"},
+                               {"-0.5 -0.5 -0.5", "-0.5 -0.5 0.5", "-0.5 0.5 0.5", "-0.5 0.5 -0.5"},
+                               {"-0.5 0.5 -0.5", "-0.5 0.5 0.5", "0.5 0.5 0.5", "0.5 0.5 -0.5"},
+                               {"-0.5 -0.5 -0.5", "0.5 -0.5 -0.5", "0.5 -0.5 0.5", "-0.5 -0.5 0.5"},
+                               {"-0.5 -0.5 0.5", "0.5 -0.5 0.5", "0.5 0.5 0.5", "-0.5 0.5 0.5"},
+                               {"-0.5 -0.5 -0.5", "-0.5 0.5 -0.5", "0.5 0.5 -0.5", "0.5 -0.5 -0.5"}};
+    std::ostringstream scene;
+    scene << R"({ "camera": {"position": [0, 0, 0], "look_at": [0, 0, -5], "up": [0, 1, 0], "fov_deg": 60},
+  "light": {"direction": [0.3, 1, 0.6], "ambient": 0.2}, "frames": {"start": 0, "end": 10, "fps": 10}, "objects": [)";
+    for (int f = 0; f < 6; ++f) {
+        std::ofstream obj(dir / ("face" + std::to_string(f) + ".obj"));
+        for (const char* v : faces[f]) obj << "v " << v << "\n";
+        obj << "f 1 2 3\nf 1 3 4\n";
+        scene << (f ? ", " : "") << R"({"mesh": "face)" << f << R"(.obj", "position": [0, 0, -5], "velocity": [0.9, 0, 0], "rotation_deg": )"
+              << rotation_deg << "}";
+    }
+    scene << "] }";
+    const auto path = dir / "faces.json";
+    std::ofstream(path) << scene.str();
+    return path.string();
+}
+
+}  // namespace
+
+// Issue 20: every pixel of a flat face under uniform motion has one shade, Lambert's law with the
+// face's outward lab normal, in every model: the rest normal (Galilean) or the contracted one,
+// n + (gamma - 1)(n . u) u normalised (Lorentz), from the rest mesh and the closed form alone.
+// Before the fix the normal was turned by the spatial test n . d, which aberration flips across
+// the trailing face: a strip of it was lit from the wrong side (about 2x brighter).
+TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
+    const auto dir = std::filesystem::temp_directory_path() / ("apparent_faces_" + std::to_string(::getpid()));
+    const double beta = 0.9, gamma = 1 / std::sqrt(1 - beta * beta);
+    const Vec3 u{1, 0, 0}, light = Vec3{0.3, 1, 0.6} / mesh4d::norm(Vec3{0.3, 1, 0.6});
+    for (const std::string rotation : {"[0, 0, 30]", "[20, 30, 10]"}) {
+        StageOptions options;
+        options.scene_path = writeFacesScene(dir, rotation);
+        options.all_models = true;
+        Stage stage;
+        std::ostringstream log;
+        std::string error;
+        ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+        for (Model model : stage.models) {
+            const bool lorentz = model == Model::Relativistic || model == Model::Contracted;
+            const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, 50, 50);
+            const TracedFrame frame = tracer.traceFrame(50, 320, 180);
+            std::map<int32_t, int> pixels;
+            for (size_t i = 0; i < frame.object.size(); ++i) {
+                const int32_t o = frame.object[i];
+                if (o < 0) continue;
+                // Step: the face's outward rest normal (the cube is centred on the mesh origin).
+                const mesh4d::RestMesh& rest = stage.objects[size_t(o)].rest;
+                const auto& t = rest.triangles[0];
+                Vec3 n = mesh4d::cross(rest.positions[t[1]] - rest.positions[t[0]], rest.positions[t[2]] - rest.positions[t[0]]);
+                n = n / mesh4d::norm(n);
+                if (mesh4d::dot(n, rest.positions[t[0]]) < 0) n = -n;
+                if (lorentz) n = n + (gamma - 1) * mesh4d::dot(n, u) * u;
+                n = n / mesh4d::norm(n);
+                const double lambert = 0.2 + 0.8 * std::max(0.0, mesh4d::dot(n, light));
+                const auto color = objectBaseColor(stage.objects, size_t(o));
+                const uint8_t* p = frame.image.rgb.data() + 3 * i;
+                for (size_t c = 0; c < 3; ++c) {
+                    const double expect = color[c] * lambert;
+                    // One 8-bit level of quantisation, or 1% of the linear value.
+                    const bool ok = std::abs(int(p[c]) - linearToSrgb8(expect)) <= 1 ||
+                                    std::fabs(srgbToLinear(p[c]) - expect) <= 0.01 * expect;
+                    ASSERT_TRUE(ok) << modelName(model) << " rotation " << rotation << " face " << o << " pixel (" << i % 320
+                                    << ", " << i / 320 << ") channel " << c << ": " << int(p[c]) << " != "
+                                    << linearToSrgb8(expect);
+                }
+                ++pixels[o];
+            }
+            // The picture shows at least three faces, each over many pixels.
+            int shown = 0;
+            for (const auto& [o, count] : pixels) shown += count >= 30;
+            EXPECT_GE(shown, 3) << modelName(model) << " rotation " << rotation;
+        }
+    }
+    std::filesystem::remove_all(dir);
 }
