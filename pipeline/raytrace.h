@@ -14,9 +14,11 @@
 #include <vector>
 
 #include "exporters/png.h"
+#include "exporters/text.h"
 #include "mesh4d/ray4d.h"
 #include "pipeline/mirror.h"
 #include "pipeline/stage.h"
+#include "pipeline/trace_progress.h"
 
 namespace apparent {
 
@@ -42,8 +44,9 @@ public:
     SceneTracer(const SceneTracer&) = delete;
     SceneTracer& operator=(const SceneTracer&) = delete;
 
-    // Traces global frame k at width x height (rows in parallel with TBB; deterministic).
-    TracedFrame traceFrame(long long k, int width, int height) const;
+    // Traces global frame k at width x height (rows in parallel with TBB; deterministic). Each row
+    // done is counted in `progress` when given.
+    TracedFrame traceFrame(long long k, int width, int height, TraceProgress* progress = nullptr) const;
 
     const std::vector<mesh4d::World4D>& worlds() const { return worlds_; }
 
@@ -67,18 +70,30 @@ private:
 struct RaytraceSettings {
     StageOptions stage;            // scene, --model (empty: the scene's), --frames, --max-frames, limits
     std::string out_dir = "out";
+    bool write_png = true;         // DIR/<model>/frame_NNNNN.png (with --video: only when --out is given)
+    std::string video_path;        // --video: the frames as an H.264 MP4 at the scene's fps (one model)
     int width = 480, height = 270;
     int threads = 0;
-    bool quiet = false;
+    bool quiet = false;            // no summary, no progress
 };
 
-// `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame. Exit codes as `render`.
+// `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame and/or one video (exporters/video.h).
+// Progress on stderr (trace_progress.h) unless quiet. Exit codes as `render`; --video with several
+// models or without ffmpeg in PATH: 2.
 int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err);
+
+constexpr int kMaxFigureColumns = 64;
 
 struct FigureSettings {
     StageOptions stage;            // scene, --max-frames, limits (the rows fix the models, the columns the frames)
     std::string out_path = "sheet.png";
-    int columns = 6;
+    std::vector<Model> models;     // --models: the rows, top to bottom (empty: instant, finite, relativistic)
+    int columns = 6;               // --columns: evenly spaced frames (figureFrames)
+    std::vector<double> times;     // --times: the columns' camera times (nearest frame each)
+    long long frame_from = -1, frame_to = -1;  // --frames A:B: columns A..B-1 (-1: unset; B -1: to the end)
+    std::string title;             // --title: one line above the sheet
+    bool labels = true;            // row labels (model names) and column labels (camera times)
+    std::string video_path;        // --video: an MP4 of every frame in --frames, the models side by side
     int width = 320, height = 180;  // one panel
     int threads = 0;
     bool quiet = false;
@@ -87,8 +102,40 @@ struct FigureSettings {
 // The frames a figure shows in its columns: evenly spaced over the scene's frames, first and last included.
 std::vector<long long> figureFrames(const Scene& scene, int columns);
 
-// `apparent figure`: the paper's comparison sheet, rows instant, finite, relativistic, columns
-// sequential frames (figureFrames), panels separated by 4-pixel grey lines.
+// The frame nearest to each camera time; false with the message for a time outside the scene's frames.
+bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::vector<long long>* frames,
+                   std::string* error);
+
+// "t = 10 s": frame k's camera time, as the figure labels its columns.
+std::string cameraTimeLabel(const Scene& scene, long long k);
+
+// What a sheet writes around its panels (empty: no band for it).
+struct SheetText {
+    std::string title;
+    std::vector<std::string> row_labels, column_labels;
+};
+
+// Where a sheet's bands and panels go: a title band on top, a band of column labels under it, a
+// band of row labels on the left (sized by drawSheet), panels separated by kGap grey pixels.
+struct SheetLayout {
+    static constexpr int kGap = 4;
+    static constexpr uint8_t kGapGrey = 96;
+    SheetLayout(int rows, int columns, int panel_width, int panel_height, const SheetText& text, bool with_text);
+    int rows, columns, panel_width, panel_height;
+    int font_px = 12, title_px = 16, pad = 6;  // label and title pixel heights: a ninth of the panel, 11..32
+    int title_band = 0, top_band = 0, left_band = 0;
+    int width = 0, height = 0;
+    int panelX(int column) const;
+    int panelY(int row) const;
+};
+
+// The sheet's background with its text drawn (painter null: no text, the bands stay empty);
+// completes `layout` (the left band's width).
+RgbImage drawSheet(const SheetText& text, const TextPainter* painter, SheetLayout* layout);
+
+// `apparent figure`: the paper's comparison sheet, a row per model, a column per frame, labelled
+// with model names and camera times, panels separated by 4-pixel grey lines; or with --video the
+// models side by side in an MP4 of every frame in --frames. Exit 2 for a missing font or ffmpeg.
 int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err);
 
 }  // namespace apparent
