@@ -5,13 +5,18 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <random>
 #include <sstream>
+
+#include <unistd.h>
 
 #include "exporters/png.h"
 #include "mesh4d/ray4d.h"
@@ -207,12 +212,12 @@ TEST(RaytraceCommand, WritesPngFramesAndRefusesBadInput) {
 TEST(RaytraceCommand, FigureLaysOutRowsAndColumns) {
     const auto path = std::filesystem::temp_directory_path() / ("apparent_sheet_" + std::to_string(::getpid()) + ".png");
     const CommandRun r = run({"figure", source("data/scenes/flanges.json"), "--out", path.string(), "--columns", "2",
-                                 "--size", "32x18", "--quiet"});
+                                 "--size", "32x18", "--quiet", "--no-labels"});
     ASSERT_EQ(r.code, 0) << r.err;
     RgbImage img;
     std::string error;
     ASSERT_TRUE(readPng(path.string(), &img, &error)) << error;
-    // Two 32-pixel columns and three 18-pixel rows, with 4-pixel gaps around and between.
+    // Two 32-pixel columns and three 18-pixel rows, with 4-pixel gaps around and between (no label bands).
     EXPECT_EQ(img.width, 2 * 32 + 3 * 4);
     EXPECT_EQ(img.height, 3 * 18 + 4 * 4);
     std::filesystem::remove(path);
@@ -473,7 +478,7 @@ int linearToSrgb8(double c) {
 
 // Writes a unit cube whose six faces are separate objects (one quad each), rotated by
 // `rotation_deg`, at [0, 0, -5] at t = 0 moving at 0.9c along x, lit by a distant light.
-std::string writeFacesScene(const std::filesystem::path& dir, const std::string& rotation_deg) {
+std::string writeFacesScene(const std::filesystem::path& dir, const std::string& rotation_deg, const std::string& light) {
     std::filesystem::create_directories(dir);
     const char* faces[6][4] = {{"0.5 -0.5 -0.5", "0.5 0.5 -0.5", "0.5 0.5 0.5", "0.5 -0.5 0.5"},
                                {"-0.5 -0.5 -0.5", "-0.5 -0.5 0.5", "-0.5 0.5 0.5", "-0.5 0.5 -0.5"},
@@ -483,7 +488,7 @@ std::string writeFacesScene(const std::filesystem::path& dir, const std::string&
                                {"-0.5 -0.5 -0.5", "-0.5 0.5 -0.5", "0.5 0.5 -0.5", "0.5 -0.5 -0.5"}};
     std::ostringstream scene;
     scene << R"({ "camera": {"position": [0, 0, 0], "look_at": [0, 0, -5], "up": [0, 1, 0], "fov_deg": 60},
-  "light": {"direction": [0.3, 1, 0.6], "ambient": 0.2}, "frames": {"start": 0, "end": 10, "fps": 10}, "objects": [)";
+  )" << light << R"( "frames": {"start": 0, "end": 10, "fps": 10}, "objects": [)";
     for (int f = 0; f < 6; ++f) {
         std::ofstream obj(dir / ("face" + std::to_string(f) + ".obj"));
         for (const char* v : faces[f]) obj << "v " << v << "\n";
@@ -503,14 +508,25 @@ std::string writeFacesScene(const std::filesystem::path& dir, const std::string&
 // face's outward lab normal, in every model: the rest normal (Galilean) or the contracted one,
 // n + (gamma - 1)(n . u) u normalised (Lorentz), from the rest mesh and the closed form alone.
 // Before the fix the normal was turned by the spatial test n . d, which aberration flips across
-// the trailing face: a strip of it was lit from the wrong side (about 2x brighter).
+// the trailing face: a strip of it was lit from the wrong side (about 2x brighter). Lit by a given
+// light, and by the default pair (README "Scene format"): overhead with weight 0.3 and a key light
+// towards (back 1, left 0.45, up 0.15) in the camera's basis with weight 0.7.
 TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
     const auto dir = std::filesystem::temp_directory_path() / ("apparent_faces_" + std::to_string(::getpid()));
     const double beta = 0.9, gamma = 1 / std::sqrt(1 - beta * beta);
-    const Vec3 u{1, 0, 0}, light = Vec3{0.3, 1, 0.6} / mesh4d::norm(Vec3{0.3, 1, 0.6});
-    for (const std::string rotation : {"[0, 0, 30]", "[20, 30, 10]"}) {
+    const Vec3 u{1, 0, 0};
+    struct Light {
+        std::string json;
+        std::vector<std::pair<Vec3, double>> lights;  // unit direction towards the light, weight
+    };
+    const Vec3 key = Vec3{-0.45, 0.15, 1} / mesh4d::norm(Vec3{-0.45, 0.15, 1});  // camera looks down -z
+    const Light lights[] = {{R"("light": {"direction": [0.3, 1, 0.6], "ambient": 0.2},)",
+                             {{Vec3{0.3, 1, 0.6} / mesh4d::norm(Vec3{0.3, 1, 0.6}), 1.0}}},
+                            {"", {{Vec3{0, 1, 0}, 0.3}, {key, 0.7}}}};
+    for (const auto& [rotation, light] : {std::pair{"[0, 0, 30]", lights[0]}, std::pair{"[20, 30, 10]", lights[0]},
+                                          std::pair{"[0, 0, 30]", lights[1]}, std::pair{"[20, 30, 10]", lights[1]}}) {
         StageOptions options;
-        options.scene_path = writeFacesScene(dir, rotation);
+        options.scene_path = writeFacesScene(dir, rotation, light.json);
         options.all_models = true;
         Stage stage;
         std::ostringstream log;
@@ -532,7 +548,9 @@ TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
                 if (mesh4d::dot(n, rest.positions[t[0]]) < 0) n = -n;
                 if (lorentz) n = n + (gamma - 1) * mesh4d::dot(n, u) * u;
                 n = n / mesh4d::norm(n);
-                const double lambert = 0.2 + 0.8 * std::max(0.0, mesh4d::dot(n, light));
+                double diffuse = 0;
+                for (const auto& [l, weight] : light.lights) diffuse += weight * std::max(0.0, mesh4d::dot(n, l));
+                const double lambert = 0.2 + 0.8 * diffuse;
                 const auto color = objectBaseColor(stage.objects, size_t(o));
                 const uint8_t* p = frame.image.rgb.data() + 3 * i;
                 for (size_t c = 0; c < 3; ++c) {
@@ -553,4 +571,153 @@ TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
         }
     }
     std::filesystem::remove_all(dir);
+}
+
+// The default light shows a box's faces apart: a single-coloured static cube seen from above left
+// shows three faces in three shades; the overhead light alone shows the two side faces alike.
+TEST(RaytraceShading, DefaultLightShowsTheFacesOfABoxApart) {
+    const auto dir = std::filesystem::temp_directory_path() / ("apparent_box_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(source("data/meshes/box.obj"), dir / "box.obj", std::filesystem::copy_options::overwrite_existing);
+    for (const bool overhead_only : {false, true}) {
+        std::ofstream(dir / "box.json") << R"({ "camera": {"position": [-1.6, 1.3, 2.2], "look_at": [0, 0, 0]},)"
+                                        << (overhead_only ? R"("light": {"direction": [0, 1, 0]},)" : "")
+                                        << R"( "objects": [{"mesh": "box.obj"}] })";
+        StageOptions options;
+        options.scene_path = (dir / "box.json").string();
+        Stage stage;
+        std::ostringstream log;
+        std::string error;
+        ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+        const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, stage.models[0], 0, 0);
+        const TracedFrame frame = tracer.traceFrame(0, 160, 90);
+        std::map<std::array<uint8_t, 3>, int> shades;
+        for (size_t i = 0; i < frame.object.size(); ++i)
+            if (frame.object[i] == 0) ++shades[{frame.image.rgb[3 * i], frame.image.rgb[3 * i + 1], frame.image.rgb[3 * i + 2]}];
+        int faces = 0;
+        for (const auto& [shade, count] : shades) faces += count >= 100;
+        EXPECT_EQ(faces, overhead_only ? 2 : 3) << (overhead_only ? "overhead light" : "default light");
+    }
+    std::filesystem::remove_all(dir);
+}
+
+namespace {
+
+// ffprobe's view of a video's first stream: "key=value" lines.
+std::map<std::string, std::string> probeVideo(const std::string& path) {
+    std::map<std::string, std::string> fields;
+    const std::string cmd = "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+                            "stream=codec_name,nb_read_frames,r_frame_rate,width,height,pix_fmt -of default=nw=1 '" +
+                            path + "'";
+    FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) return fields;
+    char line[512];
+    while (std::fgets(line, sizeof line, p)) {
+        std::string l(line);
+        while (!l.empty() && (l.back() == '\n' || l.back() == '\r')) l.pop_back();
+        const auto eq = l.find('=');
+        if (eq != std::string::npos) fields[l.substr(0, eq)] = l.substr(eq + 1);
+    }
+    ::pclose(p);
+    return fields;
+}
+
+}  // namespace
+
+// raytrace --video and figure --video: H.264 MP4 in yuv420p that ffprobe reads, with the frame
+// count asked for, the scene's 10 fps and odd sizes padded to even; without ffmpeg one line, exit 2.
+TEST(RaytraceVideo, RaytraceAndFigureWriteH264) {
+    const auto dir = std::filesystem::temp_directory_path() / ("apparent_video_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    const std::string one = (dir / "one.mp4").string(), side = (dir / "side.mp4").string();
+    const CommandRun r = run({"raytrace", source("data/scenes/flanges.json"), "--model", "relativistic", "--size", "65x37",
+                              "--frames", "95:102", "--video", one, "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(std::filesystem::exists("out/relativistic/frame_00095.png"));  // --video without --out: no PNGs
+    auto f = probeVideo(one);
+    EXPECT_EQ(f["codec_name"], "h264");
+    EXPECT_EQ(f["pix_fmt"], "yuv420p");
+    EXPECT_EQ(f["nb_read_frames"], "7");
+    EXPECT_EQ(f["r_frame_rate"], "10/1");
+    EXPECT_EQ(f["width"], "66");
+    EXPECT_EQ(f["height"], "38");
+    const CommandRun fig = run({"figure", source("data/scenes/flanges.json"), "--models", "finite,relativistic", "--size",
+                                "64x36", "--frames", "99:102", "--video", side, "--quiet"});
+    ASSERT_EQ(fig.code, 0) << fig.err;
+    f = probeVideo(side);
+    EXPECT_EQ(f["codec_name"], "h264");
+    EXPECT_EQ(f["nb_read_frames"], "3");
+    EXPECT_EQ(f["r_frame_rate"], "10/1");
+    EXPECT_GE(std::stoi(f["width"]), 2 * 64 + 3 * 4);
+    // Several models in one raytrace video, and no ffmpeg in PATH: one line each, exit 2, no file.
+    const CommandRun two = run({"raytrace", source("data/scenes/flanges.json"), "--model", "finite,relativistic",
+                                "--video", (dir / "two.mp4").string()});
+    EXPECT_EQ(two.code, 2);
+    EXPECT_NE(two.err.find("--video: a video shows one model"), std::string::npos) << two.err;
+    const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+    ::setenv("PATH", (dir / "empty").string().c_str(), 1);
+    const CommandRun none = run({"raytrace", source("data/scenes/flanges.json"), "--model", "relativistic", "--video",
+                                 (dir / "none.mp4").string()});
+    const CommandRun none_fig = run({"figure", source("data/scenes/flanges.json"), "--video", (dir / "none.mp4").string()});
+    ::setenv("PATH", path.c_str(), 1);
+    for (const CommandRun& c : {none, none_fig}) {
+        EXPECT_EQ(c.code, 2);
+        EXPECT_NE(c.err.find("--video: the ffmpeg program is not in PATH"), std::string::npos) << c.err;
+        EXPECT_EQ(std::count(c.err.begin(), c.err.end(), '\n'), 1) << c.err;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "two.mp4"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "none.mp4"));
+    std::filesystem::remove_all(dir);
+}
+
+// figure's labels: with them, bands left of and above the panels hold text (bright pixels drawn by
+// FreeType); with --no-labels the sheet is the bare grid, every pixel between panels gap grey.
+TEST(RaytraceCommand, FigureLabelsRowsAndColumns) {
+    const auto base = std::filesystem::temp_directory_path() / ("apparent_labels_" + std::to_string(::getpid()));
+    const std::string labelled = base.string() + "_on.png", bare = base.string() + "_off.png";
+    const std::vector<std::string> common = {"figure", source("data/scenes/flanges.json"), "--times", "5,10", "--models",
+                                             "instant,relativistic", "--size", "96x54", "--quiet"};
+    std::vector<std::string> a = common, b = common;
+    a.insert(a.end(), {"--out", labelled});
+    b.insert(b.end(), {"--out", bare, "--no-labels"});
+    const CommandRun ra = run(a), rb = run(b);
+    ASSERT_EQ(ra.code, 0) << ra.err;
+    ASSERT_EQ(rb.code, 0) << rb.err;
+    RgbImage on, off;
+    std::string error;
+    ASSERT_TRUE(readPng(labelled, &on, &error)) << error;
+    ASSERT_TRUE(readPng(bare, &off, &error)) << error;
+    constexpr int kGap = 4;
+    ASSERT_EQ(off.width, 2 * 96 + 3 * kGap);
+    ASSERT_EQ(off.height, 2 * 54 + 3 * kGap);
+    // The bare sheet: gap grey everywhere outside the panels.
+    auto inPanel = [&](int x, int y) {
+        const int cx = (x - kGap) % (96 + kGap), cy = (y - kGap) % (54 + kGap);
+        return x >= kGap && y >= kGap && cx < 96 && cy < 54;
+    };
+    int stray = 0;
+    for (int y = 0; y < off.height; ++y)
+        for (int x = 0; x < off.width; ++x)
+            if (!inPanel(x, y))
+                for (int c = 0; c < 3; ++c) stray += off.pixel(x, y)[c] != 96;
+    EXPECT_EQ(stray, 0);
+    // The labelled sheet: the same panels shifted by the bands, text in both bands.
+    const int left = on.width - off.width, top = on.height - off.height;
+    ASSERT_GT(left, 0);
+    ASSERT_GT(top, 0);
+    auto brightIn = [&](int x0, int y0, int x1, int y1) {
+        int n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const uint8_t* p = on.pixel(x, y);
+                n += p[0] > 200 && p[1] > 200 && p[2] > 200;
+            }
+        return n;
+    };
+    EXPECT_GT(brightIn(0, top, left, on.height), 20) << "row labels";
+    EXPECT_GT(brightIn(left, 0, on.width, top), 20) << "column labels";
+    for (int y = 0; y < off.height; ++y)
+        EXPECT_TRUE(std::equal(off.pixel(0, y), off.pixel(0, y) + 3 * off.width, on.pixel(left, top + y))) << "row " << y;
+    std::filesystem::remove(labelled);
+    std::filesystem::remove(bare);
 }
