@@ -268,8 +268,10 @@ bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::ve
 }
 
 std::string cameraTimeLabel(const Scene& scene, long long k) {
+    // As many decimals as the frame rate needs (10 fps: one), so labels keep their width in a video.
+    const int decimals = scene.frames.fps <= 1 ? 0 : std::min(6, int(std::ceil(std::log10(scene.frames.fps) - 1e-9)));
     std::ostringstream s;
-    s << "t = " << std::setprecision(6) << frameTime(scene.frames, k) << " s";
+    s << "t = " << std::fixed << std::setprecision(decimals) << frameTime(scene.frames, k) << " s";
     return s.str();
 }
 

@@ -106,7 +106,8 @@ std::vector<long long> figureFrames(const Scene& scene, int columns);
 bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::vector<long long>* frames,
                    std::string* error);
 
-// "t = 10 s": frame k's camera time, as the figure labels its columns.
+// "t = 10.0 s": frame k's camera time with as many decimals as the frame rate needs (10 fps: 1,
+// 12 or 30 fps: 2), as the figure labels its columns and video frames.
 std::string cameraTimeLabel(const Scene& scene, long long k);
 
 // What a sheet writes around its panels (empty: no band for it).
