@@ -193,6 +193,16 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
     figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary, no progress");
     addStageLimits(figure_cmd, &fs.stage);
+    figure_cmd->footer(
+        "Examples:\n"
+        "  apparent figure data/scenes/flanges.json --out sheet.png --times 4,7,8.5,10,13,16 --title \"Flanges at 0.866c\"\n"
+        "  apparent figure data/scenes/terrell_cube.json --models contracted,relativistic --video cube.mp4\n"
+        "Labels and titles use DejaVu Sans (Debian fonts-dejavu-core); --video needs the ffmpeg program in PATH.");
+    raytrace_cmd->footer(
+        "Examples:\n"
+        "  apparent raytrace data/scenes/flanges.json --out frames --model all --frames 80:120\n"
+        "  apparent raytrace data/scenes/terrell_cube.json --model relativistic --video cube.mp4\n"
+        "--video needs the ffmpeg program in PATH. Progress goes to stderr unless --quiet.");
 
     // `trade`: the speed-accuracy trade measured on the user's scene (pipeline/trade.h).
     TradeSettings trs;
@@ -258,6 +268,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!figure_frames_text.empty() && !parseFrames(figure_frames_text, &fs.frame_from, &fs.frame_to))
             return usage("--frames: '" + figure_frames_text + "' is not A:B with 0 <= A < B");
         if (!figure_times_text.empty() && !figure_frames_text.empty()) return usage("--times: give --times or --frames, not both");
+        if (!fs.video_path.empty() && !figure_times_text.empty())
+            return usage("--times: not with --video (a video shows every frame of --frames)");
+        if (!fs.video_path.empty() && figure_cmd->count("--columns") > 0)
+            return usage("--columns: not with --video (a video shows every frame of --frames)");
         std::stringstream times(figure_times_text);
         for (std::string item; !figure_times_text.empty() && std::getline(times, item, ',');) {
             size_t used = 0;

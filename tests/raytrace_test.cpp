@@ -200,6 +200,10 @@ TEST(RaytraceCommand, WritesPngFramesAndRefusesBadInput) {
         {{"raytrace", source("data/fixtures/scene_mirror_moving.json"), "--out", dir.string()},
          "scene_mirror_moving.json: objects[0].mirror: a mirror must be at rest"},
         {{"figure", source("data/scenes/flanges.json"), "--columns", "0"}, "--columns: must be in 1..64"},
+        {{"figure", source("data/scenes/flanges.json"), "--times", "99"}, "--times: t = 99 s is outside the scene's frames (0 to 19.9 s)"},
+        {{"figure", source("data/scenes/flanges.json"), "--times", "5,x"}, "--times: 'x' is not a number"},
+        {{"figure", source("data/scenes/flanges.json"), "--models", "slow"}, "--models: unknown model 'slow'"},
+        {{"figure", source("data/scenes/flanges.json"), "--video", "v.mp4", "--times", "3"}, "--times: not with --video"},
     };
     for (const auto& [args, expected] : bad) {
         const CommandRun b = run(args);
