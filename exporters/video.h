@@ -28,7 +28,8 @@ public:
     VideoWriter& operator=(const VideoWriter&) = delete;
 
     // Starts ffmpeg for a width x height video at `fps` frames per second to be named `path`.
-    // False with one line in `error` when ffmpeg is not in PATH or cannot be started.
+    // False with one line in `error` when ffmpeg is not in PATH or cannot be started. From here
+    // on SIGPIPE is ignored in the process: a write to an ffmpeg that died fails with EPIPE.
     bool open(const std::string& path, int width, int height, double fps, std::string* error);
     // Sends one frame (its size must be the one given to open).
     bool addFrame(const RgbImage& frame, std::string* error);

@@ -22,10 +22,10 @@ void TraceProgress::rowDone() {
     const long long done = ++done_;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double every = terminal_ ? 0.2 : 10.0;
-    if (elapsed - last_ < every) return;
+    if (elapsed - last_.load(std::memory_order_relaxed) < every) return;
     std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || elapsed - last_ < every) return;  // another thread is printing
-    last_ = elapsed;
+    if (!lock.owns_lock() || elapsed - last_.load() < every) return;  // another thread is printing
+    last_.store(elapsed);
     print(done, elapsed);
 }
 

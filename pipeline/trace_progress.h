@@ -33,7 +33,7 @@ private:
     std::mutex mutex_;
     std::string label_;
     std::chrono::steady_clock::time_point start_;
-    double last_ = 0;
+    std::atomic<double> last_{0};
     bool printed_ = false;
 };
 
