@@ -6,7 +6,18 @@
 //   BM_TraceRays/H/N   160x90 rays (24 degrees high) along the past cone from the camera when a torus of
 //                      about N triangles, passing 10 ls ahead at 0.9c, is seen crossing the view
 //                      axis; H = 1 hierarchy, 0 linear scan; one core; items = rays
+//   BM_TraceFrame/H/S  one whole frame of a scene as `raytrace` traces it (SceneTracer, 480x270,
+//                      one thread, mirror bounces included): S = 0 the paper's flanges at t = 10 s
+//                      (relativistic), 1 the Penrose sphere at t = 5 s (relativistic)
 #include <benchmark/benchmark.h>
+
+#include <ostream>
+#include <sstream>
+#include <string>
+
+#include <tbb/task_arena.h>
+
+#include "pipeline/raytrace.h"
 
 #include <cmath>
 #include <map>
@@ -50,8 +61,35 @@ void BM_TraceRays(benchmark::State& state) {
     state.counters["hit_share"] = double(hits) / double(state.iterations() * kW * kH);
 }
 
+void BM_TraceFrame(benchmark::State& state) {
+    const bool hierarchy = state.range(0) != 0;
+    const bool sphere = state.range(1) != 0;
+    apparent::StageOptions options;
+    options.scene_path = std::string(APPARENT_SOURCE_DIR) + (sphere ? "/data/scenes/penrose_sphere.json" : "/data/scenes/flanges.json");
+    options.models = {apparent::Model::Relativistic};
+    options.quiet = true;
+    apparent::Stage stage;
+    std::ostringstream log;
+    std::string error;
+    if (!apparent::loadStage(options, &stage, log, &error)) {
+        state.SkipWithError(error.c_str());
+        return;
+    }
+    const long long k = sphere ? 48 : 100;  // t = 5 s (12 fps, start 1) and t = 10 s
+    const apparent::SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, apparent::Model::Relativistic, k, k,
+                                       hierarchy);
+    tbb::task_arena one(1);
+    for (auto _ : state) {
+        apparent::TracedFrame frame;
+        one.execute([&] { frame = tracer.traceFrame(k, 480, 270); });
+        benchmark::DoNotOptimize(frame.image.rgb.data());
+    }
+    state.SetItemsProcessed(state.iterations() * 480 * 270);
+}
+
 }  // namespace
 
+BENCHMARK(BM_TraceFrame)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TraceRays)
     ->ArgsProduct({{0, 1}, {320, 2'000, 20'000}})
     ->Unit(benchmark::kMillisecond);

@@ -77,7 +77,7 @@ Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int
 
 SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects,
                          const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
-                         long long last_frame)
+                         long long last_frame, bool hierarchy)
     : scene_(scene), model_(model), mirrors_(mirrors), mirror_of_object_(objects.size(), -1) {
     for (size_t m = 0; m < mirrors_.size(); ++m) mirror_of_object_[mirrors_[m].object] = int32_t(m);
     // Step: build the static worlds once, then their per-prism trace data (which points into worlds_).
@@ -86,7 +86,7 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
         colors_.push_back(objectBaseColor(objects, i));
         worlds_.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
     }
-    for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w));
+    for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w, hierarchy));
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {

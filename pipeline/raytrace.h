@@ -39,8 +39,9 @@ struct TracedFrame {
 class SceneTracer {
 public:
     // Preconditions: the scene passed checkSceneForModel for `model`; mirrors from findMirrors.
+    // hierarchy false: every prism is tested for every ray (the benchmarks' peer, ray4d.h).
     SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects, const std::vector<MirrorPlane>& mirrors,
-                Model model, long long first_frame, long long last_frame);
+                Model model, long long first_frame, long long last_frame, bool hierarchy = true);
     SceneTracer(const SceneTracer&) = delete;
     SceneTracer& operator=(const SceneTracer&) = delete;
 
