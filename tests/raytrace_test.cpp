@@ -778,3 +778,20 @@ TEST(Ray4D, HierarchyFindsWhatTheLinearScanFinds) {
     std::cout << "[hierarchy] " << hits << " of " << rays << " rays hit; hierarchy and linear scan agree on all\n";
     EXPECT_GT(hits, rays / 4);
 }
+
+// The label font: DejaVu Sans is found (setup.sh installs fonts-dejavu-core) and draws; a missing
+// font file is one line naming the path and the Debian package.
+TEST(RaytraceCommand, LabelFontLoadsOrSaysWhichPackage) {
+    TextPainter painter;
+    std::string error;
+    ASSERT_TRUE(painter.open(kLabelFontPath, &error)) << error;
+    EXPECT_GT(painter.width("relativistic", 16), 40);
+    RgbImage img(80, 20);
+    painter.draw(&img, 2, 15, "t = 10 s", 14, {255, 255, 255});
+    EXPECT_GT(std::count_if(img.rgb.begin(), img.rgb.end(), [](uint8_t v) { return v > 128; }), 30);
+    TextPainter none;
+    EXPECT_FALSE(none.open("/nonexistent/DejaVuSans.ttf", &error));
+    EXPECT_NE(error.find("/nonexistent/DejaVuSans.ttf: font not found (Debian package fonts-dejavu-core"), std::string::npos)
+        << error;
+    EXPECT_EQ(error.find('\n'), std::string::npos);
+}
