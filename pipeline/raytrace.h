@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "exporters/png.h"
-#include "exporters/text.h"
 #include "mesh4d/ray4d.h"
 #include "pipeline/mirror.h"
+#include "pipeline/sheet.h"
 #include "pipeline/stage.h"
 #include "pipeline/trace_progress.h"
 
@@ -110,30 +110,6 @@ bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::ve
 // "t = 10.0 s": frame k's camera time with as many decimals as the frame rate needs (10 fps: 1,
 // 12 or 30 fps: 2), as the figure labels its columns and video frames.
 std::string cameraTimeLabel(const Scene& scene, long long k);
-
-// What a sheet writes around its panels (empty: no band for it).
-struct SheetText {
-    std::string title;
-    std::vector<std::string> row_labels, column_labels;
-};
-
-// Where a sheet's bands and panels go: a title band on top, a band of column labels under it, a
-// band of row labels on the left (sized by drawSheet), panels separated by kGap grey pixels.
-struct SheetLayout {
-    static constexpr int kGap = 4;
-    static constexpr uint8_t kGapGrey = 96;
-    SheetLayout(int rows, int columns, int panel_width, int panel_height, const SheetText& text, bool with_text);
-    int rows, columns, panel_width, panel_height;
-    int font_px = 12, title_px = 16, pad = 6;  // label and title pixel heights: a ninth of the panel, 11..32
-    int title_band = 0, top_band = 0, left_band = 0;
-    int width = 0, height = 0;
-    int panelX(int column) const;
-    int panelY(int row) const;
-};
-
-// The sheet's background with its text drawn (painter null: no text, the bands stay empty);
-// completes `layout` (the left band's width).
-RgbImage drawSheet(const SheetText& text, const TextPainter* painter, SheetLayout* layout);
 
 // `apparent figure`: the paper's comparison sheet, a row per model, a column per frame, labelled
 // with model names and camera times, panels separated by 4-pixel grey lines; or with --video the
