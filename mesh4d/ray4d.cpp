@@ -80,7 +80,64 @@ std::optional<TetHit> intersectTet(const Ray4D& ray, const std::array<Event, 4>&
     return hit;
 }
 
-TraceWorld prepareTrace(const World4D& world) {
+namespace {
+
+// The co-moving position y = x - v t of event e.
+Vec3 comoving(const Event& e, const Vec3& v) { return e.x - e.t * v; }
+
+// Builds the node for order[begin, end) at nodes[index] and, recursively, its children.
+void buildNode(TraceWorld* trace, const std::vector<EventBox>& boxes, uint32_t index, uint32_t begin, uint32_t end) {
+    EventBox box, centres;
+    for (uint32_t i = begin; i < end; ++i) {
+        const EventBox& b = boxes[trace->order[i]];
+        box.add({b.t_lo, b.lo});
+        box.add({b.t_hi, b.hi});
+        centres.addPoint(b.center());
+    }
+    trace->nodes[index].box = box;
+    trace->nodes[index].begin = begin;
+    trace->nodes[index].end = end;
+    if (end - begin <= kLeafPrisms) return;
+    // Step: split at the median centre along the widest axis of the centres.
+    const Vec3 ext = centres.hi - centres.lo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    auto key = [&](uint32_t p) {
+        const Vec3 c = boxes[p].center();
+        return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
+    };
+    const uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(trace->order.begin() + begin, trace->order.begin() + mid, trace->order.begin() + end,
+                     [&](uint32_t a, uint32_t b) { return key(a) < key(b) || (key(a) == key(b) && a < b); });
+    const uint32_t left = uint32_t(trace->nodes.size());
+    trace->nodes[index].left = left;
+    trace->nodes.resize(trace->nodes.size() + 2);
+    buildNode(trace, boxes, left, begin, mid);
+    buildNode(trace, boxes, left + 1, mid, end);
+}
+
+// The ray parameters [*s_lo, *s_hi] inside `box` widened by `slack`, clipped to the input range;
+// false when empty. Origin o and direction D are in the box's coordinates (t, y).
+bool slab(const EventBox& box, double slack, const Vec4& o, const Vec4& D, double* s_lo, double* s_hi) {
+    const double lo[4] = {box.t_lo - slack, box.lo.x - slack, box.lo.y - slack, box.lo.z - slack};
+    const double hi[4] = {box.t_hi + slack, box.hi.x + slack, box.hi.y + slack, box.hi.z + slack};
+    for (size_t i = 0; i < 4; ++i) {
+        if (D[i] == 0) {
+            if (o[i] < lo[i] || o[i] > hi[i]) return false;
+            continue;
+        }
+        const double inv = 1 / D[i];
+        double a = (lo[i] - o[i]) * inv, b = (hi[i] - o[i]) * inv;
+        if (a > b) std::swap(a, b);
+        *s_lo = std::max(*s_lo, a);
+        *s_hi = std::min(*s_hi, b);
+        if (*s_lo > *s_hi) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+TraceWorld prepareTrace(const World4D& world, bool hierarchy) {
     TraceWorld trace;
     trace.world = &world;
     if (world.empty()) return trace;
@@ -97,6 +154,21 @@ TraceWorld prepareTrace(const World4D& world) {
         for (uint32_t vi : world.mesh.triangles[f])
             for (uint32_t cap = 0; cap < 2; ++cap) p.box.add(world.events[2 * vi + cap]);
     }
+    if (!hierarchy) return trace;
+    // Step: the co-moving boxes, then the hierarchy over them.
+    trace.velocity = world.motion.velocity;
+    std::vector<EventBox> boxes(trace.prisms.size());
+    for (size_t f = 0; f < world.mesh.triangles.size(); ++f)
+        for (uint32_t vi : world.mesh.triangles[f])
+            for (uint32_t cap = 0; cap < 2; ++cap) {
+                const Event& e = world.events[2 * vi + cap];
+                boxes[f].add({e.t, comoving(e, trace.velocity)});
+            }
+    trace.order.resize(trace.prisms.size());
+    for (uint32_t f = 0; f < trace.order.size(); ++f) trace.order[f] = f;
+    trace.nodes.reserve(2 * trace.prisms.size() / kLeafPrisms + 2);
+    trace.nodes.resize(1);
+    buildNode(&trace, boxes, 0, 0, uint32_t(trace.order.size()));
     return trace;
 }
 
@@ -107,19 +179,19 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
     const Vec4 o = toVec4(ray.origin);
     std::optional<WorldHit> best;
     double best_s = s_max;
-    for (size_t f = 0; f < trace.prisms.size(); ++f) {
+    auto testPrism = [&](size_t f) {
         const TraceWorld::Prism& p = trace.prisms[f];
         // Step: cheap rejection: where the ray meets the prism's 3-flat must be ahead, nearer than
         // the best hit so far and inside the prism's bounds (slack of 1e-9 of the box and the
         // position, far above the rounding of s, far below any pixel).
         const double nd = dot4(p.normal, d);
-        if (nd == 0) continue;
+        if (nd == 0) return;
         const double s_flat = (p.offset - dot4(p.normal, o)) / nd;
         const double slack_s = 1e-9 * (std::fabs(s_flat) + 1);
-        if (!(s_flat > -slack_s && s_flat < best_s + slack_s)) continue;
+        if (!(s_flat > -slack_s && s_flat < best_s + slack_s)) return;
         const Event at = ray.at(s_flat);
         const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
-        if (!p.box.contains(at, slack)) continue;
+        if (!p.box.contains(at, slack)) return;
         // Step: the prism's three tetrahedra by the 4D barycentric method; the nearest hit wins.
         for (size_t j = 0; j < 3; ++j) {
             const auto t = world.tet(3 * f + j);
@@ -131,10 +203,42 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             w.s = hit->s;
             w.event = ray.at(hit->s);
             w.triangle = uint32_t(f);
+            // The side the ray arrives from is a 4D question: it meets the 3-flat coming from
+            // where N . (R(s) - V) has the sign of -N . D. The spatial test n . d alone flips the
+            // normal across a moving face wherever aberration makes d graze it (issue 20).
             const Vec3 n{p.normal[1], p.normal[2], p.normal[3]};
             const double len = norm(n);
-            w.lab_normal = len > 0 ? n / len : Vec3{0, 0, 0};
+            const double facing = nd > 0 ? -1.0 : 1.0;
+            w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
             best = w;
+        }
+    };
+    if (trace.nodes.empty()) {
+        for (size_t f = 0; f < trace.prisms.size(); ++f) testPrism(f);
+        return best;
+    }
+    // Step: walk the hierarchy in co-moving coordinates, skipping nodes the ray meets only beyond
+    // the best hit so far (slack as for the prism boxes: 1e-9 of the sizes involved).
+    const Vec3& v = trace.velocity;
+    const Vec3 y0 = ray.origin.x - ray.origin.t * v;
+    const Vec3 dy = ray.along_cone ? ray.direction + v : ray.direction;
+    const Vec4 oy{ray.origin.t, y0.x, y0.y, y0.z}, Dy{d[0], dy.x, dy.y, dy.z};
+    const EventBox& root = trace.nodes[0].box;
+    const double slack = 1e-9 * (root.diagonal() + norm(y0) + (root.t_hi - root.t_lo) + std::fabs(ray.origin.t) + 1);
+    uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const TraceWorld::Node& node = trace.nodes[stack[--top]];
+        double s_lo = -slack, s_hi = best_s + slack * (1 + std::fabs(best_s));
+        if (!slab(node.box, slack, oy, Dy, &s_lo, &s_hi)) continue;
+        if (node.left == 0) {
+            for (uint32_t i = node.begin; i < node.end; ++i) testPrism(trace.order[i]);
+        } else if (top + 2 <= 128) {
+            stack[top++] = node.left + 1;
+            stack[top++] = node.left;
+        } else {
+            for (uint32_t i = node.begin; i < node.end; ++i) testPrism(trace.order[i]);
         }
     }
     return best;

@@ -57,6 +57,13 @@ std::array<double, 4> flatNormal(const std::array<Event, 4>& v);
 
 // One object's history prepared for tracing: per prism (input triangle) its 3-flat and the bounds
 // a ray must reach, built once per model and reused for every ray of every frame.
+//
+// The bounding hierarchy works in co-moving coordinates (t, y = x - v t), v the object's lab
+// velocity: every vertex's worldline is a straight line of velocity v in both kinematics, so y is
+// constant along it and a prism's box in y is its triangle's box (not the whole sweep of the
+// history), while the ray stays a straight line there: y(s) = C - v t_c + s (d + v) along the cone,
+// C - v t_c + s d along t = t_c. Nodes split the prisms at the median of their box centres along
+// the widest axis of those centres, down to kLeafPrisms per leaf.
 struct TraceWorld {
     const World4D* world = nullptr;
     struct Prism {
@@ -65,19 +72,32 @@ struct TraceWorld {
         EventBox box;                    // 4D bounds of the prism's six events
     };
     std::vector<Prism> prisms;           // one per input triangle
+    struct Node {
+        EventBox box;                    // co-moving bounds (t, y) of the node's prisms
+        uint32_t begin = 0, end = 0;     // the node's prisms: order[begin, end)
+        uint32_t left = 0;               // children left and left + 1; 0: a leaf
+    };
+    Vec3 velocity;                       // v of the co-moving coordinates
+    std::vector<Node> nodes;             // nodes[0] is the root; empty: every prism is tested (linear scan)
+    std::vector<uint32_t> order;         // prism indices grouped by leaf
 };
+constexpr uint32_t kLeafPrisms = 4;
 
-// Builds the per-prism data of `world`. `world` must outlive the result.
-TraceWorld prepareTrace(const World4D& world);
+// Builds the per-prism data of `world`, and the bounding hierarchy unless `hierarchy` is false (the
+// linear scan, kept as the benchmarks' and tests' peer). `world` must outlive the result.
+TraceWorld prepareTrace(const World4D& world, bool hierarchy = true);
 
 struct WorldHit {
     double s = 0;           // ray parameter of the hit
     Event event;            // the hit event: emission time and lab position
     uint32_t triangle = 0;  // input triangle (prism) hit
-    Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant (unoriented)
+    Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant, turned
+                            // towards the side the ray arrives from in 4D (N . D < 0, D = dR/ds): the
+                            // outward normal wherever a closed surface is seen from outside
 };
 
 // The nearest hit of `ray` with any tetrahedron of `trace`, s in (0, s_max). Empty for a miss.
+// The hierarchy and the linear scan find the same nearest hit (a test checks it).
 std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max);
 
 }  // namespace mesh4d

@@ -169,27 +169,46 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
     RaytraceSettings ts;
     std::string trace_model_text, trace_size_text, trace_frames_text;
-    CLI::App* raytrace_cmd = app.add_subcommand("raytrace", "Ray-trace the 4D histories into PNG frames DIR/<model>/frame_NNNNN.png");
+    CLI::App* raytrace_cmd = app.add_subcommand("raytrace", "Ray-trace the 4D histories into PNG frames DIR/<model>/frame_NNNNN.png and/or an MP4 video");
     raytrace_cmd->add_option("scene", ts.stage.scene_path, "Scene file (JSON or glTF)")->required();
     raytrace_cmd->add_option("--out", ts.out_dir, "Output folder (created if missing)")->capture_default_str();
     raytrace_cmd->add_option("--model", trace_model_text, "instant|finite|relativistic|contracted|all, or a comma list");
     raytrace_cmd->add_option("--size", trace_size_text, "Image size WxH (default 480x270)");
     raytrace_cmd->add_option("--frames", trace_frames_text, "A:B traces global frames A..B-1");
     raytrace_cmd->add_option("--threads", ts.threads, "Worker threads (0: all cores)")->capture_default_str();
-    raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary");
+    raytrace_cmd->add_option("--video", ts.video_path,
+                             "Also (or, without --out, only) an H.264 MP4 of the frames at the scene's fps, one model; needs ffmpeg");
+    raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary, no progress");
     addStageLimits(raytrace_cmd, &ts.stage);
     FigureSettings fs;
-    std::string figure_size_text;
+    std::string figure_size_text, figure_times_text, figure_frames_text, figure_models_text;
+    bool figure_no_labels = false;
     CLI::App* figure_cmd = app.add_subcommand(
-        "figure", "The paper's comparison sheet: rows instant, finite, relativistic; columns sequential frames");
+        "figure", "The paper's comparison sheet: a row per model, a column per frame, labelled; or a side-by-side video");
     figure_cmd->add_option("scene", fs.stage.scene_path, "Scene file (JSON or glTF)")->required();
     figure_cmd->add_option("--out", fs.out_path, "Output PNG")->capture_default_str();
     figure_cmd->add_option("--columns", fs.columns, "Frames per row, evenly spaced, first and last included")
         ->capture_default_str();
+    figure_cmd->add_option("--times", figure_times_text, "Comma list of camera times, one column each (nearest frame)");
+    figure_cmd->add_option("--frames", figure_frames_text, "A:B: columns are frames A..B-1 (with --video: the video's frames)");
+    figure_cmd->add_option("--models", figure_models_text, "Comma list of models, one row each (default instant,finite,relativistic)");
+    figure_cmd->add_option("--title", fs.title, "A title line above the sheet");
+    figure_cmd->add_flag("--no-labels", figure_no_labels, "No model names and camera times around the panels");
+    figure_cmd->add_option("--video", fs.video_path, "Instead of the sheet: an H.264 MP4, the models side by side, every frame; needs ffmpeg");
     figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
-    figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary");
+    figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary, no progress");
     addStageLimits(figure_cmd, &fs.stage);
+    figure_cmd->footer(
+        "Examples:\n"
+        "  apparent figure data/scenes/flanges.json --out sheet.png --times 4,7,8.5,10,13,16 --title \"Flanges at 0.866c\"\n"
+        "  apparent figure data/scenes/terrell_cube.json --models contracted,relativistic --video cube.mp4\n"
+        "Labels and titles use DejaVu Sans (Debian fonts-dejavu-core); --video needs the ffmpeg program in PATH.");
+    raytrace_cmd->footer(
+        "Examples:\n"
+        "  apparent raytrace data/scenes/flanges.json --out frames --model all --frames 80:120\n"
+        "  apparent raytrace data/scenes/terrell_cube.json --model relativistic --video cube.mp4\n"
+        "--video needs the ffmpeg program in PATH. Progress goes to stderr unless --quiet.");
 
     // `trade`: the speed-accuracy trade measured on the user's scene (pipeline/trade.h).
     TradeSettings trs;
@@ -256,6 +275,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
         if (ts.threads < 0 || ts.threads > kMaxThreads) return usage(threadsProblem(ts.threads));
         if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
+        ts.write_png = ts.video_path.empty() || raytrace_cmd->count("--out") > 0;
         return guarded([&] { return raytrace(ts, out, err); }, err);
     }
     if (figure_cmd->parsed()) {
@@ -264,6 +284,33 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (fs.columns < 1 || fs.columns > 64) return usage("--columns: must be in 1..64");
         if (fs.threads < 0 || fs.threads > kMaxThreads) return usage(threadsProblem(fs.threads));
         if (fs.stage.max_frames <= 0) return usage("--max-frames: must be positive");
+        if (!figure_frames_text.empty() && !parseFrames(figure_frames_text, &fs.frame_from, &fs.frame_to))
+            return usage("--frames: '" + figure_frames_text + "' is not A:B with 0 <= A < B");
+        if (!figure_times_text.empty() && !figure_frames_text.empty()) return usage("--times: give --times or --frames, not both");
+        if (!fs.video_path.empty() && !figure_times_text.empty())
+            return usage("--times: not with --video (a video shows every frame of --frames)");
+        if (!fs.video_path.empty() && figure_cmd->count("--columns") > 0)
+            return usage("--columns: not with --video (a video shows every frame of --frames)");
+        std::stringstream times(figure_times_text);
+        for (std::string item; !figure_times_text.empty() && std::getline(times, item, ',');) {
+            size_t used = 0;
+            double t = NAN;
+            try {
+                t = std::stod(item, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used == 0 || used != item.size() || !std::isfinite(t)) return usage("--times: '" + item + "' is not a number");
+            fs.times.push_back(t);
+        }
+        if (fs.times.size() > size_t(kMaxFigureColumns))
+            return usage("--times: more than " + std::to_string(kMaxFigureColumns) + " columns");
+        StageOptions figure_models;
+        if (std::string message; !parseModelList(figure_models_text, &figure_models, &message))
+            return usage("--models" + message.substr(std::string("--model").size()));
+        if (figure_models.all_models) fs.models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};
+        for (Model m : figure_models.models) fs.models.push_back(m);
+        fs.labels = !figure_no_labels;
         return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (trade_cmd->parsed()) {

@@ -6,11 +6,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
+#include <memory>
 #include <ostream>
+#include <sstream>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "exporters/video.h"
 #include "mesh4d/angles.h"
 #include "pipeline/worlds.h"
 
@@ -74,7 +77,7 @@ Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int
 
 SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects,
                          const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
-                         long long last_frame)
+                         long long last_frame, bool hierarchy)
     : scene_(scene), model_(model), mirrors_(mirrors), mirror_of_object_(objects.size(), -1) {
     for (size_t m = 0; m < mirrors_.size(); ++m) mirror_of_object_[mirrors_[m].object] = int32_t(m);
     // Step: build the static worlds once, then their per-prism trace data (which points into worlds_).
@@ -83,7 +86,7 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
         colors_.push_back(objectBaseColor(objects, i));
         worlds_.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
     }
-    for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w));
+    for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w, hierarchy));
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
@@ -100,11 +103,11 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     return best;
 }
 
-std::array<double, 3> SceneTracer::shade(const Hit& h, const Vec3& ray_dir) const {
-    // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), n turned towards the incoming ray
-    // (the surfaces are two-sided, as in the exported glTF).
-    Vec3 n = h.hit.lab_normal;
-    if (mesh4d::dot(n, ray_dir) > 0) n = -n;
+std::array<double, 3> SceneTracer::shade(const Hit& h) const {
+    // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), summed over the lights with their
+    // weights (the default key light, scene.h), n already turned towards the side
+    // the ray arrives from (the surfaces are two-sided, as in the exported glTF).
+    const Vec3 n = h.hit.lab_normal;
     const LightSpec& light = scene_.light;
     Vec3 l = light.direction;
     if (light.kind == LightSpec::Kind::Point) {
@@ -112,12 +115,14 @@ std::array<double, 3> SceneTracer::shade(const Hit& h, const Vec3& ray_dir) cons
         const double len = mesh4d::norm(to_light);
         l = len > 0 ? to_light / len : Vec3{0, 0, 0};
     }
-    const double lambert = light.ambient + (1 - light.ambient) * std::max(0.0, mesh4d::dot(n, l));
+    const double diffuse = (1 - light.key_weight) * std::max(0.0, mesh4d::dot(n, l)) +
+                           light.key_weight * std::max(0.0, mesh4d::dot(n, light.key_direction));
+    const double lambert = light.ambient + (1 - light.ambient) * diffuse;
     const auto& c = colors_[size_t(h.object)];
     return {c[0] * lambert, c[1] * lambert, c[2] * lambert};
 }
 
-TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
+TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) const {
     TracedFrame frame;
     frame.image = RgbImage(width, height);
     frame.object.assign(size_t(width) * size_t(height), -1);
@@ -135,7 +140,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
                 frame.object[idx] = hit.object;
-                color = shade(hit, ray.direction);
+                color = shade(hit);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,
@@ -147,7 +152,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
                     std::array<double, 3> reflected = kBackground;
                     if (second.object >= 0) {
                         frame.reflected[idx] = second.object;
-                        reflected = shade(second, bounce.direction);
+                        reflected = shade(second);
                     }
                     for (int c = 0; c < 3; ++c)
                         color[size_t(c)] = (1 - kMirrorReflectance) * color[size_t(c)] + kMirrorReflectance * reflected[size_t(c)];
@@ -156,12 +161,13 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height) const {
             uint8_t* p = frame.image.pixel(px, py);
             for (int c = 0; c < 3; ++c) p[c] = toSrgb8(color[size_t(c)]);
         }
+        if (progress) progress->rowDone();
     });
     return frame;
 }
 
 int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err) {
-    // Step: the stage: scene, models, frames, meshes, mirrors.
+    // Step: the stage: scene, models, frames, meshes, mirrors; then the video's one model and ffmpeg.
     Stage stage;
     StageOptions stage_options = settings.stage;
     stage_options.quiet = settings.quiet;
@@ -170,33 +176,67 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& 
         err << "error: " << error << "\n";
         return kExitBadInput;
     }
+    const bool video = !settings.video_path.empty();
+    if (video && stage.models.size() != 1) {
+        err << "error: --video: a video shows one model (" << stage.models.size()
+            << " asked); `apparent figure --video` shows several side by side\n";
+        return kExitBadInput;
+    }
+    if (video && findInPath("ffmpeg").empty()) {
+        err << "error: " << ffmpegMissingMessage("--video") << "\n";
+        return kExitBadInput;
+    }
     const long long first = stage.first, last_excl = stage.last_excl;
 
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    TraceProgress progress(err, !settings.quiet,
+                           (long long)stage.models.size() * (last_excl - first) * settings.height);
     for (Model model : stage.models) {
         const auto start = std::chrono::steady_clock::now();
         // Step: the folder, then the static worlds once per model, then every frame.
         const std::string dir = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
-        if (ec) {
-            err << "error: " << dir << ": cannot create output folder: " << ec.message() << "\n";
+        if (settings.write_png) {
+            std::error_code ec;
+            std::filesystem::create_directories(dir, ec);
+            if (ec) {
+                err << "error: " << dir << ": cannot create output folder: " << ec.message() << "\n";
+                return kExitOutputError;
+            }
+        }
+        VideoWriter writer;
+        if (video && !writer.open(settings.video_path, settings.width, settings.height, stage.scene.frames.fps, &error)) {
+            err << "error: " << error << "\n";
             return kExitOutputError;
         }
         const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
         for (long long k = first; k < last_excl; ++k) {
+            progress.setLabel(std::string(modelName(model)) + " frame " + std::to_string(k));
             TracedFrame frame;
-            arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height); });
-            if (!writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error)) {
+            arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height, &progress); });
+            if (settings.write_png &&
+                !writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error)) {
+                err << "error: " << error << "\n";
+                return kExitOutputError;
+            }
+            if (video && !writer.addFrame(frame.image, &error)) {
                 err << "error: " << error << "\n";
                 return kExitOutputError;
             }
         }
+        if (video && !writer.finish(&error)) {
+            err << "error: " << error << "\n";
+            return kExitOutputError;
+        }
+        progress.finish();
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (!settings.quiet)
+        if (!settings.quiet) {
             log << modelName(model) << ": " << (last_excl - first) << " frames of " << settings.width << "x"
-                << settings.height << " in " << std::fixed << std::setprecision(2) << seconds << " s, " << dir << "/\n"
-                << std::defaultfloat;
+                << settings.height << " in " << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat
+                << std::setprecision(6);
+            if (settings.write_png) log << ", " << dir << "/";
+            if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
+            log << "\n";
+        }
     }
     return kExitOk;
 }
@@ -209,14 +249,95 @@ std::vector<long long> figureFrames(const Scene& scene, int columns) {
     return frames;
 }
 
+bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::vector<long long>* frames,
+                   std::string* error) {
+    const long long total = frameCount(scene.frames);
+    frames->clear();
+    for (double t : times) {
+        const double k = std::round((t - scene.frames.start) * scene.frames.fps);
+        if (!(k >= 0 && k < double(total))) {
+            std::ostringstream msg;
+            msg << "--times: t = " << t << " s is outside the scene's frames (" << scene.frames.start << " to "
+                << frameTime(scene.frames, total - 1) << " s)";
+            *error = msg.str();
+            return false;
+        }
+        frames->push_back((long long)k);
+    }
+    return true;
+}
+
+std::string cameraTimeLabel(const Scene& scene, long long k) {
+    // As many decimals as the frame rate needs (10 fps: one), so labels keep their width in a video.
+    const int decimals = scene.frames.fps <= 1 ? 0 : std::min(6, int(std::ceil(std::log10(scene.frames.fps) - 1e-9)));
+    std::ostringstream s;
+    s << "t = " << std::fixed << std::setprecision(decimals) << frameTime(scene.frames, k) << " s";
+    return s.str();
+}
+
+namespace {
+
+// The side-by-side video of `figure --video`: one video frame per scene frame in the stage's range,
+// the models in columns under their names, the camera time (after the title) above.
+int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPainter* painter, std::ostream& log,
+                std::ostream& err) {
+    const Scene& scene = stage.scene;
+    std::string error;
+    SheetText text;
+    if (painter)
+        for (Model m : stage.models) text.column_labels.push_back(modelName(m));
+    text.title = "t";  // a title band for the time, filled per frame
+    SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, text, painter != nullptr);
+    std::vector<std::unique_ptr<SceneTracer>> tracers;
+    for (Model m : stage.models)
+        tracers.push_back(std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1));
+    VideoWriter writer;
+    if (!writer.open(settings.video_path, base.width, base.height, scene.frames.fps, &error)) {
+        err << "error: " << error << "\n";
+        return kExitOutputError;
+    }
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    TraceProgress progress(err, !settings.quiet,
+                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height);
+    for (long long k = stage.first; k < stage.last_excl; ++k) {
+        text.title = (settings.title.empty() ? "" : settings.title + "   ") + cameraTimeLabel(scene, k);
+        SheetLayout layout = base;
+        RgbImage sheet = drawSheet(text, painter, &layout);
+        for (size_t m = 0; m < tracers.size(); ++m) {
+            progress.setLabel(std::string(modelName(stage.models[m])) + " frame " + std::to_string(k));
+            TracedFrame frame;
+            arena.execute([&] { frame = tracers[m]->traceFrame(k, settings.width, settings.height, &progress); });
+            placePanel(&sheet, layout, 0, int(m), frame.image);
+        }
+        if (!writer.addFrame(sheet, &error)) {
+            err << "error: " << error << "\n";
+            return kExitOutputError;
+        }
+    }
+    if (!writer.finish(&error)) {
+        err << "error: " << error << "\n";
+        return kExitOutputError;
+    }
+    progress.finish();
+    if (!settings.quiet)
+        log << settings.video_path << ": " << writer.frames() << " frames of " << base.width << "x" << base.height
+            << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1 << "\n";
+    return kExitOk;
+}
+
+}  // namespace
+
 int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err) {
-    // Step: the stage, for the three rows' models and all frames.
+    // Step: the stage, for the rows' models (instant, finite, relativistic unless --models) and
+    // all frames (a video: the --frames range).
+    const bool video = !settings.video_path.empty();
     Stage stage;
     StageOptions stage_options = settings.stage;
-    stage_options.models = {Model::Instant, Model::Finite, Model::Relativistic};
+    stage_options.models = settings.models.empty() ? std::vector<Model>{Model::Instant, Model::Finite, Model::Relativistic}
+                                                   : settings.models;
     stage_options.all_models = false;
-    stage_options.frame_from = 0;
-    stage_options.frame_to = -1;
+    stage_options.frame_from = video && settings.frame_from >= 0 ? settings.frame_from : 0;
+    stage_options.frame_to = video && settings.frame_from >= 0 ? settings.frame_to : -1;
     stage_options.quiet = settings.quiet;
     std::string error;
     if (!loadStage(stage_options, &stage, err, &error)) {
@@ -225,24 +346,65 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     }
     const Scene& scene = stage.scene;
     const std::vector<Model>& rows = stage.models;
-    // Step: lay out the sheet: rows instant, finite, relativistic; columns sequential frames.
-    constexpr int kGap = 4;
-    constexpr uint8_t kGapGrey = 96;
-    const std::vector<long long> frames = figureFrames(scene, settings.columns);
-    RgbImage sheet(settings.columns * settings.width + (settings.columns + 1) * kGap,
-                   int(rows.size()) * settings.height + (int(rows.size()) + 1) * kGap);
-    std::fill(sheet.rgb.begin(), sheet.rgb.end(), kGapGrey);
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    for (size_t r = 0; r < rows.size(); ++r) {
-        const SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], frames.front(), frames.back());
-        for (size_t c = 0; c < frames.size(); ++c) {
-            TracedFrame frame;
-            arena.execute([&] { frame = tracer.traceFrame(frames[c], settings.width, settings.height); });
-            const int x0 = kGap + int(c) * (settings.width + kGap), y0 = kGap + int(r) * (settings.height + kGap);
-            for (int y = 0; y < settings.height; ++y)
-                std::copy_n(frame.image.pixel(0, y), 3 * settings.width, sheet.pixel(x0, y0 + y));
+    // Step: the columns: --times, --frames A:B, or --columns evenly spaced.
+    std::vector<long long> frames;
+    if (!video) {
+        if (!settings.times.empty()) {
+            if (!framesAtTimes(scene, settings.times, &frames, &error)) {
+                err << "error: " << error << "\n";
+                return kExitBadInput;
+            }
+        } else if (settings.frame_from >= 0) {
+            const long long total = frameCount(scene.frames);
+            const long long to = settings.frame_to < 0 ? total : settings.frame_to;
+            if (settings.frame_from >= total || to > total) {
+                err << "error: --frames: " << settings.frame_from << ":" << to << " is outside the scene's " << total
+                    << " frames\n";
+                return kExitBadInput;
+            }
+            if (to - settings.frame_from > kMaxFigureColumns) {
+                err << "error: --frames: " << to - settings.frame_from << " columns, more than " << kMaxFigureColumns << "\n";
+                return kExitBadInput;
+            }
+            for (long long k = settings.frame_from; k < to; ++k) frames.push_back(k);
+        } else {
+            frames = figureFrames(scene, settings.columns);
         }
     }
+    // Step: the font (labels and title) and ffmpeg (video), before any tracing.
+    TextPainter painter;
+    const bool with_text = settings.labels || !settings.title.empty();
+    if (with_text && !painter.open(kLabelFontPath, &error)) {
+        err << "error: " << error << "\n";
+        return kExitBadInput;
+    }
+    if (video && findInPath("ffmpeg").empty()) {
+        err << "error: " << ffmpegMissingMessage("--video") << "\n";
+        return kExitBadInput;
+    }
+    if (video) return figureVideo(settings, stage, with_text ? &painter : nullptr, log, err);
+    // Step: lay out the sheet: a row per model, a column per frame, labels in bands left and above.
+    SheetText text;
+    text.title = settings.title;
+    if (settings.labels) {
+        for (Model m : rows) text.row_labels.push_back(modelName(m));
+        for (long long k : frames) text.column_labels.push_back(cameraTimeLabel(scene, k));
+    }
+    SheetLayout layout(int(rows.size()), int(frames.size()), settings.width, settings.height, text, with_text);
+    RgbImage sheet = drawSheet(text, with_text ? &painter : nullptr, &layout);
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    TraceProgress progress(err, !settings.quiet, (long long)rows.size() * (long long)frames.size() * settings.height);
+    const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
+    for (size_t r = 0; r < rows.size(); ++r) {
+        const SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi);
+        for (size_t c = 0; c < frames.size(); ++c) {
+            progress.setLabel(std::string(modelName(rows[r])) + " frame " + std::to_string(frames[c]));
+            TracedFrame frame;
+            arena.execute([&] { frame = tracer.traceFrame(frames[c], settings.width, settings.height, &progress); });
+            placePanel(&sheet, layout, int(r), int(c), frame.image);
+        }
+    }
+    progress.finish();
     const std::filesystem::path parent = std::filesystem::path(settings.out_path).parent_path();
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
@@ -251,8 +413,9 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
         return kExitOutputError;
     }
     if (!settings.quiet) {
-        log << settings.out_path << ": " << sheet.width << "x" << sheet.height << ", rows instant, finite, relativistic;"
-            << " frames";
+        log << settings.out_path << ": " << sheet.width << "x" << sheet.height << ", rows";
+        for (Model m : rows) log << " " << modelName(m);
+        log << "; frames";
         for (long long k : frames) log << " " << k << " (t = " << frameTime(scene.frames, k) << " s)";
         log << "\n";
     }

@@ -16,7 +16,9 @@
 #include "exporters/png.h"
 #include "mesh4d/ray4d.h"
 #include "pipeline/mirror.h"
+#include "pipeline/sheet.h"
 #include "pipeline/stage.h"
+#include "pipeline/trace_progress.h"
 
 namespace apparent {
 
@@ -37,13 +39,15 @@ struct TracedFrame {
 class SceneTracer {
 public:
     // Preconditions: the scene passed checkSceneForModel for `model`; mirrors from findMirrors.
+    // hierarchy false: every prism is tested for every ray (the benchmarks' peer, ray4d.h).
     SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects, const std::vector<MirrorPlane>& mirrors,
-                Model model, long long first_frame, long long last_frame);
+                Model model, long long first_frame, long long last_frame, bool hierarchy = true);
     SceneTracer(const SceneTracer&) = delete;
     SceneTracer& operator=(const SceneTracer&) = delete;
 
-    // Traces global frame k at width x height (rows in parallel with TBB; deterministic).
-    TracedFrame traceFrame(long long k, int width, int height) const;
+    // Traces global frame k at width x height (rows in parallel with TBB; deterministic). Each row
+    // done is counted in `progress` when given.
+    TracedFrame traceFrame(long long k, int width, int height, TraceProgress* progress = nullptr) const;
 
     const std::vector<mesh4d::World4D>& worlds() const { return worlds_; }
 
@@ -53,7 +57,7 @@ private:
         mesh4d::WorldHit hit;
     };
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
-    std::array<double, 3> shade(const Hit& h, const mesh4d::Vec3& ray_dir) const;
+    std::array<double, 3> shade(const Hit& h) const;
 
     Scene scene_;
     Model model_;
@@ -67,18 +71,30 @@ private:
 struct RaytraceSettings {
     StageOptions stage;            // scene, --model (empty: the scene's), --frames, --max-frames, limits
     std::string out_dir = "out";
+    bool write_png = true;         // DIR/<model>/frame_NNNNN.png (with --video: only when --out is given)
+    std::string video_path;        // --video: the frames as an H.264 MP4 at the scene's fps (one model)
     int width = 480, height = 270;
     int threads = 0;
-    bool quiet = false;
+    bool quiet = false;            // no summary, no progress
 };
 
-// `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame. Exit codes as `render`.
+// `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame and/or one video (exporters/video.h).
+// Progress on stderr (trace_progress.h) unless quiet. Exit codes as `render`; --video with several
+// models or without ffmpeg in PATH: 2.
 int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err);
+
+constexpr int kMaxFigureColumns = 64;
 
 struct FigureSettings {
     StageOptions stage;            // scene, --max-frames, limits (the rows fix the models, the columns the frames)
     std::string out_path = "sheet.png";
-    int columns = 6;
+    std::vector<Model> models;     // --models: the rows, top to bottom (empty: instant, finite, relativistic)
+    int columns = 6;               // --columns: evenly spaced frames (figureFrames)
+    std::vector<double> times;     // --times: the columns' camera times (nearest frame each)
+    long long frame_from = -1, frame_to = -1;  // --frames A:B: columns A..B-1 (-1: unset; B -1: to the end)
+    std::string title;             // --title: one line above the sheet
+    bool labels = true;            // row labels (model names) and column labels (camera times)
+    std::string video_path;        // --video: an MP4 of every frame in --frames, the models side by side
     int width = 320, height = 180;  // one panel
     int threads = 0;
     bool quiet = false;
@@ -87,8 +103,17 @@ struct FigureSettings {
 // The frames a figure shows in its columns: evenly spaced over the scene's frames, first and last included.
 std::vector<long long> figureFrames(const Scene& scene, int columns);
 
-// `apparent figure`: the paper's comparison sheet, rows instant, finite, relativistic, columns
-// sequential frames (figureFrames), panels separated by 4-pixel grey lines.
+// The frame nearest to each camera time; false with the message for a time outside the scene's frames.
+bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::vector<long long>* frames,
+                   std::string* error);
+
+// "t = 10.0 s": frame k's camera time with as many decimals as the frame rate needs (10 fps: 1,
+// 12 or 30 fps: 2), as the figure labels its columns and video frames.
+std::string cameraTimeLabel(const Scene& scene, long long k);
+
+// `apparent figure`: the paper's comparison sheet, a row per model, a column per frame, labelled
+// with model names and camera times, panels separated by 4-pixel grey lines; or with --video the
+// models side by side in an MP4 of every frame in --frames. Exit 2 for a missing font or ffmpeg.
 int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err);
 
 }  // namespace apparent

@@ -37,6 +37,11 @@ struct LightSpec {
     mesh4d::Vec3 position;              // Point: lab position
     mesh4d::Vec3 direction{0, 1, 0};    // Directional: unit vector towards the light
     double ambient = 0.2;               // fraction of the base colour lit regardless of the normal
+    // A scene without `light` gets two distant lights: overhead (`direction` = camera.up) and a key
+    // light from the camera's upper left (`key_direction`), which gets `key_weight` of the diffuse
+    // share, so that each visible face of a box shows its own shade. key_weight 0: one light.
+    mesh4d::Vec3 key_direction{0, 0, 1};
+    double key_weight = 0;
 };
 
 struct FrameSpec {
@@ -79,7 +84,7 @@ constexpr double kDefaultToleranceRelative = 1e-3;
 struct Scene {
     std::string path;                  // the scene file, as given
     CameraSpec camera;
-    LightSpec light;                   // default: directional, from camera.up (overhead)
+    LightSpec light;                   // default: overhead (camera.up) plus a key light from the camera
     FrameSpec frames;
     Model model = Model::Relativistic;
     // The tolerance: absolute (`tolerance` light-seconds > 0; 0 = vertex mode) when

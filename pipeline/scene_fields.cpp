@@ -360,7 +360,22 @@ void readLight(FieldReader& r, const json& parent, const std::string& top, Scene
     // directional from camera.up, i.e. overhead.
     scene->light.direction = scene->camera.up / std::max(mesh4d::norm(scene->camera.up), 1e-300);
     const json* li = nullptr;
-    if (!r.object(parent, "light", top, &li)) return;
+    if (!r.object(parent, "light", top, &li)) {
+        // The default key light: towards the camera's side of the scene, a little left and above
+        // (back 1, left 0.45, up 0.15 in the camera's basis), 70% of the diffuse share. A box
+        // facing the camera then shows front, top and left faces at 0.71, 0.52 and 0.43 of
+        // full light, the others at the ambient 0.2 (README "Scene format").
+        const CameraSpec& c = scene->camera;
+        const Vec3 f = c.look_at - c.position, right = mesh4d::cross(f, c.up);
+        const double nf = mesh4d::norm(f), nr = mesh4d::norm(right);
+        if (nf > 0 && nr > 0) {
+            const Vec3 fu = f / nf, ru = right / nr, uu = mesh4d::cross(ru, fu);
+            const Vec3 k = -1.0 * fu - 0.45 * ru + 0.15 * uu;
+            scene->light.key_direction = k / mesh4d::norm(k);
+            scene->light.key_weight = 0.7;
+        }
+        return;
+    }
     const std::string lp = FieldReader::join(top, "light");
     r.checkKeys(*li, lp, {"position", "direction", "ambient"});
     if (li->contains("position") == li->contains("direction")) {

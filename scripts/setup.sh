@@ -19,7 +19,8 @@ jobs=${JOBS:-$(nproc)}
 packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels libpng-dev
-  gnuplot-nox gltfpack)  # gltfpack: the peer of benchmarks/load_bench; gnuplot draws `apparent trade`'s plot (DIR/trade.png) and docs/accuracy.png
+  gnuplot-nox gltfpack  # gltfpack: the peer of benchmarks/load_bench; gnuplot draws `apparent trade`'s plot (DIR/trade.png) and docs/accuracy.png
+  libfreetype-dev fonts-dejavu-core ffmpeg)  # figure labels; raytrace/figure --video (and ffprobe in the tests)
 if [ "$mode" = test ]; then
   packages+=(chromium)            # three.js viewer test (tests/web), headless
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
