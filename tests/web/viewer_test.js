@@ -167,7 +167,11 @@ async function main() {
     });
     page.on('pageerror', (err) => consoleMsgs.push(`pageerror: ${err.message}`));
     page.on('requestfailed', (req) => consoleMsgs.push(`requestfailed: ${req.url()} ${req.failure()?.errorText}`));
-    page.on('response', (res) => { if (res.status() >= 400) consoleMsgs.push(`http ${res.status()}: ${res.url()}`); });
+    const delivered = new Set();  // URLs answered with a success at least once
+    page.on('response', (res) => {
+      if (res.status() >= 400) consoleMsgs.push(`http ${res.status()}: ${res.url()}`);
+      else delivered.add(res.url());
+    });
 
     const viewerUrl = `${url}/exporters/web/?dir=/out&models=${opts.models.join(',')}&paused=1&t=0`;
     console.log(`  browser: ${await ctx.browser()?.version() ?? 'chromium'}; opening ${viewerUrl}`);
@@ -279,7 +283,14 @@ async function main() {
 
     // 6. console
     // SwiftShader's performance notes about ReadPixels (screenshots) are harmless
-    const ignorable = (s) => /favicon\.ico|GPU stall due to ReadPixels/.test(s);
+    // A cancelled duplicate of a request that was answered (three.js's DRACOLoader may fetch its
+    // decoder once per loader; under load one fetch can be aborted after another delivered it) is
+    // not an error; an aborted request whose URL never arrived still is.
+    const abortedDuplicate = (s) => {
+      const m = /^requestfailed: (\S+) net::ERR_ABORTED$/.exec(s);
+      return !!m && delivered.has(m[1]);
+    };
+    const ignorable = (s) => /favicon\.ico|GPU stall due to ReadPixels/.test(s) || abortedDuplicate(s);
     const relevant = consoleMsgs.filter((s) => !ignorable(s));
     for (const s of relevant) console.log(`  console ${s}`);
     check(!relevant.some((s) => /^(error|pageerror|requestfailed|http)/.test(s)), 'no browser errors',
