@@ -33,6 +33,7 @@ bool keptFace(const std::array<uint32_t, 3>& t) { return t[0] != t[1] && t[1] !=
 
 constexpr size_t kBlock = size_t(1) << 16;  // triangles or vertices serialized by one task
 constexpr size_t kVertexBytes = 32;         // double x y z quality
+constexpr size_t kFactorBytes = 16;         // double doppler proper_time (when every object has them)
 constexpr size_t kFaceBytes = 13;           // uchar 3, int i j k
 
 // A run of one object's triangles, with the kept faces before it in the whole frame.
@@ -69,29 +70,39 @@ void serializePly(const ExportFrame& frame, std::string* out) {
         faces += kept[i];
     }
 
-    // Step: the header, then every vertex (x y z quality, absolute lab values) and face, each
-    // block written in place in parallel: the bytes do not depend on the thread count.
+    // Step: the header, then every vertex (x y z quality, absolute lab values; doppler and
+    // proper_time when the frame loop computed them, mesh4d/light_factors.h) and face, each block
+    // written in place in parallel: the bytes do not depend on the thread count.
+    const bool factors = std::all_of(frame.objects.begin(), frame.objects.end(), [](const mesh4d::ApparentMesh& o) {
+        return o.doppler.size() == o.positions.size() && o.proper_time.size() == o.positions.size();
+    });
+    const size_t vertex_bytes = kVertexBytes + (factors ? kFactorBytes : 0);
     const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
-                               "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n"
+                               "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n" +
+                               (factors ? "property double doppler\nproperty double proper_time\n" : "") +
                                "element face " + std::to_string(faces) +
                                "\nproperty list uchar int vertex_indices\nend_header\n";
     std::string& bytes = *out;
-    bytes.resize(header.size() + kVertexBytes * vertices + kFaceBytes * faces);
+    bytes.resize(header.size() + vertex_bytes * vertices + kFaceBytes * faces);
     std::memcpy(&bytes[0], header.data(), header.size());
     char* const vertex_start = &bytes[0] + header.size();
-    char* const face_start = vertex_start + kVertexBytes * vertices;
+    char* const face_start = vertex_start + vertex_bytes * vertices;
     size_t base = 0;
     for (const auto& part : frame.objects) {
-        char* const dst = vertex_start + kVertexBytes * base;
+        char* const dst = vertex_start + vertex_bytes * base;
         tbb::parallel_for(size_t(0), part.positions.size(), kBlock, [&](size_t first) {
             const size_t last = std::min(part.positions.size(), first + kBlock);
-            char* p = dst + kVertexBytes * first;
+            char* p = dst + vertex_bytes * first;
             for (size_t i = first; i < last; ++i) {
                 const mesh4d::Vec3 q = part.absolutePosition(i);
                 p = storeLittleEndian(p, q.x, little);
                 p = storeLittleEndian(p, q.y, little);
                 p = storeLittleEndian(p, q.z, little);
                 p = storeLittleEndian(p, part.absoluteTime(i), little);
+                if (factors) {
+                    p = storeLittleEndian(p, part.doppler[i], little);
+                    p = storeLittleEndian(p, part.proper_time[i], little);
+                }
             }
         });
         base += part.positions.size();

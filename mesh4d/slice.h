@@ -70,6 +70,10 @@ struct ApparentMesh {
     Vec3 origin{0, 0, 0};                 // lab point the positions are relative to
     double time_origin = 0;               // lab time the emission times are relative to
     std::vector<Vec3> rest_points;        // the rest-frame point each apparent point is the image of
+    // Per apparent point, when the frame loop asked for them (light_factors.h, else empty): the
+    // Doppler factor of the light that reaches the camera, and the object's clock at emission.
+    std::vector<double> doppler;
+    std::vector<double> proper_time;
     std::vector<std::array<uint32_t, 3>> triangles;  // orientation of the input triangles kept
     std::vector<uint32_t> source_triangles;  // the input triangle each output triangle lies on
     size_t clipped_triangles = 0;         // input triangles cut by a real cap in this frame

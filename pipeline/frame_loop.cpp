@@ -18,6 +18,7 @@
 #include <tbb/task_arena.h>
 
 #include "mesh4d/check.h"
+#include "mesh4d/light_factors.h"
 
 namespace apparent {
 
@@ -179,6 +180,7 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             mesh4d::SliceSettings own = slice_settings;
             own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
             frame.objects[o] = mesh4d::sliceWorld(world, view, own);
+            mesh4d::addLightFactors(world, view, &frame.objects[o]);
         });
         // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
         reflections.append(view, slice_settings, &frame.objects, &stage.tolerances);

@@ -7,6 +7,7 @@
 
 #include "mesh4d/box.h"
 #include "mesh4d/check.h"
+#include "mesh4d/light_factors.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -75,10 +76,12 @@ struct Corner {
     double t = 0;
     Vec3 q;
     int64_t source = -1;
+    double doppler = 1, proper_time = 0;  // interpolated along a clipped side, as t is
 };
 
 Corner mix(const Corner& a, const Corner& b, double s) {
-    return {a.p + s * (b.p - a.p), a.t + s * (b.t - a.t), a.q + s * (b.q - a.q), -1};
+    return {a.p + s * (b.p - a.p), a.t + s * (b.t - a.t), a.q + s * (b.q - a.q), -1,
+            a.doppler + s * (b.doppler - a.doppler), a.proper_time + s * (b.proper_time - a.proper_time)};
 }
 
 // Sutherland-Hodgman: keeps the part of `poly` where dot(n, p - o) >= 0.
@@ -152,7 +155,9 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
         std::vector<Corner> tri;
         for (size_t c : {size_t(0), size_t(2), size_t(1)}) {
             const uint32_t v = cut.triangles[t][c];
-            tri.push_back({reflectPoint(mirror, absolutePoint(cut, v)), absoluteTime(cut, v), cut.rest_points[v], int64_t(v)});
+            const bool factors = cut.doppler.size() == cut.positions.size();
+            tri.push_back({reflectPoint(mirror, absolutePoint(cut, v)), absoluteTime(cut, v), cut.rest_points[v], int64_t(v),
+                           factors ? cut.doppler[v] : 1.0, factors ? cut.proper_time[v] : 0.0});
         }
         tri = clipHalfSpace(tri, mirror.point, beyond);
         if (tri.size() < 3) continue;
@@ -182,6 +187,10 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
                 out.positions.push_back(c.p);
                 out.emission_times.push_back(c.t);
                 out.rest_points.push_back(c.q);
+                if (cut.doppler.size() == cut.positions.size()) {
+                    out.doppler.push_back(c.doppler);
+                    out.proper_time.push_back(c.proper_time);
+                }
             }
             for (size_t i = 1; i + 1 < poly.size(); ++i) {
                 out.triangles.push_back({index[0], index[i], index[i + 1]});
@@ -234,7 +243,10 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         image.apex = reflectPoint(m, view.apex);
         mesh4d::SliceSettings own = settings;
         if (object_tolerances) own.tolerance = (*object_tolerances)[target.object];
-        const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
+        mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
+        // The light factors of the path through the mirror: a mirror at rest changes no frequency,
+        // so they are those seen by the image of the camera.
+        mesh4d::addLightFactors(target.world, image, &cut);
         objects->push_back(reflectAndClip(cut, m, seen[target.mirror], camera_));
     }
 }

@@ -99,10 +99,14 @@ std::vector<std::array<double, 4>> readPlyDoubles(const fs::path& p, size_t* fac
         << header;
     const size_t n = std::stoul(header.substr(header.find("element vertex ") + 15));
     *faces = std::stoul(header.substr(header.find("element face ") + 13));
+    // x y z quality, then doppler and proper_time when the frame loop computed them.
+    const bool factors = header.find("property double quality\nproperty double doppler\nproperty double proper_time\n") !=
+                         std::string::npos;
+    const size_t stride = factors ? 48 : 32;
     std::vector<std::array<double, 4>> v(n);
     const char* data = bytes.data() + end + 11;
-    EXPECT_EQ(bytes.size(), end + 11 + 32 * n + 13 * *faces);
-    for (size_t i = 0; i < n; ++i) std::memcpy(v[i].data(), data + 32 * i, 32);  // the test machine is little-endian
+    EXPECT_EQ(bytes.size(), end + 11 + stride * n + 13 * *faces);
+    for (size_t i = 0; i < n; ++i) std::memcpy(v[i].data(), data + stride * i, 32);  // the test machine is little-endian
     return v;
 }
 
