@@ -20,6 +20,23 @@
 // are Edgebreaker-coded; POSITION is quantized to `position_bits` over the primitive's largest
 // extent, NORMAL to `normal_bits`, and _EMISSION_TIME kept lossless. Accessor counts and bounds
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
+// With meshopt (EXT_meshopt_compression and KHR_mesh_quantization, both required; the BIN chunk
+// holds the compressed streams, a fallback buffer without data stands for the decoded ones):
+// each primitive's vertices are one interleaved stream of 16 bytes, POSITION as int16 (not
+// normalized) multiples of the frame's step about the frame's origin, NORMAL as normalized int8,
+// _EMISSION_TIME float32 (lossless); indices uint16 (uint32 past 65535 vertices) in vertex-cache
+// order (meshopt_optimizeVertexCache: triangles reordered, vertices kept in place). The frame
+// node's scale is its step (the animation shows it with scale = step, hides it with 0), so a
+// reader gets origin + step * q. The step: with a tolerance T, T / sqrt(3), which bounds the
+// quantization error by T / 2 (each coordinate moves at most step / 2); in vertex mode (no
+// tolerance), 16 bits over the frame's largest extent E: step = E / 65534, error at most
+// sqrt(3) / 2 * E / 65534 (about 1.3e-5 E); --meshopt-bits B asks for step = E / (2^B - 2)
+// instead (a warning says when its bound exceeds T). When E / step would exceed int16 the step
+// grows to E / 65534 and the warning says so too.
+// Index buffers are shared: a primitive whose index list (and vertex count) equals that of the
+// same object in the previous frame refers to that frame's index accessor (plain and meshopt;
+// Draco codes indices with the vertices). In vertex mode with nothing clipped, each object then
+// has one index accessor for the whole sequence.
 #pragma once
 
 #include <memory>
@@ -34,13 +51,16 @@ struct GlbOptions {
     bool draco = false;
     int position_bits = 14;  // Draco position quantization, 1..30
     int normal_bits = 10;    // Draco normal quantization, 1..30
+    bool meshopt = false;    // EXT_meshopt_compression + KHR_mesh_quantization (not with draco)
+    int meshopt_bits = 0;    // meshopt position bits 2..16 over each frame's extent; 0: step from the tolerance
 };
 
 struct GlbStats {
     size_t bytes = 0;                 // size of the written file
-    size_t bytes_without_draco = 0;   // with Draco: size of the same file without it (0 otherwise)
+    size_t bytes_without_draco = 0;   // with Draco or meshopt: size of the same file without it (0 otherwise)
     double max_float_error = 0;       // largest |float32 - double| over exported positions, light-seconds
-    double max_quantization_error = 0;  // Draco: largest position quantization error bound, light-seconds
+    double max_quantization_error = 0;  // Draco, meshopt: largest position quantization error bound, light-seconds
+    bool meshopt_range_clamped = false;  // meshopt: a frame's step had to grow to fit int16
     double max_extent = 0;            // largest frame extent, light-seconds (to judge the errors above)
 };
 

@@ -19,6 +19,7 @@ jobs=${JOBS:-$(nproc)}
 packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels libpng-dev
+  libmeshoptimizer-dev  # EXT_meshopt_compression in the .glb (--compress meshopt)
   gnuplot-nox)  # gnuplot draws `apparent trade`'s plot (DIR/trade.png) and docs/accuracy.png
 if [ "$mode" = test ]; then
   packages+=(chromium)            # three.js viewer test (tests/web), headless
