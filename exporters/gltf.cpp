@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <map>
+#include <mutex>
 #include <sstream>
 
 #include <draco/compression/decode.h>
@@ -16,6 +17,8 @@
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include "exporters/atomic_file.h"
 #include "mesh4d/angles.h"
@@ -313,35 +316,42 @@ private:
 // Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
 // are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
 constexpr double kCreaseDeg = 30.0;
-// With `step` > 0 also the meshopt streams, positions quantized to multiples of `step`
-// (*max_quant receives the largest coordinate error).
-PrimitiveData toPrimitive(const mesh4d::ApparentMesh& input, const double origin[3], double step, double* max_err,
-                          double* max_quant) {
-    PrimitiveData d;
-    const mesh4d::CreasedMesh creased = mesh4d::creaseSplit(input, kCreaseDeg);
-    const mesh4d::ApparentMesh& m = creased.mesh;
-    const std::vector<Vec3>& normals = creased.normals;
-    d.positions.reserve(3 * m.positions.size());
-    d.normals.reserve(3 * m.positions.size());
-    std::vector<double> exact;
-    if (step > 0) exact.reserve(3 * m.positions.size());
-    for (size_t i = 0; i < m.positions.size(); ++i) {
-        for (int c = 0; c < 3; ++c) {
-            // The object's own origin first: both large terms cancel before the small local one is added.
-            const double rel = (m.origin[c] - origin[c]) + m.positions[i][c];
-            const float fv = float(rel);
-            d.positions.push_back(fv);
-            *max_err = std::max(*max_err, std::fabs(double(fv) - rel));
-            d.normals.push_back(float(normals[i][c]));
-            if (step > 0) exact.push_back(rel);
-        }
-    }
-    d.emission.reserve(m.emission_times.size());
-    for (size_t i = 0; i < m.emission_times.size(); ++i) d.emission.push_back(float(m.absoluteTime(i)));
-    d.indices.reserve(3 * m.triangles.size());
-    for (const auto& t : m.triangles) d.indices.insert(d.indices.end(), t.begin(), t.end());
-    if (step > 0) *max_quant = std::max(*max_quant, packMeshopt(&d, exact, step));
-    return d;
+// With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
+// receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
+// `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
+// split's (reused the same way, object by object).
+void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
+                 double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work) {
+    mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
+    const size_t nv = map->source.size();
+    d->positions.resize(3 * nv);
+    d->normals.resize(3 * nv);
+    d->emission.resize(nv);
+    std::vector<double> exact(step > 0 ? 3 * nv : 0);
+    // The object's own origin first: both large terms cancel before the small local one is added.
+    const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
+    const double worst = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double w) {
+            for (size_t k = r.begin(); k < r.end(); ++k) {
+                const uint32_t v = map->source[k];
+                for (int c = 0; c < 3; ++c) {
+                    const double rel = shift[c] + m.positions[v][c];
+                    const float fv = float(rel);
+                    d->positions[3 * k + c] = fv;
+                    w = std::max(w, std::fabs(double(fv) - rel));
+                    d->normals[3 * k + c] = float(map->normals[k][c]);
+                    if (step > 0) exact[3 * k + c] = rel;
+                }
+                d->emission[k] = float(m.absoluteTime(v));
+            }
+            return w;
+        },
+        [](double x, double y) { return std::max(x, y); });
+    *max_err = std::max(*max_err, worst);
+    d->indices.resize(3 * map->triangles.size());
+    if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
+    if (step > 0) *max_quant = std::max(*max_quant, packMeshopt(d, exact, step));
 }
 
 // Rotation quaternion (x, y, z, w) of the camera node: glTF cameras look down local -Z with +Y
@@ -683,6 +693,43 @@ size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
 
 }  // namespace
 
+struct GlbFrameData : PreparedFrame {
+    // For a frame of `objects` objects, keeping every vector's capacity.
+    void reset(size_t objects) {
+        origin[0] = origin[1] = origin[2] = 0;
+        step = 0;
+        clamped = false;
+        meshopt.encoded.clear();
+        meshopt.count = 0;
+        meshopt.first.clear();
+        data.resize(objects);
+        crease_map.resize(objects);
+        crease_work.resize(objects);
+        for (PrimitiveData& p : data) {
+            for (auto* v : {&p.positions, &p.normals, &p.emission}) v->clear();
+            p.indices.clear();
+            p.ordered.clear();
+            p.packed.clear();
+        }
+        far = max_extent = max_float_error = max_quantization_error = 0;
+    }
+    double origin[3] = {0, 0, 0};
+    double step = 0;       // meshopt: the quantization step (0 without meshopt)
+    bool clamped = false;  // meshopt: the step grew to fit int16
+    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex stream
+    std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
+    std::vector<mesh4d::CreaseMap> crease_map;  // per object, toPrimitive's scratch
+    std::vector<mesh4d::CreaseWork> crease_work;
+    double far = 0, max_extent = 0, max_float_error = 0, max_quantization_error = 0;
+};
+
+// Frame buffers given back by released GlbFrameData (shared with their deleters, so it outlives
+// the writer while a prepared frame is still held).
+struct FramePool {
+    std::mutex mutex;
+    std::vector<std::unique_ptr<GlbFrameData>> free;
+};
+
 struct GlbSequenceWriter::Impl {
     Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
         : path(p), info(i), options(o), model(info, options, &sink) {
@@ -707,6 +754,7 @@ struct GlbSequenceWriter::Impl {
     std::unique_ptr<SequenceModel> plain;  // with Draco or meshopt: the same sequence without it, counted
     GlbStats stats;
     double far = 0;
+    std::shared_ptr<FramePool> pool = std::make_shared<FramePool>();
 };
 
 GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options)
@@ -714,14 +762,6 @@ GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo
 
 GlbSequenceWriter::~GlbSequenceWriter() = default;
 
-struct GlbFrameData : PreparedFrame {
-    double origin[3] = {0, 0, 0};
-    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex stream
-    double step = 0;  // meshopt: the quantization step (0 without meshopt)
-    bool clamped = false;  // meshopt: the step grew to fit int16
-    std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
-    double far = 0, max_extent = 0, max_float_error = 0, max_quantization_error = 0;
-};
 
 namespace {
 
@@ -740,19 +780,57 @@ double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
 }  // namespace
 
 std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
-    auto d = std::make_shared<GlbFrameData>();
-    // Step: the frame's origin (the centre of its bounding box) and the far distance.
-    mesh4d::EventBox box;
-    for (const auto& o : f.objects)
-        for (size_t i = 0; i < o.positions.size(); ++i) {
-            const Vec3 p = o.absolutePosition(i);
-            d->far = std::max(d->far, mesh4d::norm(p - impl_->info.camera.position));
-            box.addPoint(p);
+    // Step: a frame's buffers from the writer's pool (they keep their capacity: a sequence does
+    // not allocate again frame after frame); the shared pointer gives them back when released.
+    std::shared_ptr<FramePool> pool = impl_->pool;
+    GlbFrameData* raw = nullptr;
+    {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (!pool->free.empty()) {
+            raw = pool->free.back().release();
+            pool->free.pop_back();
         }
+    }
+    if (!raw) raw = new GlbFrameData;
+    std::shared_ptr<GlbFrameData> d(raw, [pool](GlbFrameData* back) {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        pool->free.emplace_back(back);
+    });
+    d->reset(f.objects.size());
+    // Step: the frame's origin (the centre of its bounding box) and the far distance (parallel
+    // minima and maxima: exact in any order).
+    mesh4d::EventBox box;
+    const Vec3 camera = impl_->info.camera.position;
+    for (const auto& o : f.objects) {
+        struct Extremes {
+            mesh4d::EventBox box;
+            double far = 0;
+        };
+        const Extremes e = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, o.positions.size(), 16384), Extremes{},
+            [&](const tbb::blocked_range<size_t>& r, Extremes x) {
+                for (size_t i = r.begin(); i < r.end(); ++i) {
+                    const Vec3 p = o.absolutePosition(i);
+                    x.far = std::max(x.far, mesh4d::norm(p - camera));
+                    x.box.addPoint(p);
+                }
+                return x;
+            },
+            [](Extremes a, const Extremes& b) {
+                a.box.addPoint(b.box.lo);
+                a.box.addPoint(b.box.hi);
+                a.far = std::max(a.far, b.far);
+                return a;
+            });
+        d->far = std::max(d->far, e.far);
+        if (!o.positions.empty()) {
+            box.addPoint(e.box.lo);
+            box.addPoint(e.box.hi);
+        }
+    }
     const Vec3 center = box.center();
     for (int c = 0; c < 3; ++c) d->origin[c] = center[c];
     // Step: each object's float32 data with normals (crease split), relative to the origin.
-    d->data.resize(f.objects.size());
     if (f.triangleCount() > 0) {
         d->max_extent = std::max(d->max_extent, box.extent());
         if (impl_->options.meshopt) {
@@ -762,7 +840,8 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         double worst_coordinate = 0;
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty())
-                d->data[o] = toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate);
+                toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
+                            &d->crease_map[o], &d->crease_work[o]);
         if (impl_->options.meshopt) {
             // Step: one vertex stream for the whole frame, encoded here (on the worker thread).
             MeshoptFrame& mf = d->meshopt;
