@@ -56,6 +56,14 @@ struct MeshoptFrame {
 
 constexpr size_t kMeshoptStride = 16;  // int16 x, y, z, 0 | int8 nx, ny, nz, 0 | float32 emission time
 
+// The emission time as meshopt stores it: rounded (half away from zero) to a multiple of the
+// largest power of two not above `step`, so that its low mantissa bits are zero and compress;
+// it stays a float32 that readers use as it is, within step / 2 seconds of the plain file's.
+float emissionQuantized(float t, double step) {
+    const double q = std::ldexp(1.0, int(std::floor(std::log2(step))));
+    return float(std::round(double(t) / q) * q);
+}
+
 // The meshopt form of `d`: positions quantized from the exact relative coordinates `rel` (xyz
 // per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
 // triangles first use them (both depend on the index list alone, so frames with equal index
@@ -85,7 +93,8 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
         }
         std::memcpy(v, q, 8);
         std::memcpy(v + 8, n, 4);
-        std::memcpy(v + 12, &d->emission[i], 4);
+        const float t = emissionQuantized(d->emission[i], step);
+        std::memcpy(v + 12, &t, 4);
     }
     return worst;
 }
@@ -766,11 +775,14 @@ GlbSequenceWriter::~GlbSequenceWriter() = default;
 namespace {
 
 // The meshopt quantization step of a frame of largest extent `extent` (gltf.h): from the
-// tolerance (T / sqrt(3)), from `bits` (E / (2^bits - 2)), or 16 bits over E in vertex mode; at
-// least E / 65534 so that every coordinate fits int16 (*clamped says when that decided).
+// tolerance (T / sqrt(3)), from `bits` (E / (2^bits - 2)), or 14 bits over E in vertex mode; at
+// least E / 65534 so that every coordinate fits int16 (*clamped says when that decided). In
+// vertex mode 14 bits over E (E / 16382).
 double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
     const double finest = extent / 65534.0;
-    double step = bits > 0 ? extent / (std::ldexp(1.0, bits) - 2) : tolerance > 0 ? tolerance / std::sqrt(3.0) : finest;
+    double step = bits > 0        ? extent / (std::ldexp(1.0, bits) - 2)
+                  : tolerance > 0 ? tolerance / std::sqrt(3.0)
+                                  : extent / 16382.0;  // vertex mode: 14 bits, Draco's and gltfpack's default
     *clamped = step < finest;  // only a tolerance can ask for more than int16 holds
     if (*clamped) step = finest;
     if (!(step > 0)) step = 1;  // every point at the origin: any step is exact

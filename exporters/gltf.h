@@ -22,16 +22,19 @@
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
 // With meshopt (EXT_meshopt_compression and KHR_mesh_quantization, both required; the BIN chunk
 // holds the compressed streams, a fallback buffer without data stands for the decoded ones):
-// each primitive's vertices are one interleaved stream of 16 bytes, POSITION as int16 (not
+// a frame's vertices (all its primitives') are one interleaved stream of 16 bytes each and its
+// indices one stream (so one compressed view each per frame), POSITION as int16 (not
 // normalized) multiples of the frame's step about the frame's origin, NORMAL as normalized int8,
-// _EMISSION_TIME float32 (lossless); indices uint16 (uint32 past 65535 vertices) in vertex-cache
-// order (meshopt_optimizeVertexCache: triangles reordered, vertices kept in place). The frame
+// _EMISSION_TIME float32 rounded to a multiple of the largest power of two not above the step
+// (within step / 2 seconds of the plain file's, c = 1: its low mantissa bits compress); indices
+// uint16 (uint32 past 65535 vertices), triangles in vertex-cache order and vertices in the order
+// they first use them (meshopt_optimizeVertexCache, meshopt_optimizeVertexFetchRemap). The frame
 // node's scale is its step (the animation shows it with scale = step, hides it with 0), so a
 // reader gets origin + step * q. The step: with a tolerance T, T / sqrt(3), which bounds the
 // quantization error by T / 2 (each coordinate moves at most step / 2); in vertex mode (no
-// tolerance), 16 bits over the frame's largest extent E: step = E / 65534, error at most
-// sqrt(3) / 2 * E / 65534 (about 1.3e-5 E); --meshopt-bits B asks for step = E / (2^B - 2)
-// instead (a warning says when its bound exceeds T). When E / step would exceed int16 the step
+// tolerance), 14 bits over the frame's largest extent E (Draco's and gltfpack's default): step =
+// E / 16382, error at most sqrt(3) / 2 * E / 16382 (about 5.3e-5 E); --meshopt-bits B asks for
+// step = E / (2^B - 2) instead (a warning says when its bound exceeds T). When E / step would exceed int16 the step
 // grows to E / 65534 and the warning says so too.
 // Index buffers are shared: a primitive whose index list (and vertex count) equals that of the
 // same object in the previous frame refers to that frame's index accessor (plain and meshopt;

@@ -143,7 +143,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->add_flag("--draco", rs.glb.draco, "Same as --compress draco");
     render_cmd->add_option("--meshopt-bits", rs.glb.meshopt_bits,
                            "meshopt position bits over each frame's extent (2-16; default: a step following the "
-                           "tolerance, 16 bits in vertex mode)");
+                           "tolerance, 14 bits in vertex mode)");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
         ->capture_default_str();
     render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
