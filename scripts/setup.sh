@@ -26,6 +26,7 @@ if [ "$mode" = test ]; then
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
   packages+=(blender python3-numpy)  # Blender imports the .glb (tests/blender); its importer needs numpy
   packages+=(python3 clang-14 libclang-rt-14-dev)  # kill test (tests/kill_test.py); libFuzzer for scripts/fuzz.sh
+  packages+=(gltfpack assimp-utils)  # scripts/measure_gltf_sizes.sh: gltfpack -cc beside our codecs; the Duck as OBJ
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi
