@@ -508,6 +508,29 @@ TEST(Cli, OutputIsIdenticalForAnyThreadCount) {
     }
 }
 
+// The same for the .glb's parallel conversion (crease split, float32, meshopt encoding) on a mesh
+// large enough to be split among threads (20480 faces), plain and meshopt, vertex mode and refined.
+TEST(Cli, GlbIsIdenticalForAnyThreadCountOnALargeMesh) {
+    TempDir dir;
+    writePassingSphereScene(dir / "scene", "icosphere20480.obj");
+    for (const char* compress : {"none", "meshopt"})
+        for (const char* tolerance : {"vertex", "0.002"}) {
+            std::string bytes[2];
+            for (int t = 0; t < 2; ++t) {
+                const fs::path out = dir / (std::string(compress) + tolerance + std::to_string(t));
+                ASSERT_EQ(apparentRun({"render", (dir / "scene/scene.json").string(), "--out", out.string(), "--frames",
+                                       "0:6", "--tolerance", tolerance, "--compress", compress, "--threads",
+                                       t == 0 ? "1" : "2", "--quiet"})
+                              .code,
+                          0);
+                std::ifstream in(out / "relativistic.glb", std::ios::binary);
+                bytes[t].assign((std::istreambuf_iterator<char>(in)), {});
+            }
+            ASSERT_FALSE(bytes[0].empty());
+            EXPECT_EQ(bytes[0], bytes[1]) << compress << " " << tolerance;
+        }
+}
+
 // An absurdly fine tolerance is refused up front (below 1e-6 of the object's size, issue 15); one
 // just above that floor stops at the refinement limit with a warning, not a crash.
 TEST(Cli, AbsurdToleranceHitsTheLimitWithAWarning) {
