@@ -71,8 +71,10 @@ struct GlbStats {
 // spill file in the output's folder that has no name (openAnonymousFile, atomic_file.h: nothing
 // is left behind whatever ends the process), only the JSON-side
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
-// under a temporary name and renames it into place. Memory does not grow with the frame data;
-// the disk briefly holds the binary data twice.
+// under a temporary name and renames it into place. Memory does not grow with the frame data:
+// besides the JSON side it keeps the previous frame's index lists (to share equal ones) and a
+// pool of frame buffers that prepare() reuses frame after frame (no allocation per frame once the
+// frames stop growing); the disk briefly holds the binary data twice.
 struct GlbFrameData;  // one frame converted for the file (GlbSequenceWriter::prepare)
 
 class GlbSequenceWriter {
@@ -99,8 +101,9 @@ private:
 
 // The .glb as a frame sink: one GlbSequenceWriter per sequence (begin() starts it), frames
 // converted by prepare() on the loop's worker threads. finish() reports the file and its size
-// (with Draco also the size without it); `verbose` adds the float32 and Draco position error
-// bounds to the summary, and a warning says when Draco's bound exceeds the sequence's tolerance.
+// (with Draco or meshopt also the size without it); `verbose` adds the float32 and the codec's
+// position error bounds to the summary, and a warning says when the codec's bound exceeds the
+// sequence's tolerance (meshopt: only with --meshopt-bits, or where int16 cannot hold a frame).
 class GlbSink : public FrameSink {
 public:
     GlbSink(std::string path, const GlbOptions& options, bool verbose);
@@ -120,7 +123,7 @@ private:
     std::string model_;
     double tolerance_ = 0;
     OutputCheck check_;
-    long long least_ = 0;  // least size of the file so far without Draco (positions and indices alone)
+    long long least_ = 0;  // least size of the file so far uncompressed (positions and normals alone)
     std::unique_ptr<GlbSequenceWriter> writer_;
 };
 
