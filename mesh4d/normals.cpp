@@ -24,13 +24,12 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();
 
     // Step: face area vectors and unit normals (parallel); faces around each vertex (CSR layout).
-    w->area.resize(nf);
-    w->unit.resize(nf);
+    w->face.resize(nf);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t f = r.begin(); f < r.end(); ++f) {
             const auto& t = mesh.triangles[f];
-            w->area[f] = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
-            w->unit[f] = unitOr(w->area[f], {0, 0, 0});
+            const Vec3 a = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
+            w->face[f] = {a, unitOr(a, {0, 0, 0})};
         }
     });
     const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
@@ -48,8 +47,7 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         for (size_t f = 0; f < nf; ++f)
             for (uint32_t v : mesh.triangles[f]) w->faces[w->fill[v]++] = uint32_t(f);
     }
-    const std::vector<Vec3>& area = w->area;
-    const std::vector<Vec3>& unit = w->unit;
+    const std::vector<CreaseWork::Face>& face = w->face;
     const std::vector<uint32_t>& start = w->start;
     const std::vector<uint32_t>& faces = w->faces;
 
@@ -59,9 +57,9 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         Vec3 sum{0, 0, 0};
         for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
             const uint32_t g = faces[k];
-            if (g == f || dot(unit[g], unit[f]) >= cos_crease) sum += area[g];
+            if (g == f || dot(face[g].unit, face[f].unit) >= cos_crease) sum += face[g].area;
         }
-        return unitOr(sum, unitOr(area[f], {0, 0, 1}));
+        return unitOr(sum, unitOr(face[f].area, {0, 0, 1}));
     };
 
     // Step (parallel): a vertex whose faces are all within the crease angle of one another gives
@@ -76,27 +74,30 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v < r.end(); ++v) {
             if (start[v] == start[v + 1]) continue;
-            Vec3 mean{0, 0, 0};
-            for (uint32_t a = start[v]; a < start[v + 1]; ++a) mean += unit[faces[a]];
+            // The mean direction, and the sum of the area vectors in CSR order (what every corner
+            // would sum), in one pass.
+            Vec3 mean{0, 0, 0}, sum{0, 0, 0};
+            for (uint32_t a = start[v]; a < start[v + 1]; ++a) {
+                mean += face[faces[a]].unit;
+                sum += face[faces[a]].area;
+            }
             const double len = norm(mean);
             bool all = len > 0;
             for (uint32_t a = start[v]; a < start[v + 1] && all; ++a)
-                all = dot(unit[faces[a]], mean) >= cos_half * len;
+                all = dot(face[faces[a]].unit, mean) >= cos_half * len;
             if (!all) {
                 all = true;
                 for (uint32_t a = start[v]; a < start[v + 1] && all; ++a) {
                     const uint32_t f = faces[a];
                     for (uint32_t b = start[v]; b < start[v + 1]; ++b) {
                         const uint32_t g = faces[b];
-                        if (g != f && !(dot(unit[g], unit[f]) >= cos_crease)) {
+                        if (g != f && !(dot(face[g].unit, face[f].unit) >= cos_crease)) {
                             all = false;
                             break;
                         }
                     }
                 }
             }
-            Vec3 sum{0, 0, 0};
-            for (uint32_t a = start[v]; a < start[v + 1]; ++a) sum += area[faces[a]];
             if (!all || !(norm(sum) > 0)) continue;
             w->uniform[v] = 1;
             w->vertex_normal[v] = sum / norm(sum);

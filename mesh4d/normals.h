@@ -37,7 +37,11 @@ struct CreaseMap {
     std::vector<std::array<uint32_t, 3>> triangles;
 };
 struct CreaseWork {
-    std::vector<Vec3> area, unit, vertex_normal;
+    struct Face {
+        Vec3 area, unit;  // edge cross product (twice the area vector) and its direction
+    };
+    std::vector<Face> face;
+    std::vector<Vec3> vertex_normal;
     std::vector<uint32_t> start, faces, fill, first_copy, next_copy;
     std::vector<unsigned char> uniform;
     std::vector<std::array<uint32_t, 3>> triangles;  // the last call's triangles (adjacency reuse)
