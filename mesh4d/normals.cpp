@@ -29,7 +29,10 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         for (size_t f = r.begin(); f < r.end(); ++f) {
             const auto& t = mesh.triangles[f];
             const Vec3 a = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
-            w->face[f] = {a, unitOr(a, {0, 0, 0})};
+            // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s
+            // hypot (the output normals below still use norm()).
+            const double len2 = dot(a, a);
+            w->face[f] = {a, len2 > 0 ? a / std::sqrt(len2) : Vec3{0, 0, 0}};
         }
     });
     const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
