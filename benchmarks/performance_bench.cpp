@@ -8,6 +8,9 @@
 //   BM_ClosedFormOnly/N    the closed form alone (no output mesh bookkeeping), one core
 //   BM_CutTolerance/N      the same at tolerance 1e-3 x the object's size
 //   BM_ExportFrame/F       1.: one frame of the 1M-triangle torus cut and written: F = 0 .glb, 1 PLY
+//   BM_GlbSequenceFrame    2.: one more frame of a .glb sequence of the 1M-triangle torus, cut and
+//                          exported (the writer's buffers reused); finish_ms_per_frame: the file's
+//                          assembly at the end, per frame
 //   BM_Frames/N            3.: `apparent render` end to end, N frames of a 20k-triangle torus (.glb)
 //   BM_Culling/C           4.: 100 objects, most not existing or out of view in a frame;
 //                          C = 1 with the 4D-box cull and --cull-view, 0 with both off
@@ -16,6 +19,7 @@
 //                          2 threads (T = 2), no export
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -123,6 +127,44 @@ void BM_ExportFrame(benchmark::State& state) {
                             : apparent::writePly((dir / "f.ply").string(), frame, &error);
         if (!ok) state.SkipWithError(error.c_str());
     }
+    state.counters["vertex_frames_per_s"] =
+        benchmark::Counter(double(p.world.mesh.positions.size()), benchmark::Counter::kIsIterationInvariantRate);
+    fs::remove_all(dir);
+}
+
+// A .glb sequence of the 1M-triangle torus, one frame per iteration (camera time advancing 0.05 s
+// a frame), cut and added to one GlbSequenceWriter: crease split, normals, float32 conversion
+// and the frame's data written out, with the buffers of earlier frames reused. The file's
+// assembly by finish() (JSON, BIN chunk copied into place, fsync, rename) is timed apart and
+// reported per frame.
+void BM_GlbSequenceFrame(benchmark::State& state) {
+    const Passing& p = passing(1'000'000);
+    const fs::path dir = fs::temp_directory_path() / "apparent_perf_sequence";
+    fs::create_directories(dir);
+    apparent::SequenceInfo info;
+    info.model = "relativistic";
+    info.fps = 20;
+    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, -1, ""});
+    long long k = 0;
+    double finish_ms = 0;
+    {
+        apparent::GlbSequenceWriter writer((dir / "s.glb").string(), info, {});
+        for (auto _ : state) {
+            mesh4d::ViewSurface view = p.view;
+            view.t_c = 0.05 * double(k);
+            apparent::ExportFrame frame;
+            frame.index = k++;
+            frame.t_c = view.t_c;
+            frame.objects.push_back(mesh4d::sliceWorld(p.world, view, {}));
+            std::string error;
+            if (!writer.add(frame, &error)) state.SkipWithError(error.c_str());
+        }
+        const auto t0 = std::chrono::steady_clock::now();
+        std::string error;
+        if (!writer.finish(nullptr, &error)) state.SkipWithError(error.c_str());
+        finish_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+    state.counters["finish_ms_per_frame"] = k > 0 ? finish_ms / double(k) : 0.0;
     state.counters["vertex_frames_per_s"] =
         benchmark::Counter(double(p.world.mesh.positions.size()), benchmark::Counter::kIsIterationInvariantRate);
     fs::remove_all(dir);
@@ -250,6 +292,7 @@ BENCHMARK(BM_CutVertexMode)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'00
 BENCHMARK(BM_ClosedFormOnly)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CutTolerance)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExportFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GlbSequenceFrame)->Iterations(40)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Frames)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_Culling)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Threads)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(2);

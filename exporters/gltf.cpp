@@ -7,13 +7,18 @@
 #include <memory>
 #include <filesystem>
 #include <iomanip>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
 #include <draco/mesh/mesh.h>
+#include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include "exporters/atomic_file.h"
 #include "mesh4d/angles.h"
@@ -30,11 +35,69 @@ namespace {
 using mesh4d::Vec3;
 
 // One primitive's data as it goes into the file: float32 positions relative to the frame origin.
+// With meshopt also its packed vertices (kMeshoptStride bytes each, in vertex-fetch order),
+// its indices in vertex-cache order referring to them, and POSITION's integer bounds.
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
-    std::vector<uint32_t> indices;
+    std::vector<uint32_t> indices;  // as cut (what index sharing compares)
+    std::vector<unsigned char> packed;
+    std::vector<uint32_t> ordered;
+    int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
     size_t vertexCount() const { return emission.size(); }
 };
+
+// A frame's meshopt vertex stream: every shown object's packed vertices in object order, encoded
+// as one EXT_meshopt_compression ATTRIBUTES view.
+struct MeshoptFrame {
+    std::vector<unsigned char> encoded;
+    size_t count = 0;                // vertices in all
+    std::vector<size_t> first;       // per object, its first vertex in the stream
+};
+
+constexpr size_t kMeshoptStride = 16;  // int16 x, y, z, 0 | int8 nx, ny, nz, 0 | float32 emission time
+
+// The emission time as meshopt stores it: rounded (half away from zero) to a multiple of the
+// largest power of two not above `step`, so that its low mantissa bits are zero and compress;
+// it stays a float32 that readers use as it is, within step / 2 seconds of the plain file's.
+float emissionQuantized(float t, double step) {
+    const double q = std::ldexp(1.0, int(std::floor(std::log2(step))));
+    return float(std::round(double(t) / q) * q);
+}
+
+// The meshopt form of `d`: positions quantized from the exact relative coordinates `rel` (xyz
+// per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
+// triangles first use them (both depend on the index list alone, so frames with equal index
+// lists get equal orders). Returns the largest |step * q - rel| over the coordinates.
+double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step) {
+    const size_t nv = d->vertexCount();
+    d->ordered.resize(d->indices.size());
+    meshopt_optimizeVertexCache(d->ordered.data(), d->indices.data(), d->indices.size(), nv);
+    std::vector<unsigned int> remap(nv);
+    const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), d->ordered.data(), d->ordered.size(), nv);
+    meshopt_remapIndexBuffer(d->ordered.data(), d->ordered.data(), d->ordered.size(), remap.data());
+    d->packed.assign(used * kMeshoptStride, 0);
+    double worst = 0;
+    for (int c = 0; c < 3; ++c) { d->qmin[c] = INT32_MAX; d->qmax[c] = INT32_MIN; }
+    for (size_t i = 0; i < nv; ++i) {
+        if (remap[i] == ~0u) continue;  // used by no triangle: dropped (a cut mesh has none)
+        unsigned char* v = d->packed.data() + size_t(remap[i]) * kMeshoptStride;
+        int16_t q[4] = {0, 0, 0, 0};
+        int8_t n[4] = {0, 0, 0, 0};
+        for (int c = 0; c < 3; ++c) {
+            const double x = std::nearbyint(rel[3 * i + c] / step);
+            q[c] = int16_t(std::clamp(x, -32767.0, 32767.0));
+            worst = std::max(worst, std::fabs(double(q[c]) * step - rel[3 * i + c]));
+            d->qmin[c] = std::min(d->qmin[c], int(q[c]));
+            d->qmax[c] = std::max(d->qmax[c], int(q[c]));
+            n[c] = int8_t(meshopt_quantizeSnorm(d->normals[3 * i + c], 8));
+        }
+        std::memcpy(v, q, 8);
+        std::memcpy(v + 8, n, 4);
+        const float t = emissionQuantized(d->emission[i], step);
+        std::memcpy(v + 12, &t, 4);
+    }
+    return worst;
+}
 
 // Where the BIN chunk goes while frames arrive: a spill file (so memory does not grow with the
 // frame count), or nowhere (counting only, for the size without Draco).
@@ -86,8 +149,8 @@ public:
         return int(model.accessors.size()) - 1;
     }
 
-    // A plain (uncompressed) primitive.
-    tinygltf::Primitive plainPrimitive(const PrimitiveData& d) {
+    // A plain (uncompressed) primitive; `shared_indices` >= 0: that index accessor instead of a new one.
+    tinygltf::Primitive plainPrimitive(const PrimitiveData& d, int shared_indices) {
         tinygltf::Primitive prim;
         std::vector<double> lo, hi;
         bounds(d.positions, &lo, &hi);
@@ -98,10 +161,67 @@ public:
         prim.attributes["_EMISSION_TIME"] = addAccessor(addView(d.emission.data(), d.emission.size() * 4, kArray),
                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
                                                         d.vertexCount());
-        prim.indices = addAccessor(addView(d.indices.data(), d.indices.size() * 4, kElements),
-                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, d.indices.size());
+        prim.indices = shared_indices >= 0
+                           ? shared_indices
+                           : addAccessor(addView(d.indices.data(), d.indices.size() * 4, kElements),
+                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, d.indices.size());
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         return prim;
+    }
+
+    // An EXT_meshopt_compression primitive: its vertices at `first_vertex` of the frame's vertex
+    // view `vview`, its indices the accessor `indices` (made by the caller: new or shared).
+    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, int vview, size_t first_vertex, int indices) {
+        tinygltf::Primitive prim;
+        const size_t nv = d.packed.size() / kMeshoptStride;
+        auto attribute = [&](size_t offset, int component, int type, bool normalized, std::vector<double> lo,
+                             std::vector<double> hi) {
+            const int a = addAccessor(vview, component, type, nv, std::move(lo), std::move(hi));
+            model.accessors[a].byteOffset = first_vertex * kMeshoptStride + offset;
+            model.accessors[a].normalized = normalized;
+            return a;
+        };
+        prim.attributes["POSITION"] =
+            attribute(0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
+                      {double(d.qmin[0]), double(d.qmin[1]), double(d.qmin[2])},
+                      {double(d.qmax[0]), double(d.qmax[1]), double(d.qmax[2])});
+        prim.attributes["NORMAL"] = attribute(8, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_TYPE_VEC3, true, {}, {});
+        prim.attributes["_EMISSION_TIME"] = attribute(12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        prim.indices = indices;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        return prim;
+    }
+
+    // A view of the fallback buffer (1, no data) whose EXT_meshopt_compression object points at
+    // `encoded` in the BIN chunk; the extension objects are added to the JSON by meshoptJson().
+    int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices) {
+        static const char zeros[4] = {0, 0, 0, 0};
+        if (sink_->size % 4) sink_->write(zeros, 4 - sink_->size % 4);
+        MeshoptView mv{sink_->size, encoded.size(), stride, count, indices};
+        sink_->write(encoded.data(), encoded.size());
+        tinygltf::BufferView v;
+        v.buffer = 1;
+        v.byteOffset = fallback_size;
+        v.byteLength = count * stride;
+        v.byteStride = indices ? 0 : stride;
+        v.target = indices ? kElements : kArray;
+        fallback_size += (v.byteLength + 3) / 4 * 4;
+        model.bufferViews.push_back(v);
+        meshopt_views.emplace_back(int(model.bufferViews.size()) - 1, mv);
+        return int(model.bufferViews.size()) - 1;
+    }
+
+    // Adds the meshopt views' extension objects and the fallback buffer to the JSON `j`.
+    void meshoptJson(nlohmann::json* j) const {
+        if (meshopt_views.empty()) return;
+        for (const auto& [view, mv] : meshopt_views) {
+            nlohmann::json ext = {{"buffer", 0},           {"byteOffset", mv.offset}, {"byteLength", mv.length},
+                                  {"byteStride", mv.stride}, {"count", mv.count},
+                                  {"mode", mv.indices ? "TRIANGLES" : "ATTRIBUTES"}};
+            (*j)["bufferViews"][size_t(view)]["extensions"]["EXT_meshopt_compression"] = ext;
+        }
+        (*j)["buffers"][1] = {{"byteLength", fallback_size},
+                              {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}};
     }
 
     // A KHR_draco_mesh_compression primitive; returns false with a message when Draco fails.
@@ -185,6 +305,12 @@ private:
     static constexpr int kElements = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
     GlbOptions options_;
     BinSink* sink_;
+    struct MeshoptView {
+        size_t offset, length, stride, count;
+        bool indices;
+    };
+    std::vector<std::pair<int, MeshoptView>> meshopt_views;
+    size_t fallback_size = 0;
 
     static void bounds(const std::vector<float>& xyz, std::vector<double>* lo, std::vector<double>* hi) {
         lo->assign(3, INFINITY);
@@ -199,26 +325,42 @@ private:
 // Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
 // are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
 constexpr double kCreaseDeg = 30.0;
-PrimitiveData toPrimitive(const mesh4d::ApparentMesh& input, const double origin[3], double* max_err) {
-    PrimitiveData d;
-    const mesh4d::CreasedMesh creased = mesh4d::creaseSplit(input, kCreaseDeg);
-    const mesh4d::ApparentMesh& m = creased.mesh;
-    const std::vector<Vec3>& normals = creased.normals;
-    d.positions.reserve(3 * m.positions.size());
-    for (size_t i = 0; i < m.positions.size(); ++i) {
-        for (int c = 0; c < 3; ++c) {
-            // The object's own origin first: both large terms cancel before the small local one is added.
-            const double rel = (m.origin[c] - origin[c]) + m.positions[i][c];
-            const float fv = float(rel);
-            d.positions.push_back(fv);
-            *max_err = std::max(*max_err, std::fabs(double(fv) - rel));
-            d.normals.push_back(float(normals[i][c]));
-        }
-    }
-    d.emission.reserve(m.emission_times.size());
-    for (size_t i = 0; i < m.emission_times.size(); ++i) d.emission.push_back(float(m.absoluteTime(i)));
-    for (const auto& t : m.triangles) d.indices.insert(d.indices.end(), t.begin(), t.end());
-    return d;
+// With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
+// receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
+// `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
+// split's (reused the same way, object by object).
+void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
+                 double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work) {
+    mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
+    const size_t nv = map->source.size();
+    d->positions.resize(3 * nv);
+    d->normals.resize(3 * nv);
+    d->emission.resize(nv);
+    std::vector<double> exact(step > 0 ? 3 * nv : 0);
+    // The object's own origin first: both large terms cancel before the small local one is added.
+    const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
+    const double worst = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double w) {
+            for (size_t k = r.begin(); k < r.end(); ++k) {
+                const uint32_t v = map->source[k];
+                for (int c = 0; c < 3; ++c) {
+                    const double rel = shift[c] + m.positions[v][c];
+                    const float fv = float(rel);
+                    d->positions[3 * k + c] = fv;
+                    w = std::max(w, std::fabs(double(fv) - rel));
+                    d->normals[3 * k + c] = float(map->normals[k][c]);
+                    if (step > 0) exact[3 * k + c] = rel;
+                }
+                d->emission[k] = float(m.absoluteTime(v));
+            }
+            return w;
+        },
+        [](double x, double y) { return std::max(x, y); });
+    *max_err = std::max(*max_err, worst);
+    d->indices.resize(3 * map->triangles.size());
+    if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
+    if (step > 0) *max_quant = std::max(*max_quant, packMeshopt(d, exact, step));
 }
 
 // Rotation quaternion (x, y, z, w) of the camera node: glTF cameras look down local -Z with +Y
@@ -286,15 +428,26 @@ struct SequenceModel {
             model.extensionsUsed.push_back("KHR_draco_mesh_compression");
             model.extensionsRequired.push_back("KHR_draco_mesh_compression");
         }
+        if (options.meshopt) {
+            for (const char* e : {"EXT_meshopt_compression", "KHR_mesh_quantization"}) {
+                model.extensionsUsed.push_back(e);
+                model.extensionsRequired.push_back(e);
+            }
+        }
+        compression = options.draco ? Compression::draco : options.meshopt ? Compression::meshopt : Compression::none;
+        previous.resize(info.objects.size());
     }
 
     // Step: frame k's node (node 1 + k), given each object's primitive data (empty: not shown).
     // The scene's own objects go into the frame node's mesh; reflections (ExportObject::mirror)
     // into one mesh per mirror, whose child node of the frame node is made in finish(), after all
     // frame nodes, so that frame k stays node 1 + k. Meshes are numbered in frame order either way.
-    bool addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3], bool draco,
-                  GlbStats* stats, std::string* error) {
+    // `scale`: the frame node's scale while shown (meshopt: the quantization step, else 1).
+    // `meshopt`: the frame's encoded vertex stream (with meshopt compression).
+    bool addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3], double scale,
+                  const MeshoptFrame* meshopt, GlbStats* stats, std::string* error) {
         tinygltf::Node node;
+        if (previous.size() < f.objects.size()) previous.resize(f.objects.size());
         node.name = frameName(f.index);
         // Step: the objects' groups in order: -1 (the frame node) first, then mirrors as they appear.
         std::vector<int> groups;
@@ -304,22 +457,78 @@ struct SequenceModel {
             if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
         }
         std::stable_partition(groups.begin(), groups.end(), [](int g) { return g < 0; });
+        // Step: which objects share the previous frame's index list (the same list as cut, and the
+        // same vertex count): their primitives refer to its accessor.
+        std::vector<int> shared(f.objects.size(), -1);
+        for (size_t o = 0; o < f.objects.size(); ++o) {
+            const Previous& prev = previous[o];
+            if (compression != Compression::draco && !f.objects[o].triangles.empty() && prev.accessor >= 0 &&
+                prev.vertices == data[o].vertexCount() && prev.indices == data[o].indices)
+                shared[o] = prev.accessor;
+        }
+        // Step (meshopt): the frame's vertex view, and one index view for the objects that do not
+        // share, uint16 unless one of them has more than 65535 vertices.
+        int vview = -1;
+        std::vector<int> meshopt_indices(f.objects.size(), -1);
+        if (compression == Compression::meshopt && meshopt && meshopt->count > 0) {
+            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, kMeshoptStride, false);
+            size_t size = 2, count = 0, most = 0;
+            for (size_t o = 0; o < f.objects.size(); ++o)
+                if (!f.objects[o].triangles.empty() && shared[o] < 0) {
+                    most = std::max(most, data[o].packed.size() / kMeshoptStride);
+                    count += data[o].ordered.size();
+                }
+            if (most > 65535) size = 4;
+            if (count > 0) {
+                std::vector<unsigned int> all;
+                all.reserve(count);
+                std::vector<size_t> first(f.objects.size(), 0);
+                for (size_t o = 0; o < f.objects.size(); ++o)
+                    if (!f.objects[o].triangles.empty() && shared[o] < 0) {
+                        first[o] = all.size();
+                        all.insert(all.end(), data[o].ordered.begin(), data[o].ordered.end());
+                    }
+                std::vector<unsigned char> encoded(meshopt_encodeIndexBufferBound(all.size(), most));
+                encoded.resize(meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), all.data(), all.size()));
+                const int iview = b.addMeshoptView(encoded, all.size(), size, true);
+                for (size_t o = 0; o < f.objects.size(); ++o)
+                    if (!f.objects[o].triangles.empty() && shared[o] < 0) {
+                        const int a = b.addAccessor(iview,
+                                                    size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
+                                                              : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                                    TINYGLTF_TYPE_SCALAR, data[o].ordered.size());
+                        b.model.accessors[a].byteOffset = first[o] * size;
+                        meshopt_indices[o] = a;
+                    }
+            }
+        }
+        std::vector<bool> shown(f.objects.size(), false);
         for (const int group : groups) {
             tinygltf::Mesh mesh;
             mesh.name = group < 0 ? node.name : reflectionName(node.name, mirrorName(group));
             for (size_t o = 0; o < f.objects.size(); ++o) {
                 if (f.objects[o].triangles.empty() || groupOf(o) != group) continue;
                 tinygltf::Primitive prim;
-                if (draco) {
+                Previous& prev = previous[o];
+                if (compression == Compression::draco) {
                     double qerr = 0;
                     if (!b.dracoPrimitive(data[o], &prim, &qerr, error)) {
                         *error = mesh.name + ": " + *error;
                         return false;
                     }
                     stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
+                } else if (compression == Compression::meshopt) {
+                    prim = b.meshoptPrimitive(data[o], vview, meshopt->first[o],
+                                              shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
                 } else {
-                    prim = b.plainPrimitive(data[o]);
+                    prim = b.plainPrimitive(data[o], shared[o]);
                 }
+                if (compression != Compression::draco && shared[o] < 0) {
+                    prev.accessor = prim.indices;
+                    prev.vertices = data[o].vertexCount();
+                    prev.indices = data[o].indices;
+                }
+                shown[o] = true;
                 prim.material = o < info.objects.size() ? int(o) : -1;
                 mesh.primitives.push_back(prim);
             }
@@ -329,10 +538,14 @@ struct SequenceModel {
             else
                 reflections.push_back({frames, mirrorName(group), int(b.model.meshes.size()) - 1});
         }
+        // Sharing is between consecutive frames: an object not shown forgets its index list.
+        for (size_t o = 0; o < f.objects.size(); ++o)
+            if (!shown[o]) previous[o] = Previous();
         // Reflections are relative to the same origin: their child nodes need no transform.
         if (!groups.empty()) node.translation = {origin[0], origin[1], origin[2]};
-        const double s = frames == 0 ? 1.0 : 0.0;
+        const double s = frames == 0 ? scale : 0.0;
         node.scale = {s, s, s};
+        frame_scales.push_back(float(scale));
         b.model.nodes.push_back(node);
         scene.nodes.push_back(int(b.model.nodes.size()) - 1);
         frame_times.push_back(tinygltf::Value(f.t_c));
@@ -367,23 +580,49 @@ struct SequenceModel {
         // count: scale 0 until k/fps, 1 during frame k, 0 from (k+1)/fps on. The last frame keeps
         // scale 1 at the final key n/fps, which closes the sequence so that it lasts 1/fps too
         // (with one key per frame the last frame would have zero length).
+        // All key times in one view, the distinct scale sequences (a handful: frame scales repeat)
+        // in another, each channel's accessors pointing into them.
         const size_t n = frames;
         tinygltf::Animation anim;
         anim.name = "frames";
+        std::vector<float> all_times, all_scales;
+        std::vector<std::pair<size_t, size_t>> time_keys(n);  // offset (floats) and count per frame
+        std::vector<size_t> scale_key(n);                   // offset (floats) of the frame's scales
+        std::map<std::vector<float>, size_t> distinct;
         for (size_t k = 0; k < n; ++k) {
-            std::vector<float> times, scales;
+            std::vector<float> scales;
+            time_keys[k] = {all_times.size(), 0};
             auto key = [&](size_t i, float v) {
-                times.push_back(float(double(i) / info.fps));
+                all_times.push_back(float(double(i) / info.fps));
                 scales.insert(scales.end(), {v, v, v});
+                ++time_keys[k].second;
             };
+            const float shown = frame_scales[k];
             if (k > 0) key(0, 0.0f);
-            key(k, 1.0f);
-            key(k + 1, k + 1 == n ? 1.0f : 0.0f);
-            const int in_acc = b.addAccessor(b.addView(times.data(), times.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                             TINYGLTF_TYPE_SCALAR, times.size(), {double(times.front())},
-                                             {double(times.back())});
-            const int out_acc = b.addAccessor(b.addView(scales.data(), scales.size() * 4, 0),
-                                              TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, times.size());
+            key(k, shown);
+            key(k + 1, k + 1 == n ? shown : 0.0f);
+            auto it = distinct.find(scales);
+            if (it == distinct.end()) {
+                it = distinct.emplace(scales, all_scales.size()).first;
+                all_scales.insert(all_scales.end(), scales.begin(), scales.end());
+            }
+            scale_key[k] = it->second;
+        }
+        const int times_view = b.addView(all_times.data(), all_times.size() * 4, 0);
+        const int scales_view = b.addView(all_scales.data(), all_scales.size() * 4, 0);
+        std::map<size_t, int> scale_accessors;  // by offset
+        for (size_t k = 0; k < n; ++k) {
+            const auto [offset, count] = time_keys[k];
+            const int in_acc = b.addAccessor(times_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, count,
+                                             {double(all_times[offset])}, {double(all_times[offset + count - 1])});
+            b.model.accessors[in_acc].byteOffset = 4 * offset;
+            auto sa = scale_accessors.find(scale_key[k]);
+            if (sa == scale_accessors.end()) {
+                const int a = b.addAccessor(scales_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, count);
+                b.model.accessors[a].byteOffset = 4 * scale_key[k];
+                sa = scale_accessors.emplace(scale_key[k], a).first;
+            }
+            const int out_acc = sa->second;
             tinygltf::AnimationSampler sampler;
             sampler.input = in_acc;
             sampler.output = out_acc;
@@ -432,6 +671,7 @@ struct SequenceModel {
         std::memcpy(&json_len, bytes.data() + 12, 4);
         nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_len));
         j["buffers"][0]["byteLength"] = b.sinkSize();
+        b.meshoptJson(&j);
         return j.dump();
     }
 
@@ -439,8 +679,17 @@ struct SequenceModel {
     GlbBuilder b;
     tinygltf::Scene scene;
     tinygltf::Value::Array frame_times;
+    std::vector<float> frame_scales;  // per frame, its node's scale while shown
     long long first_frame = 0;
     size_t frames = 0;
+    enum class Compression { none, draco, meshopt } compression = Compression::none;
+    // Per object, its index list in the previous frame and the accessor holding it (-1: none).
+    struct Previous {
+        int accessor = -1;
+        size_t vertices = 0;
+        std::vector<uint32_t> indices;
+    };
+    std::vector<Previous> previous;
     struct Reflection {
         size_t frame;        // frame node 1 + frame is the parent
         std::string mirror;  // the mirror's name
@@ -453,15 +702,52 @@ size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
 
 }  // namespace
 
+struct GlbFrameData : PreparedFrame {
+    // For a frame of `objects` objects, keeping every vector's capacity.
+    void reset(size_t objects) {
+        origin[0] = origin[1] = origin[2] = 0;
+        step = 0;
+        clamped = false;
+        meshopt.encoded.clear();
+        meshopt.count = 0;
+        meshopt.first.clear();
+        data.resize(objects);
+        crease_map.resize(objects);
+        crease_work.resize(objects);
+        for (PrimitiveData& p : data) {
+            for (auto* v : {&p.positions, &p.normals, &p.emission}) v->clear();
+            p.indices.clear();
+            p.ordered.clear();
+            p.packed.clear();
+        }
+        far = max_extent = max_float_error = max_quantization_error = 0;
+    }
+    double origin[3] = {0, 0, 0};
+    double step = 0;       // meshopt: the quantization step (0 without meshopt)
+    bool clamped = false;  // meshopt: the step grew to fit int16
+    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex stream
+    std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
+    std::vector<mesh4d::CreaseMap> crease_map;  // per object, toPrimitive's scratch
+    std::vector<mesh4d::CreaseWork> crease_work;
+    double far = 0, max_extent = 0, max_float_error = 0, max_quantization_error = 0;
+};
+
+// Frame buffers given back by released GlbFrameData (shared with their deleters, so it outlives
+// the writer while a prepared frame is still held).
+struct FramePool {
+    std::mutex mutex;
+    std::vector<std::unique_ptr<GlbFrameData>> free;
+};
+
 struct GlbSequenceWriter::Impl {
     Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
         : path(p), info(i), options(o), model(info, options, &sink) {
         // The spill file has no name (atomic_file.h): nothing is left behind, even after SIGKILL.
         const std::string dir = std::filesystem::path(p).parent_path().string();
         sink.fd = openAnonymousFile(dir, &sink.error);
-        if (options.draco) {
+        if (options.draco || options.meshopt) {
             GlbOptions plain_options = options;
-            plain_options.draco = false;
+            plain_options.draco = plain_options.meshopt = false;
             plain = std::make_unique<SequenceModel>(info, plain_options, &count_only);
         }
     }
@@ -474,9 +760,10 @@ struct GlbSequenceWriter::Impl {
     GlbOptions options;
     BinSink sink, count_only;
     SequenceModel model;
-    std::unique_ptr<SequenceModel> plain;  // with Draco: the same sequence without it, counted
+    std::unique_ptr<SequenceModel> plain;  // with Draco or meshopt: the same sequence without it, counted
     GlbStats stats;
     double far = 0;
+    std::shared_ptr<FramePool> pool = std::make_shared<FramePool>();
 };
 
 GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options)
@@ -484,30 +771,103 @@ GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo
 
 GlbSequenceWriter::~GlbSequenceWriter() = default;
 
-struct GlbFrameData : PreparedFrame {
-    double origin[3] = {0, 0, 0};
-    std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
-    double far = 0, max_extent = 0, max_float_error = 0;
-};
+
+namespace {
+
+// The meshopt quantization step of a frame of largest extent `extent` (gltf.h): from the
+// tolerance (T / sqrt(3)), from `bits` (E / (2^bits - 2)), or 14 bits over E in vertex mode; at
+// least E / 65534 so that every coordinate fits int16 (*clamped says when that decided). In
+// vertex mode 14 bits over E (E / 16382).
+double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
+    const double finest = extent / 65534.0;
+    double step = bits > 0        ? extent / (std::ldexp(1.0, bits) - 2)
+                  : tolerance > 0 ? tolerance / std::sqrt(3.0)
+                                  : extent / 16382.0;  // vertex mode: 14 bits, Draco's and gltfpack's default
+    *clamped = step < finest;  // only a tolerance can ask for more than int16 holds
+    if (*clamped) step = finest;
+    if (!(step > 0)) step = 1;  // every point at the origin: any step is exact
+    return step;
+}
+
+}  // namespace
 
 std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
-    auto d = std::make_shared<GlbFrameData>();
-    // Step: the frame's origin (the centre of its bounding box) and the far distance.
-    mesh4d::EventBox box;
-    for (const auto& o : f.objects)
-        for (size_t i = 0; i < o.positions.size(); ++i) {
-            const Vec3 p = o.absolutePosition(i);
-            d->far = std::max(d->far, mesh4d::norm(p - impl_->info.camera.position));
-            box.addPoint(p);
+    // Step: a frame's buffers from the writer's pool (they keep their capacity: a sequence does
+    // not allocate again frame after frame); the shared pointer gives them back when released.
+    std::shared_ptr<FramePool> pool = impl_->pool;
+    GlbFrameData* raw = nullptr;
+    {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (!pool->free.empty()) {
+            raw = pool->free.back().release();
+            pool->free.pop_back();
         }
+    }
+    if (!raw) raw = new GlbFrameData;
+    std::shared_ptr<GlbFrameData> d(raw, [pool](GlbFrameData* back) {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        pool->free.emplace_back(back);
+    });
+    d->reset(f.objects.size());
+    // Step: the frame's origin (the centre of its bounding box) and the far distance (parallel
+    // minima and maxima: exact in any order).
+    mesh4d::EventBox box;
+    const Vec3 camera = impl_->info.camera.position;
+    for (const auto& o : f.objects) {
+        struct Extremes {
+            mesh4d::EventBox box;
+            double far = 0;
+        };
+        const Extremes e = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, o.positions.size(), 16384), Extremes{},
+            [&](const tbb::blocked_range<size_t>& r, Extremes x) {
+                for (size_t i = r.begin(); i < r.end(); ++i) {
+                    const Vec3 p = o.absolutePosition(i);
+                    x.far = std::max(x.far, mesh4d::norm(p - camera));
+                    x.box.addPoint(p);
+                }
+                return x;
+            },
+            [](Extremes a, const Extremes& b) {
+                a.box.addPoint(b.box.lo);
+                a.box.addPoint(b.box.hi);
+                a.far = std::max(a.far, b.far);
+                return a;
+            });
+        d->far = std::max(d->far, e.far);
+        if (!o.positions.empty()) {
+            box.addPoint(e.box.lo);
+            box.addPoint(e.box.hi);
+        }
+    }
     const Vec3 center = box.center();
     for (int c = 0; c < 3; ++c) d->origin[c] = center[c];
     // Step: each object's float32 data with normals (crease split), relative to the origin.
-    d->data.resize(f.objects.size());
     if (f.triangleCount() > 0) {
         d->max_extent = std::max(d->max_extent, box.extent());
+        if (impl_->options.meshopt) {
+            d->step = meshoptStep(box.extent(), impl_->info.tolerance, impl_->options.meshopt_bits, &d->clamped);
+            d->max_quantization_error = std::sqrt(3.0) / 2 * d->step;
+        }
+        double worst_coordinate = 0;
         for (size_t o = 0; o < f.objects.size(); ++o)
-            if (!f.objects[o].triangles.empty()) d->data[o] = toPrimitive(f.objects[o], d->origin, &d->max_float_error);
+            if (!f.objects[o].triangles.empty())
+                toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
+                            &d->crease_map[o], &d->crease_work[o]);
+        if (impl_->options.meshopt) {
+            // Step: one vertex stream for the whole frame, encoded here (on the worker thread).
+            MeshoptFrame& mf = d->meshopt;
+            mf.first.assign(f.objects.size(), 0);
+            std::vector<unsigned char> all;
+            for (size_t o = 0; o < f.objects.size(); ++o) {
+                mf.first[o] = all.size() / kMeshoptStride;
+                all.insert(all.end(), d->data[o].packed.begin(), d->data[o].packed.end());
+            }
+            mf.count = all.size() / kMeshoptStride;
+            mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptStride));
+            mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count,
+                                                         kMeshoptStride));
+        }
     }
     return d;
 }
@@ -521,13 +881,16 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     m.stats.max_float_error = std::max(m.stats.max_float_error, prepared.max_float_error);
     const std::vector<PrimitiveData>& data = prepared.data;
     const double* origin = prepared.origin;
+    m.stats.max_quantization_error = std::max(m.stats.max_quantization_error, prepared.max_quantization_error);
+    m.stats.meshopt_range_clamped = m.stats.meshopt_range_clamped || prepared.clamped;
     // Step: into the model (binary data to the spill file), and into the counted plain twin.
-    if (!m.model.addFrame(f, data, origin, m.options.draco, &m.stats, error)) {
+    if (!m.model.addFrame(f, data, origin, prepared.step > 0 ? prepared.step : 1.0, &prepared.meshopt, &m.stats,
+                          error)) {
         *error = m.path + ": " + *error;
         return false;
     }
     GlbStats ignored;
-    if (m.plain && !m.plain->addFrame(f, data, origin, false, &ignored, error)) {
+    if (m.plain && !m.plain->addFrame(f, data, origin, 1.0, nullptr, &ignored, error)) {
         *error = m.path + ": " + *error;
         return false;
     }
@@ -645,10 +1008,14 @@ bool GlbSink::begin(const SequenceInfo& info, std::string*) {
 std::shared_ptr<const PreparedFrame> GlbSink::prepare(const ExportFrame& frame) const { return writer_->prepare(frame); }
 
 PendingOutput GlbSink::pending(const ExportFrame& frame) {
-    // Without Draco the file holds at least the frames' positions and indices (NORMAL and the
-    // emission time add more); Draco's size is not known before encoding. Nothing of the .glb
-    // counts as written before finish().
-    if (!options_.draco) least_ += leastFrameBytes(frame);
+    // Uncompressed, the file holds at least the frames' positions and normals, 24 bytes per
+    // vertex (indices may be shared with the previous frame); Draco's and meshopt's sizes are not
+    // known before encoding. Nothing of the .glb counts as written before finish().
+    if (!options_.draco && !options_.meshopt) {
+        long long vertices = 0;
+        for (const auto& o : frame.objects) vertices += (long long)o.positions.size();
+        least_ += 24 * vertices;
+    }
     return {least_, model_ + ".glb"};
 }
 
@@ -665,13 +1032,25 @@ bool GlbSink::finish(SinkSummary* summary, std::string* error) {
     // Step: ", out/m.glb (1.2 MiB with Draco, 4.5 MiB without); float32 ... ; Draco ..."
     summary->text = ", " + path_ + " (" + humanBytes(stats.bytes);
     if (options_.draco) summary->text += " with Draco, " + humanBytes(stats.bytes_without_draco) + " without";
+    if (options_.meshopt) summary->text += " with meshopt, " + humanBytes(stats.bytes_without_draco) + " without";
     summary->text += ")";
     std::ostringstream os;
     os << std::setprecision(3);
     if (verbose_) os << "; float32 position error <= " << stats.max_float_error << " ls";
     if (options_.draco && verbose_)
         os << "; Draco " << options_.position_bits << "-bit position error <= " << stats.max_quantization_error << " ls";
+    if (options_.meshopt && verbose_) os << "; meshopt position error <= " << stats.max_quantization_error << " ls";
     summary->text += os.str();
+    // meshopt's bound against the tolerance: a requested bit count too coarse, or a tolerance
+    // finer than int16 can hold over a frame.
+    if (options_.meshopt && tolerance_ > 0 && stats.max_quantization_error > tolerance_) {
+        std::ostringstream w;
+        w << std::setprecision(3) << path_ << ": meshopt position error up to " << stats.max_quantization_error
+          << " ls exceeds the tolerance " << tolerance_ << " ls; "
+          << (stats.meshopt_range_clamped ? "16 bits cannot hold a frame at that tolerance (use --compress draco)"
+                                          : "leave out --meshopt-bits (the step then follows the tolerance)");
+        summary->warnings.push_back(w.str());
+    }
     // Warn when Draco's quantization is coarser than the accuracy asked for (gltfpack warns the
     // same way about position bits).
     if (options_.draco && tolerance_ > 0 && stats.max_quantization_error > tolerance_) {

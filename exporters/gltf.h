@@ -20,6 +20,26 @@
 // are Edgebreaker-coded; POSITION is quantized to `position_bits` over the primitive's largest
 // extent, NORMAL to `normal_bits`, and _EMISSION_TIME kept lossless. Accessor counts and bounds
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
+// With meshopt (EXT_meshopt_compression and KHR_mesh_quantization, both required; the BIN chunk
+// holds the compressed streams, a fallback buffer without data stands for the decoded ones):
+// a frame's vertices (all its primitives') are one interleaved stream of 16 bytes each and its
+// indices one stream (so one compressed view each per frame), POSITION as int16 (not
+// normalized) multiples of the frame's step about the frame's origin, NORMAL as normalized int8,
+// _EMISSION_TIME float32 rounded to a multiple of the largest power of two not above the step
+// (within step / 2 seconds of the plain file's, c = 1: its low mantissa bits compress); indices
+// uint16 (uint32 past 65535 vertices), triangles in vertex-cache order and vertices in the order
+// they first use them (meshopt_optimizeVertexCache, meshopt_optimizeVertexFetchRemap). The frame
+// node's scale is its step (the animation shows it with scale = step, hides it with 0), so a
+// reader gets origin + step * q. The step: with a tolerance T, T / sqrt(3), which bounds the
+// quantization error by T / 2 (each coordinate moves at most step / 2); in vertex mode (no
+// tolerance), 14 bits over the frame's largest extent E (Draco's and gltfpack's default): step =
+// E / 16382, error at most sqrt(3) / 2 * E / 16382 (about 5.3e-5 E); --meshopt-bits B asks for
+// step = E / (2^B - 2) instead (a warning says when its bound exceeds T). When E / step would exceed int16 the step
+// grows to E / 65534 and the warning says so too.
+// Index buffers are shared: a primitive whose index list (and vertex count) equals that of the
+// same object in the previous frame refers to that frame's index accessor (plain and meshopt;
+// Draco codes indices with the vertices). In vertex mode with nothing clipped, each object then
+// has one index accessor for the whole sequence.
 #pragma once
 
 #include <memory>
@@ -34,13 +54,16 @@ struct GlbOptions {
     bool draco = false;
     int position_bits = 14;  // Draco position quantization, 1..30
     int normal_bits = 10;    // Draco normal quantization, 1..30
+    bool meshopt = false;    // EXT_meshopt_compression + KHR_mesh_quantization (not with draco)
+    int meshopt_bits = 0;    // meshopt position bits 2..16 over each frame's extent; 0: step from the tolerance
 };
 
 struct GlbStats {
     size_t bytes = 0;                 // size of the written file
-    size_t bytes_without_draco = 0;   // with Draco: size of the same file without it (0 otherwise)
+    size_t bytes_without_draco = 0;   // with Draco or meshopt: size of the same file without it (0 otherwise)
     double max_float_error = 0;       // largest |float32 - double| over exported positions, light-seconds
-    double max_quantization_error = 0;  // Draco: largest position quantization error bound, light-seconds
+    double max_quantization_error = 0;  // Draco, meshopt: largest position quantization error bound, light-seconds
+    bool meshopt_range_clamped = false;  // meshopt: a frame's step had to grow to fit int16
     double max_extent = 0;            // largest frame extent, light-seconds (to judge the errors above)
 };
 
@@ -48,8 +71,10 @@ struct GlbStats {
 // spill file in the output's folder that has no name (openAnonymousFile, atomic_file.h: nothing
 // is left behind whatever ends the process), only the JSON-side
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
-// under a temporary name and renames it into place. Memory does not grow with the frame data;
-// the disk briefly holds the binary data twice.
+// under a temporary name and renames it into place. Memory does not grow with the frame data:
+// besides the JSON side it keeps the previous frame's index lists (to share equal ones) and a
+// pool of frame buffers that prepare() reuses frame after frame (no allocation per frame once the
+// frames stop growing); the disk briefly holds the binary data twice.
 struct GlbFrameData;  // one frame converted for the file (GlbSequenceWriter::prepare)
 
 class GlbSequenceWriter {
@@ -76,8 +101,9 @@ private:
 
 // The .glb as a frame sink: one GlbSequenceWriter per sequence (begin() starts it), frames
 // converted by prepare() on the loop's worker threads. finish() reports the file and its size
-// (with Draco also the size without it); `verbose` adds the float32 and Draco position error
-// bounds to the summary, and a warning says when Draco's bound exceeds the sequence's tolerance.
+// (with Draco or meshopt also the size without it); `verbose` adds the float32 and the codec's
+// position error bounds to the summary, and a warning says when the codec's bound exceeds the
+// sequence's tolerance (meshopt: only with --meshopt-bits, or where int16 cannot hold a frame).
 class GlbSink : public FrameSink {
 public:
     GlbSink(std::string path, const GlbOptions& options, bool verbose);
@@ -99,7 +125,7 @@ private:
     std::string model_;
     double tolerance_ = 0;
     OutputCheck check_;
-    long long least_ = 0;  // least size of the file so far without Draco (positions and indices alone)
+    long long least_ = 0;  // least size of the file so far uncompressed (positions and normals alone)
     std::unique_ptr<GlbSequenceWriter> writer_;
 };
 

@@ -1,6 +1,10 @@
 #include "normals.h"
 
 #include <cmath>
+#include <cstring>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "angles.h"
 
@@ -11,60 +15,159 @@ Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
     const double len = norm(v);
     return len > 0 ? v / len : fallback;
 }
+
+constexpr size_t kGrain = 16384;  // elements per parallel task
 }  // namespace
 
-CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
+void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out, CreaseWork* w) {
     const double cos_crease = std::cos(crease_deg * kPi / 180.0);
     const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();
 
-    // Step: face area vectors and unit normals; faces around each vertex (CSR layout).
-    std::vector<Vec3> area(nf), unit(nf);
-    std::vector<uint32_t> start(nv + 1, 0), faces(3 * nf);
-    for (size_t f = 0; f < nf; ++f) {
-        const auto& t = mesh.triangles[f];
-        area[f] = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
-        unit[f] = unitOr(area[f], {0, 0, 0});
-        for (uint32_t v : t) ++start[v + 1];
+    // Step: face area vectors and unit normals (parallel); faces around each vertex (CSR layout).
+    w->face.resize(nf);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t f = r.begin(); f < r.end(); ++f) {
+            const auto& t = mesh.triangles[f];
+            const Vec3 a = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
+            // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s
+            // hypot (the output normals below still use norm()).
+            const double len2 = dot(a, a);
+            w->face[f] = {a, len2 > 0 ? a / std::sqrt(len2) : Vec3{0, 0, 0}};
+        }
+    });
+    const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
+                      (nf == 0 || std::memcmp(w->triangles.data(), mesh.triangles.data(), nf * sizeof(mesh.triangles[0])) == 0);
+    if (!same) {
+        w->unsplit = false;
+        w->vertices = nv;
+        w->triangles = mesh.triangles;
+        w->start.assign(nv + 1, 0);
+        w->faces.resize(3 * nf);
+        for (const auto& t : mesh.triangles)
+            for (uint32_t v : t) ++w->start[v + 1];
+        for (size_t v = 0; v < nv; ++v) w->start[v + 1] += w->start[v];
+        w->fill.assign(w->start.begin(), w->start.end() - 1);
+        for (size_t f = 0; f < nf; ++f)
+            for (uint32_t v : mesh.triangles[f]) w->faces[w->fill[v]++] = uint32_t(f);
     }
-    for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (size_t f = 0; f < nf; ++f)
-        for (uint32_t v : mesh.triangles[f]) faces[fill[v]++] = uint32_t(f);
+    const std::vector<CreaseWork::Face>& face = w->face;
+    const std::vector<uint32_t>& start = w->start;
+    const std::vector<uint32_t>& faces = w->faces;
 
-    // Step: one normal per corner from the faces within the crease angle; corners of a vertex
-    // with bit-identical normals share one output vertex.
-    CreasedMesh out;
-    // Output vertices made for each input vertex, as linked lists through the output ids (most
-    // vertices get one copy; no allocation per vertex).
-    std::vector<uint32_t> first_copy(nv, UINT32_MAX), next_copy;
-    next_copy.reserve(nv);
-    out.mesh.positions.reserve(nv);
-    out.mesh.emission_times.reserve(nv);
-    out.normals.reserve(nv);
-    out.mesh.triangles.resize(nf);
+    // The normal of the corner of face f at vertex v: the faces around v within the crease angle
+    // of f, summed in CSR order.
+    auto cornerNormal = [&](size_t f, uint32_t v) {
+        Vec3 sum{0, 0, 0};
+        for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
+            const uint32_t g = faces[k];
+            if (g == f || dot(face[g].unit, face[f].unit) >= cos_crease) sum += face[g].area;
+        }
+        return unitOr(sum, unitOr(face[f].area, {0, 0, 1}));
+    };
+
+    // Step (parallel): a vertex whose faces are all within the crease angle of one another gives
+    // every corner the same sum, so one normal (the sum of all its faces, in the same order);
+    // unless that sum is zero, where each corner falls back to its own face.
+    // Quick sufficient test first: when every face is within half the crease angle (less a margin
+    // far above rounding) of their mean direction, every pair is within the crease angle (angles
+    // obey the triangle inequality); otherwise every pair is tested.
+    const double cos_half = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
+    w->uniform.assign(nv, 0);
+    w->vertex_normal.resize(nv);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v < r.end(); ++v) {
+            if (start[v] == start[v + 1]) continue;
+            // The mean direction, and the sum of the area vectors in CSR order (what every corner
+            // would sum), in one pass.
+            Vec3 mean{0, 0, 0}, sum{0, 0, 0};
+            for (uint32_t a = start[v]; a < start[v + 1]; ++a) {
+                mean += face[faces[a]].unit;
+                sum += face[faces[a]].area;
+            }
+            const double len = norm(mean);
+            bool all = len > 0;
+            for (uint32_t a = start[v]; a < start[v + 1] && all; ++a)
+                all = dot(face[faces[a]].unit, mean) >= cos_half * len;
+            if (!all) {
+                all = true;
+                for (uint32_t a = start[v]; a < start[v + 1] && all; ++a) {
+                    const uint32_t f = faces[a];
+                    for (uint32_t b = start[v]; b < start[v + 1]; ++b) {
+                        const uint32_t g = faces[b];
+                        if (g != f && !(dot(face[g].unit, face[f].unit) >= cos_crease)) {
+                            all = false;
+                            break;
+                        }
+                    }
+                }
+            }
+            if (!all || !(norm(sum) > 0)) continue;
+            w->uniform[v] = 1;
+            w->vertex_normal[v] = sum / norm(sum);
+        }
+    });
+    // No vertex split (every used vertex uniform, none unused), as in the last call on the same
+    // triangles: the numbering and triangles in `out` stand; only the normals change.
+    size_t used = 0;
+    for (size_t v = 0; v < nv; ++v) used += w->uniform[v];
+    const bool unsplit = used == nv;
+    if (same && unsplit && w->unsplit && out->source.size() == nv) {
+        out->normals.resize(nv);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t k = r.begin(); k < r.end(); ++k) out->normals[k] = w->vertex_normal[out->source[k]];
+        });
+        return;
+    }
+    w->unsplit = unsplit;
+
+    // Step: split vertices numbered in order of their first corner (faces in order); corners of a
+    // vertex with bit-identical normals share one split vertex.
+    out->source.clear();
+    out->normals.clear();
+    out->source.reserve(nv);
+    out->normals.reserve(nv);
+    out->triangles.resize(nf);
+    w->first_copy.assign(nv, UINT32_MAX);
+    w->next_copy.clear();
+    w->next_copy.reserve(nv);
     for (size_t f = 0; f < nf; ++f) {
         for (int c = 0; c < 3; ++c) {
             const uint32_t v = mesh.triangles[f][c];
-            Vec3 sum{0, 0, 0};
-            for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
-                const uint32_t g = faces[k];
-                if (g == f || dot(unit[g], unit[f]) >= cos_crease) sum += area[g];
-            }
-            const Vec3 n = unitOr(sum, unitOr(area[f], {0, 0, 1}));
             uint32_t id = UINT32_MAX;
-            for (uint32_t o = first_copy[v]; o != UINT32_MAX; o = next_copy[o])
-                if (out.normals[o] == n) id = o;
-            if (id == UINT32_MAX) {
-                id = uint32_t(out.mesh.positions.size());
-                out.mesh.positions.push_back(mesh.positions[v]);
-                out.mesh.emission_times.push_back(mesh.emission_times[v]);
-                out.normals.push_back(n);
-                next_copy.push_back(first_copy[v]);  // prepend: the list's order does not matter
-                first_copy[v] = id;
+            Vec3 n;
+            if (w->uniform[v]) {
+                id = w->first_copy[v];
+                n = w->vertex_normal[v];
+            } else {
+                n = cornerNormal(f, v);
+                for (uint32_t o = w->first_copy[v]; o != UINT32_MAX; o = w->next_copy[o])
+                    if (out->normals[o] == n) id = o;
             }
-            out.mesh.triangles[f][c] = id;
+            if (id == UINT32_MAX) {
+                id = uint32_t(out->source.size());
+                out->source.push_back(v);
+                out->normals.push_back(n);
+                w->next_copy.push_back(w->first_copy[v]);  // prepend: the list's order does not matter
+                w->first_copy[v] = id;
+            }
+            out->triangles[f][c] = id;
         }
     }
+}
+
+CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg) {
+    CreaseMap map;
+    CreaseWork work;
+    creaseSplitMap(mesh, crease_deg, &map, &work);
+    CreasedMesh out;
+    out.mesh.positions.reserve(map.source.size());
+    out.mesh.emission_times.reserve(map.source.size());
+    for (uint32_t v : map.source) {
+        out.mesh.positions.push_back(mesh.positions[v]);
+        out.mesh.emission_times.push_back(mesh.emission_times[v]);
+    }
+    out.normals = std::move(map.normals);
+    out.mesh.triangles = std::move(map.triangles);
     out.mesh.clipped_triangles = mesh.clipped_triangles;
     out.mesh.origin = mesh.origin;
     out.mesh.time_origin = mesh.time_origin;

@@ -23,4 +23,31 @@ struct CreasedMesh {
 // Splits vertices along edges sharper than crease_deg (0 < crease_deg <= 180).
 CreasedMesh creaseSplit(const ApparentMesh& mesh, double crease_deg);
 
+// The same split as a map, without copying the mesh's points: split vertex k is input vertex
+// source[k] with unit normal normals[k]; triangles index split vertices. Fills `out` reusing its
+// capacity and `work`'s (scratch kept between calls, so a sequence of frames does not allocate
+// again). Faces and vertices are processed in parallel (TBB); the result does not depend on the
+// thread count, and creaseSplit gives the same vertices, normals and triangles bit for bit.
+// Called again with the same `out` and `work` on a mesh with the same triangles (a vertex-mode
+// sequence), it reuses the vertex-face adjacency, and when no vertex is split then or now, also
+// `out`'s numbering: only the normals are computed again.
+struct CreaseMap {
+    std::vector<uint32_t> source;
+    std::vector<Vec3> normals;
+    std::vector<std::array<uint32_t, 3>> triangles;
+};
+struct CreaseWork {
+    struct Face {
+        Vec3 area, unit;  // edge cross product (twice the area vector) and its direction
+    };
+    std::vector<Face> face;
+    std::vector<Vec3> vertex_normal;
+    std::vector<uint32_t> start, faces, fill, first_copy, next_copy;
+    std::vector<unsigned char> uniform;
+    std::vector<std::array<uint32_t, 3>> triangles;  // the last call's triangles (adjacency reuse)
+    size_t vertices = 0;                              // the last call's vertex count
+    bool unsplit = false;                             // the last call split no vertex
+};
+void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out, CreaseWork* work);
+
 }  // namespace mesh4d

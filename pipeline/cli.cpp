@@ -140,7 +140,15 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "T light-seconds; Fx, F times each object's bounding-box diagonal (default 1e-3x); "
                            "or 'vertex': exact vertices joined by straight edges, no refinement");
     render_cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
-    render_cmd->add_flag("--draco", rs.glb.draco, "Compress every frame mesh of the .glb with KHR_draco_mesh_compression");
+    std::string compress_text;
+    render_cmd->add_option("--compress", compress_text,
+                           "Compression of the .glb's frame meshes: draco (KHR_draco_mesh_compression; Blender reads "
+                           "it), meshopt (EXT_meshopt_compression + KHR_mesh_quantization, smallest; web viewers) or "
+                           "none (default)");
+    render_cmd->add_flag("--draco", rs.glb.draco, "Same as --compress draco");
+    render_cmd->add_option("--meshopt-bits", rs.glb.meshopt_bits,
+                           "meshopt position bits over each frame's extent (2-16; default: a step following the "
+                           "tolerance, 14 bits in vertex mode)");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
         ->capture_default_str();
     render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
@@ -362,6 +370,17 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     }
     if (!frames_text.empty() && !parseFrames(frames_text, &rs.stage.frame_from, &rs.stage.frame_to))
         return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
+    if (!compress_text.empty()) {
+        if (compress_text != "draco" && compress_text != "meshopt" && compress_text != "none")
+            return usage("--compress: unknown compression '" + compress_text + "' (draco, meshopt, none)");
+        if (rs.glb.draco && compress_text != "draco")
+            return usage("--draco and --compress " + compress_text + " contradict each other");
+        rs.glb.draco = compress_text == "draco";
+        rs.glb.meshopt = compress_text == "meshopt";
+    }
+    if (rs.glb.meshopt_bits != 0 && (rs.glb.meshopt_bits < 2 || rs.glb.meshopt_bits > 16))
+        return usage("--meshopt-bits: " + std::to_string(rs.glb.meshopt_bits) + " is outside 2..16");
+    if (rs.glb.meshopt_bits != 0 && !rs.glb.meshopt) return usage("--meshopt-bits needs --compress meshopt");
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
     if (rs.threads < 0 || rs.threads > kMaxThreads) return usage(threadsProblem(rs.threads));

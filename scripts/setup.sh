@@ -19,6 +19,7 @@ jobs=${JOBS:-$(nproc)}
 packages=(build-essential cmake pkg-config
   libopenmesh-dev libcgal-dev libtinygltf-dev libdraco-dev draco nlohmann-json3-dev libeigen3-dev
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels libpng-dev
+  libmeshoptimizer-dev  # EXT_meshopt_compression in the .glb (--compress meshopt)
   gnuplot-nox gltfpack  # gltfpack: the peer of benchmarks/load_bench; gnuplot draws `apparent trade`'s plot (DIR/trade.png) and docs/accuracy.png
   libfreetype-dev fonts-dejavu-core ffmpeg)  # figure labels; raytrace/figure --video (and ffprobe in the tests)
 if [ "$mode" = test ]; then
@@ -26,6 +27,7 @@ if [ "$mode" = test ]; then
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
   packages+=(blender python3-numpy)  # Blender imports the .glb (tests/blender); its importer needs numpy
   packages+=(python3 clang-14 libclang-rt-14-dev)  # kill test (tests/kill_test.py); libFuzzer for scripts/fuzz.sh
+  packages+=(gltfpack assimp-utils)  # scripts/measure_gltf_sizes.sh: gltfpack -cc beside our codecs; the Duck as OBJ
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi

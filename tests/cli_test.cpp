@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
+#include <set>
 #include <fstream>
 #include <cstring>
 #include <sstream>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "mesh4d/event.h"
@@ -341,6 +344,134 @@ TEST(Cli, DracoRoundTripWithinQuantizationBound) {
     EXPECT_GT(worst_ratio, 0.0);  // quantization did happen: the test can see an error
 }
 
+namespace {
+
+// The JSON chunk of a .glb (read directly: tinygltf cannot load files requiring EXT_meshopt_compression).
+nlohmann::json glbJson(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_GE(bytes.size(), 20u) << p;
+    if (bytes.size() < 20) return nlohmann::json::object();
+    uint32_t length = 0;
+    std::memcpy(&length, bytes.data() + 12, 4);
+    return nlohmann::json::parse(bytes.substr(20, length));
+}
+
+// A scene folder with an icosphere (`sphere`, a file of data/meshes) passing the camera at 0.9c
+// through the whole sequence (never clipped: it exists at all times), and a box at rest beside it.
+void writePassingSphereScene(const fs::path& dir, const std::string& sphere) {
+    fs::create_directories(dir);
+    fs::copy_file(source("data/meshes/" + sphere), dir / "sphere.obj");
+    fs::copy_file(source("data/meshes/box.obj"), dir / "box.obj");
+    std::ofstream(dir / "scene.json") << R"({
+  "camera": { "position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_deg": 60 },
+  "frames": { "start": 0, "end": 2.4, "fps": 10 },
+  "model": "relativistic",
+  "objects": [ { "name": "sphere", "mesh": "sphere.obj", "position": [-2, 0, -10], "velocity": [0.9, 0, 0] },
+               { "name": "box", "mesh": "box.obj", "position": [0, -2, -10] } ] })";
+}
+
+}  // namespace
+
+// Shared index buffers (gltf.h): in vertex mode with nothing clipped every frame of an object has
+// the same triangles, so the .glb holds one index accessor per object, plain and meshopt; each
+// frame still has its own POSITION accessor. Read from the file's JSON. (The fine sphere keeps
+// every apparent dihedral angle below the exporter's 30-degree crease threshold: a coarse mesh
+// whose apparent angles cross it from frame to frame changes its vertex split, and so its index
+// list, as the refined test below shows.)
+TEST(Cli, VertexModeSequenceHoldsOneIndexAccessorPerObject) {
+    TempDir dir;
+    writePassingSphereScene(dir / "scene", "icosphere20480.obj");
+    for (const char* compress : {"none", "meshopt"}) {
+        const fs::path out = dir / compress;
+        const CommandResult r = apparentRun({"render", (dir / "scene/scene.json").string(), "--out", out.string(),
+                                             "--tolerance", "vertex", "--compress", compress, "--quiet"});
+        ASSERT_EQ(r.code, 0) << r.err;
+        const nlohmann::json j = glbJson(out / "relativistic.glb");
+        std::map<int, std::set<int>> indices, positions;  // by material (object)
+        size_t primitives = 0;
+        for (const auto& mesh : j["meshes"])
+            for (const auto& prim : mesh["primitives"]) {
+                indices[prim["material"].get<int>()].insert(prim["indices"].get<int>());
+                positions[prim["material"].get<int>()].insert(prim["attributes"]["POSITION"].get<int>());
+                ++primitives;
+            }
+        EXPECT_EQ(primitives, 2u * 24u) << compress;
+        ASSERT_EQ(indices.size(), 2u) << compress;
+        for (const auto& [material, set] : indices) EXPECT_EQ(set.size(), 1u) << compress << " material " << material;
+        for (const auto& [material, set] : positions) EXPECT_EQ(set.size(), 24u) << compress << " material " << material;
+    }
+}
+
+// The coarse sphere with a tolerance, where refinement (and the crease split) change its triangles
+// from frame to frame:
+// only equal index lists are shared, so the sphere has more than one index accessor.
+TEST(Cli, RefinedSequenceSharesOnlyEqualIndexLists) {
+    TempDir dir;
+    writePassingSphereScene(dir / "scene", "icosphere320.obj");
+    const CommandResult r = apparentRun({"render", (dir / "scene/scene.json").string(), "--out", (dir / "out").string(),
+                                         "--tolerance", "0.0005", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json j = glbJson(dir / "out/relativistic.glb");
+    std::map<int, std::set<int>> indices;
+    for (const auto& mesh : j["meshes"])
+        for (const auto& prim : mesh["primitives"]) indices[prim["material"].get<int>()].insert(prim["indices"].get<int>());
+    EXPECT_GT(indices[0].size(), 1u);  // the sphere, refined differently as it passes
+    EXPECT_EQ(indices[1].size(), 1u);  // the box at rest: the same triangles throughout
+}
+
+// --compress: meshopt's file requires EXT_meshopt_compression and KHR_mesh_quantization; draco
+// is --draco's alias (the same bytes); contradictions and bad values exit with code 2; a
+// --meshopt-bits too coarse for the tolerance is warned about, naming the tolerance.
+TEST(Cli, CompressOptions) {
+    TempDir dir;
+    const std::string scene = source("data/scenes/flanges.json");
+    auto render = [&](const std::string& sub, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"render", scene, "--out", (dir / sub).string(), "--frames", "95:100",
+                                         "--model", "relativistic"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return apparentRun(args);
+    };
+    CommandResult r = render("meshopt", {"--compress", "meshopt"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("with meshopt"), std::string::npos) << r.out;
+    const nlohmann::json j = glbJson(dir / "meshopt/relativistic.glb");
+    EXPECT_EQ(j["extensionsRequired"], nlohmann::json({"EXT_meshopt_compression", "KHR_mesh_quantization"}));
+    EXPECT_EQ(j["buffers"].size(), 2u);
+    EXPECT_TRUE(j["buffers"][1]["extensions"]["EXT_meshopt_compression"]["fallback"].get<bool>());
+
+    ASSERT_EQ(render("a", {"--draco", "--quiet"}).code, 0);
+    ASSERT_EQ(render("b", {"--compress", "draco", "--quiet"}).code, 0);
+    auto bytes = [](const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    };
+    EXPECT_EQ(bytes(dir / "a/relativistic.glb"), bytes(dir / "b/relativistic.glb"));
+
+    r = render("c", {"--compress", "zstd"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--compress: unknown compression 'zstd'"), std::string::npos) << r.err;
+    r = render("c", {"--draco", "--compress", "meshopt"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--draco and --compress meshopt contradict"), std::string::npos) << r.err;
+    r = render("c", {"--compress", "meshopt", "--meshopt-bits", "17"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--meshopt-bits: 17 is outside 2..16"), std::string::npos) << r.err;
+    r = render("c", {"--meshopt-bits", "12"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--meshopt-bits needs --compress meshopt"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "c"));
+
+    // 6 bits over the frame (about 50 light-seconds across): a step near 0.8 ls, far above the
+    // scene's tolerance of 0.01 ls.
+    r = render("coarse", {"--compress", "meshopt", "--meshopt-bits", "6"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("meshopt position error up to"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("exceeds the tolerance 0.01 ls"), std::string::npos) << r.err;
+    r = render("fine", {"--compress", "meshopt"});
+    EXPECT_EQ(r.err.find("meshopt position error"), std::string::npos) << r.err;
+}
+
 // `apparent render scene.gltf` needs no JSON: the glTF twin of the default scene gives
 // byte-identical per-frame output.
 TEST(Cli, GltfSceneRendersLikeItsJsonTwin) {
@@ -375,6 +506,29 @@ TEST(Cli, OutputIsIdenticalForAnyThreadCount) {
         const std::string da((std::istreambuf_iterator<char>(a)), {}), db((std::istreambuf_iterator<char>(b)), {});
         EXPECT_EQ(da, db) << f;
     }
+}
+
+// The same for the .glb's parallel conversion (crease split, float32, meshopt encoding) on a mesh
+// large enough to be split among threads (20480 faces), plain and meshopt, vertex mode and refined.
+TEST(Cli, GlbIsIdenticalForAnyThreadCountOnALargeMesh) {
+    TempDir dir;
+    writePassingSphereScene(dir / "scene", "icosphere20480.obj");
+    for (const char* compress : {"none", "meshopt"})
+        for (const char* tolerance : {"vertex", "0.002"}) {
+            std::string bytes[2];
+            for (int t = 0; t < 2; ++t) {
+                const fs::path out = dir / (std::string(compress) + tolerance + std::to_string(t));
+                ASSERT_EQ(apparentRun({"render", (dir / "scene/scene.json").string(), "--out", out.string(), "--frames",
+                                       "0:6", "--tolerance", tolerance, "--compress", compress, "--threads",
+                                       t == 0 ? "1" : "2", "--quiet"})
+                              .code,
+                          0);
+                std::ifstream in(out / "relativistic.glb", std::ios::binary);
+                bytes[t].assign((std::istreambuf_iterator<char>(in)), {});
+            }
+            ASSERT_FALSE(bytes[0].empty());
+            EXPECT_EQ(bytes[0], bytes[1]) << compress << " " << tolerance;
+        }
 }
 
 // An absurdly fine tolerance is refused up front (below 1e-6 of the object's size, issue 15); one

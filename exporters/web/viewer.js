@@ -7,6 +7,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 
 const VIEW_BG = '#1b1f27';   // viewport background (keep in sync with --view-bg in index.html)
 const PAGE_BG = '#0e1014';   // gaps between viewports
@@ -58,6 +59,7 @@ if (!dracoLoader.decoderPaths && !dracoLoader.decoderPath) {
 }
 const loader = new GLTFLoader();
 loader.setDRACOLoader(dracoLoader);
+loader.setMeshoptDecoder(MeshoptDecoder);  // --compress meshopt (EXT_meshopt_compression)
 
 // ---------------------------------------------------------------- models
 /** @type {Array<object>} */

@@ -4,8 +4,8 @@
 //   node tests/model_viewer/check.js OUTDIR|FILE.glb [OUTDIR|FILE.glb ...] [--models a,b,c] [--frames 0,50,100,199]
 //        [--shot-time SECONDS] [--screenshot-dir DIR] [--chromium PATH] [--keep-profile] [--debug-requests]
 //
-// Every .glb in each OUTDIR (or only <model>.glb for --models), plain or KHR_draco_mesh_compression; give the plain
-// and the --draco output directories together to check both. The script serves the repository root and each
+// Every .glb in each OUTDIR (or only <model>.glb for --models), plain, KHR_draco_mesh_compression or
+// EXT_meshopt_compression; give the plain, --draco and --compress meshopt output directories together to check all. The script serves the repository root and each
 // directory on 127.0.0.1, opens tests/model_viewer/index.html (the model-viewer dist build from node_modules, Draco
 // decoder from node_modules/three, no network) in Debian Chromium through playwright-core, and checks per file:
 //   - model-viewer fires 'load' (no 'error'), availableAnimations includes "frames", duration = frames / fps;
@@ -89,7 +89,7 @@ for (const p of opts.inputs) {
 const MV = 'node_modules/@google/model-viewer/dist/model-viewer.min.js';
 for (const f of [MV, 'node_modules/@google/model-viewer/package.json', 'node_modules/playwright-core/package.json',
   'node_modules/three/examples/jsm/libs/draco/gltf/draco_decoder.wasm',
-  'node_modules/three/examples/jsm/libs/draco/gltf/draco_wasm_wrapper.js']) {
+  'node_modules/three/examples/jsm/libs/draco/gltf/draco_wasm_wrapper.js', 'node_modules/meshoptimizer/meshopt_decoder.js']) {
   if (!fs.existsSync(path.join(REPO, f))) setupFail(`${f} not found: run "npm ci" (or "npm install") in ${REPO}`);
 }
 if (!fs.existsSync(opts.chromium)) {
@@ -158,6 +158,7 @@ async function main() {
     const d = f.d;
     d.fps = Number(d.extras.fps) > 0 ? Number(d.extras.fps) : d.duration > 0 ? d.frames.length / d.duration : NaN;
     f.draco = d.frames.some((x) => x.draco);
+    f.meshopt = (d.json.extensionsRequired || []).includes('EXT_meshopt_compression');
     // glTF mesh index -> frame node (what surfaceFromPoint reports is the mesh index)
     f.meshToFrame = new Map();
     // (a frame's reflection child nodes, "frame_NNNNN mirror M", belong to it too)
@@ -169,7 +170,7 @@ async function main() {
     });
   }
   if (!files.some((f) => f.draco)) warn('no KHR_draco_mesh_compression file among the inputs: Draco not checked');
-  if (!files.some((f) => !f.draco)) warn('no plain (non-Draco) file among the inputs');
+  if (!files.some((f) => !f.draco && !f.meshopt)) warn('no plain (uncompressed) file among the inputs');
   const shotDir = opts.shotDir || path.dirname(files[0].file);
   fs.mkdirSync(shotDir, { recursive: true });
 
@@ -214,7 +215,8 @@ async function main() {
 
     for (const f of files) {
       const d = f.d, n = d.frames.length;
-      console.log(`\n== ${f.label}: ${n} frame nodes, fps ${d.fps}, ${d.duration} s${f.draco ? ', Draco' : ''}`);
+      console.log(`\n== ${f.label}: ${n} frame nodes, fps ${d.fps}, ${d.duration} s${f.draco ? ', Draco' : ''}` +
+        `${f.meshopt ? ', meshopt' : ''}`);
       let info;
       try {
         info = await page.evaluate((src) => window.mvTest.load(src), f.url);
@@ -225,7 +227,12 @@ async function main() {
       check(info.loaded, `${f.label}: model-viewer fired 'load' and reports loaded`);
       console.log(`  loaded in ${info.loadMs} ms; availableAnimations ${JSON.stringify(info.availableAnimations)}, ` +
         `animationName ${info.animationName}, duration ${info.duration}` +
-        (f.draco ? `, Draco decoder from ${info.dracoDecoderLocation}` : ''));
+        (f.draco ? `, Draco decoder from ${info.dracoDecoderLocation}` : '') +
+        (f.meshopt ? `, meshopt decoder from ${info.meshoptDecoderLocation}` : ''));
+      if (f.meshopt) {
+        check(String(info.meshoptDecoderLocation).includes('/node_modules/meshoptimizer/'),
+          `${f.label}: meshopt decoder location is the local copy`, String(info.meshoptDecoderLocation));
+      }
       if (f.draco) {
         check(String(info.dracoDecoderLocation).includes('/node_modules/three/examples/jsm/libs/draco/gltf/'),
           `${f.label}: Draco decoder location is the local copy`, String(info.dracoDecoderLocation));

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ctest entry: renders the default scene plain and with Draco, then loads both in Google's
+# ctest entry: renders the default scene plain, with Draco and with meshopt, then loads them in Google's
 # model-viewer in headless Chromium (tests/model_viewer/check.js).
 # Usage: run_ctest.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
@@ -9,5 +9,6 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/plain" --model finite,relativistic --quiet
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/draco" --model relativistic --draco --quiet
+"$apparent" render "$src/data/scenes/flanges.json" --out "$out/meshopt" --model relativistic --compress meshopt --quiet
 cd "$src"
-node tests/model_viewer/check.js "$out/plain" "$out/draco"
+node tests/model_viewer/check.js "$out/plain" "$out/draco" "$out/meshopt"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Renders the default flange scene in every model, plain and with Draco, and checks each .glb
+# Renders the default flange scene in every model, plain, with Draco and with meshopt, and checks each .glb
 # with the Khronos glTF-Validator (0 errors and 0 warnings required; the validator does not
-# decode Draco, which it reports as INFO: the Draco round trip is tested in cli_test.cpp).
+# decode Draco or meshopt, which it reports as INFO: the Draco round trip is tested in cli_test.cpp,
+# meshopt's in tests/web/meshopt_roundtrip.js).
 # Usage: validate_flanges.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
 apparent=$1
@@ -10,5 +11,6 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/plain" --model all --quiet
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/draco" --model all --draco --quiet
+"$apparent" render "$src/data/scenes/flanges.json" --out "$out/meshopt" --model all --compress meshopt --quiet
 cd "$src"
-node tests/validators/validate_gltf.js "$out"/plain/*.glb "$out"/draco/*.glb
+node tests/validators/validate_gltf.js "$out"/plain/*.glb "$out"/draco/*.glb "$out"/meshopt/*.glb
