@@ -39,6 +39,7 @@ using mesh4d::Vec3;
 // its indices in vertex-cache order referring to them, and POSITION's integer bounds.
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
+    std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
     std::vector<unsigned char> packed;
     std::vector<uint32_t> ordered;
@@ -161,6 +162,12 @@ public:
         prim.attributes["_EMISSION_TIME"] = addAccessor(addView(d.emission.data(), d.emission.size() * 4, kArray),
                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
                                                         d.vertexCount());
+        if (!d.doppler.empty())
+            prim.attributes["_DOPPLER"] = addAccessor(addView(d.doppler.data(), d.doppler.size() * 4, kArray),
+                                                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
+        if (!d.proper_time.empty())
+            prim.attributes["_PROPER_TIME"] = addAccessor(addView(d.proper_time.data(), d.proper_time.size() * 4, kArray),
+                                                          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
         prim.indices = shared_indices >= 0
                            ? shared_indices
                            : addAccessor(addView(d.indices.data(), d.indices.size() * 4, kElements),
@@ -244,6 +251,8 @@ public:
         const int pos = addAttribute(draco::GeometryAttribute::POSITION, 3, d.positions.data());
         const int nrm = addAttribute(draco::GeometryAttribute::NORMAL, 3, d.normals.data());
         const int emt = addAttribute(draco::GeometryAttribute::GENERIC, 1, d.emission.data());
+        const int dop = d.doppler.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.doppler.data());
+        const int tau = d.proper_time.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.proper_time.data());
         for (size_t f = 0; f < d.indices.size(); f += 3)
             dm.AddFace({draco::PointIndex(d.indices[f]), draco::PointIndex(d.indices[f + 1]),
                         draco::PointIndex(d.indices[f + 2])});
@@ -287,6 +296,9 @@ public:
         prim->attributes["POSITION"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points, dlo, dhi);
         prim->attributes["NORMAL"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
         prim->attributes["_EMISSION_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
+        if (dop >= 0) prim->attributes["_DOPPLER"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
+        if (tau >= 0)
+            prim->attributes["_PROPER_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
         prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
                                     size_t(back->num_faces()) * 3);
         prim->mode = TINYGLTF_MODE_TRIANGLES;
@@ -295,6 +307,8 @@ public:
             {"POSITION", tinygltf::Value(int(dm.attribute(pos)->unique_id()))},
             {"NORMAL", tinygltf::Value(int(dm.attribute(nrm)->unique_id()))},
             {"_EMISSION_TIME", tinygltf::Value(int(dm.attribute(emt)->unique_id()))}};
+        if (dop >= 0) attrs["_DOPPLER"] = tinygltf::Value(int(dm.attribute(dop)->unique_id()));
+        if (tau >= 0) attrs["_PROPER_TIME"] = tinygltf::Value(int(dm.attribute(tau)->unique_id()));
         prim->extensions["KHR_draco_mesh_compression"] = tinygltf::Value(
             tinygltf::Value::Object{{"bufferView", tinygltf::Value(view)}, {"attributes", tinygltf::Value(attrs)}});
         return true;
@@ -330,12 +344,17 @@ constexpr double kCreaseDeg = 30.0;
 // `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
 // split's (reused the same way, object by object).
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
-                 double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work) {
+                 double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
+                 const GlbOptions& options) {
     mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
     const size_t nv = map->source.size();
     d->positions.resize(3 * nv);
     d->normals.resize(3 * nv);
     d->emission.resize(nv);
+    const bool doppler = options.doppler && m.doppler.size() == m.positions.size();
+    const bool proper_time = options.proper_time && m.proper_time.size() == m.positions.size();
+    d->doppler.resize(doppler ? nv : 0);
+    d->proper_time.resize(proper_time ? nv : 0);
     std::vector<double> exact(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
     const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
@@ -353,6 +372,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                     if (step > 0) exact[3 * k + c] = rel;
                 }
                 d->emission[k] = float(m.absoluteTime(v));
+                if (doppler) d->doppler[k] = float(m.doppler[v]);
+                if (proper_time) d->proper_time[k] = float(m.proper_time[v]);
             }
             return w;
         },
@@ -853,7 +874,7 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty())
                 toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
-                            &d->crease_map[o], &d->crease_work[o]);
+                            &d->crease_map[o], &d->crease_work[o], impl_->options);
         if (impl_->options.meshopt) {
             // Step: one vertex stream for the whole frame, encoded here (on the worker thread).
             MeshoptFrame& mf = d->meshopt;

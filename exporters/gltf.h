@@ -56,6 +56,10 @@ struct GlbOptions {
     int normal_bits = 10;    // Draco normal quantization, 1..30
     bool meshopt = false;    // EXT_meshopt_compression + KHR_mesh_quantization (not with draco)
     int meshopt_bits = 0;    // meshopt position bits 2..16 over each frame's extent; 0: step from the tolerance
+    // --attributes: per-vertex float attributes _DOPPLER and _PROPER_TIME (mesh4d/light_factors.h),
+    // plain or Draco (GENERIC, unquantized); not with meshopt yet (refused by the command).
+    bool doppler = false;
+    bool proper_time = false;
 };
 
 struct GlbStats {

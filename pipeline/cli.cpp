@@ -149,6 +149,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->add_option("--meshopt-bits", rs.glb.meshopt_bits,
                            "meshopt position bits over each frame's extent (2-16; default: a step following the "
                            "tolerance, 14 bits in vertex mode)");
+    std::string attributes_text;
+    render_cmd->add_option("--attributes", attributes_text,
+                           "Comma list of extra per-vertex .glb attributes: doppler (_DOPPLER, received over emitted "
+                           "frequency), proper_time (_PROPER_TIME, the object's clock at emission); PLY frames always "
+                           "hold both");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
         ->capture_default_str();
     render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
@@ -377,6 +382,17 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             return usage("--draco and --compress " + compress_text + " contradict each other");
         rs.glb.draco = compress_text == "draco";
         rs.glb.meshopt = compress_text == "meshopt";
+    }
+    if (!attributes_text.empty()) {
+        std::stringstream ss(attributes_text);
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+            if (item == "doppler") rs.glb.doppler = true;
+            else if (item == "proper_time") rs.glb.proper_time = true;
+            else return usage("--attributes: unknown attribute '" + item + "' (doppler, proper_time)");
+        }
+        if (rs.glb.meshopt)
+            return usage("--attributes: not with --compress meshopt yet (use none or draco; the PLY frames hold both)");
     }
     if (rs.glb.meshopt_bits != 0 && (rs.glb.meshopt_bits < 2 || rs.glb.meshopt_bits > 16))
         return usage("--meshopt-bits: " + std::to_string(rs.glb.meshopt_bits) + " is outside 2..16");

@@ -10,7 +10,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+
+#include <tiny_gltf.h>
 
 #include "mesh4d/event.h"
 #include "run_command.h"
@@ -115,4 +118,58 @@ TEST(LightFactors, EveryVertexMatchesTheTextbookFormsAndTheClock) {
         const Vec3 z = p.x - (x0 + vel * (p.t - t0));
         EXPECT_NEAR(p.proper_time, (p.t - t0) / g - g * mesh4d::dot(vel, z), 1e-12 * (1 + std::fabs(p.t)));
     }
+}
+
+// --attributes doppler,proper_time: the .glb's _DOPPLER and _PROPER_TIME hold the PLY frame's
+// values in float32 (the crease split repeats vertices, so the sets of values are compared), plain
+// and in Draco's attribute map; meshopt refuses them for now.
+TEST(LightFactors, GlbAttributesHoldThePlyValues) {
+    const fs::path dir = fs::temp_directory_path() / ("apparent_light_glb_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy_file(testcli::source("data/meshes/box.obj"), dir / "box.obj");
+    std::ofstream(dir / "scene.json") << R"({ "frames": { "start": 3, "end": 3.05, "fps": 10 }, "tolerance": "vertex",
+        "objects": [ { "mesh": "box.obj", "position": [-3, 2, -6], "velocity": [0.3, -0.5, 0.6] } ] })";
+    CommandResult r = apparentRun({"render", (dir / "scene.json").string(), "--out", (dir / "plain").string(), "--format",
+                                   "glb,ply", "--attributes", "doppler,proper_time", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto ply = readFrame(dir / "plain/relativistic/frame_00000.ply");
+    std::set<float> want_d, want_t;
+    for (const auto& p : ply) {
+        want_d.insert(float(p.doppler));
+        want_t.insert(float(p.proper_time));
+    }
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir / "plain/relativistic.glb").string())) << err;
+    auto values = [&](int accessor) {
+        const tinygltf::Accessor& a = model.accessors[size_t(accessor)];
+        const tinygltf::BufferView& v = model.bufferViews[size_t(a.bufferView)];
+        std::set<float> s;
+        for (size_t i = 0; i < a.count; ++i) {
+            float x;
+            std::memcpy(&x, model.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset + 4 * i, 4);
+            s.insert(x);
+        }
+        return s;
+    };
+    const tinygltf::Primitive& prim = model.meshes.at(0).primitives.at(0);
+    ASSERT_TRUE(prim.attributes.count("_DOPPLER") && prim.attributes.count("_PROPER_TIME"));
+    EXPECT_EQ(values(prim.attributes.at("_DOPPLER")), want_d);
+    EXPECT_EQ(values(prim.attributes.at("_PROPER_TIME")), want_t);
+
+    r = apparentRun({"render", (dir / "scene.json").string(), "--out", (dir / "draco").string(), "--compress", "draco",
+                     "--attributes", "doppler", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream in(dir / "draco/relativistic.glb", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(bytes.find(R"("_DOPPLER")"), std::string::npos);
+    EXPECT_EQ(bytes.find(R"("_PROPER_TIME")"), std::string::npos);
+
+    r = apparentRun({"render", (dir / "scene.json").string(), "--out", (dir / "m").string(), "--compress", "meshopt",
+                     "--attributes", "doppler"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--attributes: not with --compress meshopt yet"), std::string::npos) << r.err;
+    fs::remove_all(dir);
 }
