@@ -23,6 +23,7 @@
 #include "exporters/atomic_file.h"
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
+#include "mesh4d/doppler_colour.h"
 #include "mesh4d/normals.h"
 
 #include <fcntl.h>
@@ -40,6 +41,7 @@ using mesh4d::Vec3;
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
+    std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
     std::vector<unsigned char> packed;
     std::vector<uint32_t> ordered;
@@ -168,6 +170,9 @@ public:
         if (!d.proper_time.empty())
             prim.attributes["_PROPER_TIME"] = addAccessor(addView(d.proper_time.data(), d.proper_time.size() * 4, kArray),
                                                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
+        if (!d.colors.empty())
+            prim.attributes["COLOR_0"] = addAccessor(addView(d.colors.data(), d.colors.size() * 4, kArray),
+                                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount());
         prim.indices = shared_indices >= 0
                            ? shared_indices
                            : addAccessor(addView(d.indices.data(), d.indices.size() * 4, kElements),
@@ -253,6 +258,7 @@ public:
         const int emt = addAttribute(draco::GeometryAttribute::GENERIC, 1, d.emission.data());
         const int dop = d.doppler.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.doppler.data());
         const int tau = d.proper_time.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.proper_time.data());
+        const int col = d.colors.empty() ? -1 : addAttribute(draco::GeometryAttribute::COLOR, 3, d.colors.data());
         for (size_t f = 0; f < d.indices.size(); f += 3)
             dm.AddFace({draco::PointIndex(d.indices[f]), draco::PointIndex(d.indices[f + 1]),
                         draco::PointIndex(d.indices[f + 2])});
@@ -299,6 +305,7 @@ public:
         if (dop >= 0) prim->attributes["_DOPPLER"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
         if (tau >= 0)
             prim->attributes["_PROPER_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
+        if (col >= 0) prim->attributes["COLOR_0"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
         prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
                                     size_t(back->num_faces()) * 3);
         prim->mode = TINYGLTF_MODE_TRIANGLES;
@@ -309,6 +316,7 @@ public:
             {"_EMISSION_TIME", tinygltf::Value(int(dm.attribute(emt)->unique_id()))}};
         if (dop >= 0) attrs["_DOPPLER"] = tinygltf::Value(int(dm.attribute(dop)->unique_id()));
         if (tau >= 0) attrs["_PROPER_TIME"] = tinygltf::Value(int(dm.attribute(tau)->unique_id()));
+        if (col >= 0) attrs["COLOR_0"] = tinygltf::Value(int(dm.attribute(col)->unique_id()));
         prim->extensions["KHR_draco_mesh_compression"] = tinygltf::Value(
             tinygltf::Value::Object{{"bufferView", tinygltf::Value(view)}, {"attributes", tinygltf::Value(attrs)}});
         return true;
@@ -345,7 +353,7 @@ constexpr double kCreaseDeg = 30.0;
 // split's (reused the same way, object by object).
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
-                 const GlbOptions& options) {
+                 const GlbOptions& options, const std::array<double, 4>& base_color) {
     mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
     const size_t nv = map->source.size();
     d->positions.resize(3 * nv);
@@ -355,6 +363,9 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     const bool proper_time = options.proper_time && m.proper_time.size() == m.positions.size();
     d->doppler.resize(doppler ? nv : 0);
     d->proper_time.resize(proper_time ? nv : 0);
+    const bool shade = options.shade_doppler && m.doppler.size() == m.positions.size();
+    d->colors.resize(shade ? 3 * nv : 0);
+    const std::array<double, 3> base{base_color[0], base_color[1], base_color[2]};
     std::vector<double> exact(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
     const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
@@ -374,6 +385,10 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                 d->emission[k] = float(m.absoluteTime(v));
                 if (doppler) d->doppler[k] = float(m.doppler[v]);
                 if (proper_time) d->proper_time[k] = float(m.proper_time[v]);
+                if (shade) {
+                    const std::array<double, 3> c = mesh4d::dopplerColour(base, m.doppler[v]);
+                    for (int j = 0; j < 3; ++j) d->colors[3 * k + size_t(j)] = float(c[size_t(j)]);
+                }
             }
             return w;
         },
@@ -425,6 +440,15 @@ struct SequenceModel {
         tinygltf::Material mat;
         mat.name = o.name;
         mat.pbrMetallicRoughness.baseColorFactor = {o.base_color[0], o.base_color[1], o.base_color[2], o.base_color[3]};
+        if (options.shade_doppler) {
+            // COLOR_0 holds the whole shaded colour (glTF multiplies it with the factor): white
+            // here, the plain colour kept in extras for viewers that switch between the two.
+            mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, o.base_color[3]};
+            mat.extras = tinygltf::Value(tinygltf::Value::Object{
+                {"base_color", tinygltf::Value(tinygltf::Value::Array{
+                                   tinygltf::Value(o.base_color[0]), tinygltf::Value(o.base_color[1]),
+                                   tinygltf::Value(o.base_color[2]), tinygltf::Value(o.base_color[3])})}});
+        }
         mat.pbrMetallicRoughness.metallicFactor = 0.0;
         mat.pbrMetallicRoughness.roughnessFactor = 0.8;
         mat.doubleSided = true;  // thin shells such as the flanges are seen from both sides
@@ -874,7 +898,8 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty())
                 toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
-                            &d->crease_map[o], &d->crease_work[o], impl_->options);
+                            &d->crease_map[o], &d->crease_work[o], impl_->options,
+                            impl_->info.objects[o].base_color);
         if (impl_->options.meshopt) {
             // Step: one vertex stream for the whole frame, encoded here (on the worker thread).
             MeshoptFrame& mf = d->meshopt;

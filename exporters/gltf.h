@@ -6,7 +6,7 @@
 //   object's material; its translation is the frame's local origin (the centre of its bounding
 //   box, as JSON doubles) and POSITION is float32 relative to it, so scenes far from the world
 //   origin keep their precision. Each primitive has NORMAL (area-weighted) and a float
-//   _EMISSION_TIME (the lab time the light left the point). A frame with nothing visible gets a
+//   _EMISSION_TIME (the lab time the light left the point); with --shade doppler also COLOR_0. A frame with nothing visible gets a
 //   node without a mesh (glTF forbids empty accessors).
 // - reflections (ExportObject::mirror set) are their own nodes: a child "frame_NNNNN mirror M" of
 //   frame node k per mirror M showing something in frame k, with one primitive per reflected
@@ -60,6 +60,11 @@ struct GlbOptions {
     // plain or Draco (GENERIC, unquantized); not with meshopt yet (refused by the command).
     bool doppler = false;
     bool proper_time = false;
+    // --shade doppler: COLOR_0 (float VEC3, linear) per vertex, each object's base colour shifted
+    // by the vertex's Doppler factor (mesh4d/doppler_colour.h); the materials' baseColorFactor is
+    // then white (alpha kept) and the plain colour is in the material's extras "base_color".
+    // Plain or Draco (COLOR, unquantized); not with meshopt yet (refused by the command).
+    bool shade_doppler = false;
 };
 
 struct GlbStats {

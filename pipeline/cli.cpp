@@ -154,6 +154,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "Comma list of extra per-vertex .glb attributes: doppler (_DOPPLER, received over emitted "
                            "frequency), proper_time (_PROPER_TIME, the object's clock at emission); PLY frames always "
                            "hold both");
+    std::string shade_text;
+    render_cmd->add_option("--shade", shade_text,
+                           "plain (default: each material's colour) or doppler (COLOR_0 per vertex: the base colour "
+                           "shifted by the Doppler factor and brightened by the searchlight factor; README 'Doppler "
+                           "colours')");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
         ->capture_default_str();
     render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
@@ -191,6 +196,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     raytrace_cmd->add_option("--threads", ts.threads, "Worker threads (0: all cores)")->capture_default_str();
     raytrace_cmd->add_option("--video", ts.video_path,
                              "Also (or, without --out, only) an H.264 MP4 of the frames at the scene's fps, one model; needs ffmpeg");
+    std::string trace_shade_text;
+    raytrace_cmd->add_option("--shade", trace_shade_text,
+                             "plain (default) or doppler: colours shifted by the Doppler factor and scaled by the "
+                             "searchlight factor, as render --shade doppler bakes them");
     raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary, no progress");
     addStageLimits(raytrace_cmd, &ts.stage);
     FigureSettings fs;
@@ -286,6 +295,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             return usage("--size: '" + trace_size_text + "' is not WxH with W and H in 1..16384");
         if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.stage.frame_from, &ts.stage.frame_to))
             return usage("--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
+        if (!trace_shade_text.empty() && trace_shade_text != "plain" && trace_shade_text != "doppler")
+            return usage("--shade: unknown shading '" + trace_shade_text + "' (plain, doppler)");
+        ts.shade_doppler = trace_shade_text == "doppler";
         if (ts.threads < 0 || ts.threads > kMaxThreads) return usage(threadsProblem(ts.threads));
         if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         ts.write_png = ts.video_path.empty() || raytrace_cmd->count("--out") > 0;
@@ -393,6 +405,13 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         }
         if (rs.glb.meshopt)
             return usage("--attributes: not with --compress meshopt yet (use none or draco; the PLY frames hold both)");
+    }
+    if (!shade_text.empty()) {
+        if (shade_text != "plain" && shade_text != "doppler")
+            return usage("--shade: unknown shading '" + shade_text + "' (plain, doppler)");
+        rs.glb.shade_doppler = shade_text == "doppler";
+        if (rs.glb.shade_doppler && rs.glb.meshopt)
+            return usage("--shade doppler: not with --compress meshopt yet (use none or draco)");
     }
     if (rs.glb.meshopt_bits != 0 && (rs.glb.meshopt_bits < 2 || rs.glb.meshopt_bits > 16))
         return usage("--meshopt-bits: " + std::to_string(rs.glb.meshopt_bits) + " is outside 2..16");

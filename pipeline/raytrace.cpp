@@ -15,6 +15,8 @@
 
 #include "exporters/video.h"
 #include "mesh4d/angles.h"
+#include "mesh4d/doppler_colour.h"
+#include "mesh4d/light_factors.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -103,7 +105,7 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     return best;
 }
 
-std::array<double, 3> SceneTracer::shade(const Hit& h) const {
+std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, const Vec3& receiver) const {
     // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), summed over the lights with their
     // weights (the default key light, scene.h), n already turned towards the side
     // the ray arrives from (the surfaces are two-sided, as in the exported glTF).
@@ -118,7 +120,11 @@ std::array<double, 3> SceneTracer::shade(const Hit& h) const {
     const double diffuse = (1 - light.key_weight) * std::max(0.0, mesh4d::dot(n, l)) +
                            light.key_weight * std::max(0.0, mesh4d::dot(n, light.key_direction));
     const double lambert = light.ambient + (1 - light.ambient) * diffuse;
-    const auto& c = colors_[size_t(h.object)];
+    std::array<double, 3> c{colors_[size_t(h.object)][0], colors_[size_t(h.object)][1], colors_[size_t(h.object)][2]};
+    if (shade_doppler_) {
+        const double d = mesh4d::dopplerFactor(worlds_[size_t(h.object)].motion, kind, receiver, h.hit.event.x);
+        c = mesh4d::dopplerColour(c, d);
+    }
     return {c[0] * lambert, c[1] * lambert, c[2] * lambert};
 }
 
@@ -140,7 +146,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
                 frame.object[idx] = hit.object;
-                color = shade(hit);
+                color = shade(hit, view.kind, ray.origin.x);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,
@@ -152,7 +158,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                     std::array<double, 3> reflected = kBackground;
                     if (second.object >= 0) {
                         frame.reflected[idx] = second.object;
-                        reflected = shade(second);
+                        reflected = shade(second, view.kind, bounce.origin.x);
                     }
                     for (int c = 0; c < 3; ++c)
                         color[size_t(c)] = (1 - kMirrorReflectance) * color[size_t(c)] + kMirrorReflectance * reflected[size_t(c)];
@@ -208,7 +214,8 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& 
             err << "error: " << error << "\n";
             return kExitOutputError;
         }
-        const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
+        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
+        tracer.setShadeDoppler(settings.shade_doppler);
         for (long long k = first; k < last_excl; ++k) {
             progress.setLabel(std::string(modelName(model)) + " frame " + std::to_string(k));
             TracedFrame frame;

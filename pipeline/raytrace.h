@@ -3,8 +3,12 @@
 // the hyperplane t = t_c for the instant and contracted models), meet the 4D tetrahedra of every
 // object's history by the barycentric method (mesh4d/ray4d.h), the nearest event wins, and the hit
 // is shaded by Lambert's law from the scene's light with the lab-frame normal of the object's
-// triangle at the hit instant; mirrors bounce a ray once. No shadows, no Doppler or intensity
-// effects: geometry and shading only, as in the paper's comparison figure.
+// triangle at the hit instant; mirrors bounce a ray once. No shadows. By default geometry and
+// shading only, as in the paper's comparison figure; with --shade doppler the object's colour is
+// first shifted by the hit's Doppler factor (mesh4d/light_factors.h dopplerFactor from the hit
+// event to the camera, or to the mirror point for a reflection, which is at rest in the camera's
+// frame) and scaled by the searchlight factor, as `render --shade doppler` bakes it
+// (mesh4d/doppler_colour.h): pixel = Lambert * dopplerColour(base, D).
 #pragma once
 
 #include <array>
@@ -49,6 +53,9 @@ public:
     // done is counted in `progress` when given.
     TracedFrame traceFrame(long long k, int width, int height, TraceProgress* progress = nullptr) const;
 
+    // --shade doppler (off by default): colours shifted by each hit's Doppler factor.
+    void setShadeDoppler(bool on) { shade_doppler_ = on; }
+
     const std::vector<mesh4d::World4D>& worlds() const { return worlds_; }
 
 private:
@@ -57,7 +64,8 @@ private:
         mesh4d::WorldHit hit;
     };
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
-    std::array<double, 3> shade(const Hit& h) const;
+    // `receiver`: where the light goes from the hit (the camera or the mirror point), for D.
+    std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver) const;
 
     Scene scene_;
     Model model_;
@@ -66,6 +74,7 @@ private:
     std::vector<std::array<double, 4>> colors_;
     std::vector<mesh4d::World4D> worlds_;
     std::vector<mesh4d::TraceWorld> traces_;
+    bool shade_doppler_ = false;
 };
 
 struct RaytraceSettings {
@@ -76,6 +85,7 @@ struct RaytraceSettings {
     int width = 480, height = 270;
     int threads = 0;
     bool quiet = false;            // no summary, no progress
+    bool shade_doppler = false;    // --shade doppler (SceneTracer::setShadeDoppler)
 };
 
 // `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame and/or one video (exporters/video.h).
