@@ -1,7 +1,9 @@
 // apparent web viewer: plays exported .glb files (one node per frame, STEP scale animation "frames")
 // from the scene camera, several models side by side in one WebGL canvas.
 //
-// URL parameters: ?dir=/out  ?models=instant,finite,relativistic  ?t=SECONDS  ?paused=1
+// URL parameters: ?dir=/out  ?models=instant,finite,relativistic  ?t=SECONDS  ?paused=1  ?shade=plain|doppler
+// Colours: files rendered with `--shade doppler` carry COLOR_0 (the Doppler-shifted colour) with a white
+// material whose extras.base_color is the plain colour; the "Doppler" toggle switches between the two.
 // Test hook: window.apparentViewer (see the end of this file and README.md).
 
 import * as THREE from 'three';
@@ -21,6 +23,7 @@ const modelNames = (params.get('models') || 'instant,finite,relativistic')
   .split(',').map((s) => s.trim()).filter(Boolean);
 const initialTime = Math.max(0, Number(params.get('t')) || 0);
 const startPaused = ['1', 'true', 'yes'].includes((params.get('paused') || '').toLowerCase());
+let shade = (params.get('shade') || 'doppler').toLowerCase() === 'plain' ? 'plain' : 'doppler';
 // ?aspect=16:9 or 1.6: aspect ratio of every viewport (default: the file camera's aspectRatio, else 16:9)
 function parseAspect(v) {
   if (!v) return null;
@@ -41,6 +44,7 @@ const timeEl = document.getElementById('time');
 const speedSel = document.getElementById('speed');
 const loopBox = document.getElementById('loop');
 const statusEl = document.getElementById('status');
+const dopplerBox = document.getElementById('doppler');
 
 function setStatus(msg, isError = false) {
   statusEl.textContent = msg;
@@ -203,8 +207,37 @@ async function loadModel(m) {
   m.camera.add(light, light.target);
   scene.add(new THREE.HemisphereLight(0xdde6ff, 0x303028, 1.1));
 
+  // Doppler colours (--shade doppler): the meshes with COLOR_0 and their materials' plain colours
+  m.shaded = [];
+  gltf.scene.traverse((o) => {
+    const base = o.material?.userData?.base_color;
+    if (o.isMesh && o.geometry?.attributes?.color && Array.isArray(base)) m.shaded.push({ mesh: o, base });
+  });
   m.loaded = true;
   return m;
+}
+
+// 'doppler': COLOR_0 times a white material; 'plain': the material's extras.base_color without COLOR_0.
+function applyShade() {
+  for (const m of models) {
+    if (!m.loaded) continue;
+    for (const { mesh, base } of m.shaded) {
+      const doppler = shade === 'doppler';
+      mesh.material.vertexColors = doppler;
+      if (doppler) mesh.material.color.setRGB(1, 1, 1, THREE.LinearSRGBColorSpace);
+      else mesh.material.color.setRGB(base[0], base[1], base[2], THREE.LinearSRGBColorSpace);
+      mesh.material.needsUpdate = true;
+    }
+  }
+}
+
+function setShade(s) {
+  if (s !== 'plain' && s !== 'doppler') throw new Error(`setShade: 'plain' or 'doppler', not ${s}`);
+  shade = s;
+  dopplerBox.checked = shade === 'doppler';
+  applyShade();
+  render();
+  return shade;
 }
 
 // World-space box of all frames' content at rest scale (frames are hidden by a zero scale most of the time).
@@ -416,6 +449,7 @@ document.getElementById('prev').addEventListener('click', () => { setPlaying(fal
 document.getElementById('next').addEventListener('click', () => { setPlaying(false); step(+1); });
 slider.addEventListener('input', () => { setPlaying(false); setTime(Number(slider.value)); });
 window.addEventListener('resize', () => render());
+dopplerBox.addEventListener('change', () => setShade(dopplerBox.checked ? 'doppler' : 'plain'));
 function setZoom(z) {
   zoom = Math.min(50, Math.max(0.2, z));
   updateLabels();
@@ -429,6 +463,7 @@ window.addEventListener('keydown', (ev) => {
   if (ev.key === ' ') { ev.preventDefault(); setPlaying(!playing); }
   else if (ev.key === 'ArrowLeft') { ev.preventDefault(); setPlaying(false); step(-1); }
   else if (ev.key === 'ArrowRight') { ev.preventDefault(); setPlaying(false); step(+1); }
+  else if ((ev.key === 'd' || ev.key === 'D') && !dopplerBox.disabled) setShade(shade === 'doppler' ? 'plain' : 'doppler');
   else if (ev.key === 'Home') { ev.preventDefault(); setTime(0); }
   else if (ev.key === 'End') { ev.preventDefault(); setTime(maxDuration); }
   else if (ev.key === '+' || ev.key === '=') setZoom(zoom * 1.25);
@@ -442,6 +477,7 @@ function info() {
     url: m.url, loaded: m.loaded, fps: m.fps, duration: m.duration, frames: m.frames.length,
     firstFrame: m.firstFrame, frameTimes: m.frameTimes.length, camera: m.cameraSource,
     fov: m.baseFov ?? null, aspect, zoom, cameraNote: m.cameraNote || null,
+    dopplerColours: (m.shaded || []).length, shade,
   }]));
 }
 
@@ -466,6 +502,9 @@ const ready = (async () => {
   const steps = ok.filter((m) => m.fps > 0).map((m) => 1 / m.fps);
   minFrameStep = steps.length ? Math.min(...steps) : 0.1;
   slider.max = String(maxDuration || 1);
+  dopplerBox.disabled = !ok.some((m) => m.shaded.length);
+  dopplerBox.checked = shade === 'doppler';
+  applyShade();
   setTime(Math.min(initialTime, maxDuration));
   setPlaying(playing);
   requestAnimationFrame(tick);
@@ -490,6 +529,8 @@ window.apparentViewer = {
   background: VIEW_BG,
   setTime,
   setZoom,
+  // 'plain' or 'doppler' (files with COLOR_0 from --shade doppler); returns the shade now in use
+  setShade,
   getTime: () => time,
   play: () => setPlaying(true),
   pause: () => setPlaying(false),

@@ -14,7 +14,9 @@
 //     that of its reflection child nodes ("frame_NNNNN mirror M", issue #7) shown with it (a child that three.js
 //     did not attach to its frame, or shows at another time, changes the count);
 //   - a screenshot at t = --shot-time (default 10 s) has a meaningful number of non-background pixels in every
-//     model's viewport.
+//     model's viewport;
+//   - for files with COLOR_0 (render --shade doppler): the viewer found the Doppler colours, and switching to
+//     plain colours changes the picture where objects move (relativistic) but not where D = 1 (instant).
 // Exit 0 when everything passed, 1 on a failed check, 2 on a usage or setup problem (nothing is skipped).
 'use strict';
 
@@ -288,6 +290,36 @@ async function main() {
       check(frac >= minFrac, `${m}: screenshot shows geometry`, `${(100 * frac).toFixed(3)} % < ${100 * minFrac} % non-background`);
       check(bgLike / Math.max(1, total) > 0.05, `${m}: screenshot viewport shows background too`,
         `${(100 * bgLike / total).toFixed(2)} % background pixels: wrong background colour, or view filled?`);
+    }
+
+    // 5b. Doppler colours: the toggle against the plain colours, in the same viewports
+    const withColour = opts.models.filter((m) => (files[m].json.meshes || []).some((me) =>
+      me.primitives.some((p) => p.attributes.COLOR_0 !== undefined)));
+    if (withColour.length) {
+      for (const m of withColour) {
+        check(info[m].dopplerColours > 0, `${m}: viewer found the COLOR_0 meshes`, `${info[m].dopplerColours}`);
+      }
+      await page.evaluate(() => window.apparentViewer.setShade('plain'));
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      const plain = decodePNG(await page.screenshot({ type: 'png' }));
+      await page.evaluate(() => window.apparentViewer.setShade('doppler'));
+      for (const m of withColour) {
+        const r = vps[m];
+        let changed = 0, total = 0;
+        for (let y = Math.ceil(r.y) + 2; y < Math.min(img.height, Math.floor(r.y + r.height) - 2); ++y) {
+          for (let x = Math.ceil(r.x) + 2; x < Math.min(img.width, Math.floor(r.x + r.width) - 2); ++x) {
+            const o = (y * img.width + x) * img.channels;
+            const d = Math.max(Math.abs(img.data[o] - plain.data[o]), Math.abs(img.data[o + 1] - plain.data[o + 1]),
+              Math.abs(img.data[o + 2] - plain.data[o + 2]));
+            ++total;
+            if (d > 24) ++changed;
+          }
+        }
+        const frac = changed / Math.max(1, total);
+        console.log(`  ${m}: Doppler vs plain colours differ in ${(100 * frac).toFixed(2)} % of the viewport`);
+        if (m === 'instant') check(frac < 0.001, `${m}: Doppler colours equal the plain ones (D = 1)`, `${(100 * frac).toFixed(3)} %`);
+        if (m === 'relativistic') check(frac > 0.001, `${m}: Doppler colours differ from the plain ones`, `${(100 * frac).toFixed(3)} %`);
+      }
     }
 
     // 6. console
