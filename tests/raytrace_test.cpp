@@ -359,6 +359,10 @@ void crossCheck(const std::string& scene_file, long long stride, long long min_m
     mesh4d::SliceSettings slice;
     slice.tolerance = 1e-3;
     for (Model model : {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted}) {
+        if (!checkSceneForModel(scene, model).ok) {  // e.g. finite with a moving camera (not modelled yet)
+            std::cout << "[cross-check] " << modelName(model) << ": refused for this scene, skipped\n";
+            continue;
+        }
         const SceneTracer tracer(scene, objects, mirrors, model, 0, frames - 1);
         std::vector<mesh4d::World4D> worlds;
         for (const auto& o : objects) worlds.push_back(buildWorld(o, model, scene, 0, frames - 1));
@@ -448,7 +452,8 @@ TEST(RaytraceCrossCheck, ApparentMeshesShowWhatThe4DRaytracerShows) {
 }
 
 // Issue 17: the same agreement for a moving camera, the fly-by (camera at 0.9c past seven boxes at
-// rest): every model, every 10th frame.
+// rest): every model the scene allows (instant, relativistic, contracted; finite is refused for a
+// moving camera), every 10th frame.
 TEST(RaytraceCrossCheck, FlybyFromAMovingCamera) {
     crossCheck("data/scenes/flyby.json", 10, 0, nullptr);
 }
