@@ -412,6 +412,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         rs.glb.shade_doppler = shade_text == "doppler";
         if (rs.glb.shade_doppler && rs.glb.meshopt)
             return usage("--shade doppler: not with --compress meshopt yet (use none or draco)");
+        if (rs.glb.shade_doppler && std::find(rs.formats.begin(), rs.formats.end(), "glb") == rs.formats.end())
+            return usage("--shade doppler: colours go into the .glb only (add glb to --format; the PLY frames hold "
+                         "the doppler factor itself)");
     }
     if (rs.glb.meshopt_bits != 0 && (rs.glb.meshopt_bits < 2 || rs.glb.meshopt_bits > 16))
         return usage("--meshopt-bits: " + std::to_string(rs.glb.meshopt_bits) + " is outside 2..16");

@@ -194,6 +194,10 @@ TEST(DopplerColour, RenderBakesColor0FromEachVertexDoppler) {
                      "--shade", "doppler"});
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--shade doppler: not with --compress meshopt yet"), std::string::npos) << r.err;
+    r = apparentRun({"render", (dir / "scene.json").string(), "--out", (dir / "p").string(), "--format", "ply",
+                     "--shade", "doppler"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--shade doppler: colours go into the .glb only"), std::string::npos) << r.err;
     r = apparentRun({"render", (dir / "scene.json").string(), "--out", (dir / "x").string(), "--shade", "sepia"});
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--shade: unknown shading 'sepia'"), std::string::npos) << r.err;
