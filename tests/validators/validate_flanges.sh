@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Renders the default flange scene in every model, plain, with Draco and with meshopt, and checks each .glb
+# Renders the default flange scene in every model, plain, with Draco, with meshopt and with
+# --shade doppler (COLOR_0), and checks each .glb
 # with the Khronos glTF-Validator (0 errors and 0 warnings required; the validator does not
 # decode Draco or meshopt, which it reports as INFO: the Draco round trip is tested in cli_test.cpp,
 # meshopt's in tests/web/meshopt_roundtrip.js).
@@ -12,5 +13,6 @@ trap 'rm -rf "$out"' EXIT
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/plain" --model all --quiet
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/draco" --model all --draco --quiet
 "$apparent" render "$src/data/scenes/flanges.json" --out "$out/meshopt" --model all --compress meshopt --quiet
+"$apparent" render "$src/data/scenes/flanges.json" --out "$out/shaded" --model all --shade doppler --quiet
 cd "$src"
-node tests/validators/validate_gltf.js "$out"/plain/*.glb "$out"/draco/*.glb "$out"/meshopt/*.glb
+node tests/validators/validate_gltf.js "$out"/plain/*.glb "$out"/draco/*.glb "$out"/meshopt/*.glb "$out"/shaded/*.glb
