@@ -216,6 +216,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--models", figure_models_text, "Comma list of models, one row each (default instant,finite,relativistic)");
     figure_cmd->add_option("--title", fs.title, "A title line above the sheet");
     figure_cmd->add_flag("--no-labels", figure_no_labels, "No model names and camera times around the panels");
+    std::string figure_shade_text;
+    figure_cmd->add_option("--shade", figure_shade_text, "plain (default) or doppler, as raytrace --shade");
     figure_cmd->add_option("--video", fs.video_path, "Instead of the sheet: an H.264 MP4, the models side by side, every frame; needs ffmpeg");
     figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
@@ -336,6 +338,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (figure_models.all_models) fs.models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};
         for (Model m : figure_models.models) fs.models.push_back(m);
         fs.labels = !figure_no_labels;
+        if (!figure_shade_text.empty() && figure_shade_text != "plain" && figure_shade_text != "doppler")
+            return usage("--shade: unknown shading '" + figure_shade_text + "' (plain, doppler)");
+        fs.shade_doppler = figure_shade_text == "doppler";
         return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (trade_cmd->parsed()) {

@@ -296,8 +296,10 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     text.title = "t";  // a title band for the time, filled per frame
     SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, text, painter != nullptr);
     std::vector<std::unique_ptr<SceneTracer>> tracers;
-    for (Model m : stage.models)
+    for (Model m : stage.models) {
         tracers.push_back(std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1));
+        tracers.back()->setShadeDoppler(settings.shade_doppler);
+    }
     VideoWriter writer;
     if (!writer.open(settings.video_path, base.width, base.height, scene.frames.fps, &error)) {
         err << "error: " << error << "\n";
@@ -403,7 +405,8 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     TraceProgress progress(err, !settings.quiet, (long long)rows.size() * (long long)frames.size() * settings.height);
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
-        const SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi);
+        SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi);
+        tracer.setShadeDoppler(settings.shade_doppler);
         for (size_t c = 0; c < frames.size(); ++c) {
             progress.setLabel(std::string(modelName(rows[r])) + " frame " + std::to_string(frames[c]));
             TracedFrame frame;

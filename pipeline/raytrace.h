@@ -108,6 +108,7 @@ struct FigureSettings {
     int width = 320, height = 180;  // one panel
     int threads = 0;
     bool quiet = false;
+    bool shade_doppler = false;    // --shade doppler, as raytrace's (SceneTracer::setShadeDoppler)
 };
 
 // The frames a figure shows in its columns: evenly spaced over the scene's frames, first and last included.

@@ -232,3 +232,29 @@ TEST(DopplerColour, RaytraceShiftsApproachingBlueAndRecedingRed) {
         fs::remove_all(dir);
     }
 }
+
+// figure --shade doppler: the relativistic row changes colour against --shade plain, the
+// contracted row (no light travel: D = 1) keeps every pixel.
+TEST(DopplerColour, FigureShadesItsRelativisticRowOnly) {
+    const fs::path dir = freshDir("figure");
+    std::ofstream(dir / "scene.json") << R"({ "frames": { "start": 0, "end": 0.1, "fps": 10 }, "model": "relativistic",
+        "objects": [ { "mesh": "box.obj", "position": [0, 0, -4], "velocity": [0, 0, -0.3] } ] })";
+    apparent::RgbImage img[2];
+    for (int shade = 0; shade < 2; ++shade) {
+        const fs::path out = dir / (shade ? "doppler.png" : "plain.png");
+        const CommandResult r =
+            apparentRun({"figure", (dir / "scene.json").string(), "--out", out.string(), "--models", "relativistic,contracted",
+                         "--columns", "1", "--no-labels", "--size", "64x36", "--shade", shade ? "doppler" : "plain", "--quiet"});
+        ASSERT_EQ(r.code, 0) << r.err;
+        std::string error;
+        ASSERT_TRUE(apparent::readPng(out.string(), &img[shade], &error)) << error;
+    }
+    ASSERT_EQ(img[0].rgb.size(), img[1].rgb.size());
+    size_t differ[2] = {0, 0};  // top half (relativistic row), bottom half (contracted row)
+    for (int y = 0; y < img[0].height; ++y)
+        for (int x = 0; x < img[0].width; ++x)
+            if (std::memcmp(img[0].pixel(x, y), img[1].pixel(x, y), 3) != 0) ++differ[y < img[0].height / 2 ? 0 : 1];
+    EXPECT_GT(differ[0], 20u);
+    EXPECT_EQ(differ[1], 0u);
+    fs::remove_all(dir);
+}
