@@ -34,6 +34,7 @@
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 #include "test_meshes.h"
+#include "quiet_stage.h"
 
 namespace {
 
@@ -114,13 +115,9 @@ ChildRun runChild(const std::vector<std::string>& args) {
 
 // The child's work: what `apparent render` does before its first frame.
 int loadChild(const std::string& scene) {
-    apparent::StageOptions options;
-    options.scene_path = scene;
-    options.quiet = true;
     apparent::Stage stage;
-    std::ostringstream log;
     std::string error;
-    if (!apparent::loadStage(options, &stage, log, &error)) {
+    if (!apparent::loadQuietStage(scene, &stage, &error)) {
         std::fprintf(stderr, "%s\n", error.c_str());
         return 2;
     }

@@ -35,6 +35,7 @@
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 #include "test_meshes.h"
+#include "quiet_stage.h"
 
 namespace {
 
@@ -223,13 +224,9 @@ void BM_Culling(benchmark::State& state) {
     }
     const std::string scene = writeScene("culling", 2000, 20.0, 10.0, objects.str());
     const bool cull = state.range(0) == 1;
-    apparent::StageOptions options;
-    options.scene_path = scene;
-    options.quiet = true;
     apparent::Stage stage;
-    std::ostringstream log;
     std::string error;
-    if (!apparent::loadStage(options, &stage, log, &error)) {
+    if (!apparent::loadQuietStage(scene, &stage, &error)) {
         state.SkipWithError(error.c_str());
         return;
     }

@@ -25,6 +25,7 @@
 #include "mesh4d/angles.h"
 #include "mesh4d/ray4d.h"
 #include "test_meshes.h"
+#include "quiet_stage.h"
 
 namespace {
 
@@ -64,14 +65,11 @@ void BM_TraceRays(benchmark::State& state) {
 void BM_TraceFrame(benchmark::State& state) {
     const bool hierarchy = state.range(0) != 0;
     const bool sphere = state.range(1) != 0;
-    apparent::StageOptions options;
-    options.scene_path = std::string(APPARENT_SOURCE_DIR) + (sphere ? "/data/scenes/penrose_sphere.json" : "/data/scenes/flanges.json");
-    options.models = {apparent::Model::Relativistic};
-    options.quiet = true;
     apparent::Stage stage;
-    std::ostringstream log;
     std::string error;
-    if (!apparent::loadStage(options, &stage, log, &error)) {
+    if (!apparent::loadQuietStage(
+            std::string(APPARENT_SOURCE_DIR) + (sphere ? "/data/scenes/penrose_sphere.json" : "/data/scenes/flanges.json"),
+            &stage, &error, {apparent::Model::Relativistic})) {
         state.SkipWithError(error.c_str());
         return;
     }

@@ -17,6 +17,7 @@
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 #include "run_command.h"
+#include "quiet_stage.h"
 
 using namespace apparent;
 using mesh4d::Event;
@@ -51,12 +52,8 @@ void loadScene(const std::string& name, const std::string& scene_json, Fixture* 
     fs::create_directories(f->dir);
     fs::copy_file(fs::path(APPARENT_SOURCE_DIR) / "data/meshes/box.obj", f->dir / "box.obj");
     std::ofstream(f->dir / "scene.json") << scene_json;
-    StageOptions options;
-    options.scene_path = (f->dir / "scene.json").string();
-    options.quiet = true;
-    std::ostringstream log;
     std::string error;
-    ASSERT_TRUE(loadStage(options, &f->stage, log, &error)) << error;
+    ASSERT_TRUE(loadQuietStage((f->dir / "scene.json").string(), &f->stage, &error)) << error;
 }
 
 // Checks every vertex of frame k of every object in vertex mode; returns the vertex count.
