@@ -90,4 +90,14 @@ MotionInCameraFrame motionInCameraFrame(const Motion& lab, const CameraMotion& c
     return out;
 }
 
+Vec3 labRayDirection(const CameraMotion& camera, const Vec3& k) {
+    if (!camera.moving()) return k;
+    const Vec3& v = camera.velocity;
+    const double kv = dot(k, v);
+    const double root = std::sqrt(kv * kv + camera.one_minus_b2);
+    const double a = kv >= 0 ? kv + root : camera.one_minus_b2 / (root - kv);
+    const Vec3 d = k * a - v;
+    return d / norm(d);  // unit already to rounding
+}
+
 }  // namespace mesh4d

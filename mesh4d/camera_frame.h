@@ -21,8 +21,9 @@
 // entries carry an absolute error of about 1e-19 g_u g_v g_w (R is exactly I, not computed, in the
 // parallel case, which includes every object at rest in the lab).
 //
-// Galilean kinematics (instant; and finite, whose light moves at c in the lab: see camera_frame
-// users): x' = x - v t, t' = t about the same event: w = u - v, R = I.
+// Galilean kinematics (instant): x' = x - v t, t' = t about the same event: w = u - v, R = I.
+// The finite model maps its outputs the same way, but its light moves at c in the lab, so it is
+// cut there and sheared afterwards (lightcone.h ViewSurface::shear; labRayDirection below).
 //
 // With v = 0 the motion is returned unchanged (bit for bit), so scenes with a camera at rest keep
 // their bytes.
@@ -65,5 +66,14 @@ struct MotionInCameraFrame {
 
 // `lab` (an object's motion in the lab) as seen in the camera frame. Precondition: |v| < 1.
 MotionInCameraFrame motionInCameraFrame(const Motion& lab, const CameraMotion& camera);
+
+// The finite model with a moving camera (light at c in the lab; its cut is made there and sheared
+// into the camera's frame, lightcone.h ViewSurface::shear): the unit lab direction d of the light
+// ray the camera sees along the unit camera-frame direction k (both from the camera into the
+// scene). The ray's events are (t_c - s, C + v t_c + s d) in the lab, at P + s (d + v) in the
+// camera's frame, so d + v lies along k: d = a k - v with |d| = 1,
+//     a = k.v + sqrt((k.v)^2 + 1 - |v|^2) > 0   (the conjugate (1 - |v|^2) / (sqrt(...) - k.v) when k.v < 0).
+// This is classical aberration: a star at rest in lab direction d appears along d + v.
+Vec3 labRayDirection(const CameraMotion& camera, const Vec3& k);
 
 }  // namespace mesh4d

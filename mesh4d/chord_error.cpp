@@ -48,8 +48,13 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
 
 ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const double t_mid[3], const Vec3 s[3],
                              const double xm[3], double tolerance) {
+    return displacedChordError(m, m.beta, t_corner, t_mid, s, xm, tolerance);
+}
+
+ChordError displacedChordError(const Motion& m, double speed, const double t_corner[3], const double t_mid[3],
+                               const Vec3 s[3], const double xm[3], double tolerance) {
     ChordError r;
-    if (m.beta == 0) return r;
+    if (speed == 0) return r;  // no displacement: the map is affine
     // Delays (delta = -t) and the midpoint bubbles, |beta| (delta is convex: beta <= 0 up to rounding).
     double c[3];
     for (int e = 0; e < 3; ++e) {
@@ -57,7 +62,7 @@ ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const do
         c[e] = 4 * std::fabs(dm - 0.5 * (d0 + d1));
     }
     const double Q = bubbleMax(c[0], c[1], c[2]);
-    r.quadratic = m.beta * Q;
+    r.quadratic = speed * Q;
     // Over the tolerance on the bubbles alone: R only adds (callers compare the bound only).
     if (!(r.quadratic <= tolerance)) {
         r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
@@ -78,7 +83,7 @@ ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const do
     const double rM = std::sqrt(q);
     const double mlow = xm_min - 2 * rM;
     const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
-    r.bound = m.beta * (Q + R);
+    r.bound = speed * (Q + R);
     if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
     return r;
 }

@@ -86,6 +86,18 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
 ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const double t_mid[3], const Vec3 s[3],
                              const double xm[3], double tolerance = INFINITY);
 
+// A moving camera in the finite model (lightcone.h ViewSurface::shear = v): the cut is made in the
+// lab with the object's lab velocity u, and each output event (t, x) becomes (t, x - v t). A local
+// event (t = -delta, y = s - u delta) thus becomes y' = y + v delta = s - w delta, w = u - v:
+//     F'(q) = s(q) - w delta(q),     |F' - L F'| = |w| |delta - L delta| <= |w| (Q + R),
+// with delta, Q and R exactly as above (the same light delay, the quadratic with u: only the
+// displacement is along w). So the bound is chordErrorOfTerms' with the factor b = |u| replaced by
+// `speed` = |w|. An object at rest in the lab (u = 0: delta is the Euclidean distance, convex too,
+// |.|_M Euclidean and 1 - b^2 = 1) is not affine in the camera's frame then (w = -v), and this
+// bound applies to it as well. chordErrorOfTerms is this with speed = b (0 when b = 0).
+ChordError displacedChordError(const Motion& m, double speed, const double t_corner[3], const double t_mid[3],
+                               const Vec3 s[3], const double xm[3], double tolerance = INFINITY);
+
 // A bound from the corners alone, for triangles that need no refinement: no midpoint is cut.
 // The Hessian of delta satisfies u^T H u <= |u|_M^2 / ((1 - b^2) |x|_M) (that of a norm is at
 // most M / |x|_M), and the linear interpolant of a function with such a Hessian errs by at most

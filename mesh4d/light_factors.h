@@ -6,6 +6,7 @@
 // unit vector from the emission event's position to the camera (the view's apex):
 //     Lorentz (relativistic):   D = 1 / (g (1 - w.n)),   g = 1/sqrt(1 - b^2)
 //     Galilean (finite; light at c in that frame, the camera at rest in it):  D = 1 / (1 - w.n)
+//       (with a moving camera the frame is the lab and D = (1 - v.n) / (1 - u.n): dopplerFactor)
 //     on a hyperplane (instant, contracted: no light travel): D = 1.
 // On the line of sight D = sqrt((1 + b)/(1 - b)) approaching and sqrt((1 - b)/(1 + b)) receding;
 // at right angles to w in the camera's frame D = 1/g (the transverse Doppler effect).
@@ -23,10 +24,18 @@
 
 namespace mesh4d {
 
-// D for a source moving with `m` seen from `apex`, emitting at position x.
-double dopplerFactor(const Motion& m, ViewKind kind, const Vec3& apex, const Vec3& x);
+// D for a source moving with `m` seen from `apex`, emitting at position x. `receiver`: the
+// camera's velocity in the frame of m, x and apex, which only the finite model with a moving
+// camera has (that frame is the lab, the light's medium, and the camera moves through it):
+//     Galilean, moving receiver v:   D = (1 - v.n) / (1 - u.n),   n from x to the camera at reception,
+// the classical factor with both velocities measured against the medium (1 - v.n formed as
+// 1 - u.n is). Lorentz kinematics take the camera at rest (receiver zero): the frame is its own.
+double dopplerFactor(const Motion& m, ViewKind kind, const Vec3& apex, const Vec3& x, const Vec3& receiver = {0, 0, 0});
 
 // Fills m->doppler and m->proper_time (one per apparent point) for a cut of `world` by `view`.
+// A sheared view (the finite model with a moving camera, lightcone.h): m's points are in the
+// camera's frame; each is taken back to the lab (x + shear t) and seen by a receiver moving at
+// `shear` from `apex`, the camera's lab position at reception.
 void addLightFactors(const World4D& world, const ViewSurface& view, ApparentMesh* m);
 
 }  // namespace mesh4d

@@ -31,6 +31,13 @@ struct ViewSurface {
     ViewKind kind = ViewKind::PastCone;
     double t_c = 0;  // camera time of the frame
     Vec3 apex;       // camera position C (unused for the hyperplane)
+    // The Galilean map applied to what a cut outputs (the finite model with a moving camera:
+    // physics.h viewAt). The surface above and every function of this file live in the frame of
+    // the light's medium (the lab, where the cone is round; apex = the camera's lab position at
+    // t_c); slice.h's outputs are the events (t, x - shear t) of the camera's frame. Zero: outputs
+    // in the cut's own frame (every other case).
+    Vec3 shear{0, 0, 0};
+    bool sheared() const { return shear.x != 0 || shear.y != 0 || shear.z != 0; }
 };
 
 // Side function h(E) above.

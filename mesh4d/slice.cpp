@@ -151,6 +151,14 @@ struct FrameBuilder {
     FrameBuilder(const FrameBuilder&) = delete;
     FrameBuilder& operator=(const FrameBuilder&) = delete;
 
+    // A piece's bound (chord_error.h): displaced along the object's velocity u, or along
+    // w = u - shear when the view shears its outputs (the finite model with a moving camera).
+    ChordError pieceBound(const double t_corner[3], const double t_mid[3], const Vec3 s[3], const double xm[3]) const {
+        if (!view.sheared()) return chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
+        return displacedChordError(world.motion, norm(world.motion.velocity - view.shear), t_corner, t_mid, s, xm,
+                                   settings.tolerance);
+    }
+
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
         // A clip point that fell on a visible corner is that corner (see crossingPoint): the
         // triangle has no area then and is not emitted.
@@ -588,7 +596,7 @@ struct FrameBuilder {
                 const double t_corner[3] = {k0.t, k1.t, k2.t};
                 const Vec3 s[3] = {k0.s, k1.s, k2.s};
                 const double xm[3] = {k0.xm, k1.xm, k2.xm};
-                const ChordError ce = chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
+                const ChordError ce = pieceBound(t_corner, t_mid, s, xm);
                 if (ce.bound <= settings.tolerance) continue;
                 r_tri[id].failed = 1;
             }
@@ -736,9 +744,11 @@ struct FrameBuilder {
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
             const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
             const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
-            if (passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
+            // (The corners' bounds have the factor |u|: a sheared view takes the full bound.)
+            if (!view.sheared() && passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
             const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
-            if (chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance) candidates.push_back(uint32_t(f));
+            if (view.sheared() || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
+                candidates.push_back(uint32_t(f));
         }
         if (!candidates.empty()) {
             e_done.assign(ne, 0);
@@ -776,7 +786,7 @@ struct FrameBuilder {
                     sc[c] = r_terms[v].s;
                     xc[c] = r_terms[v].xm;
                 }
-                const double bound = chordErrorOfTerms(world.motion, t_corner, t_mid, sc, xc, settings.tolerance).bound;
+                const double bound = pieceBound(t_corner, t_mid, sc, xc).bound;
                 if (bound > settings.tolerance) {
                     failing.push_back(f);
                     // About bound / T pieces once halved down to T (the error falls about as the area).
@@ -1213,15 +1223,20 @@ bool chunkMayShow(const World4D& world, const ViewSurface& view, const TriangleC
 
 }  // namespace
 
-ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& requested) {
+namespace {
+
+// The cut in the view's own frame (sliceWorld before the shear).
+ApparentMesh sliceUnsheared(const World4D& world, const ViewSurface& view, const SliceSettings& requested) {
     // Model only what the cut requires: on a hyperplane, or at rest, the map from the rest
-    // surface to the apparent one is affine, so straight edges are exact and nothing is refined.
+    // surface to the apparent one is affine, so straight edges are exact and nothing is refined
+    // (at rest under a shear it is not: chord_error.h displacedChordError).
     SliceSettings settings = requested;
+    const bool at_rest = world.motion.beta == 0 && !view.sheared();
     // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
     // are refined (FrameBuilder::restPlan).
-    const bool rest_clip = view.kind == ViewKind::PastCone && world.motion.beta == 0 && settings.tolerance > 0 &&
+    const bool rest_clip = view.kind == ViewKind::PastCone && at_rest && settings.tolerance > 0 &&
                            (world.cap_a_real || world.cap_b_real);
-    if (view.kind == ViewKind::Hyperplane || world.motion.beta == 0) settings.tolerance = 0;
+    if (view.kind == ViewKind::Hyperplane || at_rest) settings.tolerance = 0;
     FrameBuilder b(world, view, settings);
     b.rest_clip = rest_clip;
     b.rest_tolerance = requested.tolerance;
@@ -1276,22 +1291,43 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
     return std::move(b.out);
 }
 
+// The output origin under the view's shear: (t, x) -> (t, x - shear t) at the anchor's origin.
+Vec3 shearedOrigin(const ViewSurface& view, const ViewAnchor& anchor) {
+    return anchor.origin - view.shear * anchor.time_origin;
+}
+
+}  // namespace
+
+ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings) {
+    ApparentMesh out = sliceUnsheared(world, view, settings);
+    if (!view.sheared()) return out;
+    // Step: the Galilean map into the output frame, origin and local parts apart (each local
+    // point moves by -shear times its local time, a term of the object's size).
+    out.origin = out.origin - view.shear * out.time_origin;
+    for (size_t i = 0; i < out.positions.size(); ++i) out.positions[i] -= view.shear * out.emission_times[i];
+    return out;
+}
+
 Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q) {
     const ViewAnchor anchor = viewAnchor(view, world.motion);
     const Event local = cutRestLocal(anchor, world.motion, q);
-    return {anchor.time_origin + local.t, anchor.origin + local.x};
+    return {anchor.time_origin + local.t, shearedOrigin(view, anchor) + (local.x - view.shear * local.t)};
 }
 
 BoundingSphere apparentBound(const World4D& world, const ViewSurface& view) {
     const ViewAnchor anchor = viewAnchor(view, world.motion);
     const double b = world.motion.beta;
-    const double stretch = view.kind == ViewKind::PastCone ? (1 + b) / world.motion.one_minus_beta2 : 1.0;
+    double stretch = view.kind == ViewKind::PastCone ? (1 + b) / world.motion.one_minus_beta2 : 1.0;
+    // Sheared, local points are s - w delta, w = u - shear, with |s| <= R and |delta| <= R / (1 - b).
+    if (view.sheared() && view.kind == ViewKind::PastCone)
+        stretch = 1 + norm(world.motion.velocity - view.shear) * (1 + b) / world.motion.one_minus_beta2;
     // A relative 1e-9 more for the rounding of the points themselves.
-    return {anchor.origin, world.shape_radius * stretch * (1 + 1e-9)};
+    return {shearedOrigin(view, anchor), world.shape_radius * stretch * (1 + 1e-9)};
 }
 
 Event exactLocalPoint(const World4D& world, const ViewSurface& view, const Vec3& q) {
-    return cutRestLocal(viewAnchor(view, world.motion), world.motion, q);
+    const Event local = cutRestLocal(viewAnchor(view, world.motion), world.motion, q);
+    return {local.t, local.x - view.shear * local.t};
 }
 
 }  // namespace mesh4d

@@ -107,14 +107,20 @@ struct SliceSettings {
 };
 
 // Cuts `world` with `view`. Precondition: world.motion.beta < 1 when view.kind == PastCone.
-// The result is empty when no part of the history meets the view surface.
+// The result is empty when no part of the history meets the view surface. A sheared view
+// (lightcone.h ViewSurface::shear, the finite model with a moving camera) is cut in its own frame
+// and every output event (t, x) returned as (t, x - shear t): origin and local parts apart, so
+// the shape keeps its relative accuracy; the tolerance holds for these outputs (the refinement's
+// bound displaces along u - shear, chord_error.h displacedChordError, objects at rest included).
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
 
 // A sphere that holds every apparent point of `world` in `view`: centred on the apparent position
 // of the object's origin, radius R / (1 - b) on the cone (R = World4D::shape_radius: the shape
 // offset never lengthens q; the light delay changes by at most |delta e| / (1 - b) between two
 // points, so each point lies within |s| + b |s| / (1 - b) of the origin's image) and R on the
-// hyperplane. For view culling (pipeline/render.cpp, --cull-view).
+// hyperplane. Under a shear (sliceWorld) the points are s - w delta, w = u - shear: radius
+// R (1 + |w| / (1 - b)), centred on the origin's sheared image. For view culling
+// (pipeline/render.cpp, --cull-view).
 struct BoundingSphere {
     Vec3 center;
     double radius = 0;
@@ -122,7 +128,8 @@ struct BoundingSphere {
 BoundingSphere apparentBound(const World4D& world, const ViewSurface& view);
 
 // The exact apparent point of rest point `q` (any point of the object's rest frame): the crossing of
-// its worldline with the view surface. Used by tests and tools to measure the error of a mesh.
+// its worldline with the view surface (sheared as sliceWorld's outputs). Used by tests and tools to
+// measure the error of a mesh.
 Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Vec3& q);
 // The same point in the local coordinates of sliceWorld's output for this world and view
 // (relative to ApparentMesh::origin and time_origin), computed the same way.

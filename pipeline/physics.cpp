@@ -28,6 +28,11 @@ mesh4d::MotionInCameraFrame cameraFrameMotionOf(const ObjectSpec& s, Model model
     return mesh4d::motionInCameraFrame(motionOf(s, model), cameraMotionOf(scene));
 }
 
+mesh4d::MotionInCameraFrame cutMotionOf(const ObjectSpec& s, Model model, const Scene& scene) {
+    if (model == Model::Finite) return {motionOf(s, model)};  // cut in the lab, sheared at output (viewAt)
+    return cameraFrameMotionOf(s, model, scene);
+}
+
 const mesh4d::RestMesh& restInCameraFrame(const mesh4d::RestMesh& rest, const mesh4d::MotionInCameraFrame& m,
                                           mesh4d::RestMesh* storage) {
     if (!m.rotated) return rest;
@@ -48,6 +53,14 @@ mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c) {
     // The hyperplane models may look back by the stage's light delay (scene camera.instant_delay).
     if (view.kind == mesh4d::ViewKind::Hyperplane) view.t_c -= scene.camera.instant_delay;
     view.apex = scene.camera.position;
+    // The finite model with a moving camera: light moves at c in the lab, so the cone is the lab's,
+    // from the camera's lab position at t_c (its proper time, the lab's under Galilean kinematics),
+    // and the outputs are sheared into the camera's frame, x' = x - v t (slice.h sliceWorld).
+    const mesh4d::CameraMotion camera = cameraMotionOf(scene);
+    if (model == Model::Finite && camera.moving()) {
+        view.apex = camera.position + camera.velocity * t_c;
+        view.shear = camera.velocity;
+    }
     return view;
 }
 

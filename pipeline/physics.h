@@ -28,11 +28,21 @@ mesh4d::CameraMotion cameraMotionOf(const Scene& scene);
 // unchanged, for a camera at rest.
 mesh4d::MotionInCameraFrame cameraFrameMotionOf(const ObjectSpec& object, Model model, const Scene& scene);
 
+// The motion of `object` in the frame its cut is computed in (buildWorld): the camera's rest frame
+// (cameraFrameMotionOf), except in the finite model, whose cut is always made in the lab, where its
+// light is isotropic, and sheared into the camera's frame at output (viewAt): the lab motion then.
+mesh4d::MotionInCameraFrame cutMotionOf(const ObjectSpec& object, Model model, const Scene& scene);
+
 // `rest` with the rotation of `m` applied to its points (a copy only when m.rotated).
 const mesh4d::RestMesh& restInCameraFrame(const mesh4d::RestMesh& rest, const mesh4d::MotionInCameraFrame& m,
                                           mesh4d::RestMesh* storage);
 
 // The view surface at camera time t_c, and at global frame k (t_c = frameTime(scene.frames, k)).
+// Finite with a moving camera (velocity v): the lab's past cone of the camera's lab event
+// (t_c, position + v t_c), with shear v, so that cuts output the camera frame's x - v t
+// (lightcone.h ViewSurface::shear). In the camera's frame the object moves at w = u - v, and the
+// light delay d of a point now at e relative to the camera solves |e - u d| = d (the lab's quadratic
+// with the lab velocity u), its image being e - w d: the same as cutting in the lab and shearing.
 mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c);
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k);
 

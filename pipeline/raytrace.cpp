@@ -105,7 +105,8 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     return best;
 }
 
-std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, const Vec3& receiver) const {
+std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, const Vec3& receiver,
+                                         const Vec3& receiver_velocity) const {
     // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), summed over the lights with their
     // weights (the default key light, scene.h), n already turned towards the side
     // the ray arrives from (the surfaces are two-sided, as in the exported glTF).
@@ -122,7 +123,8 @@ std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, co
     const double lambert = light.ambient + (1 - light.ambient) * diffuse;
     std::array<double, 3> c{colors_[size_t(h.object)][0], colors_[size_t(h.object)][1], colors_[size_t(h.object)][2]};
     if (shade_doppler_) {
-        const double d = mesh4d::dopplerFactor(worlds_[size_t(h.object)].motion, kind, receiver, h.hit.event.x);
+        const double d =
+            mesh4d::dopplerFactor(worlds_[size_t(h.object)].motion, kind, receiver, h.hit.event.x, receiver_velocity);
         c = mesh4d::dopplerColour(c, d);
     }
     return {c[0] * lambert, c[1] * lambert, c[2] * lambert};
@@ -134,19 +136,23 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
     frame.object.assign(size_t(width) * size_t(height), -1);
     frame.reflected.assign(size_t(width) * size_t(height), -1);
     const mesh4d::ViewSurface view = viewForFrame(scene_, model_, k);
+    const mesh4d::CameraMotion camera = cameraMotionOf(scene_);
     tbb::parallel_for(0, height, [&](int py) {
         for (int px = 0; px < width; ++px) {
             const size_t idx = size_t(py) * size_t(width) + size_t(px);
-            // Step: the primary ray, back along the past cone (or along t = t_c).
+            // Step: the primary ray, back along the past cone (or along t = t_c). A sheared view
+            // (finite, moving camera) is traced in the lab from the camera's lab position, along
+            // the lab direction the pixel's camera-frame direction sees (camera_frame.h).
             mesh4d::Ray4D ray;
-            ray.origin = {view.t_c, scene_.camera.position};
+            ray.origin = {view.t_c, view.apex};
             ray.direction = pixelDirection(scene_.camera, width, height, px, py);
+            if (view.sheared()) ray.direction = mesh4d::labRayDirection(camera, ray.direction);
             ray.along_cone = view.kind == mesh4d::ViewKind::PastCone;
             const Hit hit = nearest(ray, false);
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
                 frame.object[idx] = hit.object;
-                color = shade(hit, view.kind, ray.origin.x);
+                color = shade(hit, view.kind, ray.origin.x, view.shear);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,

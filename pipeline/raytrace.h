@@ -64,8 +64,10 @@ private:
         mesh4d::WorldHit hit;
     };
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
-    // `receiver`: where the light goes from the hit (the camera or the mirror point), for D.
-    std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver) const;
+    // `receiver`: where the light goes from the hit (the camera or the mirror point), for D, and its
+    // velocity (light_factors.h dopplerFactor: nonzero only for finite with a moving camera).
+    std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
+                                const mesh4d::Vec3& receiver_velocity = {0, 0, 0}) const;
 
     Scene scene_;
     Model model_;

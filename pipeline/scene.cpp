@@ -131,12 +131,6 @@ Status loadScene(const std::string& path, Scene* scene) {
 }
 
 Status checkSceneForModel(const Scene& scene, Model model) {
-    // A moving camera in the finite model would see light that moves at c in the lab (the
-    // medium), anisotropic in the camera's frame: not modelled yet.
-    if (model == Model::Finite && (scene.camera.velocity.x != 0 || scene.camera.velocity.y != 0 || scene.camera.velocity.z != 0))
-        return Status::failure(scene.path + ": camera.velocity: a moving camera is not supported for model finite "
-                                            "(light at c in the lab is anisotropic in the camera's frame); use "
-                                            "relativistic, contracted or instant");
     if (model == Model::Instant) return Status::success();
     for (size_t i = 0; i < scene.objects.size(); ++i) {
         if (scene.objects[i].speed != ObjectSpec::Speed::Velocity) continue;  // b < 1 by construction

@@ -13,8 +13,9 @@ using mesh4d::Vec3;
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame) {
     const ObjectSpec& s = object.spec;
-    // In the camera's rest frame (the lab's for a camera at rest): its motion and rest points.
-    const mesh4d::MotionInCameraFrame in_camera = cameraFrameMotionOf(s, model, scene);
+    // In the frame the cut is made in (the camera's rest frame; the lab for finite): its motion
+    // and rest points.
+    const mesh4d::MotionInCameraFrame in_camera = cutMotionOf(s, model, scene);
     const mesh4d::Motion& motion = in_camera.motion;
     mesh4d::RestMesh rotated;
     const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_camera, &rotated);

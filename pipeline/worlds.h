@@ -16,7 +16,8 @@ namespace apparent {
 // The 4D history of one object for `model`, extruded over the proper-time span that frames
 // [first_frame, last_frame] (global numbers, both included) can see from the scene's camera,
 // padded by the object's light-crossing time; only ends of the object's existence are real caps.
-// Empty (motion set, no tetrahedra) when the object does not exist within that span.
+// Empty (motion set, no tetrahedra) when the object does not exist within that span. In the frame
+// the cut is made in (physics.h cutMotionOf: the camera's, or the lab for finite).
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame);
 

@@ -359,7 +359,7 @@ void crossCheck(const std::string& scene_file, long long stride, long long min_m
     mesh4d::SliceSettings slice;
     slice.tolerance = 1e-3;
     for (Model model : {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted}) {
-        if (!checkSceneForModel(scene, model).ok) {  // e.g. finite with a moving camera (not modelled yet)
+        if (!checkSceneForModel(scene, model).ok) {  // a model the scene cannot be shown in
             std::cout << "[cross-check] " << modelName(model) << ": refused for this scene, skipped\n";
             continue;
         }
