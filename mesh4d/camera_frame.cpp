@@ -51,6 +51,32 @@ Event toCameraFrame(const CameraMotion& camera, Kinematics kinematics, const Eve
     return {g * (e.t - rv), camera.position + r + v * (g * g / (g + 1.0) * rv) - v * (g * e.t)};
 }
 
+namespace {
+// The boost (Lorentz) or shear (Galilean) with velocity b on an event difference d.
+Event boostDifference(const Vec3& b, double one_minus_b2, Kinematics kinematics, const Event& d) {
+    if (kinematics == Kinematics::Galilean) return {d.t, d.x - b * d.t};
+    const double g = 1.0 / std::sqrt(one_minus_b2);
+    const double rb = dot(d.x, b);
+    return {g * (d.t - rb), d.x + b * (g * g / (g + 1.0) * rb) - b * (g * d.t)};
+}
+}  // namespace
+
+Event toCameraFrameDifference(const CameraMotion& camera, Kinematics kinematics, const Event& d) {
+    if (!camera.moving()) return d;
+    return boostDifference(camera.velocity, camera.one_minus_b2, kinematics, d);
+}
+
+Event fromCameraFrameDifference(const CameraMotion& camera, Kinematics kinematics, const Event& d) {
+    if (!camera.moving()) return d;
+    return boostDifference(-camera.velocity, camera.one_minus_b2, kinematics, d);
+}
+
+Event fromCameraFrame(const CameraMotion& camera, Kinematics kinematics, const Event& e) {
+    if (!camera.moving()) return e;
+    const Event d = fromCameraFrameDifference(camera, kinematics, {e.t, e.x - camera.position});
+    return {d.t, camera.position + d.x};
+}
+
 MotionInCameraFrame motionInCameraFrame(const Motion& lab, const CameraMotion& camera) {
     MotionInCameraFrame out;
     if (!camera.moving()) {

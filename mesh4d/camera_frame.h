@@ -57,6 +57,15 @@ CameraMotion makeCameraMotion(const Vec3& position, const Vec3& velocity);
 
 // The lab event e in the camera frame.
 Event toCameraFrame(const CameraMotion& camera, Kinematics kinematics, const Event& e);
+// The linear part of toCameraFrame: the camera-frame difference of two events whose lab
+// difference is d (so that outputs in local coordinates are mapped as origin plus difference).
+Event toCameraFrameDifference(const CameraMotion& camera, Kinematics kinematics, const Event& d);
+// The inverse of toCameraFrame: the camera-frame event e in the lab (the boost with +v about
+// (0, P): t = g (t' + v.r'), x = P + r' + (g^2 / (g + 1)) (v.r') v + g v t', r' = x' - P; Galilean
+// x = x' + v t').
+Event fromCameraFrame(const CameraMotion& camera, Kinematics kinematics, const Event& e);
+// Its linear part, as toCameraFrameDifference.
+Event fromCameraFrameDifference(const CameraMotion& camera, Kinematics kinematics, const Event& d);
 
 struct MotionInCameraFrame {
     Motion motion;                          // the object's motion in the camera frame

@@ -13,8 +13,11 @@ double dopplerFactor(const Motion& m, ViewKind kind, const Vec3& apex, const Vec
     // The receiver's factor 1 - v.n (1 when it is at rest), formed as the source's below.
     double received = 1.0;
     const double r = norm(receiver);
-    if (r > 0 && dist > 0)
-        received = oneMinusNorm2(receiver.x, receiver.y, receiver.z) / (1.0 + r) + r * 0.5 * norm2(receiver / r - d / dist);
+    if (r > 0 && dist > 0) {
+        const double one_minus_r2 = oneMinusNorm2(receiver.x, receiver.y, receiver.z);
+        received = one_minus_r2 / (1.0 + r) + r * 0.5 * norm2(receiver / r - d / dist);
+        if (m.kinematics == Kinematics::Lorentz) received /= std::sqrt(one_minus_r2);  // g_r (1 - v.n)
+    }
     if (!(dist > 0) || !(m.beta > 0)) return received * (m.kinematics == Kinematics::Lorentz ? 1.0 / m.gamma : 1.0);
     const Vec3 n = d / dist;
     const Vec3 u = m.velocity / m.beta;

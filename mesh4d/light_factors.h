@@ -29,7 +29,9 @@ namespace mesh4d {
 // camera has (that frame is the lab, the light's medium, and the camera moves through it):
 //     Galilean, moving receiver v:   D = (1 - v.n) / (1 - u.n),   n from x to the camera at reception,
 // the classical factor with both velocities measured against the medium (1 - v.n formed as
-// 1 - u.n is). Lorentz kinematics take the camera at rest (receiver zero): the frame is its own.
+// 1 - u.n is); Lorentz, moving receiver: D = g_v (1 - v.n) / (g (1 - u.n)) (the frame's
+// frequency received by a moving observer). The pipeline's own cuts are in the camera's frame
+// (receiver zero) except finite's and the reflections a moving camera sees (pipeline/mirror.h).
 double dopplerFactor(const Motion& m, ViewKind kind, const Vec3& apex, const Vec3& x, const Vec3& receiver = {0, 0, 0});
 
 // Fills m->doppler and m->proper_time (one per apparent point) for a cut of `world` by `view`.

@@ -154,6 +154,8 @@ struct FrameBuilder {
     // A piece's bound (chord_error.h): displaced along the object's velocity u, or along
     // w = u - shear when the view shears its outputs (the finite model with a moving camera).
     ChordError pieceBound(const double t_corner[3], const double t_mid[3], const Vec3 s[3], const double xm[3]) const {
+        if (settings.displacement >= 0)
+            return displacedChordError(world.motion, settings.displacement, t_corner, t_mid, s, xm, settings.tolerance);
         if (!view.sheared()) return chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
         return displacedChordError(world.motion, norm(world.motion.velocity - view.shear), t_corner, t_mid, s, xm,
                                    settings.tolerance);
@@ -744,10 +746,11 @@ struct FrameBuilder {
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
             const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
             const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
-            // (The corners' bounds have the factor |u|: a sheared view takes the full bound.)
-            if (!view.sheared() && passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
+            // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
+            const bool displaced = view.sheared() || settings.displacement >= 0;
+            if (!displaced && passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
             const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
-            if (view.sheared() || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
+            if (displaced || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
                 candidates.push_back(uint32_t(f));
         }
         if (!candidates.empty()) {
@@ -1231,7 +1234,7 @@ ApparentMesh sliceUnsheared(const World4D& world, const ViewSurface& view, const
     // surface to the apparent one is affine, so straight edges are exact and nothing is refined
     // (at rest under a shear it is not: chord_error.h displacedChordError).
     SliceSettings settings = requested;
-    const bool at_rest = world.motion.beta == 0 && !view.sheared();
+    const bool at_rest = world.motion.beta == 0 && !view.sheared() && !(settings.displacement > 0);
     // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
     // are refined (FrameBuilder::restPlan).
     const bool rest_clip = view.kind == ViewKind::PastCone && at_rest && settings.tolerance > 0 &&

@@ -104,6 +104,11 @@ struct SliceSettings {
     // the runs' 4D boxes with a margin above rounding, so a skipped run never holds a visible
     // point. Off only to measure what it saves (benchmarks/performance_bench.cpp).
     bool cull = true;
+    // The speed the refinement's bound multiplies the light delay's error by (chord_error.h
+    // displacedChordError), for a cut whose outputs are mapped afterwards by a linear map that
+    // turns the object's displacement (1, u) into one of this spatial length (reflections seen by a
+    // moving camera: pipeline/mirror.h). Negative: |u - view.shear| (the outputs themselves).
+    double displacement = -1;
 };
 
 // Cuts `world` with `view`. Precondition: world.motion.beta < 1 when view.kind == PastCone.

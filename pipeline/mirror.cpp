@@ -20,6 +20,35 @@ Vec3 reflectPoint(const MirrorPlane& m, const Vec3& p) {
 
 Vec3 reflectDirection(const MirrorPlane& m, const Vec3& d) { return d - 2 * mesh4d::dot(d, m.normal) * m.normal; }
 
+Vec3 reflectRayDirection(const MirrorPlane& m, const mesh4d::CameraMotion& camera, mesh4d::Kinematics kinematics,
+                         bool along_cone, const Vec3& d) {
+    if (!camera.moving()) return reflectDirection(m, d);
+    if (!along_cone) {
+        const Vec3 a_n = mesh4d::fromCameraFrameDifference(camera, kinematics, {0, m.normal}).x;
+        const Vec3 n = a_n / mesh4d::norm(a_n);
+        return d - 2 * mesh4d::dot(d, n) * n;
+    }
+    const mesh4d::Event lab = mesh4d::fromCameraFrameDifference(camera, kinematics, {-1, d});
+    const mesh4d::Event back = mesh4d::toCameraFrameDifference(camera, kinematics, {lab.t, reflectDirection(m, lab.x)});
+    const Vec3 r = back.x / -back.t;
+    return r / mesh4d::norm(r);
+}
+
+mesh4d::ViewSurface imageView(const MirrorPlane& m, const Scene& scene, Model model, double t_c) {
+    mesh4d::ViewSurface view = viewAt(scene, model, t_c);
+    const mesh4d::CameraMotion camera = cameraMotionOf(scene);
+    if (view.kind == mesh4d::ViewKind::Hyperplane) return view;
+    if (!camera.moving()) {
+        view.apex = reflectPoint(m, view.apex);
+        return view;
+    }
+    const mesh4d::Kinematics kinematics = kinematicsOf(model);
+    const mesh4d::Event lab = mesh4d::fromCameraFrame(camera, kinematics, {t_c, scene.camera.position});
+    const mesh4d::Event image{lab.t, reflectPoint(m, lab.x)};
+    const mesh4d::Event in_cut = model == Model::Finite ? image : mesh4d::toCameraFrame(camera, kinematics, image);
+    return {mesh4d::ViewKind::PastCone, in_cut.t, in_cut.x};
+}
+
 Status findMirrors(const std::vector<PreparedObject>& objects, const std::string& scene_path,
                    std::vector<MirrorPlane>* mirrors) {
     mirrors->clear();
@@ -204,9 +233,49 @@ mesh4d::ApparentMesh reflectAndClip(const mesh4d::ApparentMesh& cut, const Mirro
 MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<PreparedObject>& objects,
                                      const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
                                      long long last_frame)
-    : mirrors_(mirrors), camera_(scene.camera.position), scene_objects_(objects.size()) {
+    : mirrors_(mirrors),
+      camera_(scene.camera.position),
+      camera_motion_(cameraMotionOf(scene)),
+      model_(model),
+      scene_objects_(objects.size()) {
     for (const MirrorPlane& m : mirrors_) names_.push_back(objects[m.object].spec.name);
-    // Step: each non-mirror object's history over the span the image camera can see, once.
+    // Step (moving camera, cone models): each object's lab history over the span the lab image
+    // camera can see, and the speed its refinement bounds (the class comment).
+    const bool cone = model == Model::Finite || model == Model::Relativistic;
+    if (camera_motion_.moving() && cone) {
+        const mesh4d::Event first = cameraInLab(frameTime(scene.frames, first_frame));
+        const mesh4d::Event last = cameraInLab(frameTime(scene.frames, last_frame));
+        const Vec3& v = camera_motion_.velocity;
+        for (size_t mi = 0; mi < mirrors_.size(); ++mi) {
+            const MirrorPlane& m = mirrors_[mi];
+            const mesh4d::ViewSurface view_first{mesh4d::ViewKind::PastCone, first.t, reflectPoint(m, first.x)};
+            const mesh4d::ViewSurface view_last{mesh4d::ViewKind::PastCone, last.t, reflectPoint(m, last.x)};
+            for (size_t i = 0; i < objects.size(); ++i) {
+                if (objects[i].spec.mirror) continue;
+                const mesh4d::Motion lab = motionOf(objects[i].spec, model);
+                Target target{mi, i, extrudeSeen(objects[i].spec, objects[i].rest, lab, view_first, view_last)};
+                const Vec3 u_r = reflectDirection(m, lab.velocity);
+                if (model == Model::Finite) {
+                    target.displacement = mesh4d::norm(u_r - v);
+                } else {
+                    const double one_minus_uv = camera_motion_.one_minus_b2 + mesh4d::dot(v, v - u_r);
+                    const double w2 = one_minus_uv * one_minus_uv - lab.one_minus_beta2 * camera_motion_.one_minus_b2;
+                    target.displacement = std::sqrt(std::max(w2, 0.0) / camera_motion_.one_minus_b2);
+                }
+                targets_.push_back(std::move(target));
+            }
+        }
+        return;
+    }
+    // Step: each non-mirror object's history over the span the image camera can see, once (with a
+    // moving camera, the hyperplane models: in the camera's frame, where the apex does not matter).
+    if (camera_motion_.moving()) {
+        for (size_t mi = 0; mi < mirrors_.size(); ++mi)
+            for (size_t i = 0; i < objects.size(); ++i)
+                if (!objects[i].spec.mirror)
+                    targets_.push_back({mi, i, buildWorld(objects[i], model, scene, first_frame, last_frame)});
+        return;
+    }
     for (size_t mi = 0; mi < mirrors_.size(); ++mi) {
         Scene image = scene;
         image.camera.position = reflectPoint(mirrors_[mi], scene.camera.position);
@@ -233,6 +302,10 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
             if (area2 > 1e-12 * longest * longest) seen[mi].push_back(tri);
         }
     }
+    if (camera_motion_.moving()) {
+        appendMoving(view, settings, objects, object_tolerances, seen);
+        return;
+    }
     for (const Target& target : targets_) {
         const MirrorPlane& m = mirrors_[target.mirror];
         if (seen[target.mirror].empty()) {  // the mirror shows nothing: not in view or not existing
@@ -248,6 +321,81 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         // so they are those seen by the image of the camera.
         mesh4d::addLightFactors(target.world, image, &cut);
         objects->push_back(reflectAndClip(cut, m, seen[target.mirror], camera_));
+    }
+}
+
+mesh4d::Event MirrorReflections::cameraInLab(double t_c) const {
+    return mesh4d::fromCameraFrame(camera_motion_, kinematicsOf(model_), {t_c, camera_});
+}
+
+void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
+                                     std::vector<mesh4d::ApparentMesh>* objects,
+                                     const std::vector<double>* object_tolerances,
+                                     const std::vector<std::vector<std::array<Vec3, 3>>>& seen) const {
+    const mesh4d::Kinematics kinematics = kinematicsOf(model_);
+    const bool cone = view.kind == mesh4d::ViewKind::PastCone;
+    // Step (cone models): the camera's lab event at this frame's camera time, and each mirror as
+    // the camera sees it, taken back to the lab (the events of its cut; slivers give no pyramid).
+    const mesh4d::Event camera_lab = cone ? cameraInLab(view.t_c) : mesh4d::Event{view.t_c, camera_};
+    std::vector<std::vector<std::array<Vec3, 3>>> seen_lab(mirrors_.size());
+    for (size_t mi = 0; mi < mirrors_.size() && cone; ++mi) {
+        const mesh4d::ApparentMesh& m = (*objects)[mirrors_[mi].object];
+        auto lab = [&](uint32_t i) {
+            return mesh4d::fromCameraFrame(camera_motion_, kinematics, {m.absoluteTime(i), m.absolutePosition(i)}).x;
+        };
+        for (const auto& t : m.triangles) {
+            const std::array<Vec3, 3> tri{lab(t[0]), lab(t[1]), lab(t[2])};
+            const double area2 = mesh4d::norm(mesh4d::cross(tri[1] - tri[0], tri[2] - tri[0]));
+            const double longest = std::max({mesh4d::norm(tri[1] - tri[0]), mesh4d::norm(tri[2] - tri[1]),
+                                             mesh4d::norm(tri[0] - tri[2])});
+            if (area2 > 1e-12 * longest * longest) seen_lab[mi].push_back(tri);
+        }
+    }
+    for (const Target& target : targets_) {
+        const MirrorPlane& m = mirrors_[target.mirror];
+        if (seen[target.mirror].empty() || (cone && seen_lab[target.mirror].empty())) {
+            objects->emplace_back();
+            continue;
+        }
+        mesh4d::SliceSettings own = settings;
+        if (object_tolerances) own.tolerance = (*object_tolerances)[target.object];
+        if (!cone) {
+            // Step (hyperplane models): the mirror's plane at the view's time in the camera's frame:
+            // x' with n.(lab position - point) = 0, lab position = A x' + b(t'), A symmetric: normal
+            // A n through the point of the line from the camera along it.
+            const Vec3 a_n = mesh4d::fromCameraFrameDifference(camera_motion_, kinematics, {0, m.normal}).x;
+            const double off = mesh4d::dot(m.normal, mesh4d::fromCameraFrame(camera_motion_, kinematics, {view.t_c, camera_}).x - m.point);
+            const MirrorPlane now{m.object, camera_ - a_n * (off / mesh4d::norm2(a_n)), a_n / mesh4d::norm(a_n)};
+            mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, view, own);
+            mesh4d::addLightFactors(target.world, view, &cut);
+            objects->push_back(reflectAndClip(cut, now, seen[target.mirror], camera_));
+            continue;
+        }
+        // Step (cone models): the lab cut for the image camera, its light factors with the image
+        // camera moving at the reflected velocity, the reflection and clip in the lab.
+        const mesh4d::ViewSurface image{mesh4d::ViewKind::PastCone, camera_lab.t, reflectPoint(m, camera_lab.x)};
+        own.displacement = target.displacement;
+        mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
+        const Vec3 v_r = reflectDirection(m, camera_motion_.velocity);
+        cut.doppler.resize(cut.positions.size());
+        cut.proper_time.resize(cut.positions.size());
+        for (size_t i = 0; i < cut.positions.size(); ++i) {
+            cut.doppler[i] = mesh4d::dopplerFactor(target.world.motion, image.kind, image.apex, cut.absolutePosition(i), v_r);
+            cut.proper_time[i] = mesh4d::properTimeAt(target.world.motion, cut.rest_points[i], cut.absoluteTime(i));
+        }
+        mesh4d::ApparentMesh out = reflectAndClip(cut, m, seen_lab[target.mirror], camera_lab.x);
+        // Step: every output event (the virtual source) into the camera's frame, origin and local
+        // parts apart (the map is affine).
+        const mesh4d::Event origin = mesh4d::toCameraFrame(camera_motion_, kinematics, {out.time_origin, out.origin});
+        out.origin = origin.x;
+        out.time_origin = origin.t;
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const mesh4d::Event d =
+                mesh4d::toCameraFrameDifference(camera_motion_, kinematics, {out.emission_times[i], out.positions[i]});
+            out.positions[i] = d.x;
+            out.emission_times[i] = d.t;
+        }
+        objects->push_back(std::move(out));
     }
 }
 

@@ -46,16 +46,25 @@ mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scen
     if (mirrors.empty()) return direct;
     double tau_a = direct.empty() ? INFINITY : direct.tau_a, tau_b = direct.empty() ? -INFINITY : direct.tau_b;
     bool real_a = direct.cap_a_real, real_b = direct.cap_b_real;
+    // A moving camera: the image cameras' views in the frame traced (mirror.h imageView), the rest
+    // points as that frame has them (the Thomas-Wigner rotation).
+    const bool moving = cameraMotionOf(scene).moving();
+    const mesh4d::MotionInCameraFrame in_cut = cutMotionOf(object.spec, model, scene);
+    mesh4d::RestMesh rotated;
+    const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_cut, &rotated);
     for (const MirrorPlane& m : mirrors) {
         Scene image = scene;
         image.camera.position = reflectPoint(m, scene.camera.position);
-        const mesh4d::World4D w = buildWorld(object, model, image, first, last);
+        const mesh4d::World4D w =
+            moving ? extrudeSeen(object.spec, rest, in_cut.motion, imageView(m, scene, model, frameTime(scene.frames, first)),
+                                 imageView(m, scene, model, frameTime(scene.frames, last)))
+                   : buildWorld(object, model, image, first, last);
         if (w.empty()) continue;
         if (w.tau_a < tau_a) { tau_a = w.tau_a; real_a = w.cap_a_real; }
         if (w.tau_b > tau_b) { tau_b = w.tau_b; real_b = w.cap_b_real; }
     }
     if (!(tau_a < tau_b)) return direct;
-    return mesh4d::extrude(object.rest, direct.motion, tau_a, tau_b, real_a, real_b);
+    return mesh4d::extrude(rest, direct.motion, tau_a, tau_b, real_a, real_b);
 }
 
 
@@ -86,6 +95,7 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
     worlds_.reserve(objects.size());
     for (size_t i = 0; i < objects.size(); ++i) {
         colors_.push_back(objectBaseColor(objects, i));
+        lab_motions_.push_back(motionOf(objects[i].spec, model));
         worlds_.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
     }
     for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w, hierarchy));
@@ -107,6 +117,12 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
 
 std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, const Vec3& receiver,
                                          const Vec3& receiver_velocity) const {
+    return shadeWith(h, worlds_[size_t(h.object)].motion, h.hit.event.x, kind, receiver, receiver_velocity);
+}
+
+std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion& motion, const Vec3& emitted_at,
+                                             mesh4d::ViewKind kind, const Vec3& receiver,
+                                             const Vec3& receiver_velocity) const {
     // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), summed over the lights with their
     // weights (the default key light, scene.h), n already turned towards the side
     // the ray arrives from (the surfaces are two-sided, as in the exported glTF).
@@ -123,11 +139,23 @@ std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, co
     const double lambert = light.ambient + (1 - light.ambient) * diffuse;
     std::array<double, 3> c{colors_[size_t(h.object)][0], colors_[size_t(h.object)][1], colors_[size_t(h.object)][2]};
     if (shade_doppler_) {
-        const double d =
-            mesh4d::dopplerFactor(worlds_[size_t(h.object)].motion, kind, receiver, h.hit.event.x, receiver_velocity);
+        const double d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
         c = mesh4d::dopplerColour(c, d);
     }
     return {c[0] * lambert, c[1] * lambert, c[2] * lambert};
+}
+
+std::array<double, 3> SceneTracer::shadeReflected(const Hit& h, const mesh4d::ViewSurface& view, const MirrorPlane& m,
+                                                  const mesh4d::CameraMotion& camera) const {
+    // Doppler from the lab (mirror.h): the hit and the camera's reception in the lab, the source's
+    // lab motion, seen from the image camera moving at the reflected velocity.
+    const mesh4d::Kinematics kinematics = kinematicsOf(model_);
+    const bool lab = view.sheared();  // finite: traced in the lab already
+    const Vec3 emitted_at = lab ? h.hit.event.x : mesh4d::fromCameraFrame(camera, kinematics, h.hit.event).x;
+    const mesh4d::Event receiver =
+        lab ? mesh4d::Event{view.t_c, view.apex} : mesh4d::fromCameraFrame(camera, kinematics, {view.t_c, scene_.camera.position});
+    return shadeWith(h, lab_motions_[size_t(h.object)], emitted_at, view.kind, reflectPoint(m, receiver.x),
+                     reflectDirection(m, camera.velocity));
 }
 
 TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) const {
@@ -157,14 +185,19 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,
                     // still running back in time; other mirrors are not seen in a mirror.
+                    // With a moving camera the mirror moves in the frame traced (not in finite's lab).
+                    const MirrorPlane& plane = mirrors_[size_t(mirror)];
                     mesh4d::Ray4D bounce = ray;
                     bounce.origin = hit.hit.event;
-                    bounce.direction = reflectDirection(mirrors_[size_t(mirror)], ray.direction);
+                    bounce.direction = view.sheared() ? reflectDirection(plane, ray.direction)
+                                                      : reflectRayDirection(plane, camera, kinematicsOf(model_),
+                                                                            ray.along_cone, ray.direction);
                     const Hit second = nearest(bounce, true);
                     std::array<double, 3> reflected = kBackground;
                     if (second.object >= 0) {
                         frame.reflected[idx] = second.object;
-                        reflected = shade(second, view.kind, bounce.origin.x);
+                        reflected = camera.moving() ? shadeReflected(second, view, plane, camera)
+                                                    : shade(second, view.kind, bounce.origin.x);
                     }
                     for (int c = 0; c < 3; ++c)
                         color[size_t(c)] = (1 - kMirrorReflectance) * color[size_t(c)] + kMirrorReflectance * reflected[size_t(c)];

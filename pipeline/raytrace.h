@@ -68,6 +68,13 @@ private:
     // velocity (light_factors.h dopplerFactor: nonzero only for finite with a moving camera).
     std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
                                 const mesh4d::Vec3& receiver_velocity = {0, 0, 0}) const;
+    // The same with the source's `motion` and emission point given for D (in that motion's frame).
+    std::array<double, 3> shadeWith(const Hit& h, const mesh4d::Motion& motion, const mesh4d::Vec3& emitted_at,
+                                    mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
+                                    const mesh4d::Vec3& receiver_velocity) const;
+    // A reflection seen by a moving camera: its Doppler factor from the lab (pipeline/mirror.h).
+    std::array<double, 3> shadeReflected(const Hit& h, const mesh4d::ViewSurface& view, const MirrorPlane& m,
+                                         const mesh4d::CameraMotion& camera) const;
 
     Scene scene_;
     Model model_;
@@ -75,6 +82,7 @@ private:
     std::vector<int32_t> mirror_of_object_;  // index into mirrors_, or -1
     std::vector<std::array<double, 4>> colors_;
     std::vector<mesh4d::World4D> worlds_;
+    std::vector<mesh4d::Motion> lab_motions_;  // each object's lab motion (reflections' Doppler)
     std::vector<mesh4d::TraceWorld> traces_;
     bool shade_doppler_ = false;
 };

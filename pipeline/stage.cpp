@@ -50,11 +50,6 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     if (Status s = prepareObjects(scene, options.limits, &stage->objects, log, options.quiet); !s.ok)
         return fail(s.message);
     if (Status s = findMirrors(stage->objects, scene.path, &stage->mirrors); !s.ok) return fail(s.message);
-    // Mirrors are at rest in the frame the outputs are in (docs/DESIGN.md section 8): a moving
-    // camera would see them move.
-    if (!stage->mirrors.empty() && cameraMotionOf(scene).moving())
-        return fail(scene.path + ": camera.velocity: mirrors need a camera at rest (they are modelled at rest in the "
-                                 "camera's frame); remove the velocity or the mirrors");
     // Step: what the inputs derive, before any work: finite and in range, bounded in number.
     if (options.max_object_frames <= 0) return fail("--max-object-frames: must be positive");
     const long long frames = stage->last_excl - stage->first;

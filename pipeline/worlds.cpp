@@ -12,17 +12,20 @@ using mesh4d::Vec3;
 
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame) {
-    const ObjectSpec& s = object.spec;
     // In the frame the cut is made in (the camera's rest frame; the lab for finite): its motion
     // and rest points.
-    const mesh4d::MotionInCameraFrame in_camera = cutMotionOf(s, model, scene);
-    const mesh4d::Motion& motion = in_camera.motion;
+    const mesh4d::MotionInCameraFrame in_camera = cutMotionOf(object.spec, model, scene);
     mesh4d::RestMesh rotated;
     const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_camera, &rotated);
+    return extrudeSeen(object.spec, rest, in_camera.motion, viewForFrame(scene, model, first_frame),
+                       viewForFrame(scene, model, last_frame));
+}
+
+mesh4d::World4D extrudeSeen(const ObjectSpec& s, const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
+                            const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last) {
     // Step: the proper-time span the requested frames can see, padded by the object's own light
     // crossing time so that rounding in the vertex crossings never reaches an artificial cap.
-    const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(rest, motion, viewForFrame(scene, model, first_frame),
-                                                         viewForFrame(scene, model, last_frame));
+    const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(rest, motion, first, last);
     mesh4d::EventBox box;
     for (const Vec3& p : rest.positions) box.addPoint(p);
     // Interior points of a triangle can emit up to diag (1 + b) / (1 - b^2) = diag / (1 - b) later or

@@ -21,6 +21,11 @@ namespace apparent {
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
                            long long last_frame);
 
+// The same from the parts: `rest` moving with `motion`, extruded over the span that the views
+// `first` and `last` (a frame range's first and last) can see, cut to the `exists` of `spec`.
+mesh4d::World4D extrudeSeen(const ObjectSpec& spec, const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
+                            const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last);
+
 // buildWorld for every object, in scene order.
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
                                          long long first_frame, long long last_frame);

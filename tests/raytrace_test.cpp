@@ -458,6 +458,13 @@ TEST(RaytraceCrossCheck, FlybyFromAMovingCamera) {
     crossCheck("data/scenes/flyby.json", 10, 0, nullptr);
 }
 
+// Mirrors seen by a moving camera (pipeline/mirror.h): the mirror, at rest in the lab, moves in the
+// camera's frame. The raytracer bounces each ray off it as the lab reflects it (mirror.h
+// reflectRayDirection), independently of the meshes' lab cut, reflection and map.
+TEST(RaytraceCrossCheck, MirrorSeenFromAMovingCamera) {
+    crossCheck("data/fixtures/scene_mirror_camera.json", 10, 1000, nullptr);
+}
+
 // A mirror's `exists` applies to what it reflects: the backdrop of scene_mirror_exists.json is
 // there for lab time [-16, -10] only. With finite light speed its points (23.675 to 28.65 ls from
 // the camera) are seen from t = 7.675 s to 18.65 s, so its reflections are empty before and after
