@@ -336,7 +336,7 @@ void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh
     const bool cone = view.kind == mesh4d::ViewKind::PastCone;
     // Step (cone models): the camera's lab event at this frame's camera time, and each mirror as
     // the camera sees it, taken back to the lab (the events of its cut; slivers give no pyramid).
-    const mesh4d::Event camera_lab = cone ? cameraInLab(view.t_c) : mesh4d::Event{view.t_c, camera_};
+    const mesh4d::Event camera_lab = cameraInLab(view.t_c);  // used on the cone only
     std::vector<std::vector<std::array<Vec3, 3>>> seen_lab(mirrors_.size());
     for (size_t mi = 0; mi < mirrors_.size() && cone; ++mi) {
         const mesh4d::ApparentMesh& m = (*objects)[mirrors_[mi].object];

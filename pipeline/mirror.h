@@ -113,8 +113,9 @@ private:
     mesh4d::Vec3 camera_;
     mesh4d::CameraMotion camera_motion_;  // moving: the reflections are made as the class comment says
     Model model_ = Model::Relativistic;
-    // The lab events of the camera at camera time t_c and of its image through `m` (cone models).
+    // The camera's lab event at camera time t_c (its proper time; the lab's in Galilean models).
     mesh4d::Event cameraInLab(double t_c) const;
+    // append() for a moving camera (the class comment); `seen`: each mirror's cut triangles.
     void appendMoving(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                       std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances,
                       const std::vector<std::vector<std::array<mesh4d::Vec3, 3>>>& seen) const;

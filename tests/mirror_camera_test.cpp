@@ -205,8 +205,9 @@ TEST(MirrorCamera, HyperplaneReflectionsAreThroughTheMirrorsPlaneAtThatTime) {
 // Doppler along the reflected path with a moving camera: D = g_v (1 - v.n2) / (g_u (1 - u.n1))
 // (relativistic; finite without the gammas), n1 the lab direction from the real emission point to
 // its mirror point, n2 from the mirror point to the camera's lab position at reception (which is
-// n1 reflected), computed here from the test's own lab events.
-TEST(MirrorCamera, DopplerAlongTheReflectedPathUsesBothLegs) {
+// n1 reflected), computed here from the test's own lab events; and the object's clock at the real
+// emission event.
+TEST(MirrorCamera, DopplerUsesBothLegsAndTheClockReadsAtTheRealEmission) {
     for (const char* model_name : {"finite", "relativistic"}) {
         Fixture f;
         loadScene(std::string("doppler_") + model_name, R"("position": [0, 0, 0], "velocity": [0.3, 0.1, -0.5])",
@@ -230,6 +231,12 @@ TEST(MirrorCamera, DopplerAlongTheReflectedPathUsesBothLegs) {
             const double gv = lorentz ? 1 / std::sqrt(1 - mesh4d::dot(v, v)) : 1;
             const double want = gv * (1 - mesh4d::dot(v, n2)) / (gu * (1 - mesh4d::dot(u, n1)));
             EXPECT_NEAR(m.doppler[i], want, 1e-12 * want) << model_name << " vertex " << i;
+            // The clock at the real emission event (the virtual one reflected back, same lab time):
+            // (t - t0)/g - g u.z (relativistic) or t - t0 (finite), z its offset from the origin's worldline.
+            const ObjectSpec& spec = f.stage.objects[2].spec;
+            const Vec3 z = reflectZ(virt.x) - (spec.position + u * (virt.t - spec.t0));
+            const double clock = lorentz ? (virt.t - spec.t0) / gu - gu * mesh4d::dot(u, z) : virt.t - spec.t0;
+            EXPECT_NEAR(m.proper_time[i], clock, 1e-9 * (1 + std::fabs(clock))) << model_name << " vertex " << i;
         }
         fs::remove_all(f.dir);
     }
