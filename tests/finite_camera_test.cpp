@@ -315,3 +315,36 @@ TEST(FiniteCamera, RefinedFramesAreWithinTheToleranceBothWays) {
         }
     }
 }
+
+// A camera at 1 - 1e-12 of light speed in the finite model: every output finite, and each vertex
+// the sheared lab event to 1e-9 of the scale (the shear is exact arithmetic on bounded terms:
+// nothing grows with the camera's speed in Galilean kinematics).
+TEST(FiniteCamera, NearLightSpeedCameraStaysFiniteAndExact) {
+    Fixture f;
+    loadScene("fast", R"({ "camera": { "position": [0, 0, 0], "velocity": [0.999999999999, 0, 0] },
+        "frames": { "start": -2, "end": 2, "fps": 1 }, "model": "finite", "tolerance": "vertex",
+        "objects": [ { "name": "rest", "mesh": "box.obj", "position": [0, 0, -3] },
+                     { "name": "with", "mesh": "box.obj", "position": [-1, 1, -3], "velocity": [0.99, 0, 0] } ] })",
+              &f);
+    const Scene& scene = f.stage.scene;
+    for (long long k = 0; k < 4; ++k) {
+        const double t_c = frameTime(scene.frames, k);
+        for (const PreparedObject& o : f.stage.objects) {
+            const mesh4d::World4D world = buildWorld(o, Model::Finite, scene, k, k);
+            mesh4d::SliceSettings s;
+            s.tolerance = 1e-3;
+            for (const mesh4d::SliceSettings& settings : {mesh4d::SliceSettings{}, s}) {
+                const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(world, viewForFrame(scene, Model::Finite, k), settings);
+                ASSERT_FALSE(cut.positions.empty());
+                for (size_t i = 0; i < cut.positions.size(); ++i) {
+                    ASSERT_TRUE(mesh4d::isFinite(cut.absolutePosition(i)) && std::isfinite(cut.absoluteTime(i)));
+                    const Event want = exactImage(o.spec.position, o.spec.t0, o.spec.velocity, cut.rest_points[i], t_c,
+                                                  scene.camera.position, scene.camera.velocity);
+                    const double scale = std::max({1.0, mesh4d::norm(want.x), std::fabs(want.t)});
+                    EXPECT_LT(mesh4d::norm(cut.absolutePosition(i) - want.x), 1e-9 * scale) << o.spec.name << " frame " << k;
+                }
+            }
+        }
+    }
+    fs::remove_all(f.dir);
+}
