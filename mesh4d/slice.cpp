@@ -151,8 +151,9 @@ struct FrameBuilder {
     FrameBuilder(const FrameBuilder&) = delete;
     FrameBuilder& operator=(const FrameBuilder&) = delete;
 
-    // A piece's bound (chord_error.h): displaced along the object's velocity u, or along
-    // w = u - shear when the view shears its outputs (the finite model with a moving camera).
+    // A piece's bound (chord_error.h): displaced along the object's velocity u, along w = u -
+    // shear when the view shears its outputs (the finite model with a moving camera), or by
+    // settings.displacement when that is given (outputs mapped afterwards).
     ChordError pieceBound(const double t_corner[3], const double t_mid[3], const Vec3 s[3], const double xm[3]) const {
         if (settings.displacement >= 0)
             return displacedChordError(world.motion, settings.displacement, t_corner, t_mid, s, xm, settings.tolerance);

@@ -117,6 +117,9 @@ struct SliceSettings {
 // and every output event (t, x) returned as (t, x - shear t): origin and local parts apart, so
 // the shape keeps its relative accuracy; the tolerance holds for these outputs (the refinement's
 // bound displaces along u - shear, chord_error.h displacedChordError, objects at rest included).
+// Limit: an object at rest under a shear (or SliceSettings::displacement) is refined as a moving
+// one, so a real cap's clip curve wholly inside one triangle whose corners are all unseen (its
+// middle seen first) is not found: the search for those (restPlan) serves unsheared views.
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
 
 // A sphere that holds every apparent point of `world` in `view`: centred on the apparent position
