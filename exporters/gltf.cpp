@@ -10,6 +10,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <thread>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
@@ -777,12 +778,20 @@ struct GlbFrameData : PreparedFrame {
     double far = 0, max_extent = 0, max_float_error = 0, max_quantization_error = 0;
 };
 
-// Frame buffers given back by released GlbFrameData (shared with their deleters, so it outlives
-// the writer while a prepared frame is still held).
+// Frame buffers given back by released GlbFrameData, shared by every writer of the process (and
+// with the deleters, so it outlives them): a frame written alone to its own file, or the next
+// model's sequence, reuses the buffers of the last one instead of allocating and touching fresh
+// memory. It keeps at most poolFrames() frames' buffers (as many as the frame loop holds in
+// flight); more are freed when given back.
 struct FramePool {
     std::mutex mutex;
     std::vector<std::unique_ptr<GlbFrameData>> free;
 };
+size_t poolFrames() { return std::max<size_t>(4, 2 * size_t(std::thread::hardware_concurrency())); }
+std::shared_ptr<FramePool> processFramePool() {
+    static const std::shared_ptr<FramePool> pool = std::make_shared<FramePool>();
+    return pool;
+}
 
 struct GlbSequenceWriter::Impl {
     Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
@@ -808,7 +817,7 @@ struct GlbSequenceWriter::Impl {
     std::unique_ptr<SequenceModel> plain;  // with Draco or meshopt: the same sequence without it, counted
     GlbStats stats;
     double far = 0;
-    std::shared_ptr<FramePool> pool = std::make_shared<FramePool>();
+    std::shared_ptr<FramePool> pool = processFramePool();
 };
 
 GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options)
@@ -837,8 +846,9 @@ double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
 }  // namespace
 
 std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
-    // Step: a frame's buffers from the writer's pool (they keep their capacity: a sequence does
-    // not allocate again frame after frame); the shared pointer gives them back when released.
+    // Step: a frame's buffers from the process's pool (they keep their capacity: a sequence does
+    // not allocate again frame after frame, nor a lone frame after the first); the shared pointer
+    // gives them back when released.
     std::shared_ptr<FramePool> pool = impl_->pool;
     GlbFrameData* raw = nullptr;
     {
@@ -850,8 +860,9 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
     }
     if (!raw) raw = new GlbFrameData;
     std::shared_ptr<GlbFrameData> d(raw, [pool](GlbFrameData* back) {
+        std::unique_ptr<GlbFrameData> owned(back);
         std::lock_guard<std::mutex> lock(pool->mutex);
-        pool->free.emplace_back(back);
+        if (pool->free.size() < poolFrames()) pool->free.push_back(std::move(owned));
     });
     d->reset(f.objects.size());
     // Step: the frame's origin (the centre of its bounding box) and the far distance (parallel
@@ -1001,8 +1012,18 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
     put32(&head, 0x004E4942);  // BIN
     std::string werr;
     bool ok = writeAll(fd, head.data(), head.size(), &werr);
-    std::vector<char> chunk(size_t(1) << 20);
-    for (size_t off = 0; ok && off < bin;) {
+    // The BIN chunk by copy_file_range (the kernel copies between the two files' pages, no trip
+    // through a user buffer); where it cannot (another file system, an old kernel), by pread and write.
+    size_t off = 0;
+    while (ok && off < bin) {
+        loff_t in = loff_t(off);
+        const ssize_t r = ::copy_file_range(m.sink.fd, &in, fd, nullptr, bin - off, 0);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) break;  // the fallback below takes over from `off`
+        off += size_t(r);
+    }
+    std::vector<char> chunk(off < bin ? size_t(1) << 20 : 0);
+    while (ok && off < bin) {
         const ssize_t r = ::pread(m.sink.fd, chunk.data(), std::min(chunk.size(), bin - off), off_t(off));
         if (r < 0 && errno == EINTR) continue;
         if (r <= 0) {

@@ -84,7 +84,7 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
                 mean += face[faces[a]].unit;
                 sum += face[faces[a]].area;
             }
-            const double len = norm(mean);
+            const double len = std::sqrt(dot(mean, mean));  // feeds the sufficient test alone (margin above)
             bool all = len > 0;
             for (uint32_t a = start[v]; a < start[v + 1] && all; ++a)
                 all = dot(face[faces[a]].unit, mean) >= cos_half * len;
@@ -101,9 +101,11 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
                     }
                 }
             }
-            if (!all || !(norm(sum) > 0)) continue;
+            if (!all) continue;
+            const double length = norm(sum);
+            if (!(length > 0)) continue;
             w->uniform[v] = 1;
-            w->vertex_normal[v] = sum / norm(sum);
+            w->vertex_normal[v] = sum / length;
         }
     });
     // No vertex split (every used vertex uniform, none unused), as in the last call on the same
