@@ -37,28 +37,44 @@ namespace {
 using mesh4d::Vec3;
 
 // One primitive's data as it goes into the file: float32 positions relative to the frame origin.
-// With meshopt also its packed vertices (kMeshoptStride bytes each, in vertex-fetch order),
-// its indices in vertex-cache order referring to them, and POSITION's integer bounds.
+// With meshopt also its packed vertices (MeshoptLayout::stride bytes each, in vertex-fetch order)
+// and their octahedral normals (kMeshoptNormalStride bytes each, same order), its indices in
+// vertex-cache order referring to them, and POSITION's integer bounds.
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
     std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
-    std::vector<unsigned char> packed;
+    std::vector<unsigned char> packed, packed_normals;
     std::vector<uint32_t> ordered;
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
     size_t vertexCount() const { return emission.size(); }
 };
 
-// A frame's meshopt vertex stream: every shown object's packed vertices in object order, encoded
-// as one EXT_meshopt_compression ATTRIBUTES view.
+// A frame's meshopt vertex streams: every shown object's packed vertices in object order, encoded
+// as one EXT_meshopt_compression ATTRIBUTES view, and their normals as another (filter OCTAHEDRAL).
 struct MeshoptFrame {
-    std::vector<unsigned char> encoded;
+    std::vector<unsigned char> encoded, encoded_normals;
     size_t count = 0;                // vertices in all
     std::vector<size_t> first;       // per object, its first vertex in the stream
 };
 
-constexpr size_t kMeshoptStride = 16;  // int16 x, y, z, 0 | int8 nx, ny, nz, 0 | float32 emission time
+// The meshopt vertex record (gltf.h): int16 x, y, z, 0 | float32 emission time, then with
+// --attributes float32 _DOPPLER and/or _PROPER_TIME, with --shade doppler uint16 (normalized)
+// R, G, B, 0; the same for every frame of a sequence (an offset < 0: not in the record).
+struct MeshoptLayout {
+    explicit MeshoptLayout(const GlbOptions& o) {
+        if (o.doppler) { doppler = int(stride); stride += 4; }
+        if (o.proper_time) { proper_time = int(stride); stride += 4; }
+        if (o.shade_doppler) { color = int(stride); stride += 8; }
+    }
+    size_t stride = 12;
+    int doppler = -1, proper_time = -1, color = -1;
+};
+// The normals' stream: the EXT_meshopt_compression OCTAHEDRAL filter's 8-bit form (4 bytes a
+// vertex), which the decoder turns into normalized int8 x, y, z (and a fourth byte).
+constexpr size_t kMeshoptNormalStride = 4;
+constexpr int kMeshoptNormalBits = 8;
 
 // The emission time as meshopt stores it: rounded (half away from zero) to a multiple of the
 // largest power of two not above `step`, so that its low mantissa bits are zero and compress;
@@ -72,34 +88,47 @@ float emissionQuantized(float t, double step) {
 // per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
 // triangles first use them (both depend on the index list alone, so frames with equal index
 // lists get equal orders). Returns the largest |step * q - rel| over the coordinates.
-double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step) {
+double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step, const MeshoptLayout& layout,
+                   std::vector<unsigned int>* remap_work, std::vector<float>* normal_work) {
     const size_t nv = d->vertexCount();
     d->ordered.resize(d->indices.size());
     meshopt_optimizeVertexCache(d->ordered.data(), d->indices.data(), d->indices.size(), nv);
-    std::vector<unsigned int> remap(nv);
+    std::vector<unsigned int>& remap = *remap_work;
+    remap.resize(nv);
     const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), d->ordered.data(), d->ordered.size(), nv);
     meshopt_remapIndexBuffer(d->ordered.data(), d->ordered.data(), d->ordered.size(), remap.data());
-    d->packed.assign(used * kMeshoptStride, 0);
+    const size_t stride = layout.stride;
+    d->packed.assign(used * stride, 0);
+    std::vector<float>& normals = *normal_work;  // x, y, z, 0 per vertex in stream order, for the filter
+    normals.assign(4 * used, 0.0f);
     double worst = 0;
     for (int c = 0; c < 3; ++c) { d->qmin[c] = INT32_MAX; d->qmax[c] = INT32_MIN; }
     for (size_t i = 0; i < nv; ++i) {
         if (remap[i] == ~0u) continue;  // used by no triangle: dropped (a cut mesh has none)
-        unsigned char* v = d->packed.data() + size_t(remap[i]) * kMeshoptStride;
+        unsigned char* v = d->packed.data() + size_t(remap[i]) * stride;
         int16_t q[4] = {0, 0, 0, 0};
-        int8_t n[4] = {0, 0, 0, 0};
         for (int c = 0; c < 3; ++c) {
             const double x = std::nearbyint(rel[3 * i + c] / step);
             q[c] = int16_t(std::clamp(x, -32767.0, 32767.0));
             worst = std::max(worst, std::fabs(double(q[c]) * step - rel[3 * i + c]));
             d->qmin[c] = std::min(d->qmin[c], int(q[c]));
             d->qmax[c] = std::max(d->qmax[c], int(q[c]));
-            n[c] = int8_t(meshopt_quantizeSnorm(d->normals[3 * i + c], 8));
+            normals[4 * size_t(remap[i]) + size_t(c)] = d->normals[3 * i + c];
         }
         std::memcpy(v, q, 8);
-        std::memcpy(v + 8, n, 4);
         const float t = emissionQuantized(d->emission[i], step);
-        std::memcpy(v + 12, &t, 4);
+        std::memcpy(v + 8, &t, 4);
+        if (layout.doppler >= 0 && !d->doppler.empty()) std::memcpy(v + layout.doppler, &d->doppler[i], 4);
+        if (layout.proper_time >= 0 && !d->proper_time.empty()) std::memcpy(v + layout.proper_time, &d->proper_time[i], 4);
+        if (layout.color >= 0 && !d->colors.empty()) {
+            uint16_t rgb[4] = {0, 0, 0, 0};
+            for (int c = 0; c < 3; ++c) rgb[c] = uint16_t(meshopt_quantizeUnorm(std::clamp(d->colors[3 * i + c], 0.0f, 1.0f), 16));
+            std::memcpy(v + layout.color, rgb, 8);
+        }
     }
+    d->packed_normals.resize(used * kMeshoptNormalStride);
+    if (used > 0)
+        meshopt_encodeFilterOct(d->packed_normals.data(), used, kMeshoptNormalStride, kMeshoptNormalBits, normals.data());
     return worst;
 }
 
@@ -183,23 +212,37 @@ public:
     }
 
     // An EXT_meshopt_compression primitive: its vertices at `first_vertex` of the frame's vertex
-    // view `vview`, its indices the accessor `indices` (made by the caller: new or shared).
-    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, int vview, size_t first_vertex, int indices) {
+    // view `vview` (records of `layout`) and normal view `nview`, its indices the accessor
+    // `indices` (made by the caller: new or shared).
+    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, int vview, int nview,
+                                         size_t first_vertex, int indices) {
         tinygltf::Primitive prim;
-        const size_t nv = d.packed.size() / kMeshoptStride;
-        auto attribute = [&](size_t offset, int component, int type, bool normalized, std::vector<double> lo,
-                             std::vector<double> hi) {
-            const int a = addAccessor(vview, component, type, nv, std::move(lo), std::move(hi));
-            model.accessors[a].byteOffset = first_vertex * kMeshoptStride + offset;
+        const size_t nv = d.packed.size() / layout.stride;
+        auto attribute = [&](int view, size_t stride, size_t offset, int component, int type, bool normalized,
+                             std::vector<double> lo, std::vector<double> hi) {
+            const int a = addAccessor(view, component, type, nv, std::move(lo), std::move(hi));
+            model.accessors[a].byteOffset = first_vertex * stride + offset;
             model.accessors[a].normalized = normalized;
             return a;
         };
+        const size_t stride = layout.stride;
         prim.attributes["POSITION"] =
-            attribute(0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
+            attribute(vview, stride, 0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
                       {double(d.qmin[0]), double(d.qmin[1]), double(d.qmin[2])},
                       {double(d.qmax[0]), double(d.qmax[1]), double(d.qmax[2])});
-        prim.attributes["NORMAL"] = attribute(8, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_TYPE_VEC3, true, {}, {});
-        prim.attributes["_EMISSION_TIME"] = attribute(12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        prim.attributes["NORMAL"] = attribute(nview, kMeshoptNormalStride, 0, TINYGLTF_COMPONENT_TYPE_BYTE,
+                                              TINYGLTF_TYPE_VEC3, true, {}, {});
+        prim.attributes["_EMISSION_TIME"] =
+            attribute(vview, stride, 8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        if (layout.doppler >= 0 && !d.doppler.empty())
+            prim.attributes["_DOPPLER"] = attribute(vview, stride, size_t(layout.doppler), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                                    TINYGLTF_TYPE_SCALAR, false, {}, {});
+        if (layout.proper_time >= 0 && !d.proper_time.empty())
+            prim.attributes["_PROPER_TIME"] = attribute(vview, stride, size_t(layout.proper_time),
+                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        if (layout.color >= 0 && !d.colors.empty())
+            prim.attributes["COLOR_0"] = attribute(vview, stride, size_t(layout.color), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                                   TINYGLTF_TYPE_VEC3, true, {}, {});
         prim.indices = indices;
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         return prim;
@@ -207,10 +250,12 @@ public:
 
     // A view of the fallback buffer (1, no data) whose EXT_meshopt_compression object points at
     // `encoded` in the BIN chunk; the extension objects are added to the JSON by meshoptJson().
-    int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices) {
+    // `octahedral`: the view's data went through the OCTAHEDRAL filter.
+    int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices,
+                       bool octahedral = false) {
         static const char zeros[4] = {0, 0, 0, 0};
         if (sink_->size % 4) sink_->write(zeros, 4 - sink_->size % 4);
-        MeshoptView mv{sink_->size, encoded.size(), stride, count, indices};
+        MeshoptView mv{sink_->size, encoded.size(), stride, count, indices, octahedral};
         sink_->write(encoded.data(), encoded.size());
         tinygltf::BufferView v;
         v.buffer = 1;
@@ -231,6 +276,7 @@ public:
             nlohmann::json ext = {{"buffer", 0},           {"byteOffset", mv.offset}, {"byteLength", mv.length},
                                   {"byteStride", mv.stride}, {"count", mv.count},
                                   {"mode", mv.indices ? "TRIANGLES" : "ATTRIBUTES"}};
+            if (mv.octahedral) ext["filter"] = "OCTAHEDRAL";
             (*j)["bufferViews"][size_t(view)]["extensions"]["EXT_meshopt_compression"] = ext;
         }
         (*j)["buffers"][1] = {{"byteLength", fallback_size},
@@ -330,7 +376,7 @@ private:
     BinSink* sink_;
     struct MeshoptView {
         size_t offset, length, stride, count;
-        bool indices;
+        bool indices, octahedral;
     };
     std::vector<std::pair<int, MeshoptView>> meshopt_views;
     size_t fallback_size = 0;
@@ -348,13 +394,20 @@ private:
 // Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
 // are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
 constexpr double kCreaseDeg = 30.0;
+// The meshopt form's scratch vectors (kept by the frame's buffers, used object by object).
+struct MeshoptScratch {
+    std::vector<double> exact;
+    std::vector<unsigned int> remap;
+    std::vector<float> normals;
+    std::vector<unsigned char> vertices, normal_stream;  // the frame's streams before encoding
+};
 // With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
 // receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
 // `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
-// split's (reused the same way, object by object).
+// split's (reused the same way, object by object), `scratch` meshopt's.
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
-                 const GlbOptions& options, const std::array<double, 4>& base_color) {
+                 MeshoptScratch* scratch, const GlbOptions& options, const std::array<double, 4>& base_color) {
     mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
     const size_t nv = map->source.size();
     d->positions.resize(3 * nv);
@@ -367,7 +420,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     const bool shade = options.shade_doppler && m.doppler.size() == m.positions.size();
     d->colors.resize(shade ? 3 * nv : 0);
     const std::array<double, 3> base{base_color[0], base_color[1], base_color[2]};
-    std::vector<double> exact(step > 0 ? 3 * nv : 0);
+    std::vector<double>& exact = scratch->exact;
+    exact.resize(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
     const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
     const double worst = tbb::parallel_reduce(
@@ -397,7 +451,9 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     *max_err = std::max(*max_err, worst);
     d->indices.resize(3 * map->triangles.size());
     if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
-    if (step > 0) *max_quant = std::max(*max_quant, packMeshopt(d, exact, step));
+    if (step > 0)
+        *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), &scratch->remap,
+                                                      &scratch->normals));
 }
 
 // Rotation quaternion (x, y, z, w) of the camera node: glTF cameras look down local -Z with +Y
@@ -434,7 +490,8 @@ tinygltf::Value number(double v) { return tinygltf::Value(v); }
 // streamed to the sink. Two run side by side with Draco: the real one and a plain one that only
 // counts, for the size without Draco.
 struct SequenceModel {
-    SequenceModel(const SequenceInfo& info_, const GlbOptions& options, BinSink* sink) : info(info_), b(options, sink) {
+    SequenceModel(const SequenceInfo& info_, const GlbOptions& options, BinSink* sink)
+        : info(info_), b(options, sink), layout(options) {
         tinygltf::Model& model = b.model;
     // Step: one material per object.
     for (const ExportObject& o : info.objects) {
@@ -512,16 +569,17 @@ struct SequenceModel {
                 prev.vertices == data[o].vertexCount() && prev.indices == data[o].indices)
                 shared[o] = prev.accessor;
         }
-        // Step (meshopt): the frame's vertex view, and one index view for the objects that do not
-        // share, uint16 unless one of them has more than 65535 vertices.
-        int vview = -1;
+        // Step (meshopt): the frame's vertex and normal views, and one index view for the objects
+        // that do not share, uint16 unless one of them has more than 65535 vertices.
+        int vview = -1, nview = -1;
         std::vector<int> meshopt_indices(f.objects.size(), -1);
         if (compression == Compression::meshopt && meshopt && meshopt->count > 0) {
-            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, kMeshoptStride, false);
+            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, layout.stride, false);
+            nview = b.addMeshoptView(meshopt->encoded_normals, meshopt->count, kMeshoptNormalStride, false, true);
             size_t size = 2, count = 0, most = 0;
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty() && shared[o] < 0) {
-                    most = std::max(most, data[o].packed.size() / kMeshoptStride);
+                    most = std::max(most, data[o].packed.size() / layout.stride);
                     count += data[o].ordered.size();
                 }
             if (most > 65535) size = 4;
@@ -564,7 +622,7 @@ struct SequenceModel {
                     }
                     stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
                 } else if (compression == Compression::meshopt) {
-                    prim = b.meshoptPrimitive(data[o], vview, meshopt->first[o],
+                    prim = b.meshoptPrimitive(data[o], layout, vview, nview, meshopt->first[o],
                                               shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
                 } else {
                     prim = b.plainPrimitive(data[o], shared[o]);
@@ -723,6 +781,7 @@ struct SequenceModel {
 
     const SequenceInfo& info;
     GlbBuilder b;
+    MeshoptLayout layout;  // with meshopt: the vertex record
     tinygltf::Scene scene;
     tinygltf::Value::Array frame_times;
     std::vector<float> frame_scales;  // per frame, its node's scale while shown
@@ -755,23 +814,26 @@ struct GlbFrameData : PreparedFrame {
         step = 0;
         clamped = false;
         meshopt.encoded.clear();
+        meshopt.encoded_normals.clear();
         meshopt.count = 0;
         meshopt.first.clear();
         data.resize(objects);
         crease_map.resize(objects);
         crease_work.resize(objects);
         for (PrimitiveData& p : data) {
-            for (auto* v : {&p.positions, &p.normals, &p.emission}) v->clear();
+            for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
             p.indices.clear();
             p.ordered.clear();
             p.packed.clear();
+            p.packed_normals.clear();
         }
         far = max_extent = max_float_error = max_quantization_error = 0;
     }
     double origin[3] = {0, 0, 0};
     double step = 0;       // meshopt: the quantization step (0 without meshopt)
     bool clamped = false;  // meshopt: the step grew to fit int16
-    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex stream
+    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex streams
+    MeshoptScratch meshopt_scratch;
     std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
     std::vector<mesh4d::CreaseMap> crease_map;  // per object, toPrimitive's scratch
     std::vector<mesh4d::CreaseWork> crease_work;
@@ -909,21 +971,29 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty())
                 toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
-                            &d->crease_map[o], &d->crease_work[o], impl_->options,
+                            &d->crease_map[o], &d->crease_work[o], &d->meshopt_scratch, impl_->options,
                             impl_->info.objects[o].base_color);
         if (impl_->options.meshopt) {
-            // Step: one vertex stream for the whole frame, encoded here (on the worker thread).
+            // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
+            // worker thread).
+            const size_t stride = MeshoptLayout(impl_->options).stride;
             MeshoptFrame& mf = d->meshopt;
             mf.first.assign(f.objects.size(), 0);
-            std::vector<unsigned char> all;
+            std::vector<unsigned char>& all = d->meshopt_scratch.vertices;
+            std::vector<unsigned char>& normals = d->meshopt_scratch.normal_stream;
+            all.clear();
+            normals.clear();
             for (size_t o = 0; o < f.objects.size(); ++o) {
-                mf.first[o] = all.size() / kMeshoptStride;
+                mf.first[o] = all.size() / stride;
                 all.insert(all.end(), d->data[o].packed.begin(), d->data[o].packed.end());
+                normals.insert(normals.end(), d->data[o].packed_normals.begin(), d->data[o].packed_normals.end());
             }
-            mf.count = all.size() / kMeshoptStride;
-            mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptStride));
-            mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count,
-                                                         kMeshoptStride));
+            mf.count = all.size() / stride;
+            mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, stride));
+            mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count, stride));
+            mf.encoded_normals.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptNormalStride));
+            mf.encoded_normals.resize(meshopt_encodeVertexBuffer(mf.encoded_normals.data(), mf.encoded_normals.size(),
+                                                                 normals.data(), mf.count, kMeshoptNormalStride));
         }
     }
     return d;
