@@ -46,7 +46,7 @@ struct PrimitiveData {
     std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
     std::vector<unsigned char> packed, packed_normals;
-    std::vector<uint32_t> ordered;
+    std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
     size_t vertexCount() const { return emission.size(); }
 };
@@ -79,53 +79,89 @@ constexpr int kMeshoptNormalBits = 8;
 // The emission time as meshopt stores it: rounded (half away from zero) to a multiple of the
 // largest power of two not above `step`, so that its low mantissa bits are zero and compress;
 // it stays a float32 that readers use as it is, within step / 2 seconds of the plain file's.
-float emissionQuantized(float t, double step) {
-    const double q = std::ldexp(1.0, int(std::floor(std::log2(step))));
-    return float(std::round(double(t) / q) * q);
-}
+double emissionStep(double step) { return std::ldexp(1.0, int(std::floor(std::log2(step)))); }
+float emissionRounded(float t, double q) { return float(std::round(double(t) / q) * q); }
+
+// One object's vertex-cache and vertex-fetch orders for an index list, kept for the next frame:
+// both depend on the index list alone, so an equal list (vertex mode, or the same refinement)
+// takes them from here instead of optimizing again (meshopt_optimizeVertexCache costs about
+// 100 ms at 1M triangles).
+struct MeshoptOrder {
+    std::vector<uint32_t> indices;   // the index list they were computed for
+    size_t vertices = 0;             // and its vertex count
+    std::shared_ptr<std::vector<uint32_t>> ordered;  // the triangles in cache order, in fetch numbering
+    std::vector<unsigned int> remap; // fetch number of each vertex (~0u: unused)
+    size_t used = 0;                 // vertices used by a triangle
+};
 
 // The meshopt form of `d`: positions quantized from the exact relative coordinates `rel` (xyz
 // per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
 // triangles first use them (both depend on the index list alone, so frames with equal index
-// lists get equal orders). Returns the largest |step * q - rel| over the coordinates.
+// lists get equal orders; `order` keeps them from the object's last frame). Returns the largest
+// |step * q - rel| over the coordinates.
 double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step, const MeshoptLayout& layout,
-                   std::vector<unsigned int>* remap_work, std::vector<float>* normal_work) {
+                   MeshoptOrder* order, std::vector<float>* normal_work) {
     const size_t nv = d->vertexCount();
-    d->ordered.resize(d->indices.size());
-    meshopt_optimizeVertexCache(d->ordered.data(), d->indices.data(), d->indices.size(), nv);
-    std::vector<unsigned int>& remap = *remap_work;
-    remap.resize(nv);
-    const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), d->ordered.data(), d->ordered.size(), nv);
-    meshopt_remapIndexBuffer(d->ordered.data(), d->ordered.data(), d->ordered.size(), remap.data());
+    if (!order->ordered || order->vertices != nv || order->indices != d->indices) {
+        order->indices = d->indices;
+        order->vertices = nv;
+        // A frame still held refers to the old order: a new vector then, else this one again.
+        if (!order->ordered || order->ordered.use_count() > 1) order->ordered = std::make_shared<std::vector<uint32_t>>();
+        std::vector<uint32_t>& ordered = *order->ordered;
+        ordered.resize(d->indices.size());
+        meshopt_optimizeVertexCache(ordered.data(), d->indices.data(), d->indices.size(), nv);
+        order->remap.resize(nv);
+        order->used = meshopt_optimizeVertexFetchRemap(order->remap.data(), ordered.data(), ordered.size(), nv);
+        meshopt_remapIndexBuffer(ordered.data(), ordered.data(), ordered.size(), order->remap.data());
+    }
+    d->ordered = order->ordered;
+    const std::vector<unsigned int>& remap = order->remap;
+    const size_t used = order->used;
     const size_t stride = layout.stride;
     d->packed.assign(used * stride, 0);
     std::vector<float>& normals = *normal_work;  // x, y, z, 0 per vertex in stream order, for the filter
     normals.assign(4 * used, 0.0f);
-    double worst = 0;
-    for (int c = 0; c < 3; ++c) { d->qmin[c] = INT32_MAX; d->qmax[c] = INT32_MIN; }
-    for (size_t i = 0; i < nv; ++i) {
-        if (remap[i] == ~0u) continue;  // used by no triangle: dropped (a cut mesh has none)
-        unsigned char* v = d->packed.data() + size_t(remap[i]) * stride;
-        int16_t q[4] = {0, 0, 0, 0};
-        for (int c = 0; c < 3; ++c) {
-            const double x = std::nearbyint(rel[3 * i + c] / step);
-            q[c] = int16_t(std::clamp(x, -32767.0, 32767.0));
-            worst = std::max(worst, std::fabs(double(q[c]) * step - rel[3 * i + c]));
-            d->qmin[c] = std::min(d->qmin[c], int(q[c]));
-            d->qmax[c] = std::max(d->qmax[c], int(q[c]));
-            normals[4 * size_t(remap[i]) + size_t(c)] = d->normals[3 * i + c];
-        }
-        std::memcpy(v, q, 8);
-        const float t = emissionQuantized(d->emission[i], step);
-        std::memcpy(v + 8, &t, 4);
-        if (layout.doppler >= 0 && !d->doppler.empty()) std::memcpy(v + layout.doppler, &d->doppler[i], 4);
-        if (layout.proper_time >= 0 && !d->proper_time.empty()) std::memcpy(v + layout.proper_time, &d->proper_time[i], 4);
-        if (layout.color >= 0 && !d->colors.empty()) {
-            uint16_t rgb[4] = {0, 0, 0, 0};
-            for (int c = 0; c < 3; ++c) rgb[c] = uint16_t(meshopt_quantizeUnorm(std::clamp(d->colors[3 * i + c], 0.0f, 1.0f), 16));
-            std::memcpy(v + layout.color, rgb, 8);
-        }
-    }
+    const double time_step = emissionStep(step);
+    // Vertices in parallel (each writes its own record); the largest error and the bounds reduced.
+    struct Extremes {
+        double worst = 0;
+        int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    };
+    const Extremes e = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), Extremes{},
+        [&](const tbb::blocked_range<size_t>& r, Extremes x) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                if (remap[i] == ~0u) continue;  // used by no triangle: dropped (a cut mesh has none)
+                unsigned char* v = d->packed.data() + size_t(remap[i]) * stride;
+                int16_t q[4] = {0, 0, 0, 0};
+                for (int c = 0; c < 3; ++c) {
+                    const double p = std::nearbyint(rel[3 * i + c] / step);
+                    q[c] = int16_t(std::clamp(p, -32767.0, 32767.0));
+                    x.worst = std::max(x.worst, std::fabs(double(q[c]) * step - rel[3 * i + c]));
+                    x.lo[c] = std::min(x.lo[c], int(q[c]));
+                    x.hi[c] = std::max(x.hi[c], int(q[c]));
+                    normals[4 * size_t(remap[i]) + size_t(c)] = d->normals[3 * i + c];
+                }
+                std::memcpy(v, q, 8);
+                const float t = emissionRounded(d->emission[i], time_step);
+                std::memcpy(v + 8, &t, 4);
+                if (layout.doppler >= 0 && !d->doppler.empty()) std::memcpy(v + layout.doppler, &d->doppler[i], 4);
+                if (layout.proper_time >= 0 && !d->proper_time.empty()) std::memcpy(v + layout.proper_time, &d->proper_time[i], 4);
+                if (layout.color >= 0 && !d->colors.empty()) {
+                    uint16_t rgb[4] = {0, 0, 0, 0};
+                    for (int c = 0; c < 3; ++c) rgb[c] = uint16_t(meshopt_quantizeUnorm(std::clamp(d->colors[3 * i + c], 0.0f, 1.0f), 16));
+                    std::memcpy(v + layout.color, rgb, 8);
+                }
+            }
+            return x;
+        },
+        [](Extremes a, const Extremes& b) {
+            a.worst = std::max(a.worst, b.worst);
+            for (int c = 0; c < 3; ++c) { a.lo[c] = std::min(a.lo[c], b.lo[c]); a.hi[c] = std::max(a.hi[c], b.hi[c]); }
+            return a;
+        });
+    const double worst = e.worst;
+    for (int c = 0; c < 3; ++c) { d->qmin[c] = e.lo[c]; d->qmax[c] = e.hi[c]; }
     d->packed_normals.resize(used * kMeshoptNormalStride);
     if (used > 0)
         meshopt_encodeFilterOct(d->packed_normals.data(), used, kMeshoptNormalStride, kMeshoptNormalBits, normals.data());
@@ -397,17 +433,19 @@ constexpr double kCreaseDeg = 30.0;
 // The meshopt form's scratch vectors (kept by the frame's buffers, used object by object).
 struct MeshoptScratch {
     std::vector<double> exact;
-    std::vector<unsigned int> remap;
+    std::vector<MeshoptOrder> orders;  // per object
     std::vector<float> normals;
     std::vector<unsigned char> vertices, normal_stream;  // the frame's streams before encoding
 };
 // With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
 // receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
 // `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
-// split's (reused the same way, object by object), `scratch` meshopt's.
+// split's (reused the same way, object by object), `scratch` meshopt's and `order` the object's
+// meshopt orders.
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
-                 MeshoptScratch* scratch, const GlbOptions& options, const std::array<double, 4>& base_color) {
+                 MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
+                 const std::array<double, 4>& base_color) {
     mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
     const size_t nv = map->source.size();
     d->positions.resize(3 * nv);
@@ -452,7 +490,7 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     d->indices.resize(3 * map->triangles.size());
     if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
     if (step > 0)
-        *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), &scratch->remap,
+        *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), order,
                                                       &scratch->normals));
 }
 
@@ -580,7 +618,7 @@ struct SequenceModel {
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty() && shared[o] < 0) {
                     most = std::max(most, data[o].packed.size() / layout.stride);
-                    count += data[o].ordered.size();
+                    count += data[o].ordered->size();
                 }
             if (most > 65535) size = 4;
             if (count > 0) {
@@ -590,7 +628,7 @@ struct SequenceModel {
                 for (size_t o = 0; o < f.objects.size(); ++o)
                     if (!f.objects[o].triangles.empty() && shared[o] < 0) {
                         first[o] = all.size();
-                        all.insert(all.end(), data[o].ordered.begin(), data[o].ordered.end());
+                        all.insert(all.end(), data[o].ordered->begin(), data[o].ordered->end());
                     }
                 std::vector<unsigned char> encoded(meshopt_encodeIndexBufferBound(all.size(), most));
                 encoded.resize(meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), all.data(), all.size()));
@@ -600,7 +638,7 @@ struct SequenceModel {
                         const int a = b.addAccessor(iview,
                                                     size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
                                                               : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                                    TINYGLTF_TYPE_SCALAR, data[o].ordered.size());
+                                                    TINYGLTF_TYPE_SCALAR, data[o].ordered->size());
                         b.model.accessors[a].byteOffset = first[o] * size;
                         meshopt_indices[o] = a;
                     }
@@ -818,12 +856,10 @@ struct GlbFrameData : PreparedFrame {
         meshopt.count = 0;
         meshopt.first.clear();
         data.resize(objects);
-        crease_map.resize(objects);
-        crease_work.resize(objects);
         for (PrimitiveData& p : data) {
             for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
             p.indices.clear();
-            p.ordered.clear();
+            p.ordered.reset();
             p.packed.clear();
             p.packed_normals.clear();
         }
@@ -833,11 +869,18 @@ struct GlbFrameData : PreparedFrame {
     double step = 0;       // meshopt: the quantization step (0 without meshopt)
     bool clamped = false;  // meshopt: the step grew to fit int16
     MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex streams
-    MeshoptScratch meshopt_scratch;
     std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
-    std::vector<mesh4d::CreaseMap> crease_map;  // per object, toPrimitive's scratch
-    std::vector<mesh4d::CreaseWork> crease_work;
     double far = 0, max_extent = 0, max_float_error = 0, max_quantization_error = 0;
+};
+
+// What prepare() needs only while it runs (the crease split's work and map, meshopt's vectors): as
+// many sets as prepare() calls run at once, not one per frame held in flight, taken from a pool
+// of their own (their capacity kept, and the crease split's adjacency reused for the same
+// triangles). At 1M triangles a set is about 130 MB.
+struct PrepareScratch {
+    std::vector<mesh4d::CreaseMap> crease_map;  // per object
+    std::vector<mesh4d::CreaseWork> crease_work;
+    MeshoptScratch meshopt;
 };
 
 // Frame buffers given back by released GlbFrameData, shared by every writer of the process (and
@@ -848,6 +891,7 @@ struct GlbFrameData : PreparedFrame {
 struct FramePool {
     std::mutex mutex;
     std::vector<std::unique_ptr<GlbFrameData>> free;
+    std::vector<std::unique_ptr<PrepareScratch>> scratch;  // likewise, at most poolFrames()
 };
 size_t poolFrames() { return std::max<size_t>(4, 2 * size_t(std::thread::hardware_concurrency())); }
 std::shared_ptr<FramePool> processFramePool() {
@@ -927,6 +971,26 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         if (pool->free.size() < poolFrames()) pool->free.push_back(std::move(owned));
     });
     d->reset(f.objects.size());
+    std::unique_ptr<PrepareScratch> scratch;
+    {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (!pool->scratch.empty()) {
+            scratch = std::move(pool->scratch.back());
+            pool->scratch.pop_back();
+        }
+    }
+    if (!scratch) scratch = std::make_unique<PrepareScratch>();
+    struct GiveBack {  // the scratch back to the pool however prepare() ends
+        FramePool* pool;
+        std::unique_ptr<PrepareScratch>* scratch;
+        ~GiveBack() {
+            std::lock_guard<std::mutex> lock(pool->mutex);
+            if (pool->scratch.size() < poolFrames()) pool->scratch.push_back(std::move(*scratch));
+        }
+    } give_back{pool.get(), &scratch};
+    scratch->crease_map.resize(f.objects.size());
+    scratch->crease_work.resize(f.objects.size());
+    scratch->meshopt.orders.resize(f.objects.size());
     // Step: the frame's origin (the centre of its bounding box) and the far distance (parallel
     // minima and maxima: exact in any order).
     mesh4d::EventBox box;
@@ -971,7 +1035,8 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty())
                 toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
-                            &d->crease_map[o], &d->crease_work[o], &d->meshopt_scratch, impl_->options,
+                            &scratch->crease_map[o], &scratch->crease_work[o], &scratch->meshopt,
+                            &scratch->meshopt.orders[o], impl_->options,
                             impl_->info.objects[o].base_color);
         if (impl_->options.meshopt) {
             // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
@@ -979,8 +1044,8 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
             const size_t stride = MeshoptLayout(impl_->options).stride;
             MeshoptFrame& mf = d->meshopt;
             mf.first.assign(f.objects.size(), 0);
-            std::vector<unsigned char>& all = d->meshopt_scratch.vertices;
-            std::vector<unsigned char>& normals = d->meshopt_scratch.normal_stream;
+            std::vector<unsigned char>& all = scratch->meshopt.vertices;
+            std::vector<unsigned char>& normals = scratch->meshopt.normal_stream;
             all.clear();
             normals.clear();
             for (size_t o = 0; o < f.objects.size(); ++o) {
