@@ -992,20 +992,27 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
     scratch->crease_work.resize(f.objects.size());
     scratch->meshopt.orders.resize(f.objects.size());
     // Step: the frame's origin (the centre of its bounding box) and the far distance (parallel
-    // minima and maxima: exact in any order).
+    // minima and maxima: exact in any order). The far distance is the largest norm() (hypot) of
+    // any point, but norm() is taken only where the squared distance comes within 1e-9 of the
+    // largest so far: the point of largest norm() always does (the two agree to a few ulps).
     mesh4d::EventBox box;
     const Vec3 camera = impl_->info.camera.position;
     for (const auto& o : f.objects) {
         struct Extremes {
             mesh4d::EventBox box;
-            double far = 0;
+            double far = 0, far2 = 0;
         };
         const Extremes e = tbb::parallel_reduce(
             tbb::blocked_range<size_t>(0, o.positions.size(), 16384), Extremes{},
             [&](const tbb::blocked_range<size_t>& r, Extremes x) {
                 for (size_t i = r.begin(); i < r.end(); ++i) {
                     const Vec3 p = o.absolutePosition(i);
-                    x.far = std::max(x.far, mesh4d::norm(p - camera));
+                    const Vec3 d = p - camera;
+                    const double d2 = mesh4d::dot(d, d);
+                    if (d2 >= x.far2 * (1 - 1e-9)) {
+                        x.far = std::max(x.far, mesh4d::norm(d));
+                        x.far2 = std::max(x.far2, d2);
+                    }
                     x.box.addPoint(p);
                 }
                 return x;
@@ -1014,6 +1021,7 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
                 a.box.addPoint(b.box.lo);
                 a.box.addPoint(b.box.hi);
                 a.far = std::max(a.far, b.far);
+                a.far2 = std::max(a.far2, b.far2);
                 return a;
             });
         d->far = std::max(d->far, e.far);
