@@ -38,26 +38,32 @@ using mesh4d::Vec3;
 
 // One primitive's data as it goes into the file: float32 positions relative to the frame origin.
 // With meshopt also its packed vertices (MeshoptLayout::stride bytes each, in vertex-fetch order)
-// and their octahedral normals (kMeshoptNormalStride bytes each, same order), its indices in
+// and their normals in the two forms a frame may use (octahedral, kMeshoptNormalStride bytes
+// each, and int8 x, y, z, 0 for the record; same order), its indices in
 // vertex-cache order referring to them, and POSITION's integer bounds.
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
     std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
-    std::vector<unsigned char> packed, packed_normals;
+    std::vector<unsigned char> packed, packed_normals, packed_snorm;
     std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
     size_t vertexCount() const { return emission.size(); }
 };
 
 // A frame's meshopt vertex streams: every shown object's packed vertices in object order, encoded
-// as one EXT_meshopt_compression ATTRIBUTES view, and their normals as another (filter OCTAHEDRAL).
+// as one EXT_meshopt_compression ATTRIBUTES view, and their normals either as another view
+// (filter OCTAHEDRAL) or as int8 x, y, z, 0 at the end of each record, whichever makes the
+// smaller file (a view costs about kMeshoptViewJsonBytes of JSON: small frames keep them inline).
 struct MeshoptFrame {
-    std::vector<unsigned char> encoded, encoded_normals;
+    std::vector<unsigned char> encoded, encoded_normals;  // encoded_normals empty: normals inline
     size_t count = 0;                // vertices in all
+    size_t stride = 0;               // bytes per record (MeshoptLayout::stride, + 4 with inline normals)
+    bool normals_inline = false;
     std::vector<size_t> first;       // per object, its first vertex in the stream
 };
+constexpr size_t kMeshoptViewJsonBytes = 200;
 
 // The meshopt vertex record (gltf.h): int16 x, y, z, 0 | float32 emission time, then with
 // --attributes float32 _DOPPLER and/or _PROPER_TIME, with --shade doppler uint16 (normalized)
@@ -72,7 +78,8 @@ struct MeshoptLayout {
     int doppler = -1, proper_time = -1, color = -1;
 };
 // The normals' stream: the EXT_meshopt_compression OCTAHEDRAL filter's 8-bit form (4 bytes a
-// vertex), which the decoder turns into normalized int8 x, y, z (and a fourth byte).
+// vertex), which the decoder turns into normalized int8 x, y, z (and a fourth byte); in the
+// record instead (MeshoptFrame), normalized int8 x, y, z, 0 rounded from the float normal.
 constexpr size_t kMeshoptNormalStride = 4;
 constexpr int kMeshoptNormalBits = 8;
 
@@ -119,6 +126,7 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
     const size_t used = order->used;
     const size_t stride = layout.stride;
     d->packed.assign(used * stride, 0);
+    d->packed_snorm.assign(used * 4, 0);
     std::vector<float>& normals = *normal_work;  // x, y, z, 0 per vertex in stream order, for the filter
     normals.assign(4 * used, 0.0f);
     const double time_step = emissionStep(step);
@@ -141,6 +149,8 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
                     x.lo[c] = std::min(x.lo[c], int(q[c]));
                     x.hi[c] = std::max(x.hi[c], int(q[c]));
                     normals[4 * size_t(remap[i]) + size_t(c)] = d->normals[3 * i + c];
+                    d->packed_snorm[4 * size_t(remap[i]) + size_t(c)] =
+                        static_cast<unsigned char>(int8_t(meshopt_quantizeSnorm(d->normals[3 * i + c], 8)));
                 }
                 std::memcpy(v, q, 8);
                 const float t = emissionRounded(d->emission[i], time_step);
@@ -248,26 +258,28 @@ public:
     }
 
     // An EXT_meshopt_compression primitive: its vertices at `first_vertex` of the frame's vertex
-    // view `vview` (records of `layout`) and normal view `nview`, its indices the accessor
-    // `indices` (made by the caller: new or shared).
-    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, int vview, int nview,
-                                         size_t first_vertex, int indices) {
+    // view `vview` (records of `layout`, `stride` bytes each) and normal view `nview` (-1: the
+    // normals end each record), its indices the accessor `indices` (made by the caller: new or
+    // shared).
+    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, size_t stride, int vview,
+                                         int nview, size_t first_vertex, int indices) {
         tinygltf::Primitive prim;
         const size_t nv = d.packed.size() / layout.stride;
-        auto attribute = [&](int view, size_t stride, size_t offset, int component, int type, bool normalized,
+        auto attribute = [&](int view, size_t view_stride, size_t offset, int component, int type, bool normalized,
                              std::vector<double> lo, std::vector<double> hi) {
             const int a = addAccessor(view, component, type, nv, std::move(lo), std::move(hi));
-            model.accessors[a].byteOffset = first_vertex * stride + offset;
+            model.accessors[a].byteOffset = first_vertex * view_stride + offset;
             model.accessors[a].normalized = normalized;
             return a;
         };
-        const size_t stride = layout.stride;
         prim.attributes["POSITION"] =
             attribute(vview, stride, 0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
                       {double(d.qmin[0]), double(d.qmin[1]), double(d.qmin[2])},
                       {double(d.qmax[0]), double(d.qmax[1]), double(d.qmax[2])});
-        prim.attributes["NORMAL"] = attribute(nview, kMeshoptNormalStride, 0, TINYGLTF_COMPONENT_TYPE_BYTE,
-                                              TINYGLTF_TYPE_VEC3, true, {}, {});
+        prim.attributes["NORMAL"] = nview >= 0 ? attribute(nview, kMeshoptNormalStride, 0, TINYGLTF_COMPONENT_TYPE_BYTE,
+                                                           TINYGLTF_TYPE_VEC3, true, {}, {})
+                                               : attribute(vview, stride, layout.stride, TINYGLTF_COMPONENT_TYPE_BYTE,
+                                                           TINYGLTF_TYPE_VEC3, true, {}, {});
         prim.attributes["_EMISSION_TIME"] =
             attribute(vview, stride, 8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
         if (layout.doppler >= 0 && !d.doppler.empty())
@@ -436,6 +448,7 @@ struct MeshoptScratch {
     std::vector<MeshoptOrder> orders;  // per object
     std::vector<float> normals;
     std::vector<unsigned char> vertices, normal_stream;  // the frame's streams before encoding
+    std::vector<unsigned char> inline_records, inline_encoded;  // the same with the normals inline
 };
 // With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
 // receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
@@ -612,8 +625,9 @@ struct SequenceModel {
         int vview = -1, nview = -1;
         std::vector<int> meshopt_indices(f.objects.size(), -1);
         if (compression == Compression::meshopt && meshopt && meshopt->count > 0) {
-            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, layout.stride, false);
-            nview = b.addMeshoptView(meshopt->encoded_normals, meshopt->count, kMeshoptNormalStride, false, true);
+            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, meshopt->stride, false);
+            if (!meshopt->normals_inline)
+                nview = b.addMeshoptView(meshopt->encoded_normals, meshopt->count, kMeshoptNormalStride, false, true);
             size_t size = 2, count = 0, most = 0;
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty() && shared[o] < 0) {
@@ -660,7 +674,7 @@ struct SequenceModel {
                     }
                     stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
                 } else if (compression == Compression::meshopt) {
-                    prim = b.meshoptPrimitive(data[o], layout, vview, nview, meshopt->first[o],
+                    prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
                                               shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
                 } else {
                     prim = b.plainPrimitive(data[o], shared[o]);
@@ -862,6 +876,7 @@ struct GlbFrameData : PreparedFrame {
             p.ordered.reset();
             p.packed.clear();
             p.packed_normals.clear();
+            p.packed_snorm.clear();
         }
         far = max_extent = max_float_error = max_quantization_error = 0;
     }
@@ -1007,10 +1022,10 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
             [&](const tbb::blocked_range<size_t>& r, Extremes x) {
                 for (size_t i = r.begin(); i < r.end(); ++i) {
                     const Vec3 p = o.absolutePosition(i);
-                    const Vec3 d = p - camera;
-                    const double d2 = mesh4d::dot(d, d);
+                    const Vec3 to = p - camera;
+                    const double d2 = mesh4d::dot(to, to);
                     if (d2 >= x.far2 * (1 - 1e-9)) {
-                        x.far = std::max(x.far, mesh4d::norm(d));
+                        x.far = std::max(x.far, mesh4d::norm(to));
                         x.far2 = std::max(x.far2, d2);
                     }
                     x.box.addPoint(p);
@@ -1067,6 +1082,30 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
             mf.encoded_normals.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptNormalStride));
             mf.encoded_normals.resize(meshopt_encodeVertexBuffer(mf.encoded_normals.data(), mf.encoded_normals.size(),
                                                                  normals.data(), mf.count, kMeshoptNormalStride));
+            // Step: the records with the int8 normals at their end, encoded too; the smaller wins
+            // (the separate view counted with its JSON).
+            const size_t wide = stride + 4;
+            std::vector<unsigned char>& records = scratch->meshopt.inline_records;
+            records.resize(mf.count * wide);
+            size_t k = 0;
+            for (size_t o = 0; o < f.objects.size(); ++o) {
+                const PrimitiveData& p = d->data[o];
+                for (size_t i = 0; i < p.packed.size() / stride; ++i, ++k) {
+                    std::memcpy(&records[k * wide], &p.packed[i * stride], stride);
+                    std::memcpy(&records[k * wide + stride], &p.packed_snorm[4 * i], 4);
+                }
+            }
+            std::vector<unsigned char>& encoded_inline = scratch->meshopt.inline_encoded;
+            encoded_inline.resize(meshopt_encodeVertexBufferBound(mf.count, wide));
+            encoded_inline.resize(
+                meshopt_encodeVertexBuffer(encoded_inline.data(), encoded_inline.size(), records.data(), mf.count, wide));
+            mf.stride = stride;
+            mf.normals_inline = encoded_inline.size() <= mf.encoded.size() + mf.encoded_normals.size() + kMeshoptViewJsonBytes;
+            if (mf.normals_inline) {
+                mf.encoded.swap(encoded_inline);
+                mf.encoded_normals.clear();
+                mf.stride = wide;
+            }
         }
     }
     return d;

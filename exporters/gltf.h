@@ -22,17 +22,19 @@
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
 // With meshopt (EXT_meshopt_compression and KHR_mesh_quantization, both required; the BIN chunk
 // holds the compressed streams, a fallback buffer without data stands for the decoded ones):
-// a frame's vertices (all its primitives') are one interleaved stream of records and one stream
-// of normals, and its indices one stream (so three compressed views per frame, the index view
-// left out when every object shares the previous frame's). The record: POSITION as int16 (not
+// a frame's vertices (all its primitives') are one interleaved stream of records, with the
+// normals either in a stream of their own or at the end of each record (whichever encodes smaller,
+// the extra view counted as 200 bytes of JSON: small frames keep them inline), and its indices one
+// stream (the index view left out when every object shares the previous frame's). The record: POSITION as int16 (not
 // normalized) multiples of the frame's step about the frame's origin (8 bytes with padding),
 // _EMISSION_TIME float32 rounded to a multiple of the largest power of two not above the step
 // (within step / 2 seconds of the plain file's, c = 1: its low mantissa bits compress), then with
 // --attributes _DOPPLER and/or _PROPER_TIME as float32 (the plain file's values, bit for bit), and
 // with --shade doppler COLOR_0 as normalized uint16 RGB (8 bytes with padding; within 0.5 / 65535
-// of the plain file's float colour, clamped to [0, 1]). NORMAL is its own view with the
+// of the plain file's float colour, clamped to [0, 1]). NORMAL in its own view goes through the
 // OCTAHEDRAL filter at 8 bits (decoded to normalized int8; each component within 2.63 / 127 of
-// the plain file's normal, derived in tests/web/meshopt_roundtrip.js). Indices
+// the plain file's normal, derived in tests/web/meshopt_roundtrip.js); in the record it is
+// normalized int8 x, y, z, 0 (within 0.5 / 127). Indices
 // uint16 (uint32 past 65535 vertices), triangles in vertex-cache order and vertices in the order
 // they first use them (meshopt_optimizeVertexCache, meshopt_optimizeVertexFetchRemap). The frame
 // node's scale is its step (the animation shows it with scale = step, hides it with 0), so a
