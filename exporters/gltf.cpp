@@ -10,6 +10,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <thread>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
@@ -36,69 +37,144 @@ namespace {
 using mesh4d::Vec3;
 
 // One primitive's data as it goes into the file: float32 positions relative to the frame origin.
-// With meshopt also its packed vertices (kMeshoptStride bytes each, in vertex-fetch order),
-// its indices in vertex-cache order referring to them, and POSITION's integer bounds.
+// With meshopt also its packed vertices (MeshoptLayout::stride bytes each, in vertex-fetch order)
+// and their normals in the two forms a frame may use (octahedral, kMeshoptNormalStride bytes
+// each, and int8 x, y, z, 0 for the record; same order), its indices in
+// vertex-cache order referring to them, and POSITION's integer bounds.
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
     std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
-    std::vector<unsigned char> packed;
-    std::vector<uint32_t> ordered;
+    std::vector<unsigned char> packed, packed_normals, packed_snorm;
+    std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
     size_t vertexCount() const { return emission.size(); }
 };
 
-// A frame's meshopt vertex stream: every shown object's packed vertices in object order, encoded
-// as one EXT_meshopt_compression ATTRIBUTES view.
+// A frame's meshopt vertex streams: every shown object's packed vertices in object order, encoded
+// as one EXT_meshopt_compression ATTRIBUTES view, and their normals either as another view
+// (filter OCTAHEDRAL) or as int8 x, y, z, 0 at the end of each record, whichever makes the
+// smaller file (a view costs about kMeshoptViewJsonBytes of JSON: small frames keep them inline).
 struct MeshoptFrame {
-    std::vector<unsigned char> encoded;
+    std::vector<unsigned char> encoded, encoded_normals;  // encoded_normals empty: normals inline
     size_t count = 0;                // vertices in all
+    size_t stride = 0;               // bytes per record (MeshoptLayout::stride, + 4 with inline normals)
+    bool normals_inline = false;
     std::vector<size_t> first;       // per object, its first vertex in the stream
 };
+constexpr size_t kMeshoptViewJsonBytes = 200;
 
-constexpr size_t kMeshoptStride = 16;  // int16 x, y, z, 0 | int8 nx, ny, nz, 0 | float32 emission time
+// The meshopt vertex record (gltf.h): int16 x, y, z, 0 | float32 emission time, then with
+// --attributes float32 _DOPPLER and/or _PROPER_TIME, with --shade doppler uint16 (normalized)
+// R, G, B, 0; the same for every frame of a sequence (an offset < 0: not in the record).
+struct MeshoptLayout {
+    explicit MeshoptLayout(const GlbOptions& o) {
+        if (o.doppler) { doppler = int(stride); stride += 4; }
+        if (o.proper_time) { proper_time = int(stride); stride += 4; }
+        if (o.shade_doppler) { color = int(stride); stride += 8; }
+    }
+    size_t stride = 12;
+    int doppler = -1, proper_time = -1, color = -1;
+};
+// The normals' stream: the EXT_meshopt_compression OCTAHEDRAL filter's 8-bit form (4 bytes a
+// vertex), which the decoder turns into normalized int8 x, y, z (and a fourth byte); in the
+// record instead (MeshoptFrame), normalized int8 x, y, z, 0 rounded from the float normal.
+constexpr size_t kMeshoptNormalStride = 4;
+constexpr int kMeshoptNormalBits = 8;
 
 // The emission time as meshopt stores it: rounded (half away from zero) to a multiple of the
 // largest power of two not above `step`, so that its low mantissa bits are zero and compress;
 // it stays a float32 that readers use as it is, within step / 2 seconds of the plain file's.
-float emissionQuantized(float t, double step) {
-    const double q = std::ldexp(1.0, int(std::floor(std::log2(step))));
-    return float(std::round(double(t) / q) * q);
-}
+double emissionStep(double step) { return std::ldexp(1.0, int(std::floor(std::log2(step)))); }
+float emissionRounded(float t, double q) { return float(std::round(double(t) / q) * q); }
+
+// One object's vertex-cache and vertex-fetch orders for an index list, kept for the next frame:
+// both depend on the index list alone, so an equal list (vertex mode, or the same refinement)
+// takes them from here instead of optimizing again (meshopt_optimizeVertexCache costs about
+// 100 ms at 1M triangles).
+struct MeshoptOrder {
+    std::vector<uint32_t> indices;   // the index list they were computed for
+    size_t vertices = 0;             // and its vertex count
+    std::shared_ptr<std::vector<uint32_t>> ordered;  // the triangles in cache order, in fetch numbering
+    std::vector<unsigned int> remap; // fetch number of each vertex (~0u: unused)
+    size_t used = 0;                 // vertices used by a triangle
+};
 
 // The meshopt form of `d`: positions quantized from the exact relative coordinates `rel` (xyz
 // per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
 // triangles first use them (both depend on the index list alone, so frames with equal index
-// lists get equal orders). Returns the largest |step * q - rel| over the coordinates.
-double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step) {
+// lists get equal orders; `order` keeps them from the object's last frame). Returns the largest
+// |step * q - rel| over the coordinates.
+double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step, const MeshoptLayout& layout,
+                   MeshoptOrder* order, std::vector<float>* normal_work) {
     const size_t nv = d->vertexCount();
-    d->ordered.resize(d->indices.size());
-    meshopt_optimizeVertexCache(d->ordered.data(), d->indices.data(), d->indices.size(), nv);
-    std::vector<unsigned int> remap(nv);
-    const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), d->ordered.data(), d->ordered.size(), nv);
-    meshopt_remapIndexBuffer(d->ordered.data(), d->ordered.data(), d->ordered.size(), remap.data());
-    d->packed.assign(used * kMeshoptStride, 0);
-    double worst = 0;
-    for (int c = 0; c < 3; ++c) { d->qmin[c] = INT32_MAX; d->qmax[c] = INT32_MIN; }
-    for (size_t i = 0; i < nv; ++i) {
-        if (remap[i] == ~0u) continue;  // used by no triangle: dropped (a cut mesh has none)
-        unsigned char* v = d->packed.data() + size_t(remap[i]) * kMeshoptStride;
-        int16_t q[4] = {0, 0, 0, 0};
-        int8_t n[4] = {0, 0, 0, 0};
-        for (int c = 0; c < 3; ++c) {
-            const double x = std::nearbyint(rel[3 * i + c] / step);
-            q[c] = int16_t(std::clamp(x, -32767.0, 32767.0));
-            worst = std::max(worst, std::fabs(double(q[c]) * step - rel[3 * i + c]));
-            d->qmin[c] = std::min(d->qmin[c], int(q[c]));
-            d->qmax[c] = std::max(d->qmax[c], int(q[c]));
-            n[c] = int8_t(meshopt_quantizeSnorm(d->normals[3 * i + c], 8));
-        }
-        std::memcpy(v, q, 8);
-        std::memcpy(v + 8, n, 4);
-        const float t = emissionQuantized(d->emission[i], step);
-        std::memcpy(v + 12, &t, 4);
+    if (!order->ordered || order->vertices != nv || order->indices != d->indices) {
+        order->indices = d->indices;
+        order->vertices = nv;
+        // A frame still held refers to the old order: a new vector then, else this one again.
+        if (!order->ordered || order->ordered.use_count() > 1) order->ordered = std::make_shared<std::vector<uint32_t>>();
+        std::vector<uint32_t>& ordered = *order->ordered;
+        ordered.resize(d->indices.size());
+        meshopt_optimizeVertexCache(ordered.data(), d->indices.data(), d->indices.size(), nv);
+        order->remap.resize(nv);
+        order->used = meshopt_optimizeVertexFetchRemap(order->remap.data(), ordered.data(), ordered.size(), nv);
+        meshopt_remapIndexBuffer(ordered.data(), ordered.data(), ordered.size(), order->remap.data());
     }
+    d->ordered = order->ordered;
+    const std::vector<unsigned int>& remap = order->remap;
+    const size_t used = order->used;
+    const size_t stride = layout.stride;
+    d->packed.assign(used * stride, 0);
+    d->packed_snorm.assign(used * 4, 0);
+    std::vector<float>& normals = *normal_work;  // x, y, z, 0 per vertex in stream order, for the filter
+    normals.assign(4 * used, 0.0f);
+    const double time_step = emissionStep(step);
+    // Vertices in parallel (each writes its own record); the largest error and the bounds reduced.
+    struct Extremes {
+        double worst = 0;
+        int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    };
+    const Extremes e = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), Extremes{},
+        [&](const tbb::blocked_range<size_t>& r, Extremes x) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                if (remap[i] == ~0u) continue;  // used by no triangle: dropped (a cut mesh has none)
+                unsigned char* v = d->packed.data() + size_t(remap[i]) * stride;
+                int16_t q[4] = {0, 0, 0, 0};
+                for (int c = 0; c < 3; ++c) {
+                    const double p = std::nearbyint(rel[3 * i + c] / step);
+                    q[c] = int16_t(std::clamp(p, -32767.0, 32767.0));
+                    x.worst = std::max(x.worst, std::fabs(double(q[c]) * step - rel[3 * i + c]));
+                    x.lo[c] = std::min(x.lo[c], int(q[c]));
+                    x.hi[c] = std::max(x.hi[c], int(q[c]));
+                    normals[4 * size_t(remap[i]) + size_t(c)] = d->normals[3 * i + c];
+                    d->packed_snorm[4 * size_t(remap[i]) + size_t(c)] =
+                        static_cast<unsigned char>(int8_t(meshopt_quantizeSnorm(d->normals[3 * i + c], 8)));
+                }
+                std::memcpy(v, q, 8);
+                const float t = emissionRounded(d->emission[i], time_step);
+                std::memcpy(v + 8, &t, 4);
+                if (layout.doppler >= 0 && !d->doppler.empty()) std::memcpy(v + layout.doppler, &d->doppler[i], 4);
+                if (layout.proper_time >= 0 && !d->proper_time.empty()) std::memcpy(v + layout.proper_time, &d->proper_time[i], 4);
+                if (layout.color >= 0 && !d->colors.empty()) {
+                    uint16_t rgb[4] = {0, 0, 0, 0};
+                    for (int c = 0; c < 3; ++c) rgb[c] = uint16_t(meshopt_quantizeUnorm(std::clamp(d->colors[3 * i + c], 0.0f, 1.0f), 16));
+                    std::memcpy(v + layout.color, rgb, 8);
+                }
+            }
+            return x;
+        },
+        [](Extremes a, const Extremes& b) {
+            a.worst = std::max(a.worst, b.worst);
+            for (int c = 0; c < 3; ++c) { a.lo[c] = std::min(a.lo[c], b.lo[c]); a.hi[c] = std::max(a.hi[c], b.hi[c]); }
+            return a;
+        });
+    const double worst = e.worst;
+    for (int c = 0; c < 3; ++c) { d->qmin[c] = e.lo[c]; d->qmax[c] = e.hi[c]; }
+    d->packed_normals.resize(used * kMeshoptNormalStride);
+    if (used > 0)
+        meshopt_encodeFilterOct(d->packed_normals.data(), used, kMeshoptNormalStride, kMeshoptNormalBits, normals.data());
     return worst;
 }
 
@@ -182,23 +258,39 @@ public:
     }
 
     // An EXT_meshopt_compression primitive: its vertices at `first_vertex` of the frame's vertex
-    // view `vview`, its indices the accessor `indices` (made by the caller: new or shared).
-    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, int vview, size_t first_vertex, int indices) {
+    // view `vview` (records of `layout`, `stride` bytes each) and normal view `nview` (-1: the
+    // normals end each record), its indices the accessor `indices` (made by the caller: new or
+    // shared).
+    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, size_t stride, int vview,
+                                         int nview, size_t first_vertex, int indices) {
         tinygltf::Primitive prim;
-        const size_t nv = d.packed.size() / kMeshoptStride;
-        auto attribute = [&](size_t offset, int component, int type, bool normalized, std::vector<double> lo,
-                             std::vector<double> hi) {
-            const int a = addAccessor(vview, component, type, nv, std::move(lo), std::move(hi));
-            model.accessors[a].byteOffset = first_vertex * kMeshoptStride + offset;
+        const size_t nv = d.packed.size() / layout.stride;
+        auto attribute = [&](int view, size_t view_stride, size_t offset, int component, int type, bool normalized,
+                             std::vector<double> lo, std::vector<double> hi) {
+            const int a = addAccessor(view, component, type, nv, std::move(lo), std::move(hi));
+            model.accessors[a].byteOffset = first_vertex * view_stride + offset;
             model.accessors[a].normalized = normalized;
             return a;
         };
         prim.attributes["POSITION"] =
-            attribute(0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
+            attribute(vview, stride, 0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
                       {double(d.qmin[0]), double(d.qmin[1]), double(d.qmin[2])},
                       {double(d.qmax[0]), double(d.qmax[1]), double(d.qmax[2])});
-        prim.attributes["NORMAL"] = attribute(8, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_TYPE_VEC3, true, {}, {});
-        prim.attributes["_EMISSION_TIME"] = attribute(12, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        prim.attributes["NORMAL"] = nview >= 0 ? attribute(nview, kMeshoptNormalStride, 0, TINYGLTF_COMPONENT_TYPE_BYTE,
+                                                           TINYGLTF_TYPE_VEC3, true, {}, {})
+                                               : attribute(vview, stride, layout.stride, TINYGLTF_COMPONENT_TYPE_BYTE,
+                                                           TINYGLTF_TYPE_VEC3, true, {}, {});
+        prim.attributes["_EMISSION_TIME"] =
+            attribute(vview, stride, 8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        if (layout.doppler >= 0 && !d.doppler.empty())
+            prim.attributes["_DOPPLER"] = attribute(vview, stride, size_t(layout.doppler), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                                    TINYGLTF_TYPE_SCALAR, false, {}, {});
+        if (layout.proper_time >= 0 && !d.proper_time.empty())
+            prim.attributes["_PROPER_TIME"] = attribute(vview, stride, size_t(layout.proper_time),
+                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        if (layout.color >= 0 && !d.colors.empty())
+            prim.attributes["COLOR_0"] = attribute(vview, stride, size_t(layout.color), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                                   TINYGLTF_TYPE_VEC3, true, {}, {});
         prim.indices = indices;
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         return prim;
@@ -206,10 +298,12 @@ public:
 
     // A view of the fallback buffer (1, no data) whose EXT_meshopt_compression object points at
     // `encoded` in the BIN chunk; the extension objects are added to the JSON by meshoptJson().
-    int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices) {
+    // `octahedral`: the view's data went through the OCTAHEDRAL filter.
+    int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices,
+                       bool octahedral = false) {
         static const char zeros[4] = {0, 0, 0, 0};
         if (sink_->size % 4) sink_->write(zeros, 4 - sink_->size % 4);
-        MeshoptView mv{sink_->size, encoded.size(), stride, count, indices};
+        MeshoptView mv{sink_->size, encoded.size(), stride, count, indices, octahedral};
         sink_->write(encoded.data(), encoded.size());
         tinygltf::BufferView v;
         v.buffer = 1;
@@ -230,6 +324,7 @@ public:
             nlohmann::json ext = {{"buffer", 0},           {"byteOffset", mv.offset}, {"byteLength", mv.length},
                                   {"byteStride", mv.stride}, {"count", mv.count},
                                   {"mode", mv.indices ? "TRIANGLES" : "ATTRIBUTES"}};
+            if (mv.octahedral) ext["filter"] = "OCTAHEDRAL";
             (*j)["bufferViews"][size_t(view)]["extensions"]["EXT_meshopt_compression"] = ext;
         }
         (*j)["buffers"][1] = {{"byteLength", fallback_size},
@@ -329,7 +424,7 @@ private:
     BinSink* sink_;
     struct MeshoptView {
         size_t offset, length, stride, count;
-        bool indices;
+        bool indices, octahedral;
     };
     std::vector<std::pair<int, MeshoptView>> meshopt_views;
     size_t fallback_size = 0;
@@ -347,13 +442,23 @@ private:
 // Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
 // are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
 constexpr double kCreaseDeg = 30.0;
+// The meshopt form's scratch vectors (kept by the frame's buffers, used object by object).
+struct MeshoptScratch {
+    std::vector<double> exact;
+    std::vector<MeshoptOrder> orders;  // per object
+    std::vector<float> normals;
+    std::vector<unsigned char> vertices, normal_stream;  // the frame's streams before encoding
+    std::vector<unsigned char> inline_records, inline_encoded;  // the same with the normals inline
+};
 // With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
 // receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
 // `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
-// split's (reused the same way, object by object).
+// split's (reused the same way, object by object), `scratch` meshopt's and `order` the object's
+// meshopt orders.
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
-                 const GlbOptions& options, const std::array<double, 4>& base_color) {
+                 MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
+                 const std::array<double, 4>& base_color) {
     mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
     const size_t nv = map->source.size();
     d->positions.resize(3 * nv);
@@ -366,7 +471,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     const bool shade = options.shade_doppler && m.doppler.size() == m.positions.size();
     d->colors.resize(shade ? 3 * nv : 0);
     const std::array<double, 3> base{base_color[0], base_color[1], base_color[2]};
-    std::vector<double> exact(step > 0 ? 3 * nv : 0);
+    std::vector<double>& exact = scratch->exact;
+    exact.resize(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
     const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
     const double worst = tbb::parallel_reduce(
@@ -396,7 +502,9 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     *max_err = std::max(*max_err, worst);
     d->indices.resize(3 * map->triangles.size());
     if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
-    if (step > 0) *max_quant = std::max(*max_quant, packMeshopt(d, exact, step));
+    if (step > 0)
+        *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), order,
+                                                      &scratch->normals));
 }
 
 // Rotation quaternion (x, y, z, w) of the camera node: glTF cameras look down local -Z with +Y
@@ -433,7 +541,8 @@ tinygltf::Value number(double v) { return tinygltf::Value(v); }
 // streamed to the sink. Two run side by side with Draco: the real one and a plain one that only
 // counts, for the size without Draco.
 struct SequenceModel {
-    SequenceModel(const SequenceInfo& info_, const GlbOptions& options, BinSink* sink) : info(info_), b(options, sink) {
+    SequenceModel(const SequenceInfo& info_, const GlbOptions& options, BinSink* sink)
+        : info(info_), b(options, sink), layout(options) {
         tinygltf::Model& model = b.model;
     // Step: one material per object.
     for (const ExportObject& o : info.objects) {
@@ -511,17 +620,19 @@ struct SequenceModel {
                 prev.vertices == data[o].vertexCount() && prev.indices == data[o].indices)
                 shared[o] = prev.accessor;
         }
-        // Step (meshopt): the frame's vertex view, and one index view for the objects that do not
-        // share, uint16 unless one of them has more than 65535 vertices.
-        int vview = -1;
+        // Step (meshopt): the frame's vertex and normal views, and one index view for the objects
+        // that do not share, uint16 unless one of them has more than 65535 vertices.
+        int vview = -1, nview = -1;
         std::vector<int> meshopt_indices(f.objects.size(), -1);
         if (compression == Compression::meshopt && meshopt && meshopt->count > 0) {
-            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, kMeshoptStride, false);
+            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, meshopt->stride, false);
+            if (!meshopt->normals_inline)
+                nview = b.addMeshoptView(meshopt->encoded_normals, meshopt->count, kMeshoptNormalStride, false, true);
             size_t size = 2, count = 0, most = 0;
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty() && shared[o] < 0) {
-                    most = std::max(most, data[o].packed.size() / kMeshoptStride);
-                    count += data[o].ordered.size();
+                    most = std::max(most, data[o].packed.size() / layout.stride);
+                    count += data[o].ordered->size();
                 }
             if (most > 65535) size = 4;
             if (count > 0) {
@@ -531,7 +642,7 @@ struct SequenceModel {
                 for (size_t o = 0; o < f.objects.size(); ++o)
                     if (!f.objects[o].triangles.empty() && shared[o] < 0) {
                         first[o] = all.size();
-                        all.insert(all.end(), data[o].ordered.begin(), data[o].ordered.end());
+                        all.insert(all.end(), data[o].ordered->begin(), data[o].ordered->end());
                     }
                 std::vector<unsigned char> encoded(meshopt_encodeIndexBufferBound(all.size(), most));
                 encoded.resize(meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), all.data(), all.size()));
@@ -541,7 +652,7 @@ struct SequenceModel {
                         const int a = b.addAccessor(iview,
                                                     size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
                                                               : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                                    TINYGLTF_TYPE_SCALAR, data[o].ordered.size());
+                                                    TINYGLTF_TYPE_SCALAR, data[o].ordered->size());
                         b.model.accessors[a].byteOffset = first[o] * size;
                         meshopt_indices[o] = a;
                     }
@@ -563,7 +674,7 @@ struct SequenceModel {
                     }
                     stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
                 } else if (compression == Compression::meshopt) {
-                    prim = b.meshoptPrimitive(data[o], vview, meshopt->first[o],
+                    prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
                                               shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
                 } else {
                     prim = b.plainPrimitive(data[o], shared[o]);
@@ -722,6 +833,7 @@ struct SequenceModel {
 
     const SequenceInfo& info;
     GlbBuilder b;
+    MeshoptLayout layout;  // with meshopt: the vertex record
     tinygltf::Scene scene;
     tinygltf::Value::Array frame_times;
     std::vector<float> frame_scales;  // per frame, its node's scale while shown
@@ -754,35 +866,53 @@ struct GlbFrameData : PreparedFrame {
         step = 0;
         clamped = false;
         meshopt.encoded.clear();
+        meshopt.encoded_normals.clear();
         meshopt.count = 0;
         meshopt.first.clear();
         data.resize(objects);
-        crease_map.resize(objects);
-        crease_work.resize(objects);
         for (PrimitiveData& p : data) {
-            for (auto* v : {&p.positions, &p.normals, &p.emission}) v->clear();
+            for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
             p.indices.clear();
-            p.ordered.clear();
+            p.ordered.reset();
             p.packed.clear();
+            p.packed_normals.clear();
+            p.packed_snorm.clear();
         }
         far = max_extent = max_float_error = max_quantization_error = 0;
     }
     double origin[3] = {0, 0, 0};
     double step = 0;       // meshopt: the quantization step (0 without meshopt)
     bool clamped = false;  // meshopt: the step grew to fit int16
-    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex stream
+    MeshoptFrame meshopt;  // with meshopt: the frame's encoded vertex streams
     std::vector<PrimitiveData> data;  // per object; empty when it shows nothing
-    std::vector<mesh4d::CreaseMap> crease_map;  // per object, toPrimitive's scratch
-    std::vector<mesh4d::CreaseWork> crease_work;
     double far = 0, max_extent = 0, max_float_error = 0, max_quantization_error = 0;
 };
 
-// Frame buffers given back by released GlbFrameData (shared with their deleters, so it outlives
-// the writer while a prepared frame is still held).
+// What prepare() needs only while it runs (the crease split's work and map, meshopt's vectors): as
+// many sets as prepare() calls run at once, not one per frame held in flight, taken from a pool
+// of their own (their capacity kept, and the crease split's adjacency reused for the same
+// triangles). At 1M triangles a set is about 130 MB.
+struct PrepareScratch {
+    std::vector<mesh4d::CreaseMap> crease_map;  // per object
+    std::vector<mesh4d::CreaseWork> crease_work;
+    MeshoptScratch meshopt;
+};
+
+// Frame buffers given back by released GlbFrameData, shared by every writer of the process (and
+// with the deleters, so it outlives them): a frame written alone to its own file, or the next
+// model's sequence, reuses the buffers of the last one instead of allocating and touching fresh
+// memory. It keeps at most poolFrames() frames' buffers (as many as the frame loop holds in
+// flight); more are freed when given back.
 struct FramePool {
     std::mutex mutex;
     std::vector<std::unique_ptr<GlbFrameData>> free;
+    std::vector<std::unique_ptr<PrepareScratch>> scratch;  // likewise, at most poolFrames()
 };
+size_t poolFrames() { return std::max<size_t>(4, 2 * size_t(std::thread::hardware_concurrency())); }
+std::shared_ptr<FramePool> processFramePool() {
+    static const std::shared_ptr<FramePool> pool = std::make_shared<FramePool>();
+    return pool;
+}
 
 struct GlbSequenceWriter::Impl {
     Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
@@ -808,7 +938,7 @@ struct GlbSequenceWriter::Impl {
     std::unique_ptr<SequenceModel> plain;  // with Draco or meshopt: the same sequence without it, counted
     GlbStats stats;
     double far = 0;
-    std::shared_ptr<FramePool> pool = std::make_shared<FramePool>();
+    std::shared_ptr<FramePool> pool = processFramePool();
 };
 
 GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options)
@@ -837,8 +967,9 @@ double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
 }  // namespace
 
 std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
-    // Step: a frame's buffers from the writer's pool (they keep their capacity: a sequence does
-    // not allocate again frame after frame); the shared pointer gives them back when released.
+    // Step: a frame's buffers from the process's pool (they keep their capacity: a sequence does
+    // not allocate again frame after frame, nor a lone frame after the first); the shared pointer
+    // gives them back when released.
     std::shared_ptr<FramePool> pool = impl_->pool;
     GlbFrameData* raw = nullptr;
     {
@@ -850,25 +981,53 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
     }
     if (!raw) raw = new GlbFrameData;
     std::shared_ptr<GlbFrameData> d(raw, [pool](GlbFrameData* back) {
+        std::unique_ptr<GlbFrameData> owned(back);
         std::lock_guard<std::mutex> lock(pool->mutex);
-        pool->free.emplace_back(back);
+        if (pool->free.size() < poolFrames()) pool->free.push_back(std::move(owned));
     });
     d->reset(f.objects.size());
+    std::unique_ptr<PrepareScratch> scratch;
+    {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (!pool->scratch.empty()) {
+            scratch = std::move(pool->scratch.back());
+            pool->scratch.pop_back();
+        }
+    }
+    if (!scratch) scratch = std::make_unique<PrepareScratch>();
+    struct GiveBack {  // the scratch back to the pool however prepare() ends
+        FramePool* pool;
+        std::unique_ptr<PrepareScratch>* scratch;
+        ~GiveBack() {
+            std::lock_guard<std::mutex> lock(pool->mutex);
+            if (pool->scratch.size() < poolFrames()) pool->scratch.push_back(std::move(*scratch));
+        }
+    } give_back{pool.get(), &scratch};
+    scratch->crease_map.resize(f.objects.size());
+    scratch->crease_work.resize(f.objects.size());
+    scratch->meshopt.orders.resize(f.objects.size());
     // Step: the frame's origin (the centre of its bounding box) and the far distance (parallel
-    // minima and maxima: exact in any order).
+    // minima and maxima: exact in any order). The far distance is the largest norm() (hypot) of
+    // any point, but norm() is taken only where the squared distance comes within 1e-9 of the
+    // largest so far: the point of largest norm() always does (the two agree to a few ulps).
     mesh4d::EventBox box;
     const Vec3 camera = impl_->info.camera.position;
     for (const auto& o : f.objects) {
         struct Extremes {
             mesh4d::EventBox box;
-            double far = 0;
+            double far = 0, far2 = 0;
         };
         const Extremes e = tbb::parallel_reduce(
             tbb::blocked_range<size_t>(0, o.positions.size(), 16384), Extremes{},
             [&](const tbb::blocked_range<size_t>& r, Extremes x) {
                 for (size_t i = r.begin(); i < r.end(); ++i) {
                     const Vec3 p = o.absolutePosition(i);
-                    x.far = std::max(x.far, mesh4d::norm(p - camera));
+                    const Vec3 to = p - camera;
+                    const double d2 = mesh4d::dot(to, to);
+                    if (d2 >= x.far2 * (1 - 1e-9)) {
+                        x.far = std::max(x.far, mesh4d::norm(to));
+                        x.far2 = std::max(x.far2, d2);
+                    }
                     x.box.addPoint(p);
                 }
                 return x;
@@ -877,6 +1036,7 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
                 a.box.addPoint(b.box.lo);
                 a.box.addPoint(b.box.hi);
                 a.far = std::max(a.far, b.far);
+                a.far2 = std::max(a.far2, b.far2);
                 return a;
             });
         d->far = std::max(d->far, e.far);
@@ -898,21 +1058,54 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!f.objects[o].triangles.empty())
                 toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
-                            &d->crease_map[o], &d->crease_work[o], impl_->options,
+                            &scratch->crease_map[o], &scratch->crease_work[o], &scratch->meshopt,
+                            &scratch->meshopt.orders[o], impl_->options,
                             impl_->info.objects[o].base_color);
         if (impl_->options.meshopt) {
-            // Step: one vertex stream for the whole frame, encoded here (on the worker thread).
+            // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
+            // worker thread).
+            const size_t stride = MeshoptLayout(impl_->options).stride;
             MeshoptFrame& mf = d->meshopt;
             mf.first.assign(f.objects.size(), 0);
-            std::vector<unsigned char> all;
+            std::vector<unsigned char>& all = scratch->meshopt.vertices;
+            std::vector<unsigned char>& normals = scratch->meshopt.normal_stream;
+            all.clear();
+            normals.clear();
             for (size_t o = 0; o < f.objects.size(); ++o) {
-                mf.first[o] = all.size() / kMeshoptStride;
+                mf.first[o] = all.size() / stride;
                 all.insert(all.end(), d->data[o].packed.begin(), d->data[o].packed.end());
+                normals.insert(normals.end(), d->data[o].packed_normals.begin(), d->data[o].packed_normals.end());
             }
-            mf.count = all.size() / kMeshoptStride;
-            mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptStride));
-            mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count,
-                                                         kMeshoptStride));
+            mf.count = all.size() / stride;
+            mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, stride));
+            mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count, stride));
+            mf.encoded_normals.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptNormalStride));
+            mf.encoded_normals.resize(meshopt_encodeVertexBuffer(mf.encoded_normals.data(), mf.encoded_normals.size(),
+                                                                 normals.data(), mf.count, kMeshoptNormalStride));
+            // Step: the records with the int8 normals at their end, encoded too; the smaller wins
+            // (the separate view counted with its JSON).
+            const size_t wide = stride + 4;
+            std::vector<unsigned char>& records = scratch->meshopt.inline_records;
+            records.resize(mf.count * wide);
+            size_t k = 0;
+            for (size_t o = 0; o < f.objects.size(); ++o) {
+                const PrimitiveData& p = d->data[o];
+                for (size_t i = 0; i < p.packed.size() / stride; ++i, ++k) {
+                    std::memcpy(&records[k * wide], &p.packed[i * stride], stride);
+                    std::memcpy(&records[k * wide + stride], &p.packed_snorm[4 * i], 4);
+                }
+            }
+            std::vector<unsigned char>& encoded_inline = scratch->meshopt.inline_encoded;
+            encoded_inline.resize(meshopt_encodeVertexBufferBound(mf.count, wide));
+            encoded_inline.resize(
+                meshopt_encodeVertexBuffer(encoded_inline.data(), encoded_inline.size(), records.data(), mf.count, wide));
+            mf.stride = stride;
+            mf.normals_inline = encoded_inline.size() <= mf.encoded.size() + mf.encoded_normals.size() + kMeshoptViewJsonBytes;
+            if (mf.normals_inline) {
+                mf.encoded.swap(encoded_inline);
+                mf.encoded_normals.clear();
+                mf.stride = wide;
+            }
         }
     }
     return d;
@@ -1001,8 +1194,18 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
     put32(&head, 0x004E4942);  // BIN
     std::string werr;
     bool ok = writeAll(fd, head.data(), head.size(), &werr);
-    std::vector<char> chunk(size_t(1) << 20);
-    for (size_t off = 0; ok && off < bin;) {
+    // The BIN chunk by copy_file_range (the kernel copies between the two files' pages, no trip
+    // through a user buffer); where it cannot (another file system, an old kernel), by pread and write.
+    size_t off = 0;
+    while (ok && off < bin) {
+        loff_t in = loff_t(off);
+        const ssize_t r = ::copy_file_range(m.sink.fd, &in, fd, nullptr, bin - off, 0);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) break;  // the fallback below takes over from `off`
+        off += size_t(r);
+    }
+    std::vector<char> chunk(off < bin ? size_t(1) << 20 : 0);
+    while (ok && off < bin) {
         const ssize_t r = ::pread(m.sink.fd, chunk.data(), std::min(chunk.size(), bin - off), off_t(off));
         if (r < 0 && errno == EINTR) continue;
         if (r <= 0) {

@@ -22,11 +22,19 @@
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
 // With meshopt (EXT_meshopt_compression and KHR_mesh_quantization, both required; the BIN chunk
 // holds the compressed streams, a fallback buffer without data stands for the decoded ones):
-// a frame's vertices (all its primitives') are one interleaved stream of 16 bytes each and its
-// indices one stream (so one compressed view each per frame), POSITION as int16 (not
-// normalized) multiples of the frame's step about the frame's origin, NORMAL as normalized int8,
+// a frame's vertices (all its primitives') are one interleaved stream of records, with the
+// normals either in a stream of their own or at the end of each record (whichever encodes smaller,
+// the extra view counted as 200 bytes of JSON: small frames keep them inline), and its indices one
+// stream (the index view left out when every object shares the previous frame's). The record: POSITION as int16 (not
+// normalized) multiples of the frame's step about the frame's origin (8 bytes with padding),
 // _EMISSION_TIME float32 rounded to a multiple of the largest power of two not above the step
-// (within step / 2 seconds of the plain file's, c = 1: its low mantissa bits compress); indices
+// (within step / 2 seconds of the plain file's, c = 1: its low mantissa bits compress), then with
+// --attributes _DOPPLER and/or _PROPER_TIME as float32 (the plain file's values, bit for bit), and
+// with --shade doppler COLOR_0 as normalized uint16 RGB (8 bytes with padding; within 0.5 / 65535
+// of the plain file's float colour, clamped to [0, 1]). NORMAL in its own view goes through the
+// OCTAHEDRAL filter at 8 bits (decoded to normalized int8; each component within 2.63 / 127 of
+// the plain file's normal, derived in tests/web/meshopt_roundtrip.js); in the record it is
+// normalized int8 x, y, z, 0 (within 0.5 / 127). Indices
 // uint16 (uint32 past 65535 vertices), triangles in vertex-cache order and vertices in the order
 // they first use them (meshopt_optimizeVertexCache, meshopt_optimizeVertexFetchRemap). The frame
 // node's scale is its step (the animation shows it with scale = step, hides it with 0), so a
@@ -57,13 +65,13 @@ struct GlbOptions {
     bool meshopt = false;    // EXT_meshopt_compression + KHR_mesh_quantization (not with draco)
     int meshopt_bits = 0;    // meshopt position bits 2..16 over each frame's extent; 0: step from the tolerance
     // --attributes: per-vertex float attributes _DOPPLER and _PROPER_TIME (mesh4d/light_factors.h),
-    // plain or Draco (GENERIC, unquantized); not with meshopt yet (refused by the command).
+    // plain, Draco (GENERIC, unquantized) or meshopt (float32 in the vertex record).
     bool doppler = false;
     bool proper_time = false;
     // --shade doppler: COLOR_0 (float VEC3, linear) per vertex, each object's base colour shifted
     // by the vertex's Doppler factor (mesh4d/doppler_colour.h); the materials' baseColorFactor is
     // then white (alpha kept) and the plain colour is in the material's extras "base_color".
-    // Plain or Draco (COLOR, unquantized); not with meshopt yet (refused by the command).
+    // Plain or Draco (COLOR, unquantized) as float; meshopt as normalized uint16 (see above).
     bool shade_doppler = false;
 };
 
@@ -80,10 +88,13 @@ struct GlbStats {
 // spill file in the output's folder that has no name (openAnonymousFile, atomic_file.h: nothing
 // is left behind whatever ends the process), only the JSON-side
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
-// under a temporary name and renames it into place. Memory does not grow with the frame data:
-// besides the JSON side it keeps the previous frame's index lists (to share equal ones) and a
-// pool of frame buffers that prepare() reuses frame after frame (no allocation per frame once the
-// frames stop growing); the disk briefly holds the binary data twice.
+// under a temporary name (the BIN chunk placed by copy_file_range) and renames it into place.
+// Memory does not grow with the frame data: besides the JSON side it keeps the previous frame's
+// index lists (to share equal ones). Frame buffers come from a pool shared by every writer of
+// the process (at most max(4, 2 x cores) kept), so neither the frames of a sequence nor a lone
+// frame written after another allocate again once the frames stop growing; prepare()'s scratch
+// (crease split, meshopt orders) is pooled apart, one set per prepare() running at once, not
+// one per frame held in flight. The disk briefly holds the binary data twice.
 struct GlbFrameData;  // one frame converted for the file (GlbSequenceWriter::prepare)
 
 class GlbSequenceWriter {

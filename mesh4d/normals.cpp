@@ -17,6 +17,30 @@ Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
 }
 
 constexpr size_t kGrain = 16384;  // elements per parallel task
+
+// v / norm(v) for two vectors at once, bit for bit what the scalar code gives: norm() is
+// std::hypot(x, y, z), which libstdc++ computes as a * sqrt((x/a)^2 + (y/a)^2 + (z/a)^2) with a
+// the largest magnitude (0 when a is 0), and every step here is the same IEEE operation in the
+// same order on SSE2 lanes (no contraction: the build has no FMA). `length` receives the norms.
+typedef double Pair __attribute__((vector_size(16)));
+typedef long long PairMask __attribute__((vector_size(16)));
+void unitPair(Pair x, Pair y, Pair z, Pair* ux, Pair* uy, Pair* uz, Pair* length) {
+    const PairMask sign = {(long long)0x8000000000000000ull, (long long)0x8000000000000000ull};
+    auto abs = [&](Pair v) { return (Pair)((PairMask)v & ~sign); };
+    const Pair ax = abs(x), ay = abs(y), az = abs(z);
+    const Pair t1 = ay < az ? az : ay, t2 = ax < az ? az : ax;
+    const Pair a = ax < ay ? t1 : t2;
+    const Pair zero = {0, 0}, one = {1, 1};
+    const PairMask is_zero = a == zero;
+    const Pair safe = is_zero ? one : a;
+    const Pair qx = ax / safe, qy = ay / safe, qz = az / safe;
+    const Pair len = safe * __builtin_ia32_sqrtpd(qx * qx + qy * qy + qz * qz);
+    *length = is_zero ? zero : len;
+    const Pair d = is_zero ? one : len;
+    *ux = x / d;
+    *uy = y / d;
+    *uz = z / d;
+}
 }  // namespace
 
 void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out, CreaseWork* w) {
@@ -84,7 +108,7 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
                 mean += face[faces[a]].unit;
                 sum += face[faces[a]].area;
             }
-            const double len = norm(mean);
+            const double len = std::sqrt(dot(mean, mean));  // feeds the sufficient test alone (margin above)
             bool all = len > 0;
             for (uint32_t a = start[v]; a < start[v + 1] && all; ++a)
                 all = dot(face[faces[a]].unit, mean) >= cos_half * len;
@@ -101,9 +125,23 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
                     }
                 }
             }
-            if (!all || !(norm(sum) > 0)) continue;
+            if (!all) continue;
             w->uniform[v] = 1;
-            w->vertex_normal[v] = sum / norm(sum);
+            w->vertex_normal[v] = sum;  // normalized below, two at a time
+        }
+        // sum / norm(sum), or not uniform after all where the sum is zero (each corner then
+        // falls back to its own face).
+        for (size_t v = r.begin(); v < r.end(); v += 2) {
+            const size_t b = std::min(v + 1, r.end() - 1);  // an odd end repeats its last vertex
+            const Vec3 s0 = w->vertex_normal[v], s1 = w->vertex_normal[b];
+            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, length;
+            unitPair(x, y, z, &ux, &uy, &uz, &length);
+            for (int k = 0; k < 2; ++k) {
+                const size_t i = k == 0 ? v : b;
+                if (!w->uniform[i]) continue;
+                if (!(length[k] > 0)) w->uniform[i] = 0;
+                else w->vertex_normal[i] = {ux[k], uy[k], uz[k]};
+            }
         }
     });
     // No vertex split (every used vertex uniform, none unused), as in the last call on the same

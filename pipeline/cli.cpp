@@ -408,15 +408,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             else if (item == "proper_time") rs.glb.proper_time = true;
             else return usage("--attributes: unknown attribute '" + item + "' (doppler, proper_time)");
         }
-        if (rs.glb.meshopt)
-            return usage("--attributes: not with --compress meshopt yet (use none or draco; the PLY frames hold both)");
     }
     if (!shade_text.empty()) {
         if (shade_text != "plain" && shade_text != "doppler")
             return usage("--shade: unknown shading '" + shade_text + "' (plain, doppler)");
         rs.glb.shade_doppler = shade_text == "doppler";
-        if (rs.glb.shade_doppler && rs.glb.meshopt)
-            return usage("--shade doppler: not with --compress meshopt yet (use none or draco)");
         if (rs.glb.shade_doppler && std::find(rs.formats.begin(), rs.formats.end(), "glb") == rs.formats.end())
             return usage("--shade doppler: colours go into the .glb only (add glb to --format; the PLY frames hold "
                          "the doppler factor itself)");

@@ -12,8 +12,14 @@
 //   - _EMISSION_TIME is the plain file's rounded (half away from zero) to a multiple of q, the largest power of two
 //     not above the step (gltf.h), bit for bit: so each decoded vertex has plain vertices with that rounded time;
 //   - every decoded position (step * q) lies within the stated bound sqrt(3) / 2 * step (plus float32 rounding of
-//     the plain file) of a plain vertex with the same rounded emission time, and its normal within int8 rounding of
-//     that vertex's normal (the closest of them: crease-split copies share position and time);
+//     the plain file) of a plain vertex with the same rounded emission time, and its normal within the octahedral
+//     bound of that vertex's normal (the closest of them: crease-split copies share position and time). The normals'
+//     view uses the OCTAHEDRAL filter at 8 bits: the two octahedral coordinates are rounded to multiples of 1/127
+//     (error <= 0.5/127 each); the unnormalized vector (u, v, 1 - |u| - |v|) then moves by at most sqrt(6) * 0.5/127
+//     and has length >= 1/sqrt(3), so the direction moves by at most sqrt(18) * 0.5/127 = 2.13/127, and the decoder's
+//     int8 output adds 0.5/127 per component: each component within 2.63/127 of the plain normal;
+//   - with --attributes / --shade doppler: _DOPPLER and _PROPER_TIME equal the plain file's float32 bit for bit, and
+//     COLOR_0 (normalized uint16) is within 0.5/65535 (plus float32 rounding) of the plain file's float colour;
 //   - the triangles, each written as its three corners' rounded emission times, are the same multiset as the plain
 //     file's.
 // Prints the largest position error against the bound. Exit 0 when all passed, 1 on a failed check, 2 on usage.
@@ -106,7 +112,7 @@ async function main() {
   const shownScale = new Map();
   for (const ch of mo.channels) shownScale.set(ch.node, Math.max(...ch.values.map((v) => v[0])));
 
-  let worst = 0, worstRatio = 0, vertices = 0, primitives = 0;
+  let worst = 0, worstRatio = 0, vertices = 0, primitives = 0, worstNormal = 0, attributeVertices = 0;
   const pairs = [];
   for (let k = 0; k < Math.min(plain.frames.length, mo.frames.length); ++k) {
     const pf = plain.frames[k], mf = mo.frames[k];
@@ -139,6 +145,17 @@ async function main() {
       const anrm = readAccessor(pj, pviews, a.attributes.NORMAL), bnrm = readAccessor(mj, mviews, b.attributes.NORMAL);
       const atim = readAccessor(pj, pviews, a.attributes._EMISSION_TIME), btim = readAccessor(mj, mviews, b.attributes._EMISSION_TIME);
       const aidx = readAccessor(pj, pviews, a.indices).map((e) => e[0]), bidx = readAccessor(mj, mviews, b.indices).map((e) => e[0]);
+      // the optional attributes: present in both files or in neither
+      const extra = {};
+      for (const name of ['_DOPPLER', '_PROPER_TIME', 'COLOR_0']) {
+        if (!check((a.attributes[name] === undefined) === (b.attributes[name] === undefined), `${where}: ${name} in both files or in neither`)) continue;
+        if (a.attributes[name] !== undefined) extra[name] = [readAccessor(pj, pviews, a.attributes[name]), readAccessor(mj, mviews, b.attributes[name])];
+      }
+      if (extra.COLOR_0) {
+        const acc = mj.accessors[b.attributes.COLOR_0];
+        check(acc.componentType === 5123 && acc.normalized, `${where}: COLOR_0 is normalized uint16`);
+        extra.COLOR_0[1] = extra.COLOR_0[1].map((e) => e.map((x) => x / 65535));
+      }
       if (!check(apos.length === bpos.length, `${where}: vertex counts ${apos.length} vs ${bpos.length}`)) continue;
       check(aidx.length === bidx.length, `${where}: index counts ${aidx.length} vs ${bidx.length}`);
       check(bidx.every((i) => i < bpos.length), `${where}: indices within the vertex count`);
@@ -159,16 +176,27 @@ async function main() {
         // float32 rounding of the plain coordinates: half an ulp of each
         const slack = Math.sqrt(3) * Math.max(...bpos[i].map((q) => Math.abs(q * step))) * 2 ** -24;
         // crease-split copies share position and time: the normal is checked against the closest of them
-        let best = Infinity, bestNormal = Infinity;
+        let best = Infinity, bestNormal = Infinity, bestExtra = Infinity;
         for (const j of cands) {
           const d = Math.hypot(...[0, 1, 2].map((c) => bpos[i][c] * step - apos[j][c]));
           best = Math.min(best, d);
-          if (d <= bound + slack) bestNormal = Math.min(bestNormal, Math.max(...[0, 1, 2].map((c) => Math.abs(bnrm[i][c] - anrm[j][c]))));
+          if (d > bound + slack) continue;
+          bestNormal = Math.min(bestNormal, Math.max(...[0, 1, 2].map((c) => Math.abs(bnrm[i][c] - anrm[j][c]))));
+          // the attributes of the closest matching plain vertex: exact floats, colour within its rounding
+          let off = 0;
+          for (const name of ['_DOPPLER', '_PROPER_TIME']) if (extra[name] && bits(extra[name][0][j][0]) !== bits(extra[name][1][i][0])) off = Infinity;
+          if (extra.COLOR_0) off = Math.max(off, ...[0, 1, 2].map((c) => Math.abs(extra.COLOR_0[0][j][c] - extra.COLOR_0[1][i][c])));
+          bestExtra = Math.min(bestExtra, off);
         }
         worst = Math.max(worst, best);
         worstRatio = Math.max(worstRatio, best / bound);
         check(best <= bound + slack, `${where} vertex ${i}: position error ${best} > bound ${bound}`);
-        check(bestNormal <= 1.5 / 127 + 1e-6, `${where} vertex ${i}: normal differs by ${bestNormal}`);
+        check(bestNormal <= 2.63 / 127, `${where} vertex ${i}: normal differs by ${bestNormal}`);
+        worstNormal = Math.max(worstNormal, bestNormal);
+        if (Object.keys(extra).length) {
+          ++attributeVertices;
+          check(bestExtra <= 0.5 / 65535 + 1e-7, `${where} vertex ${i}: _DOPPLER/_PROPER_TIME/COLOR_0 differ from the plain file's (${bestExtra})`);
+        }
       }
       check(unmatched === 0, `${where}: ${unmatched} vertices whose emission time the plain file does not have`);
       const tri = (idx, tim) => {
@@ -181,7 +209,8 @@ async function main() {
     }
   }
   console.log(`meshopt_roundtrip: ${meshoptFile}: ${primitives} primitives, ${vertices} vertices; largest position ` +
-    `error ${worst.toExponential(3)} ls, ${(100 * worstRatio).toFixed(1)}% of the stated bound; ${passed} checks passed, ` +
+    `error ${worst.toExponential(3)} ls, ${(100 * worstRatio).toFixed(1)}% of the stated bound; largest normal component ` +
+    `error ${(worstNormal * 127).toFixed(2)}/127; ${attributeVertices} vertices with attributes checked; ${passed} checks passed, ` +
     `${failures} failed`);
   return failures ? 1 : 0;
 }
