@@ -10,6 +10,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <type_traits>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
@@ -1107,6 +1108,158 @@ bool GlbSink::finish(SinkSummary* summary, std::string* error) {
         summary->warnings.push_back(w.str());
     }
     return true;
+}
+
+// ---- Frames across processes: a prepared frame as bytes (gltf.h, GlbSequenceWriter::encode) ----
+
+namespace {
+
+// Little-endian host assumed for the arrays (x86-64 and aarch64; checked where decoded).
+class FrameBytesOut {
+public:
+    explicit FrameBytesOut(std::string* out) : out_(out) {}
+    template <class T>
+    void put(const T& v) {
+        static_assert(std::is_trivially_copyable<T>::value, "plain values only");
+        out_->append(reinterpret_cast<const char*>(&v), sizeof(T));
+    }
+    template <class T>
+    void putVector(const std::vector<T>& v) {
+        put(uint64_t(v.size()));
+        if (!v.empty()) out_->append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    }
+
+private:
+    std::string* out_;
+};
+
+class FrameBytesIn {
+public:
+    FrameBytesIn(const std::string& in) : in_(in) {}
+    template <class T>
+    bool get(T* v) {
+        if (in_.size() - at_ < sizeof(T)) return false;
+        std::memcpy(v, in_.data() + at_, sizeof(T));
+        at_ += sizeof(T);
+        return true;
+    }
+    template <class T>
+    bool getVector(std::vector<T>* v) {
+        uint64_t n = 0;
+        if (!get(&n) || n > (in_.size() - at_) / sizeof(T)) return false;
+        v->resize(size_t(n));
+        if (n) std::memcpy(v->data(), in_.data() + at_, size_t(n) * sizeof(T));
+        at_ += size_t(n) * sizeof(T);
+        return true;
+    }
+    bool atEnd() const { return at_ == in_.size(); }
+
+private:
+    const std::string& in_;
+    size_t at_ = 0;
+};
+
+constexpr uint32_t kFrameBytesMagic = 0x31464741;  // "AGF1": apparent glb frame, version 1
+
+}  // namespace
+
+std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d) const {
+    std::string bytes;
+    FrameBytesOut out(&bytes);
+    out.put(kFrameBytesMagic);
+    out.put(int64_t(f.index));
+    out.put(f.t_c);
+    out.put(uint64_t(f.objects.size()));
+    for (const auto& o : f.objects) out.put(uint8_t(o.triangles.empty() ? 0 : 1));
+    for (int c = 0; c < 3; ++c) out.put(d.origin[c]);
+    out.put(d.step);
+    out.put(uint8_t(d.clamped));
+    for (double v : {d.far, d.max_extent, d.max_float_error, d.max_quantization_error}) out.put(v);
+    out.putVector(d.meshopt.encoded);
+    out.put(uint64_t(d.meshopt.count));
+    out.putVector(d.meshopt.first);
+    out.put(uint64_t(d.data.size()));
+    for (const PrimitiveData& p : d.data) {
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+            out.putVector(*v);
+        out.putVector(p.indices);
+        out.putVector(p.packed);
+        out.putVector(p.ordered);
+        for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmin[c]));
+        for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmax[c]));
+    }
+    return bytes;
+}
+
+bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error) {
+    // Step: the frame as add() reads it: its number, time and which objects show (one stand-in
+    // triangle each: add() looks at nothing else of the cut mesh), and the prepared data.
+    FrameBytesIn in(bytes);
+    uint32_t magic = 0;
+    int64_t index = 0;
+    uint64_t objects = 0;
+    ExportFrame f;
+    GlbFrameData d;
+    bool ok = in.get(&magic) && magic == kFrameBytesMagic && in.get(&index) && in.get(&f.t_c) && in.get(&objects) &&
+              objects <= bytes.size();
+    f.index = index;
+    if (ok) f.objects.resize(size_t(objects));
+    for (size_t o = 0; ok && o < f.objects.size(); ++o) {
+        uint8_t shown = 0;
+        ok = in.get(&shown);
+        if (shown) f.objects[o].triangles.push_back({0, 0, 0});
+    }
+    uint8_t clamped = 0;
+    uint64_t count = 0, primitives = 0;
+    for (int c = 0; ok && c < 3; ++c) ok = in.get(&d.origin[c]);
+    ok = ok && in.get(&d.step) && in.get(&clamped) && in.get(&d.far) && in.get(&d.max_extent) &&
+         in.get(&d.max_float_error) && in.get(&d.max_quantization_error) && in.getVector(&d.meshopt.encoded) &&
+         in.get(&count) && in.getVector(&d.meshopt.first) && in.get(&primitives) && primitives == objects;
+    d.clamped = clamped != 0;
+    d.meshopt.count = size_t(count);
+    if (ok) d.data.resize(size_t(primitives));
+    for (size_t o = 0; ok && o < d.data.size(); ++o) {
+        PrimitiveData& p = d.data[o];
+        for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+            ok = ok && in.getVector(v);
+        ok = ok && in.getVector(&p.indices) && in.getVector(&p.packed) && in.getVector(&p.ordered);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmin[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmax[c]);
+        // What add() indexes by: whole vertices, indices within them, the meshopt stream's offsets.
+        const size_t nv = p.emission.size();
+        ok = ok && p.positions.size() == 3 * nv && p.normals.size() == 3 * nv && p.indices.size() % 3 == 0 &&
+             std::all_of(p.indices.begin(), p.indices.end(), [nv](uint32_t i) { return i < nv; }) &&
+             p.packed.size() % kMeshoptStride == 0;
+    }
+    ok = ok && in.atEnd() && (d.meshopt.first.empty() || d.meshopt.first.size() == d.data.size());
+    if (!ok) {
+        *error = impl_->path + ": frame data from another process is malformed (frame " + std::to_string(index) + ")";
+        return false;
+    }
+    return add(f, d, error);
+}
+
+EncodedOutput GlbSink::encode(const ExportFrame& frame, const PreparedFrame* prepared) const {
+    EncodedOutput e;
+    if (!options_.draco && !options_.meshopt)
+        for (const auto& o : frame.objects) e.least += 24 * (long long)o.positions.size();  // as pending()
+    e.estimate = estimate(frame);
+    std::shared_ptr<const PreparedFrame> own;
+    if (!prepared) {
+        own = writer_->prepare(frame);
+        prepared = own.get();
+    }
+    e.bytes = writer_->encode(frame, static_cast<const GlbFrameData&>(*prepared));
+    return e;
+}
+
+PendingOutput GlbSink::pendingEncoded(long long, const EncodedOutput& frame) {
+    least_ += frame.least;
+    return {least_, model_ + ".glb"};
+}
+
+bool GlbSink::addEncoded(long long, const EncodedOutput& frame, std::vector<std::string>*, std::string* error) {
+    return writer_->addEncoded(frame.bytes, error);
 }
 
 bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,

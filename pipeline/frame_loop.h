@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "exporters/frame_sink.h"
+#include "pipeline/distribute.h"
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 
@@ -62,6 +63,12 @@ struct FrameLoopSettings {
     // Models still to run with the same budget, this one included: the estimate made from the
     // first frames before writing (OutputBudget::fitsEstimate) counts them all.
     long long models_left = 1;
+    // This process's part of the frames (pipeline/distribute.h): a job-array shard renders only
+    // its part, and the output budget's estimate scales to the part's frames.
+    FrameSplit split;
+    // MPI: the frames of every rank of frameGroup() (`split` is then the rank's): rank r > 0 cuts
+    // and encodes its part and sends it; rank 0 writes every frame in order into the sinks.
+    bool distributed = false;
 };
 
 struct FrameLoopResult {
@@ -70,6 +77,9 @@ struct FrameLoopResult {
     size_t max_segments = 0;             // that limit
     std::vector<SinkSummary> summaries;  // per sink, in the order given
     bool over_budget = false;            // stopped at max_frame_triangles: the error is bad input
+    // MPI: the exit code the group agreed on when the loop failed (rank r > 0 has no message then:
+    // rank 0 prints it); 0 otherwise.
+    int group_code = 0;
 };
 
 // What the sinks are told about the sequence of `model`: objects (then the reflections, see
