@@ -11,6 +11,7 @@
 #include <ostream>
 #include <sstream>
 
+#include <time.h>
 #include <unistd.h>
 
 #include <tbb/parallel_for.h>
@@ -60,6 +61,13 @@ private:
     std::chrono::steady_clock::time_point start_;
     double last_ = -1;
 };
+
+// CPU time of the calling thread, seconds (user and system).
+double threadCpuSeconds() {
+    timespec t{};
+    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 }  // namespace
 
@@ -124,6 +132,10 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
                   FrameLoopResult* result, std::string* error) {
     const Scene& scene = stage.scene;
     const long long first = stage.first, last_excl = stage.last_excl;
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point loop_start = Clock::now();
+    auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    std::atomic<long long> cut_ns{0}, cut_cpu_ns{0};
     // Frames across processes (pipeline/distribute.h): a rank other than 0 only cuts and sends.
     FrameGroup& group = frameGroup();
     const bool sender = settings.distributed && group.rank() > 0;
@@ -179,11 +191,14 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
         auto w = std::make_shared<Work>();
         w->frame.index = next;
         next += split.parts;
+        ++result->frames_cut;
         return w;
     };
     // In parallel: cut every world with the frame's view surface, then each sink's conversion.
     auto cutFrame = [&](WorkPtr w) -> WorkPtr {
         if (stop) return w;
+        const Clock::time_point cut_start = Clock::now();
+        const double cpu_start = threadCpuSeconds();
         ExportFrame& frame = w->frame;
         const long long k = frame.index;
         frame.t_c = frameTime(scene.frames, k);
@@ -220,11 +235,15 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             frame.objects.shrink_to_fit();
             w->encoded = std::move(e);
         }
+        cut_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - cut_start).count();
+        cut_cpu_ns += (long long)(1e9 * (threadCpuSeconds() - cpu_start));
         return w;
     };
     // Sink, in order: the budget checks, then every sink gets the frame.
     auto deliverOne = [&](const WorkPtr& w) {
         if (stop) return;
+        const Clock::time_point write_start = Clock::now();
+        const double cpu_start = threadCpuSeconds();
         const ExportFrame& frame = w->frame;
         const EncodedFrame* e = w->encoded.get();
         if (w->over_budget) {
@@ -254,6 +273,8 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             }
         }
         progress.update(++delivered);
+        result->write_seconds += since(write_start);
+        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
     };
     // Before the first write: the output size estimated from the first kEstimateFrames frames
     // (held back until then), scaled to the whole run. A frame past --max-triangles is reported
@@ -293,8 +314,10 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             std::string bytes;
             auto w = std::make_shared<Work>();
             w->encoded = std::make_unique<EncodedFrame>();
-            if (!group.receiveFrame(from, &bytes, &failed_code, error) ||
-                !deserializeFrame(bytes, w->encoded.get(), error)) {
+            const Clock::time_point wait_start = Clock::now();
+            const bool received = group.receiveFrame(from, &bytes, &failed_code, error);
+            result->wait_seconds += since(wait_start);
+            if (!received || !deserializeFrame(bytes, w->encoded.get(), error)) {
                 if (!failed_code) failed_code = 1;
                 stop = true;
                 return;
@@ -325,6 +348,20 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
         deliver(std::move(w));
     };
     auto run = [&] {
+        // Where the time went (FrameLoopResult), whichever way the loop ends.
+        struct Account {
+            FrameLoopResult* r;
+            const std::atomic<long long>& cut;
+            const std::atomic<long long>& cut_cpu;
+            const long long& written;
+            Clock::time_point start;
+            ~Account() {
+                r->cut_seconds = double(cut) * 1e-9;
+                r->cut_cpu_seconds = double(cut_cpu) * 1e-9;
+                r->frames_written = written;
+                r->loop_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+            }
+        } account{result, cut_ns, cut_cpu_ns, delivered, loop_start};
         arena.execute([&] {
             tbb::parallel_pipeline(tokens, tbb::make_filter<void, WorkPtr>(tbb::filter_mode::serial_in_order, source) &
                                                tbb::make_filter<WorkPtr, WorkPtr>(tbb::filter_mode::parallel, cutFrame) &
@@ -355,6 +392,8 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     if (stop) return fail(failed_code ? failed_code : result->over_budget ? kExitBadInput : kExitOutputError);
 
     // Step: what needs the whole sequence (the .glb is assembled here).
+    const Clock::time_point finish_start = Clock::now();
+    const double finish_cpu = threadCpuSeconds();
     result->summaries.assign(sinks.size(), {});
     for (size_t s = 0; s < sinks.size(); ++s) {
         sinks[s]->setFinishCheck([budget](long long bytes, const std::string& name, std::string* e) {
@@ -364,6 +403,9 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
         for (const std::string& path : result->summaries[s].completed)
             if (!budget->count(path, error)) return fail(kExitOutputError);
     }
+    result->write_seconds += since(finish_start);
+    result->write_cpu_seconds += threadCpuSeconds() - finish_cpu;
+    result->loop_seconds = since(loop_start);
     if (receiver) group.endFrames(0);
     return true;
 }

@@ -80,6 +80,14 @@ struct FrameLoopResult {
     // MPI: the exit code the group agreed on when the loop failed (rank r > 0 has no message then:
     // rank 0 prints it); 0 otherwise.
     int group_code = 0;
+    // Where the time went (wall clock, seconds): cutting, converting and encoding the frames this
+    // process cut, summed over its threads; writing (the sinks' add and finish, in order, one
+    // thread); with MPI, rank 0 waiting for frames of other ranks. render --verbose prints them.
+    double cut_seconds = 0, write_seconds = 0, wait_seconds = 0, loop_seconds = 0;
+    // The same as the CPU time of the threads that did it (not slowed by other processes sharing
+    // the cores; a nested parallel loop's work stolen by another thread is not counted).
+    double cut_cpu_seconds = 0, write_cpu_seconds = 0;
+    long long frames_cut = 0, frames_written = 0;
 };
 
 // What the sinks are told about the sequence of `model`: objects (then the reflections, see

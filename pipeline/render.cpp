@@ -183,6 +183,23 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
                 << " segments; the tolerance " << stage.scene.tolerance
                 << " ls is not met there (a coarser tolerance or a finer input mesh helps)\n";
         if (distributed) summary += ", " + std::to_string(group.size()) + " processes shared the frames";
+        if (settings.verbose && !settings.quiet) {
+            // Where the time went (FrameLoopResult): what decides how far more processes help.
+            std::ostringstream t;
+            t.setf(std::ios::fixed);
+            t.precision(1);
+            const double wall = result.loop_seconds > 0 ? result.loop_seconds : 1;
+            auto perFrame = [](double seconds, long long frames) { return 1e3 * seconds / double(std::max(1LL, frames)); };
+            t << name << ": loop " << result.loop_seconds << " s; per frame: cut and encode "
+              << perFrame(result.cut_seconds, result.frames_cut) << " ms (CPU "
+              << perFrame(result.cut_cpu_seconds, result.frames_cut) << " ms; " << result.frames_cut
+              << " frames cut here), write " << perFrame(result.write_seconds, result.frames_written) << " ms (CPU "
+              << perFrame(result.write_cpu_seconds, result.frames_written) << " ms; " << result.frames_written
+              << " frames, " << 100 * result.write_seconds / wall << "% of the loop" << (distributed ? " on rank 0" : "")
+              << ")";
+            if (distributed) t << "; rank 0 waited " << result.wait_seconds << " s for other ranks";
+            log << t.str() << "\n";
+        }
         if (!settings.quiet)
             log << name << ": " << (settings.sharded ? loop.split.count(stage.first, stage.last_excl) : stage.last_excl - stage.first)
                 << " frames, up to " << result.max_triangles << " triangles" << summary << "\n";
