@@ -6,7 +6,9 @@
 //   message, printed by rank 0), rank r cuts and encodes frames k with k - first = r mod N, rank 0
 //   writes every output in frame order (the protocol of distribute.h: MPI_Send / MPI_Recv on a
 //   duplicate of MPI_COMM_WORLD, frames over 1 GiB in several messages).
-// - Every other command runs on rank 0 alone (the other ranks return 0 at once).
+// - `raytrace`: the same split; rank r traces its frames and sends each picture to rank 0, which
+//   writes the PNG files and the video in frame order.
+// - Every other command (figure among them) runs on rank 0 alone (the other ranks return 0 at once).
 // - Ranks other than 0 print nothing; rank 0 prints the progress and the summary, which says how
 //   many processes shared the frames.
 // Exit: every rank ends with rank 0's code (mpirun exits with it): the ranks meet in a final

@@ -1,6 +1,7 @@
 #!/bin/bash
 # `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
-# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ), a
+# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ; and
+# raytrace's PNG files and video), a
 # failure on any rank ends the job with the one-process code and one line from rank 0 and no
 # output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
 # Usage: mpi_test.sh APPARENT SOURCE_DIR   (ctest sets OpenMPI's run-as-root variables for it)
@@ -25,6 +26,15 @@ for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
         [ "$(echo "$out" | grep -c '^relativistic: ')" = 1 ] || fail "not one summary line (rank 0 alone): $out"
     done
 done
+# raytrace splits its frames the same way: the PNG files and the video identical.
+"$apparent" raytrace data/scenes/flanges.json --out "$work/rt1" --frames 90:100 --size 160x90 --video "$work/rt1.mp4" \
+    --quiet || fail "raytrace, one process"
+out=$(mpi raytrace data/scenes/flanges.json --out "$work/rt3" --frames 90:100 --size 160x90 --video "$work/rt3.mp4" 2>&1) ||
+    fail "raytrace under mpirun: $out"
+diff -r "$work/rt1" "$work/rt3" > /dev/null || fail "raytrace PNG files differ"
+cmp -s "$work/rt1.mp4" "$work/rt3.mp4" || fail "raytrace videos differ"
+case "$out" in *"3 processes shared the frames"*) ;; *) fail "raytrace summary without the process count: $out" ;; esac
+
 # --quiet silences every rank.
 out=$(mpi render data/scenes/flanges.json --out "$work/quiet" --frames 0:20 --quiet 2>&1)
 [ -z "$out" ] || fail "--quiet under mpirun printed: $out"
@@ -48,6 +58,7 @@ expect_failure() {  # CODE OUTDIR ARGS...: the code, our line exactly once, no o
 expect_failure 2 "$work/e1" render data/scenes/flanges.json --max-triangles 100
 expect_failure 2 "$work/e2" render data/fixtures/scene_mirror_not_planar.json
 expect_failure 3 "$work/e3" render data/scenes/flanges.json --format ply,glb --max-output-bytes 100000
+expect_failure 2 "$work/e4" raytrace data/scenes/flanges.json --model all --video "$work/e4.mp4"
 
 # Step: SIGKILL to rank 1 mid-run: mpirun exits non-zero; every file present is complete (the
 # one-process run's bytes for it), no temporary is left beside them.
