@@ -190,19 +190,6 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     addStageLimits(render_cmd, &rs.stage);
     render_cmd->footer(kRenderFooter);
 
-    // `merge`: the .glb of every model from the job-array shards in DIR/shards (pipeline/shards.h).
-    MergeSettings ms;
-    CLI::App* merge_cmd = app.add_subcommand(
-        "merge", "Assemble DIR/<model>.glb from the shards of 'render --shard I/N --out DIR' (byte-identical to one process)");
-    merge_cmd->add_option("dir", ms.out_dir, "The --out folder of the shards (reads DIR/shards)")->required();
-    merge_cmd->add_option("--max-output-bytes", ms.max_output_bytes,
-                          "Stop with exit code 3 before the .glb files would exceed this many bytes in all (0: no limit)")
-        ->capture_default_str();
-    merge_cmd->add_flag("--quiet,-q", ms.quiet, "No summary");
-    merge_cmd->add_flag("--verbose,-v", ms.verbose, "Export precision, as render --verbose");
-    merge_cmd->footer(
-        "Refuses (exit code 2, one line) a shard that is missing, duplicated, incomplete, or made from another scene,\n"
-        "other meshes or other output options (each shard holds a fingerprint of them). The shards stay in DIR/shards.");
 
     // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
     RaytraceSettings ts;
@@ -277,6 +264,20 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         "per frame; "
         "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
         "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
+
+    // `merge`: the .glb of every model from the job-array shards in DIR/shards (pipeline/shards.h).
+    MergeSettings ms;
+    CLI::App* merge_cmd = app.add_subcommand(
+        "merge", "Assemble DIR/<model>.glb from the shards of 'render --shard I/N --out DIR' (byte-identical to one process)");
+    merge_cmd->add_option("dir", ms.out_dir, "The --out folder of the shards (reads DIR/shards)")->required();
+    merge_cmd->add_option("--max-output-bytes", ms.max_output_bytes,
+                          "Stop with exit code 3 before the .glb files would exceed this many bytes in all (0: no limit)")
+        ->capture_default_str();
+    merge_cmd->add_flag("--quiet,-q", ms.quiet, "No summary");
+    merge_cmd->add_flag("--verbose,-v", ms.verbose, "Export precision, as render --verbose");
+    merge_cmd->footer(
+        "Refuses (exit code 2, one line) a shard that is missing, duplicated, incomplete, or made from another scene,\n"
+        "other meshes or other output options (each shard holds a fingerprint of them). The shards stay in DIR/shards.");
 
     // An unknown command: CLI11 would say only "A subcommand is required"; name the nearest.
     if (argc > 1 && argv[1][0] != '-') {

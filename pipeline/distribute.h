@@ -10,8 +10,8 @@
 // in the order the ranks make them (no part runs far ahead of the writer).
 //
 // The MPI protocol (FrameGroup below, one exchange per model's frame loop), rank r > 0:
-//   for each of its frames, in order: FRAME (the EncodedFrame; a blocking send, so a rank holds at
-//   most its frame loop's tokens of frames: bounded memory), or, when it fails, ERROR (exit code and
+//   for each of its frames, in order: FRAME (the EncodedFrame; a synchronous send, so a rank holds
+//   at most its frame loop's tokens of frames: bounded memory), or, when it fails, ERROR (exit code and
 //   the one-line message) instead, and no more frames; before each frame it checks for END from
 //   rank 0 and stops sending when it came; then DONE; then it waits for END(code).
 // Rank 0 receives the frames in frame order from their ranks (one at a time: bounded memory) and

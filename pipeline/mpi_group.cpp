@@ -61,8 +61,11 @@ public:
     }
 
     void sendFrame(const std::string& bytes) override {
+        // Synchronous: it returns once rank 0 has started to receive this frame, so a rank is never
+        // more than one frame ahead of the writer, however small its frames (a plain send of a
+        // message under the eager limit would return at once and let frames pile up on rank 0).
         const uint64_t n = bytes.size();
-        MPI_Send(&n, 8, MPI_BYTE, 0, kTagFrame, comm_);
+        MPI_Ssend(&n, 8, MPI_BYTE, 0, kTagFrame, comm_);
         for (size_t at = 0; at < bytes.size(); at += kChunk)
             MPI_Send(bytes.data() + at, int(std::min(kChunk, bytes.size() - at)), MPI_BYTE, 0, kTagChunk, comm_);
     }
