@@ -28,5 +28,5 @@ part=$((task - ${SLURM_ARRAY_TASK_MIN:-0}))
 # The first task submits the merge, to run after every task of the array has succeeded.
 if [ "$part" -eq 0 ]; then
     sbatch --dependency="afterok:${SLURM_ARRAY_JOB_ID}" --job-name=apparent-merge \
-        --output="apparent-merge-%j.log" --wrap="$apparent merge $out"
+        --output="apparent-merge-%j.log" --wrap="$(printf '%q merge %q' "$apparent" "$out")"
 fi
