@@ -1,5 +1,7 @@
 #include "exporters/frame_files.h"
 
+#include "exporters/atomic_file.h"
+
 #include <filesystem>
 #include <system_error>
 #include <utility>
@@ -27,8 +29,19 @@ long long leastFrameBytes(const ExportFrame& frame) {
     return 12 * (long long)vertices + 12 * (long long)frame.triangleCount();
 }
 
-FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameWriter write)
-    : dir_(std::move(dir)), extension_(std::move(extension)), write_(write) {}
+EncodedOutput FrameSink::encode(const ExportFrame&, const PreparedFrame*) const { return {}; }
+
+PendingOutput FrameSink::pendingEncoded(long long index, const EncodedOutput& frame) {
+    return {frame.least, "frame " + std::to_string(index)};
+}
+
+bool FrameSink::addEncoded(long long index, const EncodedOutput&, std::vector<std::string>*, std::string* error) {
+    *error = "frame " + std::to_string(index) + ": this output cannot take frames from another process";
+    return false;
+}
+
+FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize)
+    : dir_(std::move(dir)), extension_(std::move(extension)), write_(write), serialize_(serialize) {}
 
 std::string FrameFileSink::path(long long k) const {
     return (std::filesystem::path(dir_) / (frameName(k) + "." + extension_)).string();
@@ -52,5 +65,25 @@ bool FrameFileSink::add(const ExportFrame& frame, const PreparedFrame*, std::vec
 }
 
 bool FrameFileSink::finish(SinkSummary*, std::string*) { return true; }
+
+EncodedOutput FrameFileSink::encode(const ExportFrame& frame, const PreparedFrame*) const {
+    EncodedOutput e;
+    e.least = e.estimate = leastFrameBytes(frame);
+    serialize_(frame, &e.bytes);
+    return e;
+}
+
+PendingOutput FrameFileSink::pendingEncoded(long long index, const EncodedOutput& frame) {
+    return {frame.least, path(index)};
+}
+
+bool FrameFileSink::addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
+                               std::string* error) {
+    const std::string p = path(index);
+    AtomicOutput out(p);
+    if (!out.commitBytes(frame.bytes, error)) return false;
+    completed->push_back(p);
+    return true;
+}
 
 }  // namespace apparent

@@ -4,6 +4,10 @@
 //   prepare(frame)              on worker threads, several frames at once (optional conversion);
 //   pending(frame), add(...)   on one thread, frames in order;
 //   finish(...)                 once, after the last frame.
+// Frames made by another process (pipeline/distribute.h: MPI ranks, job-array shards) reach the
+// sink as bytes instead: beginEncoding(info) and encode(frame) where the frame was cut, then
+// pendingEncoded(...) and addEncoded(...) in frame order where the file is written, with the same
+// bytes in the file as add() would have written.
 // Every method that writes returns false with one line naming the file on failure (the command
 // exits with code 3). Sinks write through AtomicOutput (exporters/atomic_file.h): a file appears
 // whole under its final name or not at all. The output budget (--max-output-bytes) is the loop's:
@@ -37,6 +41,14 @@ struct PendingOutput {
     std::string name;
 };
 
+// One frame as a sink's add() needs it, made where the frame was cut (FrameSink::encode): the
+// bytes, the least size the frame adds (as pending() counts it) and the estimate() of the frame.
+struct EncodedOutput {
+    long long least = 0;
+    long long estimate = 0;
+    std::string bytes;
+};
+
 class FrameSink {
 public:
     virtual ~FrameSink() = default;
@@ -62,6 +74,17 @@ public:
     // Set before finish(): a sink that writes a file there checks its whole size with `check`
     // before writing any of it (the default writes nothing in finish()).
     virtual void setFinishCheck(OutputCheck /*check*/) {}
+
+    // Frames across processes. On the process that cuts frames without writing: what begin() sets
+    // up for prepare() and encode(), nothing written (the default: nothing).
+    virtual bool beginEncoding(const SequenceInfo& /*info*/, std::string* /*error*/) { return true; }
+    // The frame as the writing process's addEncoded() needs it (const, any thread). The default
+    // encodes nothing: a sink that cannot take frames from another process (addEncoded fails).
+    virtual EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const;
+    // pending() and add() of a frame that arrives encoded: frame `index`, in order.
+    virtual PendingOutput pendingEncoded(long long index, const EncodedOutput& frame);
+    virtual bool addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
+                            std::string* error);
 };
 
 // The least size of a frame in any of the formats: 12 bytes per vertex and 12 per triangle

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <type_traits>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
@@ -36,6 +37,18 @@ namespace {
 
 using mesh4d::Vec3;
 
+// One primitive's KHR_draco_mesh_compression coding (encodeDraco): the Edgebreaker bytes and what
+// the accessors take from the decoded mesh (point and face counts, position bounds, attribute ids).
+struct DracoCoded {
+    std::vector<char> bytes;
+    uint64_t points = 0, faces = 0;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    // Draco unique ids of POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME, COLOR_0 (-1: absent).
+    int32_t ids[6] = {-1, -1, -1, -1, -1, -1};
+    double quantization_error = 0;
+    std::string error;  // Draco failed (reported by add())
+};
+
 // One primitive's data as it goes into the file: float32 positions relative to the frame origin.
 // With meshopt also its packed vertices (MeshoptLayout::stride bytes each, in vertex-fetch order)
 // and their normals in the two forms a frame may use (octahedral, kMeshoptNormalStride bytes
@@ -49,6 +62,7 @@ struct PrimitiveData {
     std::vector<unsigned char> packed, packed_normals, packed_snorm;
     std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
+    DracoCoded draco;  // with Draco: the coding, made by prepare()
     size_t vertexCount() const { return emission.size(); }
 };
 
@@ -176,6 +190,82 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
     if (used > 0)
         meshopt_encodeFilterOct(d->packed_normals.data(), used, kMeshoptNormalStride, kMeshoptNormalBits, normals.data());
     return worst;
+}
+
+// One primitive's Draco coding (KHR_draco_mesh_compression), made by prepare() on the worker
+// threads (and, with MPI, on the rank that cut the frame); `error` set when Draco failed. The
+// position error bound is half a step of the quantization grid, which spans the largest extent
+// of the primitive's positions in 2^bits - 1 steps.
+void encodeDraco(const PrimitiveData& d, const GlbOptions& options, DracoCoded* out) {
+    *out = DracoCoded();
+    // Step: build the Draco mesh with identity point mapping.
+    draco::Mesh dm;
+    const size_t nv = d.vertexCount();
+    dm.set_num_points(uint32_t(nv));
+    auto addAttribute = [&](draco::GeometryAttribute::Type type, int components, const float* values) {
+        draco::GeometryAttribute ga;
+        ga.Init(type, nullptr, components, draco::DT_FLOAT32, false, 4 * components, 0);
+        const int id = dm.AddAttribute(ga, /*identity_mapping=*/true, uint32_t(nv));
+        for (size_t i = 0; i < nv; ++i)
+            dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(uint32_t(i)), values + components * i);
+        return id;
+    };
+    const int pos = addAttribute(draco::GeometryAttribute::POSITION, 3, d.positions.data());
+    const int nrm = addAttribute(draco::GeometryAttribute::NORMAL, 3, d.normals.data());
+    const int emt = addAttribute(draco::GeometryAttribute::GENERIC, 1, d.emission.data());
+    const int dop = d.doppler.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.doppler.data());
+    const int tau = d.proper_time.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.proper_time.data());
+    const int col = d.colors.empty() ? -1 : addAttribute(draco::GeometryAttribute::COLOR, 3, d.colors.data());
+    for (size_t f = 0; f < d.indices.size(); f += 3)
+        dm.AddFace({draco::PointIndex(d.indices[f]), draco::PointIndex(d.indices[f + 1]),
+                    draco::PointIndex(d.indices[f + 2])});
+
+    // Step: encode; the emission time stays unquantized (lossless).
+    draco::ExpertEncoder enc(dm);
+    enc.SetAttributeQuantization(pos, options.position_bits);
+    enc.SetAttributeQuantization(nrm, options.normal_bits);
+    enc.SetSpeedOptions(5, 5);
+    enc.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
+    draco::EncoderBuffer buf;
+    const draco::Status st = enc.EncodeToBuffer(&buf);
+    if (!st.ok()) {
+        out->error = "Draco encoding failed: " + st.error_msg_string();
+        return;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < d.positions.size(); ++i) {
+        lo[i % 3] = std::min(lo[i % 3], double(d.positions[i]));
+        hi[i % 3] = std::max(hi[i % 3], double(d.positions[i]));
+    }
+    double extent = 0;
+    for (int c = 0; c < 3; ++c) extent = std::max(extent, hi[c] - lo[c]);
+    out->quantization_error = 0.5 * extent / double((1u << options.position_bits) - 1);
+
+    // Step: decode it again; the accessors must describe what a reader will get.
+    draco::DecoderBuffer db;
+    db.Init(buf.data(), buf.size());
+    draco::Decoder dec;
+    auto decoded = dec.DecodeMeshFromBuffer(&db);
+    if (!decoded.ok()) {
+        out->error = "Draco could not decode its own output: " + decoded.status().error_msg_string();
+        return;
+    }
+    const std::unique_ptr<draco::Mesh> back = std::move(decoded).value();
+    const draco::PointAttribute* bpos = back->GetAttributeByUniqueId(dm.attribute(pos)->unique_id());
+    for (int c = 0; c < 3; ++c) {
+        out->lo[c] = INFINITY;
+        out->hi[c] = -INFINITY;
+    }
+    for (draco::PointIndex p(0); p < back->num_points(); ++p) {
+        float v[3];
+        bpos->GetMappedValue(p, v);
+        for (int c = 0; c < 3; ++c) { out->lo[c] = std::min(out->lo[c], double(v[c])); out->hi[c] = std::max(out->hi[c], double(v[c])); }
+    }
+    out->points = back->num_points();
+    out->faces = back->num_faces();
+    const int ids[6] = {pos, nrm, emt, dop, tau, col};
+    for (int a = 0; a < 6; ++a) out->ids[a] = ids[a] >= 0 ? int32_t(dm.attribute(ids[a])->unique_id()) : -1;
+    out->bytes.assign(buf.data(), buf.data() + buf.size());
 }
 
 // Where the BIN chunk goes while frames arrive: a spill file (so memory does not grow with the
@@ -331,87 +421,35 @@ public:
                               {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}};
     }
 
-    // A KHR_draco_mesh_compression primitive; returns false with a message when Draco fails.
-    // `quantization_error` receives the position error bound: half a step of the quantization
-    // grid, which spans the largest extent of the primitive's positions in 2^bits - 1 steps.
+    // A KHR_draco_mesh_compression primitive from its coding (DracoCoded, made by prepare());
+    // returns false with the message when Draco failed there. `quantization_error` receives the
+    // position error bound.
     bool dracoPrimitive(const PrimitiveData& d, tinygltf::Primitive* prim, double* quantization_error,
                         std::string* error) {
-        // Step: build the Draco mesh with identity point mapping.
-        draco::Mesh dm;
-        const size_t nv = d.vertexCount();
-        dm.set_num_points(uint32_t(nv));
-        auto addAttribute = [&](draco::GeometryAttribute::Type type, int components, const float* values) {
-            draco::GeometryAttribute ga;
-            ga.Init(type, nullptr, components, draco::DT_FLOAT32, false, 4 * components, 0);
-            const int id = dm.AddAttribute(ga, /*identity_mapping=*/true, uint32_t(nv));
-            for (size_t i = 0; i < nv; ++i)
-                dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(uint32_t(i)), values + components * i);
-            return id;
-        };
-        const int pos = addAttribute(draco::GeometryAttribute::POSITION, 3, d.positions.data());
-        const int nrm = addAttribute(draco::GeometryAttribute::NORMAL, 3, d.normals.data());
-        const int emt = addAttribute(draco::GeometryAttribute::GENERIC, 1, d.emission.data());
-        const int dop = d.doppler.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.doppler.data());
-        const int tau = d.proper_time.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.proper_time.data());
-        const int col = d.colors.empty() ? -1 : addAttribute(draco::GeometryAttribute::COLOR, 3, d.colors.data());
-        for (size_t f = 0; f < d.indices.size(); f += 3)
-            dm.AddFace({draco::PointIndex(d.indices[f]), draco::PointIndex(d.indices[f + 1]),
-                        draco::PointIndex(d.indices[f + 2])});
-
-        // Step: encode; the emission time stays unquantized (lossless).
-        draco::ExpertEncoder enc(dm);
-        enc.SetAttributeQuantization(pos, options_.position_bits);
-        enc.SetAttributeQuantization(nrm, options_.normal_bits);
-        enc.SetSpeedOptions(5, 5);
-        enc.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
-        draco::EncoderBuffer buf;
-        const draco::Status st = enc.EncodeToBuffer(&buf);
-        if (!st.ok()) {
-            *error = "Draco encoding failed: " + st.error_msg_string();
+        const DracoCoded& c = d.draco;
+        if (!c.error.empty()) {
+            *error = c.error;
             return false;
         }
-        std::vector<double> lo, hi;
-        bounds(d.positions, &lo, &hi);
-        double extent = 0;
-        for (int c = 0; c < 3; ++c) extent = std::max(extent, hi[c] - lo[c]);
-        *quantization_error = 0.5 * extent / double((1u << options_.position_bits) - 1);
-
-        // Step: decode it again; the accessors must describe what a reader will get.
-        draco::DecoderBuffer db;
-        db.Init(buf.data(), buf.size());
-        draco::Decoder dec;
-        auto decoded = dec.DecodeMeshFromBuffer(&db);
-        if (!decoded.ok()) {
-            *error = "Draco could not decode its own output: " + decoded.status().error_msg_string();
-            return false;
-        }
-        const std::unique_ptr<draco::Mesh> back = std::move(decoded).value();
-        const draco::PointAttribute* bpos = back->GetAttributeByUniqueId(dm.attribute(pos)->unique_id());
-        std::vector<double> dlo(3, INFINITY), dhi(3, -INFINITY);
-        for (draco::PointIndex p(0); p < back->num_points(); ++p) {
-            float v[3];
-            bpos->GetMappedValue(p, v);
-            for (int c = 0; c < 3; ++c) { dlo[c] = std::min(dlo[c], double(v[c])); dhi[c] = std::max(dhi[c], double(v[c])); }
-        }
-        const size_t n_points = back->num_points();
-        prim->attributes["POSITION"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points, dlo, dhi);
+        *quantization_error = c.quantization_error;
+        const size_t n_points = size_t(c.points);
+        prim->attributes["POSITION"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points,
+                                                   {c.lo[0], c.lo[1], c.lo[2]}, {c.hi[0], c.hi[1], c.hi[2]});
         prim->attributes["NORMAL"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
         prim->attributes["_EMISSION_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
-        if (dop >= 0) prim->attributes["_DOPPLER"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
-        if (tau >= 0)
+        if (c.ids[3] >= 0) prim->attributes["_DOPPLER"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
+        if (c.ids[4] >= 0)
             prim->attributes["_PROPER_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
-        if (col >= 0) prim->attributes["COLOR_0"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
-        prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                                    size_t(back->num_faces()) * 3);
+        if (c.ids[5] >= 0) prim->attributes["COLOR_0"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
+        prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, size_t(c.faces) * 3);
         prim->mode = TINYGLTF_MODE_TRIANGLES;
-        const int view = addView(buf.data(), buf.size(), 0);
-        tinygltf::Value::Object attrs{
-            {"POSITION", tinygltf::Value(int(dm.attribute(pos)->unique_id()))},
-            {"NORMAL", tinygltf::Value(int(dm.attribute(nrm)->unique_id()))},
-            {"_EMISSION_TIME", tinygltf::Value(int(dm.attribute(emt)->unique_id()))}};
-        if (dop >= 0) attrs["_DOPPLER"] = tinygltf::Value(int(dm.attribute(dop)->unique_id()));
-        if (tau >= 0) attrs["_PROPER_TIME"] = tinygltf::Value(int(dm.attribute(tau)->unique_id()));
-        if (col >= 0) attrs["COLOR_0"] = tinygltf::Value(int(dm.attribute(col)->unique_id()));
+        const int view = addView(c.bytes.data(), c.bytes.size(), 0);
+        tinygltf::Value::Object attrs{{"POSITION", tinygltf::Value(c.ids[0])},
+                                      {"NORMAL", tinygltf::Value(c.ids[1])},
+                                      {"_EMISSION_TIME", tinygltf::Value(c.ids[2])}};
+        if (c.ids[3] >= 0) attrs["_DOPPLER"] = tinygltf::Value(c.ids[3]);
+        if (c.ids[4] >= 0) attrs["_PROPER_TIME"] = tinygltf::Value(c.ids[4]);
+        if (c.ids[5] >= 0) attrs["COLOR_0"] = tinygltf::Value(c.ids[5]);
         prim->extensions["KHR_draco_mesh_compression"] = tinygltf::Value(
             tinygltf::Value::Object{{"bufferView", tinygltf::Value(view)}, {"attributes", tinygltf::Value(attrs)}});
         return true;
@@ -874,6 +912,8 @@ struct GlbFrameData : PreparedFrame {
             for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
             p.indices.clear();
             p.ordered.reset();
+            p.draco.bytes.clear();
+            p.draco.error.clear();
             p.packed.clear();
             p.packed_normals.clear();
             p.packed_snorm.clear();
@@ -1061,6 +1101,10 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
                             &scratch->crease_map[o], &scratch->crease_work[o], &scratch->meshopt,
                             &scratch->meshopt.orders[o], impl_->options,
                             impl_->info.objects[o].base_color);
+        // Step (Draco): every shown primitive coded here, on the worker thread.
+        if (impl_->options.draco)
+            for (size_t o = 0; o < f.objects.size(); ++o)
+                if (!f.objects[o].triangles.empty()) encodeDraco(d->data[o], impl_->options, &d->data[o].draco);
         if (impl_->options.meshopt) {
             // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
             // worker thread).
@@ -1310,6 +1354,195 @@ bool GlbSink::finish(SinkSummary* summary, std::string* error) {
         summary->warnings.push_back(w.str());
     }
     return true;
+}
+
+// ---- Frames across processes: a prepared frame as bytes (gltf.h, GlbSequenceWriter::encode) ----
+
+namespace {
+
+// Little-endian host assumed for the arrays (x86-64 and aarch64; checked where decoded).
+class FrameBytesOut {
+public:
+    explicit FrameBytesOut(std::string* out) : out_(out) {}
+    template <class T>
+    void put(const T& v) {
+        static_assert(std::is_trivially_copyable<T>::value, "plain values only");
+        out_->append(reinterpret_cast<const char*>(&v), sizeof(T));
+    }
+    template <class T>
+    void putVector(const std::vector<T>& v) {
+        put(uint64_t(v.size()));
+        if (!v.empty()) out_->append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    }
+
+private:
+    std::string* out_;
+};
+
+class FrameBytesIn {
+public:
+    FrameBytesIn(const std::string& in) : in_(in) {}
+    template <class T>
+    bool get(T* v) {
+        if (in_.size() - at_ < sizeof(T)) return false;
+        std::memcpy(v, in_.data() + at_, sizeof(T));
+        at_ += sizeof(T);
+        return true;
+    }
+    template <class T>
+    bool getVector(std::vector<T>* v) {
+        uint64_t n = 0;
+        if (!get(&n) || n > (in_.size() - at_) / sizeof(T)) return false;
+        v->resize(size_t(n));
+        if (n) std::memcpy(v->data(), in_.data() + at_, size_t(n) * sizeof(T));
+        at_ += size_t(n) * sizeof(T);
+        return true;
+    }
+    bool atEnd() const { return at_ == in_.size(); }
+
+private:
+    const std::string& in_;
+    size_t at_ = 0;
+};
+
+constexpr uint32_t kFrameBytesMagic = 0x31464741;  // "AGF1": apparent glb frame, version 1
+
+}  // namespace
+
+std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d) const {
+    std::string bytes;
+    FrameBytesOut out(&bytes);
+    out.put(kFrameBytesMagic);
+    out.put(int64_t(f.index));
+    out.put(f.t_c);
+    out.put(uint64_t(f.objects.size()));
+    for (const auto& o : f.objects) out.put(uint8_t(o.triangles.empty() ? 0 : 1));
+    for (int c = 0; c < 3; ++c) out.put(d.origin[c]);
+    out.put(d.step);
+    out.put(uint8_t(d.clamped));
+    for (double v : {d.far, d.max_extent, d.max_float_error, d.max_quantization_error}) out.put(v);
+    out.putVector(d.meshopt.encoded);
+    out.putVector(d.meshopt.encoded_normals);
+    out.put(uint64_t(d.meshopt.count));
+    out.put(uint64_t(d.meshopt.stride));
+    out.put(uint8_t(d.meshopt.normals_inline));
+    out.putVector(d.meshopt.first);
+    out.put(uint64_t(d.data.size()));
+    for (const PrimitiveData& p : d.data) {
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+            out.putVector(*v);
+        out.putVector(p.indices);
+        out.putVector(p.packed);
+        out.putVector(p.packed_normals);
+        out.putVector(p.packed_snorm);
+        out.put(uint8_t(p.ordered ? 1 : 0));
+        if (p.ordered) out.putVector(*p.ordered);
+        for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmin[c]));
+        for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmax[c]));
+        const DracoCoded& dc = p.draco;
+        out.putVector(dc.bytes);
+        out.put(dc.points);
+        out.put(dc.faces);
+        for (int c = 0; c < 3; ++c) out.put(dc.lo[c]);
+        for (int c = 0; c < 3; ++c) out.put(dc.hi[c]);
+        for (int32_t id : dc.ids) out.put(id);
+        out.put(dc.quantization_error);
+        out.putVector(std::vector<char>(dc.error.begin(), dc.error.end()));
+    }
+    return bytes;
+}
+
+bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error) {
+    // Step: the frame as add() reads it: its number, time and which objects show (one stand-in
+    // triangle each: add() looks at nothing else of the cut mesh), and the prepared data.
+    FrameBytesIn in(bytes);
+    uint32_t magic = 0;
+    int64_t index = 0;
+    uint64_t objects = 0;
+    ExportFrame f;
+    GlbFrameData d;
+    bool ok = in.get(&magic) && magic == kFrameBytesMagic && in.get(&index) && in.get(&f.t_c) && in.get(&objects) &&
+              objects <= bytes.size();
+    f.index = index;
+    if (ok) f.objects.resize(size_t(objects));
+    for (size_t o = 0; ok && o < f.objects.size(); ++o) {
+        uint8_t shown = 0;
+        ok = in.get(&shown);
+        if (shown) f.objects[o].triangles.push_back({0, 0, 0});
+    }
+    uint8_t clamped = 0, normals_inline = 0;
+    uint64_t count = 0, stride = 0, primitives = 0;
+    for (int c = 0; ok && c < 3; ++c) ok = in.get(&d.origin[c]);
+    ok = ok && in.get(&d.step) && in.get(&clamped) && in.get(&d.far) && in.get(&d.max_extent) &&
+         in.get(&d.max_float_error) && in.get(&d.max_quantization_error) && in.getVector(&d.meshopt.encoded) &&
+         in.getVector(&d.meshopt.encoded_normals) && in.get(&count) && in.get(&stride) && in.get(&normals_inline) &&
+         in.getVector(&d.meshopt.first) && in.get(&primitives) && primitives == objects;
+    d.clamped = clamped != 0;
+    d.meshopt.count = size_t(count);
+    d.meshopt.stride = size_t(stride);
+    d.meshopt.normals_inline = normals_inline != 0;
+    const size_t record = MeshoptLayout(impl_->options).stride;
+    if (ok) d.data.resize(size_t(primitives));
+    for (size_t o = 0; ok && o < d.data.size(); ++o) {
+        PrimitiveData& p = d.data[o];
+        for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+            ok = ok && in.getVector(v);
+        uint8_t has_ordered = 0;
+        ok = ok && in.getVector(&p.indices) && in.getVector(&p.packed) && in.getVector(&p.packed_normals) &&
+             in.getVector(&p.packed_snorm) && in.get(&has_ordered);
+        if (ok && has_ordered) {
+            auto ordered = std::make_shared<std::vector<uint32_t>>();
+            ok = in.getVector(ordered.get());
+            p.ordered = std::move(ordered);
+        }
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmin[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmax[c]);
+        DracoCoded& dc = p.draco;
+        std::vector<char> draco_error;
+        ok = ok && in.getVector(&dc.bytes) && in.get(&dc.points) && in.get(&dc.faces);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.lo[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.hi[c]);
+        for (int a = 0; ok && a < 6; ++a) ok = in.get(&dc.ids[a]);
+        ok = ok && in.get(&dc.quantization_error) && in.getVector(&draco_error);
+        dc.error.assign(draco_error.begin(), draco_error.end());
+        // What add() indexes by: whole vertices, indices within them, the meshopt stream's offsets.
+        const size_t nv = p.emission.size();
+        ok = ok && p.positions.size() == 3 * nv && p.normals.size() == 3 * nv && p.indices.size() % 3 == 0 &&
+             std::all_of(p.indices.begin(), p.indices.end(), [nv](uint32_t i) { return i < nv; }) &&
+             p.packed.size() % record == 0 &&
+             (!p.ordered || std::all_of(p.ordered->begin(), p.ordered->end(),
+                                        [&](uint32_t i) { return size_t(i) < p.packed.size() / record; })) &&
+             (!impl_->options.meshopt || f.objects[o].triangles.empty() || p.ordered);
+    }
+    ok = ok && in.atEnd() && (d.meshopt.first.empty() || d.meshopt.first.size() == d.data.size());
+    if (!ok) {
+        *error = impl_->path + ": frame data from another process is malformed (frame " + std::to_string(index) + ")";
+        return false;
+    }
+    return add(f, d, error);
+}
+
+EncodedOutput GlbSink::encode(const ExportFrame& frame, const PreparedFrame* prepared) const {
+    EncodedOutput e;
+    if (!options_.draco && !options_.meshopt)
+        for (const auto& o : frame.objects) e.least += 24 * (long long)o.positions.size();  // as pending()
+    e.estimate = estimate(frame);
+    std::shared_ptr<const PreparedFrame> own;
+    if (!prepared) {
+        own = writer_->prepare(frame);
+        prepared = own.get();
+    }
+    e.bytes = writer_->encode(frame, static_cast<const GlbFrameData&>(*prepared));
+    return e;
+}
+
+PendingOutput GlbSink::pendingEncoded(long long, const EncodedOutput& frame) {
+    least_ += frame.least;
+    return {least_, model_ + ".glb"};
+}
+
+bool GlbSink::addEncoded(long long, const EncodedOutput& frame, std::vector<std::string>*, std::string* error) {
+    return writer_->addEncoded(frame.bytes, error);
 }
 
 bool writeAnimatedGlb(const std::string& path, const std::vector<ExportFrame>& frames, const SequenceInfo& info,

@@ -110,6 +110,14 @@ public:
     // order. The file is the same either way.
     std::shared_ptr<GlbFrameData> prepare(const ExportFrame& frame) const;  // shared: GlbFrameData is opaque here
     bool add(const ExportFrame& frame, const GlbFrameData& prepared, std::string* error);
+    // Frames across processes (pipeline/distribute.h): a prepared frame as bytes (its number,
+    // camera time, which objects show, and the prepared data: float32 attributes, index lists, the
+    // meshopt streams), made where the frame was cut, and add() of such bytes where the file is
+    // written, frames in order: the file is the same bytes as add(frame, prepare(frame)) gives.
+    // Cross-frame decisions (shared index buffers, Draco coding) are made by addEncoded(), so they
+    // come out as in one process. addEncoded() refuses malformed bytes with a message.
+    std::string encode(const ExportFrame& frame, const GlbFrameData& prepared) const;
+    bool addEncoded(const std::string& bytes, std::string* error);
     // Writes the file; a .glb cannot exceed 4 GiB (refused with a message). With `check`, the
     // file's whole size (JSON chunk included) is checked with it before anything is written.
     bool finish(GlbStats* stats, std::string* error, const FrameSink::OutputCheck& check = nullptr);
@@ -137,6 +145,12 @@ public:
              std::string* error) override;
     bool finish(SinkSummary* summary, std::string* error) override;
     void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
+    // Frames across processes: GlbSequenceWriter::encode and addEncoded.
+    bool beginEncoding(const SequenceInfo& info, std::string* error) override { return begin(info, error); }
+    EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const override;
+    PendingOutput pendingEncoded(long long index, const EncodedOutput& frame) override;
+    bool addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
+                    std::string* error) override;
 
 private:
     std::string path_;

@@ -40,7 +40,7 @@ struct Block {
 
 }  // namespace
 
-bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error) {
+void serializeObj(const ExportFrame& frame, std::string* out) {
     // Step: the blocks, every object's vertices first, then every object's faces, in file order.
     std::vector<Block> blocks;
     uint64_t vertices = 0;
@@ -94,17 +94,22 @@ bool writeObj(const std::string& path, const ExportFrame& frame, std::string* er
         faces += faces_in[i];
         size += texts[i].size();
     }
-    thread_local std::string all;
+    std::string& all = *out;
     all = "# " + std::to_string(vertices) + " vertices, " + std::to_string(faces) + " faces\n";
     all.reserve(all.size() + size);
     for (size_t i = 0; i < blocks.size(); ++i) all += texts[i];
+}
+
+bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error) {
+    thread_local std::string all;  // kept between frames: no reallocation while frames do not grow
+    serializeObj(frame, &all);
     // Step: written with every error checked (exporters/atomic_file.h).
     AtomicOutput out(path);
     return out.commitBytes(all, error);
 }
 
 std::unique_ptr<FrameSink> objSink(std::string dir) {
-    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj);
+    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj, serializeObj);
 }
 
 }  // namespace apparent

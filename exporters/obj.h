@@ -11,6 +11,9 @@
 
 namespace apparent {
 
+// The file's bytes for `frame` into `bytes` (the same bytes whatever the thread count).
+void serializeObj(const ExportFrame& frame, std::string* bytes);
+
 bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error);
 
 // The OBJ sink: DIR/frame_NNNNN.obj per frame (exporters/frame_files.h).

@@ -129,7 +129,7 @@ bool writePly(const std::string& path, const ExportFrame& frame, std::string* er
 }
 
 std::unique_ptr<FrameSink> plySink(std::string dir) {
-    return std::make_unique<FrameFileSink>(std::move(dir), "ply", writePly);
+    return std::make_unique<FrameFileSink>(std::move(dir), "ply", writePly, serializePly);
 }
 
 }  // namespace apparent

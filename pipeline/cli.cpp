@@ -10,6 +10,7 @@
 #include "pipeline/raytrace.h"
 #include "pipeline/render.h"
 #include "pipeline/scene_fields.h"
+#include "pipeline/shards.h"
 #include "pipeline/trade.h"
 
 namespace apparent {
@@ -181,8 +182,14 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "Stop with exit code 3 before the outputs would exceed this many bytes in all "
                            "(estimated from the first frames before writing anything; 0: no limit)")
         ->capture_default_str();
+    std::string shard_text;
+    render_cmd->add_option("--shard", shard_text,
+                           "I/N: render part I (0..N-1) of N of the frames, as one task of a job array: frames k "
+                           "with k - first = I mod N; PLY/OBJ frames to their final names, the .glb's frames into "
+                           "DIR/shards/<model>.I-of-N.shard for 'apparent merge DIR'");
     addStageLimits(render_cmd, &rs.stage);
     render_cmd->footer(kRenderFooter);
+
 
     // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
     RaytraceSettings ts;
@@ -257,6 +264,20 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         "per frame; "
         "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
         "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
+
+    // `merge`: the .glb of every model from the job-array shards in DIR/shards (pipeline/shards.h).
+    MergeSettings ms;
+    CLI::App* merge_cmd = app.add_subcommand(
+        "merge", "Assemble DIR/<model>.glb from the shards of 'render --shard I/N --out DIR' (byte-identical to one process)");
+    merge_cmd->add_option("dir", ms.out_dir, "The --out folder of the shards (reads DIR/shards)")->required();
+    merge_cmd->add_option("--max-output-bytes", ms.max_output_bytes,
+                          "Stop with exit code 3 before the .glb files would exceed this many bytes in all (0: no limit)")
+        ->capture_default_str();
+    merge_cmd->add_flag("--quiet,-q", ms.quiet, "No summary");
+    merge_cmd->add_flag("--verbose,-v", ms.verbose, "Export precision, as render --verbose");
+    merge_cmd->footer(
+        "Refuses (exit code 2, one line) a shard that is missing, duplicated, incomplete, or made from another scene,\n"
+        "other meshes or other output options (each shard holds a fingerprint of them). The shards stay in DIR/shards.");
 
     // An unknown command: CLI11 would say only "A subcommand is required"; name the nearest.
     if (argc > 1 && argv[1][0] != '-') {
@@ -367,7 +388,16 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         }
         return guarded([&] { return trade(trs, out, err); }, err);
     }
+    if (merge_cmd->parsed()) {
+        if (ms.max_output_bytes < 0) return usage("--max-output-bytes: must be positive, or 0 for no limit");
+        return guarded([&] { return merge(ms, out, err); }, err);
+    }
     if (!render_cmd->parsed()) return kExitBadInput;
+    if (!shard_text.empty()) {
+        if (!parseShard(shard_text, &rs.shard))
+            return usage("--shard: '" + shard_text + "' is not I/N with 0 <= I < N <= " + std::to_string(kMaxShards));
+        rs.sharded = true;
+    }
     if (std::string message; !parseModelList(model_text, &rs.stage, &message)) return usage(message);
     rs.formats.clear();
     {

@@ -11,6 +11,7 @@
 #include <ostream>
 #include <sstream>
 
+#include <time.h>
 #include <unistd.h>
 
 #include <tbb/parallel_for.h>
@@ -60,6 +61,13 @@ private:
     std::chrono::steady_clock::time_point start_;
     double last_ = -1;
 };
+
+// CPU time of the calling thread, seconds (user and system).
+double threadCpuSeconds() {
+    timespec t{};
+    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 }  // namespace
 
@@ -124,13 +132,25 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
                   FrameLoopResult* result, std::string* error) {
     const Scene& scene = stage.scene;
     const long long first = stage.first, last_excl = stage.last_excl;
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point loop_start = Clock::now();
+    auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    std::atomic<long long> cut_ns{0}, cut_cpu_ns{0};
+    // Frames across processes (pipeline/distribute.h): a rank other than 0 only cuts and sends.
+    FrameGroup& group = frameGroup();
+    const bool sender = settings.distributed && group.rank() > 0;
+    const bool receiver = settings.distributed && group.rank() == 0 && group.size() > 1;
+    const FrameSplit split = settings.split;
     // Step: the static 4D worlds and the mirrors' reflections, once per model.
     const std::vector<mesh4d::World4D> worlds = buildWorlds(stage.objects, model, scene, first, last_excl - 1);
     const MirrorReflections reflections(scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
     SequenceInfo info = sequenceInfo(stage, model);
     reflections.describe(&info);
     for (FrameSink* sink : sinks)
-        if (!sink->begin(info, error)) return false;
+        if (!(sender ? sink->beginEncoding(info, error) : sink->begin(info, error))) {
+            if (receiver) group.endFrames(kExitOutputError);
+            return false;
+        }
 
     // Step: per frame, cut every world with the view surface (refined to the tolerance), then deliver.
     mesh4d::SliceSettings slice_settings;
@@ -138,34 +158,47 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     slice_settings.max_triangles = size_t(settings.max_frame_triangles);
     result->max_segments = slice_settings.max_segments;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    Progress progress(progress_out, settings.progress, info.model, last_excl - first);
+    // Frames this process delivers: all of the range on MPI's rank 0, else its part.
+    const long long delivered_total = settings.distributed ? last_excl - first : split.count(first, last_excl);
+    Progress progress(progress_out, settings.progress && !sender, info.model, delivered_total);
+    long long delivered = 0;
     // Frames are independent given the static worlds: a TBB pipeline cuts them in parallel and
     // delivers them in frame order, so files are byte-identical whatever the thread count. At most
     // `tokens` frames (cut meshes and the sinks' conversions) are held at once (and the first
     // kEstimateFrames, held back for the size estimate below), so the memory of a run is bounded by
     // about (tokens + kEstimateFrames) x the per-frame budget, also for a run the budget stops.
+    // With MPI each frame is encoded on the worker that cut it (FrameSink::encode), and frames of
+    // other ranks arrive encoded (`frame` then holds only its number).
     struct Work {
         ExportFrame frame;
+        bool over_budget = false;
         std::vector<std::shared_ptr<const PreparedFrame>> prepared;  // per sink, made on the worker
+        std::unique_ptr<EncodedFrame> encoded;                       // with MPI
     };
     using WorkPtr = std::shared_ptr<Work>;
     const size_t tokens = size_t(arena.max_concurrency()) + 1;
     long long next = first;
+    while (next < last_excl && !split.owns(next, first)) ++next;
     std::atomic<bool> stop{false};  // set by the in-order stage on an error: later frames are skipped
+    int failed_code = 0;            // with MPI: the code of a failure reported by another rank
 
-    // Source, in order: the next frame number.
+    // Source, in order: the next frame number (of this process's part).
     auto source = [&](tbb::flow_control& fc) -> WorkPtr {
         if (stop || next >= last_excl) {
             fc.stop();
             return nullptr;
         }
         auto w = std::make_shared<Work>();
-        w->frame.index = next++;
+        w->frame.index = next;
+        next += split.parts;
+        ++result->frames_cut;
         return w;
     };
     // In parallel: cut every world with the frame's view surface, then each sink's conversion.
     auto cutFrame = [&](WorkPtr w) -> WorkPtr {
         if (stop) return w;
+        const Clock::time_point cut_start = Clock::now();
+        const double cpu_start = threadCpuSeconds();
         ExportFrame& frame = w->frame;
         const long long k = frame.index;
         frame.t_c = frameTime(scene.frames, k);
@@ -185,15 +218,35 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
         // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
         reflections.append(view, slice_settings, &frame.objects, &stage.tolerances);
         APPARENT_CHECK(frame.objects.size(), ==, info.objects.size());
-        if (!overBudget(frame, settings.max_frame_triangles))
+        w->over_budget = overBudget(frame, settings.max_frame_triangles);
+        if (!w->over_budget)
             for (const FrameSink* sink : sinks) w->prepared.push_back(sink->prepare(frame));
+        if (settings.distributed) {
+            // The frame as it travels; the cut mesh and the conversions are released here.
+            auto e = std::make_unique<EncodedFrame>();
+            e->index = k;
+            e->triangles = frame.triangleCount();
+            for (const auto& o : frame.objects) e->limited_triangles += o.limited_triangles;
+            e->over_budget = w->over_budget;
+            for (size_t s = 0; !w->over_budget && s < sinks.size(); ++s)
+                e->sinks.push_back(sinks[s]->encode(frame, w->prepared[s].get()));
+            w->prepared.clear();
+            frame.objects.clear();
+            frame.objects.shrink_to_fit();
+            w->encoded = std::move(e);
+        }
+        cut_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - cut_start).count();
+        cut_cpu_ns += (long long)(1e9 * (threadCpuSeconds() - cpu_start));
         return w;
     };
     // Sink, in order: the budget checks, then every sink gets the frame.
     auto deliverOne = [&](const WorkPtr& w) {
         if (stop) return;
+        const Clock::time_point write_start = Clock::now();
+        const double cpu_start = threadCpuSeconds();
         const ExportFrame& frame = w->frame;
-        if (overBudget(frame, settings.max_frame_triangles)) {
+        const EncodedFrame* e = w->encoded.get();
+        if (w->over_budget) {
             result->over_budget = true;
             *error = scene.path + ": frame " + std::to_string(frame.index) + ": tolerance " +
                      formatNumber(scene.tolerance) + " makes more than " + std::to_string(settings.max_frame_triangles) +
@@ -201,21 +254,27 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
             stop = true;
             return;
         }
-        result->max_triangles = std::max(result->max_triangles, frame.triangleCount());
-        for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
+        result->max_triangles = std::max(result->max_triangles, e ? size_t(e->triangles) : frame.triangleCount());
+        if (e)
+            result->limited_triangles += size_t(e->limited_triangles);
+        else
+            for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
         for (size_t s = 0; s < sinks.size(); ++s) {
             // Refused before writing beyond the limit; every completed file counted after.
-            const PendingOutput pending = sinks[s]->pending(frame);
+            const PendingOutput pending = e ? sinks[s]->pendingEncoded(frame.index, e->sinks[s]) : sinks[s]->pending(frame);
             std::vector<std::string> completed;
             bool done = budget->fits(pending.bytes, pending.name, error) &&
-                        sinks[s]->add(frame, w->prepared[s].get(), &completed, error);
+                        (e ? sinks[s]->addEncoded(frame.index, e->sinks[s], &completed, error)
+                           : sinks[s]->add(frame, w->prepared[s].get(), &completed, error));
             for (size_t c = 0; done && c < completed.size(); ++c) done = budget->count(completed[c], error);
             if (!done) {
                 stop = true;
                 return;
             }
         }
-        progress.update(frame.index - first + 1);
+        progress.update(++delivered);
+        result->write_seconds += since(write_start);
+        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
     };
     // Before the first write: the output size estimated from the first kEstimateFrames frames
     // (held back until then), scaled to the whole run. A frame past --max-triangles is reported
@@ -226,42 +285,128 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     auto deliver = [&](WorkPtr w) {
         if (stop) return;
         // A frame past the budget ends the run at once (nothing held is written).
-        if (estimated || overBudget(w->frame, settings.max_frame_triangles)) return deliverOne(w);
+        if (estimated || w->over_budget) return deliverOne(w);
         held.push_back(std::move(w));
-        if (held.size() < kEstimateFrames && held.back()->frame.index + 1 < last_excl) return;
+        if (held.size() < kEstimateFrames && held.size() < size_t(delivered_total)) return;
         estimated = true;
         double bytes = 0;
         bool too_many = false;
         for (const WorkPtr& h : held) {
-            too_many = too_many || overBudget(h->frame, settings.max_frame_triangles);
-            for (const FrameSink* sink : sinks) bytes += double(sink->estimate(h->frame));
+            too_many = too_many || h->over_budget;
+            for (size_t s = 0; s < sinks.size(); ++s)
+                bytes += double(h->encoded ? h->encoded->sinks[s].estimate : sinks[s]->estimate(h->frame));
         }
         if (too_many) bytes = 0;
-        const double whole = bytes / double(held.size()) * double(last_excl - first) * double(settings.models_left);
-        if (!budget->fitsEstimate(whole, (long long)held.size(), last_excl - first, error)) {
+        const double whole = bytes / double(held.size()) * double(delivered_total) * double(settings.models_left);
+        if (!budget->fitsEstimate(whole, (long long)held.size(), delivered_total, error)) {
             stop = true;
             return;
         }
         for (const WorkPtr& h : held) deliverOne(h);
         held.clear();
     };
-    arena.execute([&] {
-        tbb::parallel_pipeline(tokens, tbb::make_filter<void, WorkPtr>(tbb::filter_mode::serial_in_order, source) &
-                                           tbb::make_filter<WorkPtr, WorkPtr>(tbb::filter_mode::parallel, cutFrame) &
-                                           tbb::make_filter<WorkPtr, void>(tbb::filter_mode::serial_in_order, deliver));
-    });
-    if (stop) return false;
+    // MPI rank 0: the frames of other ranks before frame `until`, received in order and delivered.
+    long long remote_next = first;
+    auto receiveUpTo = [&](long long until) {
+        for (; !stop && remote_next < until; ++remote_next) {
+            const int from = FrameSplit{0, group.size()}.partOf(remote_next, first);
+            if (from == 0) continue;
+            std::string bytes;
+            auto w = std::make_shared<Work>();
+            w->encoded = std::make_unique<EncodedFrame>();
+            const Clock::time_point wait_start = Clock::now();
+            const bool received = group.receiveFrame(from, &bytes, &failed_code, error);
+            result->wait_seconds += since(wait_start);
+            if (!received || !deserializeFrame(bytes, w->encoded.get(), error)) {
+                if (!failed_code) failed_code = 1;
+                stop = true;
+                return;
+            }
+            if (w->encoded->index != remote_next || w->encoded->sinks.size() != (w->encoded->over_budget ? 0 : sinks.size())) {
+                *error = "internal: rank " + std::to_string(from) + " sent frame " + std::to_string(w->encoded->index) +
+                         " where frame " + std::to_string(remote_next) + " was due";
+                failed_code = 1;
+                stop = true;
+                return;
+            }
+            w->frame.index = remote_next;
+            w->over_budget = w->encoded->over_budget;
+            deliver(std::move(w));
+        }
+    };
+    // The in-order stage: deliver (rank 0: after the frames of other ranks before it), or send.
+    auto inOrder = [&](WorkPtr w) {
+        if (sender) {
+            if (stop || (stop = group.stopRequested())) return;
+            group.sendFrame(serializeFrame(*w->encoded));
+            return;
+        }
+        if (receiver) {
+            receiveUpTo(w->frame.index);
+            remote_next = w->frame.index + 1;
+        }
+        deliver(std::move(w));
+    };
+    auto run = [&] {
+        // Where the time went (FrameLoopResult), whichever way the loop ends.
+        struct Account {
+            FrameLoopResult* r;
+            const std::atomic<long long>& cut;
+            const std::atomic<long long>& cut_cpu;
+            const long long& written;
+            Clock::time_point start;
+            ~Account() {
+                r->cut_seconds = double(cut) * 1e-9;
+                r->cut_cpu_seconds = double(cut_cpu) * 1e-9;
+                r->frames_written = written;
+                r->loop_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+            }
+        } account{result, cut_ns, cut_cpu_ns, delivered, loop_start};
+        arena.execute([&] {
+            tbb::parallel_pipeline(tokens, tbb::make_filter<void, WorkPtr>(tbb::filter_mode::serial_in_order, source) &
+                                               tbb::make_filter<WorkPtr, WorkPtr>(tbb::filter_mode::parallel, cutFrame) &
+                                               tbb::make_filter<WorkPtr, void>(tbb::filter_mode::serial_in_order, inOrder));
+        });
+        if (receiver) receiveUpTo(last_excl);
+    };
+    if (sender) {
+        // A failure here goes to rank 0 as this rank's ERROR; every rank then leaves with rank 0's code.
+        try {
+            run();
+        } catch (const std::bad_alloc&) {
+            group.sendError(kExitOutputError, "out of memory on rank " + std::to_string(group.rank()) +
+                                                  " (try a coarser --tolerance, fewer frames or more ranks)");
+        } catch (const std::exception& e) {
+            group.sendError(1, std::string("internal: rank ") + std::to_string(group.rank()) + ": " + e.what());
+        }
+        result->group_code = group.finishSending();
+        return result->group_code == 0;
+    }
+    // Rank 0 with MPI: tell the other ranks how this loop ended (after the sinks are done).
+    auto fail = [&](int code) {
+        if (receiver) group.endFrames(code);
+        result->group_code = code;
+        return false;
+    };
+    run();
+    if (stop) return fail(failed_code ? failed_code : result->over_budget ? kExitBadInput : kExitOutputError);
 
     // Step: what needs the whole sequence (the .glb is assembled here).
+    const Clock::time_point finish_start = Clock::now();
+    const double finish_cpu = threadCpuSeconds();
     result->summaries.assign(sinks.size(), {});
     for (size_t s = 0; s < sinks.size(); ++s) {
         sinks[s]->setFinishCheck([budget](long long bytes, const std::string& name, std::string* e) {
             return budget->fits(bytes, name, e);
         });
-        if (!sinks[s]->finish(&result->summaries[s], error)) return false;
+        if (!sinks[s]->finish(&result->summaries[s], error)) return fail(kExitOutputError);
         for (const std::string& path : result->summaries[s].completed)
-            if (!budget->count(path, error)) return false;
+            if (!budget->count(path, error)) return fail(kExitOutputError);
     }
+    result->write_seconds += since(finish_start);
+    result->write_cpu_seconds += threadCpuSeconds() - finish_cpu;
+    result->loop_seconds = since(loop_start);
+    if (receiver) group.endFrames(0);
     return true;
 }
 

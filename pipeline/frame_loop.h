@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "exporters/frame_sink.h"
+#include "pipeline/distribute.h"
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 
@@ -62,6 +63,12 @@ struct FrameLoopSettings {
     // Models still to run with the same budget, this one included: the estimate made from the
     // first frames before writing (OutputBudget::fitsEstimate) counts them all.
     long long models_left = 1;
+    // This process's part of the frames (pipeline/distribute.h): a job-array shard renders only
+    // its part, and the output budget's estimate scales to the part's frames.
+    FrameSplit split;
+    // MPI: the frames of every rank of frameGroup() (`split` is then the rank's): rank r > 0 cuts
+    // and encodes its part and sends it; rank 0 writes every frame in order into the sinks.
+    bool distributed = false;
 };
 
 struct FrameLoopResult {
@@ -70,6 +77,17 @@ struct FrameLoopResult {
     size_t max_segments = 0;             // that limit
     std::vector<SinkSummary> summaries;  // per sink, in the order given
     bool over_budget = false;            // stopped at max_frame_triangles: the error is bad input
+    // MPI: the exit code the group agreed on when the loop failed (rank r > 0 has no message then:
+    // rank 0 prints it); 0 otherwise.
+    int group_code = 0;
+    // Where the time went (wall clock, seconds): cutting, converting and encoding the frames this
+    // process cut, summed over its threads; writing (the sinks' add and finish, in order, one
+    // thread); with MPI, rank 0 waiting for frames of other ranks. render --verbose prints them.
+    double cut_seconds = 0, write_seconds = 0, wait_seconds = 0, loop_seconds = 0;
+    // The same as the CPU time of the threads that did it (not slowed by other processes sharing
+    // the cores; a nested parallel loop's work stolen by another thread is not counted).
+    double cut_cpu_seconds = 0, write_cpu_seconds = 0;
+    long long frames_cut = 0, frames_written = 0;
 };
 
 // What the sinks are told about the sequence of `model`: objects (then the reflections, see

@@ -17,6 +17,7 @@
 #include "mesh4d/angles.h"
 #include "mesh4d/doppler_colour.h"
 #include "mesh4d/light_factors.h"
+#include "pipeline/distribute.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -211,68 +212,95 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
     return frame;
 }
 
-int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err) {
+int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostream& err_out) {
+    // Under mpirun the ranks share the frames as render's do (pipeline/distribute.h): rank r traces
+    // frames k with k - first = r mod N and sends each picture to rank 0, which writes the PNG files
+    // and the video in frame order; the other ranks print nothing.
+    FrameGroup& group = frameGroup();
+    const bool sender = group.rank() > 0, receiver = group.rank() == 0 && group.size() > 1;
+    std::ostringstream silent;
+    std::ostream& log = sender ? silent : log_out;
+    std::ostream& err = sender ? silent : err_out;
     // Step: the stage: scene, models, frames, meshes, mirrors; then the video's one model and ffmpeg.
     Stage stage;
     StageOptions stage_options = settings.stage;
-    stage_options.quiet = settings.quiet;
+    stage_options.quiet = settings.quiet || sender;
     std::string error;
-    if (!loadStage(stage_options, &stage, err, &error)) {
-        err << "error: " << error << "\n";
-        return kExitBadInput;
-    }
+    int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     const bool video = !settings.video_path.empty();
-    if (video && stage.models.size() != 1) {
-        err << "error: --video: a video shows one model (" << stage.models.size()
-            << " asked); `apparent figure --video` shows several side by side\n";
-        return kExitBadInput;
+    if (!code && !sender && video && stage.models.size() != 1) {
+        error = "--video: a video shows one model (" + std::to_string(stage.models.size()) +
+                " asked); `apparent figure --video` shows several side by side";
+        code = kExitBadInput;
     }
-    if (video && findInPath("ffmpeg").empty()) {
-        err << "error: " << ffmpegMissingMessage("--video") << "\n";
-        return kExitBadInput;
+    if (!code && !sender && video && findInPath("ffmpeg").empty()) {
+        error = ffmpegMissingMessage("--video");
+        code = kExitBadInput;
+    }
+    if ((code = group.agree(code, &error))) {
+        err << "error: " << error << "\n";
+        return code;
     }
     const long long first = stage.first, last_excl = stage.last_excl;
+    const FrameSplit split{group.rank(), group.size()};
 
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    TraceProgress progress(err, !settings.quiet,
+    TraceProgress progress(err, !settings.quiet && !sender,
                            (long long)stage.models.size() * (last_excl - first) * settings.height);
     for (Model model : stage.models) {
         const auto start = std::chrono::steady_clock::now();
+        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
+        tracer.setShadeDoppler(settings.shade_doppler);
+        if (sender) {
+            // Step (rank r > 0): trace this rank's frames and send each picture, until rank 0 says END.
+            for (long long k = first + split.part; k < last_excl && !group.stopRequested(); k += split.parts) {
+                TracedFrame frame;
+                arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height, nullptr); });
+                group.sendFrame(std::string(frame.image.rgb.begin(), frame.image.rgb.end()));
+            }
+            if (const int end = group.finishSending()) return end;
+            continue;
+        }
+        // Rank 0 (or one process): a failure ends every rank's frames with its code.
+        auto fail = [&](int c, const std::string& message) {
+            if (receiver) group.endFrames(c);
+            err << "error: " << message << "\n";
+            return c;
+        };
         // Step: the folder, then the static worlds once per model, then every frame.
         const std::string dir = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
         if (settings.write_png) {
             std::error_code ec;
             std::filesystem::create_directories(dir, ec);
-            if (ec) {
-                err << "error: " << dir << ": cannot create output folder: " << ec.message() << "\n";
-                return kExitOutputError;
-            }
+            if (ec) return fail(kExitOutputError, dir + ": cannot create output folder: " + ec.message());
         }
         VideoWriter writer;
-        if (video && !writer.open(settings.video_path, settings.width, settings.height, stage.scene.frames.fps, &error)) {
-            err << "error: " << error << "\n";
-            return kExitOutputError;
-        }
-        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
-        tracer.setShadeDoppler(settings.shade_doppler);
+        if (video && !writer.open(settings.video_path, settings.width, settings.height, stage.scene.frames.fps, &error))
+            return fail(kExitOutputError, error);
         for (long long k = first; k < last_excl; ++k) {
             progress.setLabel(std::string(modelName(model)) + " frame " + std::to_string(k));
             TracedFrame frame;
-            arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height, &progress); });
+            if (split.partOf(k, first) == 0) {
+                arena.execute([&] { frame = tracer.traceFrame(k, settings.width, settings.height, &progress); });
+            } else {
+                std::string bytes;
+                int remote = 0;
+                if (!group.receiveFrame(split.partOf(k, first), &bytes, &remote, &error))
+                    return fail(remote ? remote : 1, error);
+                frame.image = RgbImage(settings.width, settings.height);
+                if (bytes.size() != frame.image.rgb.size())
+                    return fail(1, "internal: rank " + std::to_string(split.partOf(k, first)) + " sent a picture of " +
+                                       std::to_string(bytes.size()) + " bytes for frame " + std::to_string(k));
+                std::copy(bytes.begin(), bytes.end(), frame.image.rgb.begin());
+                for (int row = 0; row < settings.height; ++row) progress.rowDone();
+            }
             if (settings.write_png &&
-                !writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error)) {
-                err << "error: " << error << "\n";
-                return kExitOutputError;
-            }
-            if (video && !writer.addFrame(frame.image, &error)) {
-                err << "error: " << error << "\n";
-                return kExitOutputError;
-            }
+                !writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error))
+                return fail(kExitOutputError, error);
+            if (video && !writer.addFrame(frame.image, &error)) return fail(kExitOutputError, error);
         }
-        if (video && !writer.finish(&error)) {
-            err << "error: " << error << "\n";
-            return kExitOutputError;
-        }
+        if (video && !writer.finish(&error)) return fail(kExitOutputError, error);
+        if (receiver) group.endFrames(0);
         progress.finish();
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!settings.quiet) {
@@ -281,6 +309,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& 
                 << std::setprecision(6);
             if (settings.write_png) log << ", " << dir << "/";
             if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
+            if (receiver) log << ", " << group.size() << " processes shared the frames";
             log << "\n";
         }
     }

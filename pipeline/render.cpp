@@ -5,10 +5,12 @@
 #include <functional>
 #include <memory>
 #include <ostream>
+#include <sstream>
 
 #include "exporters/obj.h"
 #include "exporters/ply.h"
 #include "pipeline/mesh_check.h"
+#include "pipeline/shards.h"
 
 namespace apparent {
 
@@ -21,6 +23,36 @@ struct OutputFormat {
     std::string name;
     std::function<std::unique_ptr<FrameSink>(const RenderSettings&, const std::string& base)> make;
 };
+
+// Every setting that changes an output, as text: part of a shard's fingerprint (pipeline/shards.h).
+std::string outputSettings(const RenderSettings& s, const Stage& stage) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "models";
+    for (Model m : stage.models) os << " " << modelName(m);
+    os << "\nformats";
+    for (const std::string& f : s.formats) os << " " << f;
+    os << "\nframes " << stage.first << " " << stage.last_excl << "\ntolerance " << stage.scene.tolerance;
+    for (double t : stage.tolerances) os << " " << t;
+    const GlbOptions& g = s.glb;
+    os << "\nglb " << g.draco << " " << g.position_bits << " " << g.normal_bits << " " << g.meshopt << " "
+       << g.meshopt_bits << " " << g.doppler << " " << g.proper_time << " " << g.shade_doppler << "\ncull "
+       << s.cull_view << "\nmax-triangles " << s.max_frame_triangles << "\nscene " << stage.scene.path << "\n";
+    return os.str();
+}
+
+// The files a run reads: the scene and every mesh (a glTF node reference without its "#node").
+std::vector<std::string> inputFiles(const Stage& stage) {
+    std::vector<std::string> files = {stage.scene.path};
+    for (const PreparedObject& o : stage.objects) {
+        std::string mesh = o.spec.mesh_path;
+        std::error_code ec;
+        if (const auto hash = mesh.rfind('#'); hash != std::string::npos && !std::filesystem::exists(mesh, ec))
+            mesh.resize(hash);
+        if (!mesh.empty() && std::find(files.begin(), files.end(), mesh) == files.end()) files.push_back(mesh);
+    }
+    return files;
+}
 
 // In the order the sinks take each frame (the byte budget checks them in this order too).
 const std::vector<OutputFormat>& formatTable() {
@@ -46,13 +78,30 @@ const std::vector<std::string>& outputFormats() {
     return names;
 }
 
-int render(const RenderSettings& settings, std::ostream& log, std::ostream& err) {
-    // Step: the stage: scene, models, frames, meshes, mirrors.
+int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& err_out) {
+    // Under mpirun the ranks other than 0 print nothing: rank 0 speaks for the job.
+    FrameGroup& group = frameGroup();
+    const bool distributed = group.size() > 1;
+    std::ostringstream silent;
+    std::ostream& log = group.rank() == 0 ? log_out : silent;
+    std::ostream& err = group.rank() == 0 ? err_out : silent;
+    if (distributed && settings.sharded) {
+        err << "error: --shard: not under mpirun with " << group.size()
+            << " processes (the ranks already share the frames); run each shard as its own process\n";
+        return kExitBadInput;
+    }
+    // Step: the stage: scene, models, frames, meshes, mirrors (every rank loads it; all agree).
     Stage stage;
     std::string error;
     StageOptions stage_options = settings.stage;
-    stage_options.quiet = settings.quiet;
-    if (!loadStage(stage_options, &stage, err, &error)) {
+    stage_options.quiet = settings.quiet || group.rank() > 0;
+    const bool loaded = loadStage(stage_options, &stage, err, &error);
+    if (const int code = group.agree(loaded ? kExitOk : kExitBadInput, &error)) {
+        err << "error: " << error << "\n";
+        return code;
+    }
+    uint64_t fingerprint = 0;
+    if (settings.sharded && !runFingerprint(inputFiles(stage), outputSettings(settings, stage), &fingerprint, &error)) {
         err << "error: " << error << "\n";
         return kExitBadInput;
     }
@@ -67,7 +116,7 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     std::error_code ec;
     // A folder this run creates is removed again when the run stops before writing into it.
     const bool had_folder = std::filesystem::exists(settings.out_dir, ec);
-    std::filesystem::create_directories(settings.out_dir, ec);
+    if (group.rank() == 0) std::filesystem::create_directories(settings.out_dir, ec);
     if (ec) {
         err << "error: " << settings.out_dir << ": cannot create output folder: " << ec.message() << "\n";
         return kExitOutputError;
@@ -82,10 +131,17 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
     loop.cull_view = settings.cull_view;
     loop.progress = !settings.quiet;
     loop.models_left = (long long)stage.models.size();
+    loop.distributed = distributed;
+    if (distributed) loop.split = FrameSplit{group.rank(), group.size()};
+    if (settings.sharded) loop.split = settings.shard;
     std::vector<std::string> created;  // DIR/<model> folders of per-frame files that did not exist
     for (Model model : stage.models) {
         const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
         if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
+    }
+    if (settings.sharded) {
+        const std::string shards = (std::filesystem::path(settings.out_dir) / "shards").string();
+        if (!std::filesystem::exists(shards, ec)) created.push_back(shards);
     }
     for (Model model : stage.models) {
         const std::string name = modelName(model);
@@ -94,18 +150,24 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
         std::vector<FrameSink*> sinks;
         for (const OutputFormat& f : formatTable()) {
             if (std::find(settings.formats.begin(), settings.formats.end(), f.name) == settings.formats.end()) continue;
-            owned.push_back(f.make(settings, base));
+            if (settings.sharded && f.name == "glb")
+                owned.push_back(glbShardSink(settings.out_dir, name, settings.glb, settings.shard, fingerprint,
+                                             stage.first, stage.last_excl));
+            else
+                owned.push_back(f.make(settings, base));
             sinks.push_back(owned.back().get());
         }
         FrameLoopResult result;
         const bool ran = runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error);
         --loop.models_left;
+        if (!ran && group.rank() > 0) return result.group_code;  // rank 0 reports it
         if (!ran) {
             owned.clear();  // the sinks remove their temporaries
             // Folders this run created and left empty go too (remove() takes only empty ones).
             for (const std::string& folder : created) std::filesystem::remove(folder, ec);
             if (!had_folder) std::filesystem::remove(settings.out_dir, ec);
             err << "error: " << error << "\n";
+            if (result.group_code) return result.group_code;
             return result.over_budget ? kExitBadInput : kExitOutputError;
         }
         // Step: the summary: the sinks' warnings and files, and the refinement limit if reached.
@@ -120,9 +182,27 @@ int render(const RenderSettings& settings, std::ostream& log, std::ostream& err)
                 << " triangle-frames reached the refinement limit of " << result.max_segments
                 << " segments; the tolerance " << stage.scene.tolerance
                 << " ls is not met there (a coarser tolerance or a finer input mesh helps)\n";
+        if (distributed) summary += ", " + std::to_string(group.size()) + " processes shared the frames";
+        if (settings.verbose && !settings.quiet) {
+            // Where the time went (FrameLoopResult): what decides how far more processes help.
+            std::ostringstream t;
+            t.setf(std::ios::fixed);
+            t.precision(1);
+            const double wall = result.loop_seconds > 0 ? result.loop_seconds : 1;
+            auto perFrame = [](double seconds, long long frames) { return 1e3 * seconds / double(std::max(1LL, frames)); };
+            t << name << ": loop " << result.loop_seconds << " s; per frame: cut and encode "
+              << perFrame(result.cut_seconds, result.frames_cut) << " ms (CPU "
+              << perFrame(result.cut_cpu_seconds, result.frames_cut) << " ms; " << result.frames_cut
+              << " frames cut here), write " << perFrame(result.write_seconds, result.frames_written) << " ms (CPU "
+              << perFrame(result.write_cpu_seconds, result.frames_written) << " ms; " << result.frames_written
+              << " frames, " << 100 * result.write_seconds / wall << "% of the loop" << (distributed ? " on rank 0" : "")
+              << ")";
+            if (distributed) t << "; rank 0 waited " << result.wait_seconds << " s for other ranks";
+            log << t.str() << "\n";
+        }
         if (!settings.quiet)
-            log << name << ": " << (stage.last_excl - stage.first) << " frames, up to " << result.max_triangles
-                << " triangles" << summary << "\n";
+            log << name << ": " << (settings.sharded ? loop.split.count(stage.first, stage.last_excl) : stage.last_excl - stage.first)
+                << " frames, up to " << result.max_triangles << " triangles" << summary << "\n";
     }
     return kExitOk;
 }

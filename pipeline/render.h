@@ -1,6 +1,8 @@
 // `apparent render`: options in, the stage (pipeline/stage.h), for each model the frame loop
 // (pipeline/frame_loop.h) into one sink per output format (exporters/frame_sink.h), then the
 // summary. Exit codes: 0 success, 2 bad input or usage, 3 output could not be written.
+// Under mpirun (frameGroup() of more than one rank) the ranks share the frames and rank 0 writes
+// (pipeline/distribute.h); with --shard I/N it renders one job-array shard (pipeline/shards.h).
 #pragma once
 
 #include <iosfwd>
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "exporters/gltf.h"
+#include "pipeline/distribute.h"
 #include "pipeline/frame_loop.h"
 #include "pipeline/stage.h"
 
@@ -29,6 +32,9 @@ struct RenderSettings {
     // estimate from the first frames, before anything is written.
     long long max_output_bytes = kDefaultMaxOutputBytes;
     long long max_frame_triangles = 0;  // --max-triangles: per frame; 0: defaultFrameTriangleBudget
+    // --shard I/N: render part I of N of the frames into DIR/shards (pipeline/shards.h).
+    bool sharded = false;
+    FrameSplit shard;
 };
 
 // The names --format accepts, in the order their sinks take each frame: "ply", "obj", "glb".

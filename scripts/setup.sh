@@ -22,6 +22,7 @@ packages=(build-essential cmake pkg-config
   libmeshoptimizer-dev  # EXT_meshopt_compression in the .glb (--compress meshopt)
   gnuplot-nox gltfpack  # gltfpack: the peer of benchmarks/load_bench; gnuplot draws `apparent trade`'s plot (DIR/trade.png) and docs/accuracy.png
   libfreetype-dev fonts-dejavu-core ffmpeg)  # figure labels; raytrace/figure --video (and ffprobe in the tests)
+packages+=(libopenmpi-dev openmpi-bin)  # mpirun -n N apparent render (optional in CMake; the mpi_ranks test needs it)
 if [ "$mode" = test ]; then
   packages+=(chromium)            # three.js viewer test (tests/web), headless
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)

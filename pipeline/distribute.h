@@ -1,0 +1,91 @@
+// Frames across processes: how the frames of a sequence are split between processes, and how a
+// frame cut on one process reaches the process that writes the files. Two users:
+// - job-array shards (`render --shard I/N`, pipeline/shards.h): N independent processes, each
+//   renders its part of the frames; `apparent merge` assembles the .glb afterwards;
+// - MPI (`mpirun -n N apparent render ...`, pipeline/mpi_group.cpp): rank r cuts and encodes its
+//   part, rank 0 writes every output in frame order.
+// The split is interleaved: frame k (of frames [first, last)) belongs to part (k - first) mod N.
+// Neighbouring frames cost about the same (the scene changes smoothly), so every part gets an
+// even share of the work whatever the cost profile along the sequence, and rank 0 receives frames
+// in the order the ranks make them (no part runs far ahead of the writer).
+//
+// The MPI protocol (FrameGroup below, one exchange per model's frame loop), rank r > 0:
+//   for each of its frames, in order: FRAME (the EncodedFrame; a synchronous send, so a rank holds
+//   at most its frame loop's tokens of frames: bounded memory), or, when it fails, ERROR (exit code and
+//   the one-line message) instead, and no more frames; before each frame it checks for END from
+//   rank 0 and stops sending when it came; then DONE; then it waits for END(code).
+// Rank 0 receives the frames in frame order from their ranks (one at a time: bounded memory) and
+// writes them; at the end (the files committed), or as soon as it fails or receives an ERROR, it
+// sends END(code) to every rank and then drains each rank's messages up to its DONE (which
+// unblocks a rank stuck in a send).
+// Every rank then leaves the loop with rank 0's code; rank 0 alone prints the message, after its
+// sinks removed their temporary files. A rank that dies (a signal, the OOM killer) is mpirun's to
+// handle: it ends the job; files are committed by rename only, so none is left truncated.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "exporters/frame_sink.h"
+
+namespace apparent {
+
+// Part `part` of `parts` (0 <= part < parts) of the frames.
+struct FrameSplit {
+    int part = 0;
+    int parts = 1;
+    // Whether frame k of a sequence starting at `first` is this part's.
+    bool owns(long long k, long long first) const { return (k - first) % parts == part; }
+    // The part frame k belongs to.
+    int partOf(long long k, long long first) const { return int((k - first) % parts); }
+    // How many of frames [first, last_excl) are this part's.
+    long long count(long long first, long long last_excl) const {
+        const long long n = last_excl - first;
+        return n / parts + (part < n % parts ? 1 : 0);
+    }
+};
+
+// One frame as it travels: its number, what the frame loop's checks need (triangle counts, the
+// per-frame budget) and each sink's encoding (FrameSink::encode), in the loop's sink order.
+struct EncodedFrame {
+    long long index = 0;
+    uint64_t triangles = 0;          // ExportFrame::triangleCount()
+    uint64_t limited_triangles = 0;  // summed over objects
+    bool over_budget = false;                  // past --max-triangles: no sink data
+    std::vector<EncodedOutput> sinks;
+};
+
+// The frame as bytes and back (false when `bytes` is not one: a message then).
+std::string serializeFrame(const EncodedFrame& frame);
+bool deserializeFrame(const std::string& bytes, EncodedFrame* frame, std::string* error);
+
+// The processes of one run and the messages between them (MPI). The single-process group is
+// the default; main() installs the MPI group when the program runs under mpirun or srun.
+class FrameGroup {
+public:
+    virtual ~FrameGroup() = default;
+    virtual int rank() const { return 0; }
+    virtual int size() const { return 1; }
+    // Every rank calls it with its own status (code 0: fine): returns the code of the lowest rank
+    // that failed, and on rank 0 its message in `error` (the failing rank's own line), else 0.
+    virtual int agree(int code, std::string* error) { (void)error; return code; }
+
+    // The frame protocol above. Rank r > 0:
+    virtual bool stopRequested() { return false; }             // END has come
+    virtual void sendFrame(const std::string& /*bytes*/) {}
+    virtual void sendError(int /*code*/, const std::string& /*message*/) {}
+    virtual int finishSending() { return 0; }                   // DONE, then END's code
+    // Rank 0: frame k from rank `from`: the bytes, or false with the rank's code and message.
+    virtual bool receiveFrame(int /*from*/, std::string* /*bytes*/, int* /*code*/, std::string* /*error*/) {
+        return false;
+    }
+    virtual void endFrames(int /*code*/) {}                     // END(code) to all, then up to every DONE
+};
+
+// The group of this process (single until setFrameGroup installs another).
+FrameGroup& frameGroup();
+void setFrameGroup(std::unique_ptr<FrameGroup> group);
+
+}  // namespace apparent

@@ -1,0 +1,204 @@
+#include "pipeline/mpi_group.h"
+
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <mpi.h>
+#include <unistd.h>
+
+#include "pipeline/distribute.h"
+
+namespace apparent {
+
+namespace {
+
+// Message tags of the protocol (distribute.h).
+constexpr int kTagFrame = 1;  // 8 bytes: the frame's size; its bytes follow in kTagChunk messages
+constexpr int kTagChunk = 2;
+constexpr int kTagError = 3;  // int32 exit code, then the one-line message
+constexpr int kTagDone = 4;   // empty: no more frames from this rank
+constexpr int kTagEnd = 5;    // int32: rank 0's code for the loop
+constexpr int kTagAgree = 6;  // the message of the lowest failing rank, for rank 0
+constexpr size_t kChunk = size_t(1) << 30;  // MPI counts are int: frames go in pieces of 1 GiB
+
+class MpiFrameGroup final : public FrameGroup {
+public:
+    MpiFrameGroup() {
+        MPI_Comm_dup(MPI_COMM_WORLD, &comm_);
+        MPI_Comm_rank(comm_, &rank_);
+        MPI_Comm_size(comm_, &size_);
+        done_.assign(size_t(size_), false);
+    }
+    ~MpiFrameGroup() override = default;
+
+    int rank() const override { return rank_; }
+    int size() const override { return size_; }
+
+    int agree(int code, std::string* error) override {
+        const int mine = code ? rank_ : size_;
+        int lowest = size_;
+        MPI_Allreduce(&mine, &lowest, 1, MPI_INT, MPI_MIN, comm_);
+        if (lowest == size_) return 0;
+        int agreed = code;
+        MPI_Bcast(&agreed, 1, MPI_INT, lowest, comm_);
+        if (lowest != 0 && rank_ == lowest)
+            MPI_Send(error->data(), int(std::min(error->size(), size_t(1) << 20)), MPI_CHAR, 0, kTagAgree, comm_);
+        if (lowest != 0 && rank_ == 0) {
+            *error = receiveBytes(lowest, kTagAgree);
+            *error += " (rank " + std::to_string(lowest) + ")";
+        }
+        return agreed;
+    }
+
+    bool stopRequested() override {
+        int flag = 0;
+        MPI_Iprobe(0, kTagEnd, comm_, &flag, MPI_STATUS_IGNORE);
+        return flag != 0;
+    }
+
+    void sendFrame(const std::string& bytes) override {
+        // Synchronous: it returns once rank 0 has started to receive this frame, so a rank is never
+        // more than one frame ahead of the writer, however small its frames (a plain send of a
+        // message under the eager limit would return at once and let frames pile up on rank 0).
+        const uint64_t n = bytes.size();
+        MPI_Ssend(&n, 8, MPI_BYTE, 0, kTagFrame, comm_);
+        for (size_t at = 0; at < bytes.size(); at += kChunk)
+            MPI_Send(bytes.data() + at, int(std::min(kChunk, bytes.size() - at)), MPI_BYTE, 0, kTagChunk, comm_);
+    }
+
+    void sendError(int code, const std::string& message) override {
+        std::string m(4, '\0');
+        const int32_t c = code;
+        std::memcpy(&m[0], &c, 4);
+        m += message.substr(0, size_t(1) << 20);
+        MPI_Send(m.data(), int(m.size()), MPI_CHAR, 0, kTagError, comm_);
+    }
+
+    int finishSending() override {
+        MPI_Send(nullptr, 0, MPI_BYTE, 0, kTagDone, comm_);
+        int32_t code = 0;
+        MPI_Recv(&code, 1, MPI_INT32_T, 0, kTagEnd, comm_, MPI_STATUS_IGNORE);
+        return code;
+    }
+
+    bool receiveFrame(int from, std::string* bytes, int* code, std::string* error) override {
+        MPI_Status status;
+        MPI_Probe(from, MPI_ANY_TAG, comm_, &status);
+        if (status.MPI_TAG == kTagFrame) {
+            receiveFrameBody(from, bytes);
+            return true;
+        }
+        if (status.MPI_TAG == kTagError) {
+            const std::string m = receiveBytes(from, kTagError);
+            int32_t c = 1;
+            if (m.size() >= 4) std::memcpy(&c, m.data(), 4);
+            *code = c ? c : 1;
+            *error = m.size() > 4 ? m.substr(4) : "rank " + std::to_string(from) + " failed";
+            return false;
+        }
+        // DONE before its frames: a protocol error (a rank that stopped early without ERROR).
+        receiveBytes(from, status.MPI_TAG);
+        if (status.MPI_TAG == kTagDone) done_[size_t(from)] = true;
+        *code = 1;
+        *error = "internal: rank " + std::to_string(from) + " stopped sending frames";
+        return false;
+    }
+
+    void endFrames(int code) override {
+        // END to every rank first (a rank stuck in a send is unblocked by the drain below).
+        const int32_t c = code;
+        std::vector<MPI_Request> requests;
+        for (int r = 1; r < size_; ++r) {
+            requests.emplace_back();
+            MPI_Isend(&c, 1, MPI_INT32_T, r, kTagEnd, comm_, &requests.back());
+        }
+        for (int r = 1; r < size_; ++r) {
+            while (!done_[size_t(r)]) {
+                MPI_Status status;
+                MPI_Probe(r, MPI_ANY_TAG, comm_, &status);
+                if (status.MPI_TAG == kTagFrame) {
+                    std::string discarded;
+                    receiveFrameBody(r, &discarded);
+                } else {
+                    receiveBytes(r, status.MPI_TAG);
+                    if (status.MPI_TAG == kTagDone) done_[size_t(r)] = true;
+                }
+            }
+        }
+        MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+        done_.assign(size_t(size_), false);  // the next model's loop
+    }
+
+private:
+    // A whole message of `tag` from `from` (its size probed first).
+    std::string receiveBytes(int from, int tag) {
+        MPI_Status status;
+        MPI_Probe(from, tag, comm_, &status);
+        int n = 0;
+        MPI_Get_count(&status, MPI_BYTE, &n);
+        std::string s(size_t(n), '\0');
+        MPI_Recv(n ? &s[0] : nullptr, n, MPI_BYTE, from, tag, comm_, MPI_STATUS_IGNORE);
+        return s;
+    }
+    // The size message of a frame, then its pieces.
+    void receiveFrameBody(int from, std::string* bytes) {
+        uint64_t n = 0;
+        MPI_Recv(&n, 8, MPI_BYTE, from, kTagFrame, comm_, MPI_STATUS_IGNORE);
+        bytes->resize(size_t(n));
+        for (size_t at = 0; at < bytes->size(); at += kChunk)
+            MPI_Recv(&(*bytes)[at], int(std::min(kChunk, bytes->size() - at)), MPI_BYTE, from, kTagChunk, comm_,
+                     MPI_STATUS_IGNORE);
+    }
+
+    MPI_Comm comm_ = MPI_COMM_NULL;
+    int rank_ = 0, size_ = 1;
+    std::vector<bool> done_;  // per rank: its DONE received in this loop
+};
+
+bool started = false;
+
+}  // namespace
+
+bool launchedByMpi() {
+    for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+        if (std::getenv(v)) return true;
+    return false;
+}
+
+void startMpiGroup(int* argc, char*** argv) {
+    int provided = 0;
+    MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided);
+    started = true;
+    setFrameGroup(std::make_unique<MpiFrameGroup>());
+}
+
+bool mpiRankZero() { return frameGroup().rank() == 0; }
+
+int finishMpiGroup(int code) {
+    if (!started) return code;
+    std::cout.flush();
+    std::cerr.flush();
+    // Every rank that got this far meets in a barrier: then the job ends as one, each rank with
+    // the code rank 0 gave it (after END or the stage agreement). A rank that does not arrive
+    // within kSettleSeconds is stuck where rank 0 left the protocol (an exception on rank 0):
+    // rank 0 then aborts the job with its code.
+    constexpr double kSettleSeconds = 10;
+    MPI_Request barrier;
+    MPI_Ibarrier(MPI_COMM_WORLD, &barrier);
+    int arrived = 0;
+    const double start = MPI_Wtime();
+    while (!arrived) {
+        MPI_Test(&barrier, &arrived, MPI_STATUS_IGNORE);
+        if (!arrived && frameGroup().rank() == 0 && code != 0 && MPI_Wtime() - start > kSettleSeconds)
+            MPI_Abort(MPI_COMM_WORLD, code);
+        if (!arrived) usleep(1000);
+    }
+    MPI_Finalize();
+    return code;
+}
+
+}  // namespace apparent

@@ -1,0 +1,73 @@
+#!/bin/bash
+# Frames across processes, measured (docs/PERFORMANCE.md "Frames across processes"): a 200k-triangle
+# torus (ring radius 2, tube 0.5) passing 10 ls from the camera at 0.9c, 100 frames, relativistic,
+# default tolerance, to a plain .glb; one process with 1 and 2 threads, then mpirun -n 1, 2 and 4
+# with one thread per rank, side by side in one run. Prints a Markdown table: wall time, speed-up
+# against one process with one thread, rank 0's writing time and share, and the per-frame costs
+# (`render --verbose`), and checks that every .glb is byte-identical to the one-process file.
+# Usage: scripts/mpi_report.sh [build/apparent] [render options, e.g. --compress draco]
+# (needs mpirun: scripts/setup.sh installs it)
+set -euo pipefail
+apparent=$(realpath "${1:-build/apparent}")
+shift || true
+options="$*"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+
+# Step: the torus, 500 x 200 vertices, two triangles per quad (200,000 triangles).
+awk 'BEGIN {
+    n = 500; m = 200; R = 2; r = 0.5; pi = atan2(0, -1);
+    for (i = 0; i < n; ++i) for (j = 0; j < m; ++j) {
+        u = 2 * pi * i / n; v = 2 * pi * j / m;
+        printf "v %.12g %.12g %.12g\n", (R + r * cos(v)) * cos(u), r * sin(v), (R + r * cos(v)) * sin(u);
+    }
+    for (i = 0; i < n; ++i) for (j = 0; j < m; ++j) {
+        a = i * m + j + 1; b = ((i + 1) % n) * m + j + 1; c = ((i + 1) % n) * m + (j + 1) % m + 1; d = i * m + (j + 1) % m + 1;
+        printf "f %d %d %d\nf %d %d %d\n", a, b, c, a, c, d;
+    }
+}' > "$work/torus.obj"
+cat > "$work/torus.json" <<'JSON'
+{
+  "camera": { "position": [0, 0, 0], "look_at": [0, 0, -10], "up": [0, 1, 0], "fov_deg": 60 },
+  "frames": { "start": 0, "end": 10, "fps": 10 },
+  "model": "relativistic",
+  "objects": [ { "name": "torus", "mesh": "torus.obj", "position": [-14, 0, -10], "t0": 0, "velocity": [0.9, 0, 0] } ]
+}
+JSON
+cd "$work"
+
+# Step: the runs. "time" is the wall clock of the whole command, start-up and loading included.
+run() {  # LABEL OUTDIR COMMAND...
+    local label=$1 out=$2
+    shift 2
+    local start end
+    start=$(date +%s.%N)
+    "$@" torus.json --out "$out" --verbose --max-output-bytes 0 $options > "$out.log" 2>&1
+    end=$(date +%s.%N)
+    local line
+    line=$(grep -E '^relativistic: loop ' "$out.log") || { cat "$out.log"; exit 1; }
+    # "relativistic: loop L s; per frame: cut and encode C ms (CPU c ms; F frames cut here), write W ms
+    #  (CPU w ms; F frames, P% of the loop[ on rank 0])[; rank 0 waited T s for other ranks]"
+    field() { echo "$line" | sed -E "s/$1/\\1/"; }
+    local cut cut_cpu write write_cpu share
+    cut=$(field '.*cut and encode ([0-9.]+) ms.*')
+    cut_cpu=$(field '.*cut and encode [0-9.]+ ms \(CPU ([0-9.]+) ms.*')
+    write=$(field '.*, write ([0-9.]+) ms.*')
+    write_cpu=$(field '.*, write [0-9.]+ ms \(CPU ([0-9.]+) ms.*')
+    share=$(field '.*frames, ([0-9.]+)% of the loop.*')
+    cmp -s "$out/relativistic.glb" one1/relativistic.glb 2>/dev/null || [ "$out" = one1 ] || { echo "$label: .glb differs"; exit 1; }
+    printf '| %s | %.2f | %s (%s) | %s (%s) | %s |\n' "$label" "$(echo "$end - $start" | bc)" "$cut" "$cut_cpu" \
+        "$write" "$write_cpu" "$share" >> table.md
+}
+: > table.md
+run "1 process, 1 thread" one1 "$apparent" render --threads 1
+run "1 process, 2 threads" one2 "$apparent" render --threads 2
+for n in 1 2 4; do
+    run "mpirun -n $n, 1 thread each" "mpi$n" mpirun --oversubscribe -n "$n" "$apparent" render --threads 1
+done
+echo "| run | wall (s) | cut + encode per frame, ms (CPU) | write per frame on rank 0, ms (CPU) | writing share of rank 0's loop (%) |"
+echo "|---|---:|---:|---:|---:|"
+cat table.md
+echo
+echo ".glb $(du -m one1/relativistic.glb | cut -f1) MiB, every one byte-identical to the one-process file. $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), $(date -u +%Y-%m-%dT%H:%M:%SZ)."

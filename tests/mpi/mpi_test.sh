@@ -1,0 +1,102 @@
+#!/bin/bash
+# `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
+# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ; and
+# raytrace's PNG files and video), a
+# failure on any rank ends the job with the one-process code and one line from rank 0 and no
+# output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
+# Usage: mpi_test.sh APPARENT SOURCE_DIR   (ctest sets OpenMPI's run-as-root variables for it)
+set -u
+# Under scripts/sanitize.sh: AddressSanitizer's checks stay on in every rank, its leak report off
+# (OpenMPI keeps allocations to its exit that LeakSanitizer reports as leaks).
+export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
+apparent=$1
+cd "$2"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+mpi() { timeout 300 mpirun --oversubscribe -n 3 "$apparent" "$@"; }
+
+# Step: byte-identical outputs.
+for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
+    for options in "--format glb,ply,obj" "--compress draco --frames 40:160" "--compress meshopt --frames 40:160" \
+                   "--tolerance vertex --compress meshopt --model relativistic,finite"; do
+        rm -rf "$work/one" "$work/three"
+        "$apparent" render "$scene" --out "$work/one" --quiet $options || fail "one process: $scene $options"
+        # The summary alone (stdout): mpirun forwards stdout and stderr apart, so a warning may
+        # interleave with it in one stream.
+        out=$(mpi render "$scene" --out "$work/three" $options 2> "$work/stderr.txt") ||
+            fail "mpirun: $scene $options: $out $(cat "$work/stderr.txt")"
+        diff -r "$work/one" "$work/three" > /dev/null || fail "outputs differ: $scene $options"
+        case "$out" in *"3 processes shared the frames"*) ;; *) fail "summary without the process count: $out" ;; esac
+        [ "$(echo "$out" | grep -c '^relativistic: ')" = 1 ] || fail "not one summary line (rank 0 alone): $out"
+    done
+done
+# raytrace splits its frames the same way: the PNG files and the video identical.
+"$apparent" raytrace data/scenes/flanges.json --out "$work/rt1" --frames 90:100 --size 160x90 --video "$work/rt1.mp4" \
+    --quiet || fail "raytrace, one process"
+out=$(mpi raytrace data/scenes/flanges.json --out "$work/rt3" --frames 90:100 --size 160x90 --video "$work/rt3.mp4" \
+    2> "$work/stderr.txt") || fail "raytrace under mpirun: $out $(cat "$work/stderr.txt")"
+diff -r "$work/rt1" "$work/rt3" > /dev/null || fail "raytrace PNG files differ"
+cmp -s "$work/rt1.mp4" "$work/rt3.mp4" || fail "raytrace videos differ"
+case "$out" in *"3 processes shared the frames"*) ;; *) fail "raytrace summary without the process count: $out" ;; esac
+
+# --quiet silences every rank.
+out=$(mpi render data/scenes/flanges.json --out "$work/quiet" --frames 0:20 --quiet 2>&1)
+[ -z "$out" ] || fail "--quiet under mpirun printed: $out"
+
+# Step: failures end the job with the one-process code and line, and write nothing.
+expect_failure() {  # CODE OUTDIR ARGS...: the code, our line exactly once, no output folder
+    local code=$1 dir=$2
+    shift 2
+    "$apparent" "$@" --out "$dir.one" > "$work/one.txt" 2>&1
+    local one=$?
+    mpi "$@" --out "$dir" > /dev/null 2> "$work/mpi.txt"
+    local got=$?
+    local line
+    line=$(grep '^error: ' "$work/one.txt")
+    [ "$one" = "$code" ] || fail "one process gave $one, not $code: $*"
+    [ "$got" = "$code" ] || fail "mpirun gave $got, not $code: $* ($(cat "$work/mpi.txt"))"
+    [ "$(grep -cxF -- "$line" "$work/mpi.txt")" = 1 ] || fail "not the one-process line once: $* ($(cat "$work/mpi.txt"))"
+    [ "$(grep -c '^error: ' "$work/mpi.txt")" = 1 ] || fail "more than one error line: $*"
+    [ ! -e "$dir" ] || fail "$dir left behind: $*"
+}
+expect_failure 2 "$work/e1" render data/scenes/flanges.json --max-triangles 100
+expect_failure 2 "$work/e2" render data/fixtures/scene_mirror_not_planar.json
+expect_failure 3 "$work/e3" render data/scenes/flanges.json --format ply,glb --max-output-bytes 100000
+expect_failure 2 "$work/e4" raytrace data/scenes/flanges.json --model all --video "$work/e4.mp4"
+
+# Step: SIGKILL to rank 1 mid-run: mpirun exits non-zero; every file present is complete (the
+# one-process run's bytes for it), no temporary is left beside them.
+long=(render data/scenes/flanges.json --format ply,glb --tolerance 1e-4x --model all --quiet)
+"$apparent" "${long[@]}" --out "$work/reference" || fail "reference run"
+mpi "${long[@]}" --out "$work/killed" > "$work/killed.txt" 2>&1 &
+launcher=$!
+victim=""
+for _ in $(seq 1 600); do
+    for pid in $(pgrep -P "$launcher" 2>/dev/null) $(pgrep -f "$apparent render" 2>/dev/null); do
+        if tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then victim=$pid; fi
+    done
+    [ -n "$victim" ] && [ "$(ls "$work/killed/relativistic" 2>/dev/null | wc -l)" -gt 20 ] && break
+    sleep 0.05
+done
+if [ -z "$victim" ]; then
+    fail "rank 1 not found"
+else
+    kill -KILL "$victim"
+fi
+wait "$launcher"
+code=$?
+[ "$code" != 0 ] || fail "mpirun exited 0 after a rank was killed"
+written=0
+while IFS= read -r -d '' f; do
+    rel=${f#"$work/killed/"}
+    case "$rel" in
+        *.tmp-*) fail "temporary file left: $rel" ;;
+        *) cmp -s "$f" "$work/reference/$rel" || fail "not complete: $rel"; written=$((written + 1)) ;;
+    esac
+done < <(find "$work/killed" -type f -print0 2>/dev/null)
+echo "killed run: mpirun exit $code, $written complete files, none truncated"
+
+[ "$failures" = 0 ] && echo "mpi_test: all passed"
+exit $((failures > 0))
