@@ -48,14 +48,20 @@ ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event cor
 
 ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const double t_mid[3], const Vec3 s[3],
                              const double xm[3], double tolerance) {
-    ChordError r;
-    if (m.beta == 0) return r;
+    if (m.beta == 0) return {};
     // Delays (delta = -t) and the midpoint bubbles, |beta| (delta is convex: beta <= 0 up to rounding).
     double c[3];
     for (int e = 0; e < 3; ++e) {
         const double d0 = -t_corner[e], d1 = -t_corner[(e + 1) % 3], dm = -t_mid[e];
         c[e] = 4 * std::fabs(dm - 0.5 * (d0 + d1));
     }
+    return chordErrorOfBubbles(m, c, s, xm, tolerance);
+}
+
+ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const Vec3 s[3], const double xm[3],
+                               double tolerance) {
+    ChordError r;
+    if (m.beta == 0) return r;
     const double Q = bubbleMax(c[0], c[1], c[2]);
     r.quadratic = m.beta * Q;
     // Over the tolerance on the bubbles alone: R only adds (callers compare the bound only).
@@ -80,6 +86,29 @@ ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const do
     const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
     r.bound = m.beta * (Q + R);
     if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
+    return r;
+}
+
+EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const PointTerms& b) {
+    EdgeBubble r;
+    if (m.beta == 0) return r;
+    const double k = m.one_minus_beta2;
+    const Vec3 x = E + (a.s + b.s) * 0.5;  // the midpoint now, relative to the camera
+    const double xv = dot(x, m.velocity);
+    const double xm = std::sqrt(xv * xv + k * norm2(x));
+    const Vec3 u = b.s - a.s;
+    const double uv = dot(u, m.velocity);
+    const double l2 = uv * uv + k * norm2(u);
+    const double uMx = uv * xv + k * dot(u, x);  // u^T M x = |x|_M (u.w)
+    // h(1/2) / 2 (>= 0 but for rounding): (|u|_M^2 - (u^T M x)^2 / |x|_M^2) / (2 (1 - b^2) |x|_M).
+    const double half_h = std::max(0.0, l2 - uMx * uMx / (xm * xm)) / (2 * k * xm);
+    const double l = std::sqrt(l2);
+    const double me = xm - 0.5 * l;
+    r.c = me > 0 ? half_h + l2 * l2 / (32 * k * me * me * me) : INFINITY;
+    const double mf = std::max(me, l);
+    r.length = mf > 0 ? half_h + 8 * l * l2 / (9 * std::sqrt(3.0) * k * mf * mf) : half_h;
+    if (!(r.c == r.c)) r.c = INFINITY;
+    if (!(r.length == r.length)) r.length = 0;
     return r;
 }
 

@@ -112,6 +112,57 @@ inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion&
     return xmin > 0 && 4 * d2 <= xmin * xmin && m.beta * d2 <= 3 * m.one_minus_beta2 * tolerance * xmin;
 }
 
+// ---- The a-priori bound: the bubbles from the Hessian, no midpoint cut ----
+// The refinement decides its splits with this bound (slice.cpp): it needs only per-point terms
+// that are affine in the rest point or one square root away from it, so no exact cut is made for
+// a decision; only the output vertices are cut, in one batch after the last split.
+// Along an edge x(t) = x_a + t u (x: the point now relative to the camera, x = E + s, affine in
+// the rest point; u = s_b - s_a), let g(t) = delta(x(t)) and h(t) = g''(t) = u^T H u >= 0, H the
+// Hessian of delta (that of d):
+//     H = (M - (M x)(M x)^T / |x|_M^2) / ((1 - b^2) |x|_M),   M = v v^T + (1 - b^2) I,
+//     h = (|u|_M^2 - (u.w)^2) / ((1 - b^2) |x|_M),   w = M x / |x|_M.
+// The midpoint bubble is |beta| = integral over [0, 1] of G h, G the hat of height 1/4 at t = 1/2
+// (integral 1/8), symmetric about 1/2. Expanding h about t = 1/2, the first-order term integrates
+// to zero, and the rest is at most K4 (t - 1/2)^2 / 2 with K4 the bound of the fourth derivative:
+// for a norm |D^4 |x|_M [u]^4| <= 3 |u|_M^4 / |x|_M^3 (the Euclidean case in the coordinates where
+// |.|_M is Euclidean: max over the angle of 3 sin^2 |4 cos^2 - sin^2| / r^3), and the integral of
+// G (t - 1/2)^2 is 1/192, so
+//     c = 4 |beta| <= h(1/2) / 2 + l^4 / (32 (1 - b^2) m_e^3),
+// l = |u|_M, m_e = |x_mid|_M - l / 2 <= |x(t)|_M on the edge. Exact (h / 2) for a quadratic delta;
+// the correction is fourth order, smaller than h / 2 by about (l / |x|)^2 / 32. bubbleMax is
+// non-decreasing in every coefficient, so chordErrorOfBubbles with these c bounds |F - L| as
+// chordErrorOfTerms does with the measured bubbles, and is as tight.
+// Rounding: h is a difference of two terms of size |u|_M^2 / |x|_M; its rounding is a few ulps of
+// that, far below any tolerance the program accepts (as the bubbles' rounding above).
+
+// The terms of one point for the a-priori bound: its shape offset s and |x|_M, x = E + s (E =
+// nowBase, the object's origin now, relative to the camera).
+struct PointTerms {
+    Vec3 s;
+    double xm = 0;
+};
+inline double normMOfShape(const Motion& m, const Vec3& E, const Vec3& s) {
+    const Vec3 x = E + s;
+    const double xv = dot(x, m.velocity);
+    return std::sqrt(xv * xv + m.one_minus_beta2 * norm2(x));
+}
+
+// The edge a -> b's coefficient bound c (above; INFINITY when the edge may reach the camera,
+// m_e <= 0) and its length in the map's metric for longest-edge bisection: h(1/2) / 2 plus the
+// edge's share of the third-order term, 8 l^3 / (9 sqrt 3 (1 - b^2) m^2) with m = m_e floored at
+// l (finite near the camera, and shrinking as the edge is halved). Callers pass the ends in a
+// fixed order (lower vertex id first) so both triangles of an edge get the same bits.
+struct EdgeBubble {
+    double c = 0;
+    double length = 0;
+};
+EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const PointTerms& b);
+
+// The bound of chordErrorOfTerms from the three edges' coefficients c (c[e] on corners e, e + 1)
+// instead of the measured bubbles, and the corners' shape offsets and |x|_M.
+ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const Vec3 s[3], const double xm[3],
+                               double tolerance = INFINITY);
+
 // The length of an edge in the map's own metric, which the refinement halves longest first
 // (Rivara's longest-edge bisection, with this length): its bubble coefficient 4 |beta| (the
 // second difference of delta along the edge, i.e. its squared length in the Hessian's metric)

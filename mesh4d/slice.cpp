@@ -51,17 +51,14 @@ int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t*
     return k;
 }
 
-// The terms of the bound (chord_error.h chordErrorOfTerms) of one point, side by side: what a
+// The terms of the a-priori bound of one point (chord_error.h PointTerms), side by side: what a
 // corner or an edge's end contributes is read from one place.
-struct VTerms {
-    Vec3 s;     // shape offset y + v delta (shapeOfEvent)
-    double xm;  // |x|_M (normMOfEvent)
-    double t;   // local emission time, -delta
-};
+using VTerms = PointTerms;
 
 struct REdge {
     uint32_t mid;  // midpoint vertex once made, else kUnset
-    double len;    // edgeLength once known, else NaN
+    double len;    // EdgeBubble::length once known, else NaN
+    double c;      // EdgeBubble::c, known with len
 };
 // Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
 // touched), later ids the halves made by splits, two by two. Each slot c is the edge from v[c]
@@ -84,11 +81,11 @@ struct RTri {
 // the output). Cleared, not freed, by each frame; freed after a frame that made them larger than
 // kScratchKeep bytes, so a single huge frame does not hold its memory for the program's life.
 struct RefineScratch {
-    std::vector<Vec3> pos, rest, e_pos;
-    std::vector<double> time, e_time;
+    std::vector<Vec3> pos, rest;
+    std::vector<double> time;
     std::vector<VTerms> terms;
     std::vector<Event> cap;
-    std::vector<uint8_t> e_done, init, limited;
+    std::vector<uint8_t> init, limited;
     std::vector<REdge> edges;
     std::unique_ptr<RTri[]> tri;
     size_t tri_cap = 0;
@@ -97,12 +94,12 @@ struct RefineScratch {
     std::vector<uint32_t> vertex_out;
 
     size_t bytes() const {
-        return (pos.capacity() + rest.capacity() + e_pos.capacity()) * sizeof(Vec3) +
-               (time.capacity() + e_time.capacity()) * sizeof(double) + terms.capacity() * sizeof(VTerms) +
+        return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
+               terms.capacity() * sizeof(VTerms) +
                cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
-               e_done.capacity() + init.capacity() + limited.capacity() + side.capacity();
+               init.capacity() + limited.capacity() + side.capacity();
     }
 };
 constexpr size_t kScratchKeep = size_t(256) << 20;
@@ -129,13 +126,13 @@ struct FrameBuilder {
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)), scratch(threadScratch()),
           side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
-          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), e_pos(scratch.e_pos),
-          e_time(scratch.e_time), e_done(scratch.e_done), scratch_members(scratch.members), r_edges(scratch.edges),
+          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), scratch_members(scratch.members),
+          r_edges(scratch.edges),
           r_tri(scratch.tri), r_tri_cap(scratch.tri_cap), r_init(scratch.init), r_limited(scratch.limited) {
-        for (auto* a : {&r_pos, &r_rest, &e_pos}) a->clear();
-        for (auto* a : {&r_time, &e_time}) a->clear();
+        for (auto* a : {&r_pos, &r_rest}) a->clear();
+        r_time.clear();
         r_terms.clear();
-        for (auto* a : {&e_done, &r_init, &r_limited}) a->clear();
+        for (auto* a : {&r_init, &r_limited}) a->clear();
         side.clear();
         vertex_out.clear();
         r_cap.clear();
@@ -364,20 +361,19 @@ struct FrameBuilder {
 
     // ---- Step (refinement, tolerance > 0, moving, past cone): conforming bisection ----
     // Flat records, no allocation per piece: vertices as arrays indexed by id, edges and pieces as
-    // records in one array each, the midpoints' closed forms once per edge, the bound's per-point
-    // terms once per point.
+    // records in one array each. Every decision is made from the a-priori bound (chord_error.h
+    // edgeBubble, chordErrorOfBubbles): per point its terms (affine in the rest point but for one
+    // square root), per edge its coefficient, once each. No exact cut is made for a decision: the
+    // points the splits make are cut once, in one batch, after the last split.
     // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
-    // ids edge midpoints made when first needed. `side` and `vertex_out` grow with them.
+    // ids edge midpoints made when an edge is split. `side` and `vertex_out` grow with them.
     uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
-    std::vector<Vec3>& r_pos;     // exact local image of every id (mesh vertices: from the batch cut)
-    std::vector<double>& r_time;  // its local emission time, -delta
-    std::vector<VTerms>& r_terms; // its terms of the bound
+    Vec3 r_now{0, 0, 0};          // the object's origin now, relative to the camera (nowBase)
+    std::vector<Vec3>& r_pos;     // exact local image of every id (the batch cuts: mesh vertices first,
+    std::vector<double>& r_time;  // the splits' points after the last split); its local emission time, -delta
+    std::vector<VTerms>& r_terms; // its terms of the bound (for mesh vertices: w only where a triangle needs it)
     std::vector<Vec3>& r_rest;    // rest point of ids >= r_nv
     std::vector<Event>& r_cap;    // cap events (2 per id >= r_nv) when a cap is real
-    // Midpoints of mesh edges: exact local images (cut in batches before the splits).
-    std::vector<Vec3>& e_pos;
-    std::vector<double>& e_time;
-    std::vector<uint8_t>& e_done;
     std::vector<uint32_t>& scratch_members;
 
     // Edges of the refinement: records below r_ne are the mesh's edges, later ones the halves and
@@ -438,11 +434,11 @@ struct FrameBuilder {
         r_tri[p / 3].next[p % 3] = to;
     }
 
-    uint32_t newVertex(const Vec3& rest, const Event& e, uint32_t a, uint32_t b) {
-        const uint32_t id = uint32_t(r_pos.size());
-        r_pos.push_back(e.x);
-        r_time.push_back(e.t);
-        r_terms.push_back({shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t});
+    // A split's point: its terms now, its exact image in the batch after the last split.
+    uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b) {
+        const uint32_t id = uint32_t(r_terms.size());
+        const Vec3 sh = (r_terms[a].s + r_terms[b].s) * 0.5;  // shapeOffset is affine
+        r_terms.push_back({sh, normMOfShape(world.motion, r_now, sh)});
         r_rest.push_back(rest);
         Side s = Side::Inside;
         if (world.cap_a_real || world.cap_b_real) {
@@ -459,40 +455,28 @@ struct FrameBuilder {
         return id;
     }
 
-    double edgeLengthOf(uint32_t a, uint32_t b, uint32_t mid) const {
-        const VTerms &ta = r_terms[a], &tb = r_terms[b];
-        return edgeLengthOfTerms(world.motion, ta.t, tb.t, r_terms[mid].t, ta.s, tb.s, ta.xm, tb.xm);
+    // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
+    // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
+    const REdge& edgeOf(uint32_t id, int c) {
+        REdge& e = r_edges[r_tri[id].edge[c]];
+        if (e.len != e.len) {
+            const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
+            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
+            e.len = eb.length;
+            e.c = eb.c;
+        }
+        return e;
     }
 
-    // The midpoint vertex of slot c of triangle id (made once per edge): a mesh edge's from the
-    // batch cut, any other cut when first needed, with the edge's length.
+    // The midpoint vertex of slot c of triangle id (made once per edge, when the edge is split).
     uint32_t midVertex(uint32_t id, int c) {
-        if (id >= r_nt || r_init[id]) {  // the frequent case, kept small enough to inline
-            const uint32_t m = r_edges[r_tri[id].edge[c]].mid;
-            if (m != kUnset) return m;
-        }
-        return makeMidVertex(id, c);
-    }
-    [[gnu::noinline]] uint32_t makeMidVertex(uint32_t id, int c) {
-        ensureBase(id);
         const uint32_t rec = r_tri[id].edge[c];
         if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
-        if (rec < r_ne) {
-            const Edge& ed = world.edges[rec];
-            const Vec3 rest = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
-            if (!e_done[rec]) {
-                const Event ev = cutRestLocal(anchor, world.motion, rest);
-                e_pos[rec] = ev.x;
-                e_time[rec] = ev.t;
-                e_done[rec] = 1;
-            }
-            return r_edges[rec].mid = newVertex(rest, {e_time[rec], e_pos[rec]}, ed.lo, ed.hi);
-        }
         const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
-        const Vec3 rest = (restOfId(a) + restOfId(b)) * 0.5;
-        const uint32_t m = newVertex(rest, cutRestLocal(anchor, world.motion, rest), a, b);
-        r_edges[rec] = {m, edgeLengthOf(a, b, m)};
-        return m;
+        // A mesh edge's midpoint from its lo end, as the edge's other triangles would make it.
+        const uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        const Vec3 rest = (restOfId(lo) + restOfId(hi)) * 0.5;
+        return r_edges[rec].mid = newVertex(rest, lo, hi);
     }
 
     // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
@@ -525,8 +509,8 @@ struct FrameBuilder {
             p = nextOf(p);
         } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-        r_edges.push_back({kUnset, NAN});
-        r_edges.push_back({kUnset, NAN});
+        r_edges.push_back({kUnset, NAN, NAN});
+        r_edges.push_back({kUnset, NAN, NAN});
         reserveTris(2 * members.size());
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
@@ -542,7 +526,7 @@ struct FrameBuilder {
             const uint32_t a = old.v[cu], b = old.v[(cu + 1) % 3], o = old.v[(cu + 2) % 3];
             const uint32_t A = uint32_t(r_tri_size), B = A + 1;
             const uint32_t inner = uint32_t(r_edges.size());
-            r_edges.push_back({kUnset, NAN});
+            r_edges.push_back({kUnset, NAN, NAN});
             const uint32_t a_half = a == lo ? lo_rec : hi_rec, b_half = a == lo ? hi_rec : lo_rec;
             const uint8_t depth = uint8_t(old.depth + 1);
             r_tri[A] = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {a_half, inner, old.edge[(cu + 2) % 3]}, kUnset,
@@ -582,13 +566,12 @@ struct FrameBuilder {
             // A piece back on the stack after a neighbour's split has the same corners and
             // midpoints as when it failed: its bound is not evaluated again.
             if (!r_tri[id].failed) {
-                double t_mid[3];
-                for (int c = 0; c < 3; ++c) t_mid[c] = r_terms[midVertex(id, c)].t;
+                double c[3];
+                for (int k = 0; k < 3; ++k) c[k] = edgeOf(id, k).c;
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
-                const double t_corner[3] = {k0.t, k1.t, k2.t};
                 const Vec3 s[3] = {k0.s, k1.s, k2.s};
                 const double xm[3] = {k0.xm, k1.xm, k2.xm};
-                const ChordError ce = chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
+                const ChordError ce = chordErrorOfBubbles(world.motion, c, s, xm, settings.tolerance);
                 if (ce.bound <= settings.tolerance) continue;
                 r_tri[id].failed = 1;
             }
@@ -618,12 +601,7 @@ struct FrameBuilder {
     };
     Rank rankOf(uint32_t id, int c) {
         const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
-        const uint32_t rec = r_tri[id].edge[c];
-        if (r_edges[rec].len != r_edges[rec].len) {
-            const uint32_t m = midVertex(id, c);  // sets the length of an edge made by a split
-            if (r_edges[rec].len != r_edges[rec].len) r_edges[rec].len = edgeLengthOf(a, b, m);
-        }
-        return {r_edges[rec].len, std::min(a, b), std::max(a, b)};
+        return {edgeOf(id, c).len, std::min(a, b), std::max(a, b)};
     }
     int longestSlot(uint32_t id) {
         ensureBase(id);
@@ -718,14 +696,16 @@ struct FrameBuilder {
         if (caps) classifyVertices(live);
         else side.assign(r_nv, Side::Inside);
 
-        // Step: the corners' bound (no midpoint needed) passes most triangles that need no
-        // refinement; the others get the full bound, from their edges' midpoints cut in batches.
+        // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
+        // refinement; the others get the a-priori bound (chordErrorOfBubbles).
         std::vector<uint32_t> candidates, failing;
         double expected_pieces = 0;
+        r_now = nowBase(view, world.motion);
         r_terms.resize(r_nv);  // the bound's terms, once per vertex
         for (size_t i = 0; i < r_nv; ++i) {
             const Event e{r_time[i], r_pos[i]};
-            r_terms[i] = {shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t};
+            r_terms[i].s = shapeOfEvent(world.motion, e);
+            r_terms[i].xm = normMOfEvent(anchor, world.motion, e);
         }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
@@ -740,48 +720,21 @@ struct FrameBuilder {
             const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
             if (chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance) candidates.push_back(uint32_t(f));
         }
-        if (!candidates.empty()) {
-            e_done.assign(ne, 0);
-            e_pos.resize(ne);
-            e_time.resize(ne);
-            std::vector<uint32_t> which;
-            for (uint32_t f : candidates)
-                for (uint32_t e : world.triangle_edges[f])
-                    if (!e_done[e]) {
-                        e_done[e] = 1;
-                        which.push_back(e);
-                    }
-            constexpr size_t kBatch = 1024;  // rest points cut per call, kept in cache
-            Vec3 rest[kBatch], pos[kBatch];
-            double time[kBatch];
-            for (size_t k0 = 0; k0 < which.size(); k0 += kBatch) {
-                const size_t n = std::min(kBatch, which.size() - k0);
-                for (size_t k = 0; k < n; ++k) {
-                    const Edge& ed = world.edges[which[k0 + k]];
-                    rest[k] = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
-                }
-                cutRestLocalBatch(anchor, world.motion, rest, n, pos, time);
-                for (size_t k = 0; k < n; ++k) {
-                    e_pos[which[k0 + k]] = pos[k];
-                    e_time[which[k0 + k]] = time[k];
-                }
+        for (uint32_t f : candidates) {
+            double c[3], xc[3];
+            Vec3 sc[3];
+            for (int k = 0; k < 3; ++k) {
+                const Edge& ed = world.edges[world.triangle_edges[f][k]];
+                c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                const uint32_t v = world.mesh.triangles[f][k];
+                sc[k] = r_terms[v].s;
+                xc[k] = r_terms[v].xm;
             }
-            for (uint32_t f : candidates) {
-                double t_corner[3], t_mid[3], xc[3];
-                Vec3 sc[3];
-                for (int c = 0; c < 3; ++c) {
-                    const uint32_t v = world.mesh.triangles[f][c], e = world.triangle_edges[f][c];
-                    t_corner[c] = r_time[v];
-                    t_mid[c] = e_time[e];
-                    sc[c] = r_terms[v].s;
-                    xc[c] = r_terms[v].xm;
-                }
-                const double bound = chordErrorOfTerms(world.motion, t_corner, t_mid, sc, xc, settings.tolerance).bound;
-                if (bound > settings.tolerance) {
-                    failing.push_back(f);
-                    // About bound / T pieces once halved down to T (the error falls about as the area).
-                    expected_pieces += std::min(bound / settings.tolerance, 1e6);
-                }
+            const double bound = chordErrorOfBubbles(world.motion, c, sc, xc, settings.tolerance).bound;
+            if (bound > settings.tolerance) {
+                failing.push_back(f);
+                // About bound / T pieces once halved down to T (the error falls about as the area).
+                expected_pieces += std::min(bound / settings.tolerance, 1e6);
             }
         }
         // Nothing to refine on a simple mesh that exists throughout: vertex mode's output.
@@ -798,7 +751,7 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_edges.assign(ne, REdge{kUnset, NAN});
+            r_edges.assign(ne, REdge{kUnset, NAN, NAN});
             // Room for the pieces and points the refinement is expected to make (growth would copy them).
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
@@ -824,6 +777,11 @@ struct FrameBuilder {
                 drain(stack);
             }
             for (uint8_t l : r_limited) out.limited_triangles += l;
+            // Step: the exact images of the splits' points, in one batch.
+            const size_t n_new = r_terms.size() - r_nv;
+            r_pos.resize(r_nv + n_new);
+            r_time.resize(r_nv + n_new);
+            cutRestLocalBatch(anchor, world.motion, r_rest.data(), n_new, r_pos.data() + r_nv, r_time.data() + r_nv);
         }
 
         // Step: the leaves, mesh triangle by mesh triangle, each tree depth first.
