@@ -60,19 +60,20 @@ struct REdge {
     double len;    // EdgeBubble::length once known, else NaN
     double c;      // EdgeBubble::c, known with len
 };
-// Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
-// touched), later ids the halves made by splits, two by two. Each slot c is the edge from v[c]
-// to v[c + 1]; the slots on one edge form a cycle (next), as World4D::slot_next does for the
-// mesh, so that an edge is split in every triangle that has it: no T-junctions, however the
-// splits go.
+// Triangles of the refinement, the leaves only: ids below r_nt are the mesh's triangles (records
+// made when first touched), later ids pieces made by splits. A split keeps one half in the
+// record it halves (the one with the slot that does not move) and appends the other. Each slot c
+// is the edge from v[c] to v[c + 1]; the slots on one edge form a cycle (next), as
+// World4D::slot_next does for the mesh, so that an edge is split in every triangle that has it:
+// no T-junctions, however the splits go.
+enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2 };
 struct RTri {
     uint32_t v[3];
     uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
     uint32_t edge[3];  // the edge record of each slot
-    uint32_t child;    // the first of its two halves (the second is child + 1) once split, else kUnset
     uint32_t src;      // the mesh triangle it lies on
     uint8_t depth;     // bisections since the mesh triangle (at most 2 log2(max_segments) <= 60)
-    uint8_t failed;    // its bound is known to exceed the tolerance (it waits for a neighbour's split)
+    uint8_t state;     // kUnknown, or its bound is known to pass or to fail (it waits for a neighbour's split)
     int16_t longest;   // the slot of its longest edge once known, else -1
 };
 
@@ -393,7 +394,6 @@ struct FrameBuilder {
     size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
     std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
 
-    RTri& tri(uint32_t id) { return r_tri[id]; }
     Vec3 restOfId(uint32_t id) const { return id < r_nv ? world.mesh.positions[id] : r_rest[id - r_nv]; }
     Event capOfId(uint32_t id, int cap) const { return id < r_nv ? world.events[2 * id + cap] : r_cap[2 * (id - r_nv) + cap]; }
     Event eventOfId(uint32_t id) const { return {r_time[id], r_pos[id]}; }
@@ -417,10 +417,9 @@ struct FrameBuilder {
             t.next[c] = world.slot_next[3 * id + c];
             t.edge[c] = world.triangle_edges[id][c];
         }
-        t.child = kUnset;
         t.src = id;
         t.depth = 0;
-        t.failed = 0;
+        t.state = kUnknown;
         t.longest = -1;
     }
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
@@ -495,8 +494,9 @@ struct FrameBuilder {
     }
 
     // Halves the edge of slot c of triangle id at its midpoint, in every triangle around the edge:
-    // each becomes (a, m, o) and (m, b, o). The halves' slots on the edge form two new cycles, on
-    // two new edge records; each triangle's new inner edge (m, o) gets its own record.
+    // each (a, b, o) becomes A = (a, m, o), kept in its record (slot c + 2 stays in place), and
+    // B = (m, b, o), appended. The halves' slots on the edge form two new cycles, on two new edge
+    // records; each triangle's new inner edge (m, o) gets its own record.
     void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
         const uint32_t lo = std::min(r_tri[id].v[c], r_tri[id].v[(c + 1) % 3]);
@@ -509,45 +509,47 @@ struct FrameBuilder {
             p = nextOf(p);
         } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-        r_edges.push_back({kUnset, NAN, NAN});
-        r_edges.push_back({kUnset, NAN, NAN});
-        reserveTris(2 * members.size());
+        r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN});
+        reserveTris(members.size());
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
             if (first == kUnset) first = slot;
             else r_tri[prev / 3].next[prev % 3] = slot;
             prev = slot;
         };
+        uint32_t inner = hi_rec + 1;
         for (uint32_t q : members) {
             const uint32_t u = q / 3;
-            const int cu = int(q % 3);
+            const int cu = int(q % 3), c1 = (cu + 1) % 3, c2 = (cu + 2) % 3;
             ensureBase(u);
-            const RTri old = r_tri[u];
-            const uint32_t a = old.v[cu], b = old.v[(cu + 1) % 3], o = old.v[(cu + 2) % 3];
-            const uint32_t A = uint32_t(r_tri_size), B = A + 1;
-            const uint32_t inner = uint32_t(r_edges.size());
-            r_edges.push_back({kUnset, NAN, NAN});
+            RTri& A = r_tri[u];
+            const uint32_t a = A.v[cu], b = A.v[c1], o = A.v[c2];
+            const uint32_t B = uint32_t(r_tri_size++);
             const uint32_t a_half = a == lo ? lo_rec : hi_rec, b_half = a == lo ? hi_rec : lo_rec;
-            const uint8_t depth = uint8_t(old.depth + 1);
-            r_tri[A] = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {a_half, inner, old.edge[(cu + 2) % 3]}, kUnset,
-                            old.src, depth, 0, -1};
-            r_tri[B] = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {b_half, old.edge[(cu + 1) % 3], inner}, kUnset,
-                            old.src, depth, 0, -1};
-            r_tri_size += 2;
-            moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2);
-            moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1);
+            if (A.depth == 0) ++out.refined_triangles;
+            const uint8_t depth = uint8_t(A.depth + 1);
+            RTri& Bt = r_tri[B];
+            Bt = RTri{{m, b, o}, {kUnset, kUnset, 3 * u + uint32_t(c1)}, {b_half, A.edge[c1], inner}, A.src, depth,
+                      kUnknown, -1};
+            moveSlot(3 * u + uint32_t(c1), 3 * B + 1);  // the side b -> o goes to B
+            A.v[c1] = m;
+            A.next[c1] = 3 * B + 2;
+            A.edge[cu] = a_half;
+            A.edge[c1] = inner;
+            A.depth = depth;
+            A.state = kUnknown;
+            A.longest = -1;
             if (a == lo) {
-                link(3 * A, lo_first, lo_prev);
+                link(q, lo_first, lo_prev);
                 link(3 * B, hi_first, hi_prev);
             } else {
                 link(3 * B, lo_first, lo_prev);
-                link(3 * A, hi_first, hi_prev);
+                link(q, hi_first, hi_prev);
             }
-            r_tri[u].child = A;
+            ++inner;
             ++r_leaves;  // one piece became two
-            if (u < r_nt) ++out.refined_triangles;
             stack.push_back(B);
-            stack.push_back(A);
+            stack.push_back(u);
         }
         r_tri[lo_prev / 3].next[lo_prev % 3] = lo_first;  // close the two cycles
         r_tri[hi_prev / 3].next[hi_prev % 3] = hi_first;
@@ -559,21 +561,24 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            if (r_tri[id].child != kUnset) continue;  // split meanwhile, as a neighbour
             const uint32_t v[3] = {r_tri[id].v[0], r_tri[id].v[1], r_tri[id].v[2]};
             const Side s0 = side[v[0]];
             if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
-            // A piece back on the stack after a neighbour's split has the same corners and
-            // midpoints as when it failed: its bound is not evaluated again.
-            if (!r_tri[id].failed) {
+            // A piece back on the stack unchanged (its record is reset when it is halved) keeps
+            // its verdict: its bound is not evaluated again.
+            if (r_tri[id].state == kPassed) continue;
+            if (r_tri[id].state == kUnknown) {
                 double c[3];
                 for (int k = 0; k < 3; ++k) c[k] = edgeOf(id, k).c;
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
                 const Vec3 s[3] = {k0.s, k1.s, k2.s};
                 const double xm[3] = {k0.xm, k1.xm, k2.xm};
                 const ChordError ce = chordErrorOfBubbles(world.motion, c, s, xm, settings.tolerance);
-                if (ce.bound <= settings.tolerance) continue;
-                r_tri[id].failed = 1;
+                if (ce.bound <= settings.tolerance) {
+                    r_tri[id].state = kPassed;
+                    continue;
+                }
+                r_tri[id].state = kFailed;
             }
             if (r_tri[id].depth >= r_max_depth) {
                 r_limited[r_tri[id].src] = 1;
@@ -584,8 +589,7 @@ struct FrameBuilder {
                 stack.clear();
                 return;
             }
-            splitLongestPath(id, stack);
-            if (r_tri[id].child == kUnset) stack.push_back(id);  // a coarser neighbour went first
+            if (!splitLongestPath(id, stack)) stack.push_back(id);  // a coarser neighbour went first
         }
     }
 
@@ -625,7 +629,9 @@ struct FrameBuilder {
     // strictly along it in the total order). One split per call. Angles stay bounded in the
     // map's metric, so the pieces follow the stretch (long across the motion where the map
     // bends along it) without slivers.
-    void splitLongestPath(uint32_t id, std::vector<uint32_t>& stack) {
+    // True when the edge halved is id's own (along the path lengths grow strictly, so no edge
+    // after the first is id's).
+    bool splitLongestPath(uint32_t id, std::vector<uint32_t>& stack) {
         uint32_t t = id;
         for (;;) {
             const int c = longestSlot(t);
@@ -638,7 +644,7 @@ struct FrameBuilder {
                 }
             if (other == kUnset) {
                 splitEdge(t, c, stack);
-                return;
+                return t == id;
             }
             t = other;
         }
@@ -756,7 +762,7 @@ struct FrameBuilder {
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
             if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
-            reserveTris(r_nt + 2 * expect);  // records made on first touch (ensureBase)
+            reserveTris(r_nt + expect);  // records made on first touch (ensureBase)
             r_tri_size = r_nt;
             r_edges.reserve(ne + 2 * expect);
             for (auto* v : {&r_pos, &r_rest}) v->reserve(v->size() + expect);
@@ -784,30 +790,20 @@ struct FrameBuilder {
             cutRestLocalBatch(anchor, world.motion, r_rest.data(), n_new, r_pos.data() + r_nv, r_time.data() + r_nv);
         }
 
-        // Step: the leaves, mesh triangle by mesh triangle, each tree depth first.
-        std::vector<uint32_t>& stack = scratch.stack;
-        stack.clear();
+        // Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then
+        // the pieces the splits appended.
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
                 const auto& t = world.mesh.triangles[f];
                 const uint32_t v[3] = {t[0], t[1], t[2]};
                 emitLeaf(uint32_t(f), v);
-                continue;
-            }
-            stack.push_back(uint32_t(f));
-            while (!stack.empty()) {
-                const RTri& t = tri(stack.back());
-                stack.pop_back();
-                if (t.child != kUnset) {
-                    const uint32_t a = t.child, b = t.child + 1;
-                    stack.push_back(b);
-                    stack.push_back(a);
-                } else {
-                    emitLeaf(t.src, t.v);
-                }
+            } else {
+                emitLeaf(uint32_t(f), r_tri[f].v);
             }
         }
+        for (size_t id = r_nt; id < r_tri_size; ++id)
+            if (isLive(r_tri[id].src)) emitLeaf(r_tri[id].src, r_tri[id].v);
     }
 
     // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).
