@@ -792,6 +792,27 @@ struct FrameBuilder {
 
         // Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then
         // the pieces the splits appended.
+        if (!caps) {
+            // Nothing clipped: every point a split made is a corner of some leaf, so the points
+            // follow the mesh's visible vertices in id order, copied in bulk.
+            const size_t base = out.positions.size(), n_new = r_terms.size() - r_nv;
+            out.positions.insert(out.positions.end(), r_pos.begin() + r_nv, r_pos.begin() + r_nv + n_new);
+            out.emission_times.insert(out.emission_times.end(), r_time.begin() + r_nv, r_time.begin() + r_nv + n_new);
+            out.rest_points.insert(out.rest_points.end(), r_rest.begin(), r_rest.begin() + n_new);
+            for (size_t k = 0; k < n_new; ++k) vertex_out[r_nv + k] = uint32_t(base + k);
+            const size_t n_out = r_nt + (r_tri_size > r_nt ? r_tri_size - r_nt : 0);
+            out.triangles.reserve(out.triangles.size() + n_out);
+            out.source_triangles.reserve(out.source_triangles.size() + n_out);
+            auto leaf = [&](uint32_t src, const uint32_t* v) {
+                addOutput(src, {vertex_out[v[0]], vertex_out[v[1]], vertex_out[v[2]]});
+            };
+            for (size_t f = 0; f < r_nt; ++f) {
+                const uint32_t* v = (r_init.empty() || !r_init[f]) ? world.mesh.triangles[f].data() : r_tri[f].v;
+                leaf(uint32_t(f), v);
+            }
+            for (size_t id = r_nt; id < r_tri_size; ++id) leaf(r_tri[id].src, r_tri[id].v);
+            return;
+        }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
