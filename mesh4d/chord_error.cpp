@@ -95,18 +95,25 @@ EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const
     const double k = m.one_minus_beta2;
     const Vec3 x = E + (a.s + b.s) * 0.5;  // the midpoint now, relative to the camera
     const double xv = dot(x, m.velocity);
-    const double xm = std::sqrt(xv * xv + k * norm2(x));
+    const double xm2 = xv * xv + k * norm2(x);
+    const double xm = std::sqrt(xm2);
     const Vec3 u = b.s - a.s;
     const double uv = dot(u, m.velocity);
     const double l2 = uv * uv + k * norm2(u);
     const double uMx = uv * xv + k * dot(u, x);  // u^T M x = |x|_M (u.w)
-    // h(1/2) / 2 (>= 0 but for rounding): (|u|_M^2 - (u^T M x)^2 / |x|_M^2) / (2 (1 - b^2) |x|_M).
-    const double half_h = std::max(0.0, l2 - uMx * uMx / (xm * xm)) / (2 * k * xm);
+    // h(1/2) / 2 = (|u|_M^2 |x|_M^2 - (u^T M x)^2) / (2 (1 - b^2) |x|_M^3), >= 0 but for rounding.
+    const double half_h = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
     const double l = std::sqrt(l2);
     const double me = xm - 0.5 * l;
-    r.c = me > 0 ? half_h + l2 * l2 / (32 * k * me * me * me) : INFINITY;
-    const double mf = std::max(me, l);
-    r.length = mf > 0 ? half_h + 8 * l * l2 / (9 * std::sqrt(3.0) * k * mf * mf) : half_h;
+    constexpr double kThird = 8 / (9 * 1.7320508075688772);  // 8 / (9 sqrt 3)
+    if (me > 0) {
+        const double inv = 1 / (k * me * me * me);  // 1 / ((1 - b^2) m_e^3)
+        r.c = half_h + l2 * l2 * inv / 32;
+        r.length = half_h + kThird * l * l2 * (me >= l ? me * inv : 1 / (k * l2));
+    } else {
+        r.c = INFINITY;
+        r.length = half_h + kThird * l / k;  // m floored at l
+    }
     if (!(r.c == r.c)) r.c = INFINITY;
     if (!(r.length == r.length)) r.length = 0;
     return r;
