@@ -16,11 +16,6 @@ double bubbleMax(double c01, double c12, double c20) {
 }
 
 namespace {
-// |u|_M = sqrt((u.v)^2 + (1 - b^2) |u|^2).
-double normM(const Vec3& u, const Motion& m) {
-    const double uv = dot(u, m.velocity);
-    return std::sqrt(uv * uv + m.one_minus_beta2 * norm2(u));
-}
 // The corners' shape offsets (into s) and the least |x_i|_M.
 double cornerTerms(const ViewAnchor& anchor, const Motion& m, const Event corner[3], Vec3 s[3]) {
     double xm_min = INFINITY;
@@ -133,24 +128,6 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
     if (!(mlow > 0)) return INFINITY;
     const double bound = m.beta * d2 / (6 * m.one_minus_beta2 * mlow);
     return bound == bound ? bound : INFINITY;
-}
-
-double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid) {
-    return edgeLengthOfTerms(m, a.t, b.t, mid.t, shapeOfEvent(m, a), shapeOfEvent(m, b), normMOfEvent(anchor, m, a),
-                             normMOfEvent(anchor, m, b));
-}
-
-double edgeLengthOfTerms(const Motion& m, double ta, double tb, double tmid, const Vec3& sa, const Vec3& sb, double xma,
-                         double xmb) {
-    const double c = 4 * std::fabs(-tmid + 0.5 * (ta + tb));
-    const double l = normM(sb - sa, m);
-    const double xm = std::min(xma, xmb) - l;
-    // m is floored at l: finite near the camera, where halving an edge must still shorten it
-    // (longest-edge bisection ends only if the halves and medians are shorter than their edge).
-    const double mf = std::max(xm, l);
-    const double third = mf > 0 ? 8 * l * l * l / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mf * mf) : 0.0;
-    const double length = c + third;
-    return length == length ? length : 0.0;
 }
 
 }  // namespace mesh4d

@@ -163,18 +163,4 @@ EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const
 ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const Vec3 s[3], const double xm[3],
                                double tolerance = INFINITY);
 
-// The length of an edge in the map's own metric, which the refinement halves longest first
-// (Rivara's longest-edge bisection, with this length): its bubble coefficient 4 |beta| (the
-// second difference of delta along the edge, i.e. its squared length in the Hessian's metric)
-// plus the edge's share of the third-order term, 8 l_M^3 / (9 sqrt 3 (1 - b^2) m^2) with l_M its
-// M-length and m = max(min |x|_M of its ends minus l_M, l_M) (floored so that an edge reaching
-// the camera still has a finite length that halving reduces). A property of the edge alone, so
-// both triangles of an edge agree on it.
-double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid);
-
-// edgeLength from per-point terms: the event times of the ends and the midpoint, the ends' shape
-// offsets and |x|_M (see chordErrorOfTerms). Bit-identical to edgeLength.
-double edgeLengthOfTerms(const Motion& m, double ta, double tb, double tmid, const Vec3& sa, const Vec3& sb, double xma,
-                         double xmb);
-
 }  // namespace mesh4d
