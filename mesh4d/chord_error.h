@@ -15,8 +15,9 @@
 // patch (each output point L(p) has the exact point F(p), and back).
 //
 // The bound, term by term. Let I2 be the quadratic interpolant of delta through the corners and
-// the three edge midpoints (the values the refinement computes anyway: one closed form per edge),
-// and beta_ij = delta(m_ij) - (delta_i + delta_j) / 2 <= 0 the midpoint bubbles. Then
+// the three edge midpoints, and beta_ij = delta(m_ij) - (delta_i + delta_j) / 2 <= 0 the midpoint
+// bubbles (measured by cuts in chordError; bounded from above without a cut by edgeBubble below,
+// which is what the refinement uses). Then
 //     delta - L delta = (I2 delta - L I2 delta) + (delta - I2 delta),
 //     I2 delta - L I2 delta = sum_{i<j} 4 beta_ij l_i l_j      (l the barycentrics),
 // whose largest magnitude over the triangle, Q, has a closed form (bubbleMax). The remainder is
