@@ -92,6 +92,7 @@ EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const
     const double xv = dot(x, m.velocity);
     const double xm2 = xv * xv + k * norm2(x);
     const double xm = std::sqrt(xm2);
+    r.xm_mid = xm;
     const Vec3 u = b.s - a.s;
     const double uv = dot(u, m.velocity);
     const double l2 = uv * uv + k * norm2(u);

@@ -156,6 +156,7 @@ inline double normMOfShape(const Motion& m, const Vec3& E, const Vec3& s) {
 struct EdgeBubble {
     double c = 0;
     double length = 0;
+    double xm_mid = 0;  // |x|_M of the edge's middle (normMOfShape of the mean of the ends' s)
 };
 EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const PointTerms& b);
 

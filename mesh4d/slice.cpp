@@ -56,9 +56,10 @@ int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t*
 using VTerms = PointTerms;
 
 struct REdge {
-    uint32_t mid;  // midpoint vertex once made, else kUnset
-    double len;    // EdgeBubble::length once known, else NaN
-    double c;      // EdgeBubble::c, known with len
+    uint32_t mid;   // midpoint vertex once made, else kUnset
+    double len;     // EdgeBubble::length once known, else NaN
+    double c;       // EdgeBubble::c, known with len
+    double xm_mid;  // EdgeBubble::xm_mid, known with len (the midpoint's |x|_M, for its split)
 };
 // Triangles of the refinement, the leaves only: ids below r_nt are the mesh's triangles (records
 // made when first touched), later ids pieces made by splits. A split keeps one half in the
@@ -434,10 +435,10 @@ struct FrameBuilder {
     }
 
     // A split's point: its terms now, its exact image in the batch after the last split.
-    uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b) {
+    // xm: its |x|_M (edgeBubble made it, bit for bit normMOfShape of this shape offset).
+    uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b, double xm) {
         const uint32_t id = uint32_t(r_terms.size());
-        const Vec3 sh = (r_terms[a].s + r_terms[b].s) * 0.5;  // shapeOffset is affine
-        r_terms.push_back({sh, normMOfShape(world.motion, r_now, sh)});
+        r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
         r_rest.push_back(rest);
         Side s = Side::Inside;
         if (world.cap_a_real || world.cap_b_real) {
@@ -463,6 +464,7 @@ struct FrameBuilder {
             const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
             e.len = eb.length;
             e.c = eb.c;
+            e.xm_mid = eb.xm_mid;
         }
         return e;
     }
@@ -475,7 +477,8 @@ struct FrameBuilder {
         // A mesh edge's midpoint from its lo end, as the edge's other triangles would make it.
         const uint32_t lo = std::min(a, b), hi = std::max(a, b);
         const Vec3 rest = (restOfId(lo) + restOfId(hi)) * 0.5;
-        return r_edges[rec].mid = newVertex(rest, lo, hi);
+        const double xm = edgeOf(id, c).xm_mid;  // made with the edge's bound
+        return r_edges[rec].mid = newVertex(rest, lo, hi, xm);
     }
 
     // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
@@ -509,7 +512,7 @@ struct FrameBuilder {
             p = nextOf(p);
         } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-        r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN});
+        r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
         reserveTris(members.size());
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
@@ -568,8 +571,8 @@ struct FrameBuilder {
             // its verdict: its bound is not evaluated again.
             if (r_tri[id].state == kPassed) continue;
             if (r_tri[id].state == kUnknown) {
-                double c[3];
-                for (int k = 0; k < 3; ++k) c[k] = edgeOf(id, k).c;
+                const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
+                const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
                 const Vec3 s[3] = {k0.s, k1.s, k2.s};
                 const double xm[3] = {k0.xm, k1.xm, k2.xm};
@@ -579,6 +582,7 @@ struct FrameBuilder {
                     continue;
                 }
                 r_tri[id].state = kFailed;
+                if (r_tri[id].longest < 0) r_tri[id].longest = int16_t(longestOf(v, e));
             }
             if (r_tri[id].depth >= r_max_depth) {
                 r_limited[r_tri[id].src] = 1;
@@ -603,22 +607,25 @@ struct FrameBuilder {
             return lo != o.lo ? lo < o.lo : hi < o.hi;
         }
     };
-    Rank rankOf(uint32_t id, int c) {
-        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
-        return {edgeOf(id, c).len, std::min(a, b), std::max(a, b)};
-    }
-    int longestSlot(uint32_t id) {
-        ensureBase(id);
-        if (r_tri[id].longest >= 0) return r_tri[id].longest;
+    // The slot of the longest of the three edges e[c] (lengths known) of the triangle on v.
+    static int longestOf(const uint32_t v[3], const REdge* const e[3]) {
         int best = 0;
-        Rank r = rankOf(id, 0);
+        Rank r{e[0]->len, std::min(v[0], v[1]), std::max(v[0], v[1])};
         for (int c = 1; c < 3; ++c) {
-            const Rank rc = rankOf(id, c);
+            const uint32_t a = v[c], b = v[(c + 1) % 3];
+            const Rank rc{e[c]->len, std::min(a, b), std::max(a, b)};
             if (r < rc) {
                 r = rc;
                 best = c;
             }
         }
+        return best;
+    }
+    int longestSlot(uint32_t id) {
+        ensureBase(id);
+        if (r_tri[id].longest >= 0) return r_tri[id].longest;
+        const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
+        const int best = longestOf(r_tri[id].v, e);
         r_tri[id].longest = int16_t(best);
         return best;
     }
@@ -757,7 +764,7 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_edges.assign(ne, REdge{kUnset, NAN, NAN});
+            r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
             // Room for the pieces and points the refinement is expected to make (growth would copy them).
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
