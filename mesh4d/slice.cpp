@@ -77,6 +77,13 @@ struct RTri {
     uint8_t state;     // kUnknown, or its bound is known to pass or to fail (it waits for a neighbour's split)
     int16_t longest;   // the slot of its longest edge once known, else -1
 };
+// A slot (triangle record, side) as one number: id << 2 | side (the mesh's World4D::slot_next
+// counts 3 id + side; meshSlot converts). At most 2^30 records.
+inline uint32_t slotOf(uint32_t id, int side) { return id << 2 | uint32_t(side); }
+inline uint32_t slotTri(uint32_t slot) { return slot >> 2; }
+inline uint32_t slotSide(uint32_t slot) { return slot & 3; }
+inline uint32_t meshSlot(uint32_t slot3) { return slotOf(slot3 / 3, int(slot3 % 3)); }
+constexpr int kSucc[3] = {1, 2, 0};  // the next corner
 
 // The refinement's working arrays, kept per thread from frame to frame: a frame reuses the pages the
 // previous one touched instead of faulting fresh ones in (the arrays are several times the size of
@@ -415,7 +422,7 @@ struct FrameBuilder {
         RTri& t = r_tri[id];
         for (int c = 0; c < 3; ++c) {
             t.v[c] = world.mesh.triangles[id][c];
-            t.next[c] = world.slot_next[3 * id + c];
+            t.next[c] = meshSlot(world.slot_next[3 * id + c]);
             t.edge[c] = world.triangle_edges[id][c];
         }
         t.src = id;
@@ -425,13 +432,13 @@ struct FrameBuilder {
     }
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
     uint32_t nextOf(uint32_t p) const {
-        const uint32_t id = p / 3;
-        if (id < r_nt && !r_init[id]) return world.slot_next[p];
-        return r_tri[id].next[p % 3];
+        const uint32_t id = slotTri(p);
+        if (id < r_nt && !r_init[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
+        return r_tri[id].next[slotSide(p)];
     }
     void setNext(uint32_t p, uint32_t to) {
-        ensureBase(p / 3);
-        r_tri[p / 3].next[p % 3] = to;
+        ensureBase(slotTri(p));
+        r_tri[slotTri(p)].next[slotSide(p)] = to;
     }
 
     // A split's point: its terms now, its exact image in the batch after the last split.
@@ -460,7 +467,7 @@ struct FrameBuilder {
     const REdge& edgeOf(uint32_t id, int c) {
         REdge& e = r_edges[r_tri[id].edge[c]];
         if (e.len != e.len) {
-            const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
+            const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[kSucc[c]];
             const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
             e.len = eb.length;
             e.c = eb.c;
@@ -473,7 +480,7 @@ struct FrameBuilder {
     uint32_t midVertex(uint32_t id, int c) {
         const uint32_t rec = r_tri[id].edge[c];
         if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
-        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
+        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[kSucc[c]];
         // A mesh edge's midpoint from its lo end, as the edge's other triangles would make it.
         const uint32_t lo = std::min(a, b), hi = std::max(a, b);
         const Vec3 rest = (restOfId(lo) + restOfId(hi)) * 0.5;
@@ -485,12 +492,12 @@ struct FrameBuilder {
     // in the edge's cycle.
     void moveSlot(uint32_t from, uint32_t to) {
         const uint32_t nx = nextOf(from);
-        RTri& t = r_tri[to / 3];
+        RTri& t = r_tri[slotTri(to)];
         if (nx == from) {
-            t.next[to % 3] = to;
+            t.next[slotSide(to)] = to;
             return;
         }
-        t.next[to % 3] = nx;
+        t.next[slotSide(to)] = nx;
         uint32_t p = nx;
         while (nextOf(p) != from) p = nextOf(p);
         setNext(p, to);
@@ -502,10 +509,10 @@ struct FrameBuilder {
     // records; each triangle's new inner edge (m, o) gets its own record.
     void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
-        const uint32_t lo = std::min(r_tri[id].v[c], r_tri[id].v[(c + 1) % 3]);
+        const uint32_t lo = std::min(r_tri[id].v[c], r_tri[id].v[kSucc[c]]);
         std::vector<uint32_t>& members = scratch_members;
         members.clear();
-        const uint32_t start = 3 * id + uint32_t(c);
+        const uint32_t start = slotOf(id, c);
         uint32_t p = start;
         do {
             members.push_back(p);
@@ -517,13 +524,13 @@ struct FrameBuilder {
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
             if (first == kUnset) first = slot;
-            else r_tri[prev / 3].next[prev % 3] = slot;
+            else r_tri[slotTri(prev)].next[slotSide(prev)] = slot;
             prev = slot;
         };
         uint32_t inner = hi_rec + 1;
         for (uint32_t q : members) {
-            const uint32_t u = q / 3;
-            const int cu = int(q % 3), c1 = (cu + 1) % 3, c2 = (cu + 2) % 3;
+            const uint32_t u = slotTri(q);
+            const int cu = int(slotSide(q)), c1 = kSucc[cu], c2 = kSucc[c1];
             ensureBase(u);
             RTri& A = r_tri[u];
             const uint32_t a = A.v[cu], b = A.v[c1], o = A.v[c2];
@@ -532,11 +539,11 @@ struct FrameBuilder {
             if (A.depth == 0) ++out.refined_triangles;
             const uint8_t depth = uint8_t(A.depth + 1);
             RTri& Bt = r_tri[B];
-            Bt = RTri{{m, b, o}, {kUnset, kUnset, 3 * u + uint32_t(c1)}, {b_half, A.edge[c1], inner}, A.src, depth,
+            Bt = RTri{{m, b, o}, {kUnset, kUnset, slotOf(u, c1)}, {b_half, A.edge[c1], inner}, A.src, depth,
                       kUnknown, -1};
-            moveSlot(3 * u + uint32_t(c1), 3 * B + 1);  // the side b -> o goes to B
+            moveSlot(slotOf(u, c1), slotOf(B, 1));  // the side b -> o goes to B
             A.v[c1] = m;
-            A.next[c1] = 3 * B + 2;
+            A.next[c1] = slotOf(B, 2);
             A.edge[cu] = a_half;
             A.edge[c1] = inner;
             A.depth = depth;
@@ -544,9 +551,9 @@ struct FrameBuilder {
             A.longest = -1;
             if (a == lo) {
                 link(q, lo_first, lo_prev);
-                link(3 * B, hi_first, hi_prev);
+                link(slotOf(B, 0), hi_first, hi_prev);
             } else {
-                link(3 * B, lo_first, lo_prev);
+                link(slotOf(B, 0), lo_first, lo_prev);
                 link(q, hi_first, hi_prev);
             }
             ++inner;
@@ -554,8 +561,8 @@ struct FrameBuilder {
             stack.push_back(B);
             stack.push_back(u);
         }
-        r_tri[lo_prev / 3].next[lo_prev % 3] = lo_first;  // close the two cycles
-        r_tri[hi_prev / 3].next[hi_prev % 3] = hi_first;
+        r_tri[slotTri(lo_prev)].next[slotSide(lo_prev)] = lo_first;  // close the two cycles
+        r_tri[slotTri(hi_prev)].next[slotSide(hi_prev)] = hi_first;
     }
 
     // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
@@ -612,7 +619,7 @@ struct FrameBuilder {
         int best = 0;
         Rank r{e[0]->len, std::min(v[0], v[1]), std::max(v[0], v[1])};
         for (int c = 1; c < 3; ++c) {
-            const uint32_t a = v[c], b = v[(c + 1) % 3];
+            const uint32_t a = v[c], b = v[kSucc[c]];
             const Rank rc{e[c]->len, std::min(a, b), std::max(a, b)};
             if (r < rc) {
                 r = rc;
@@ -642,11 +649,11 @@ struct FrameBuilder {
         uint32_t t = id;
         for (;;) {
             const int c = longestSlot(t);
-            const uint32_t start = 3 * t + uint32_t(c);
+            const uint32_t start = slotOf(t, c);
             uint32_t other = kUnset;
             for (uint32_t p = nextOf(start); p != start; p = nextOf(p))
-                if (longestSlot(p / 3) != int(p % 3)) {
-                    other = p / 3;
+                if (longestSlot(slotTri(p)) != int(slotSide(p))) {
+                    other = slotTri(p);
                     break;
                 }
             if (other == kUnset) {
