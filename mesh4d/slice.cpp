@@ -394,6 +394,7 @@ struct FrameBuilder {
     // of which few triangles need refining touches only their pages (r_init says which base
     // records are made).
     std::unique_ptr<RTri[]>& r_tri;
+    RTri* rt = nullptr;  // r_tri.get(), kept in step by reserveTris
     size_t& r_tri_cap;
     size_t r_tri_size = 0;
     std::vector<uint8_t>& r_init;
@@ -413,13 +414,14 @@ struct FrameBuilder {
         std::unique_ptr<RTri[]> grown(new RTri[cap]);
         if (r_tri_size > 0) std::memcpy(static_cast<void*>(grown.get()), r_tri.get(), r_tri_size * sizeof(RTri));
         r_tri = std::move(grown);
+        rt = r_tri.get();
         r_tri_cap = cap;
     }
 
     void ensureBase(uint32_t id) {
         if (id >= r_nt || r_init[id]) return;
         r_init[id] = 1;
-        RTri& t = r_tri[id];
+        RTri& t = rt[id];
         for (int c = 0; c < 3; ++c) {
             t.v[c] = world.mesh.triangles[id][c];
             t.next[c] = meshSlot(world.slot_next[3 * id + c]);
@@ -434,11 +436,11 @@ struct FrameBuilder {
     uint32_t nextOf(uint32_t p) const {
         const uint32_t id = slotTri(p);
         if (id < r_nt && !r_init[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
-        return r_tri[id].next[slotSide(p)];
+        return rt[id].next[slotSide(p)];
     }
     void setNext(uint32_t p, uint32_t to) {
         ensureBase(slotTri(p));
-        r_tri[slotTri(p)].next[slotSide(p)] = to;
+        rt[slotTri(p)].next[slotSide(p)] = to;
     }
 
     // A split's point: its terms now, its exact image in the batch after the last split.
@@ -465,9 +467,9 @@ struct FrameBuilder {
     // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
     // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
     const REdge& edgeOf(uint32_t id, int c) {
-        REdge& e = r_edges[r_tri[id].edge[c]];
+        REdge& e = r_edges[rt[id].edge[c]];
         if (e.len != e.len) {
-            const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[kSucc[c]];
+            const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
             const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
             e.len = eb.length;
             e.c = eb.c;
@@ -478,9 +480,9 @@ struct FrameBuilder {
 
     // The midpoint vertex of slot c of triangle id (made once per edge, when the edge is split).
     uint32_t midVertex(uint32_t id, int c) {
-        const uint32_t rec = r_tri[id].edge[c];
+        const uint32_t rec = rt[id].edge[c];
         if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
-        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[kSucc[c]];
+        const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
         // A mesh edge's midpoint from its lo end, as the edge's other triangles would make it.
         const uint32_t lo = std::min(a, b), hi = std::max(a, b);
         const Vec3 rest = (restOfId(lo) + restOfId(hi)) * 0.5;
@@ -492,7 +494,7 @@ struct FrameBuilder {
     // in the edge's cycle.
     void moveSlot(uint32_t from, uint32_t to) {
         const uint32_t nx = nextOf(from);
-        RTri& t = r_tri[slotTri(to)];
+        RTri& t = rt[slotTri(to)];
         if (nx == from) {
             t.next[slotSide(to)] = to;
             return;
@@ -509,7 +511,7 @@ struct FrameBuilder {
     // records; each triangle's new inner edge (m, o) gets its own record.
     void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
-        const uint32_t lo = std::min(r_tri[id].v[c], r_tri[id].v[kSucc[c]]);
+        const uint32_t lo = std::min(rt[id].v[c], rt[id].v[kSucc[c]]);
         std::vector<uint32_t>& members = scratch_members;
         members.clear();
         const uint32_t start = slotOf(id, c);
@@ -524,7 +526,7 @@ struct FrameBuilder {
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
             if (first == kUnset) first = slot;
-            else r_tri[slotTri(prev)].next[slotSide(prev)] = slot;
+            else rt[slotTri(prev)].next[slotSide(prev)] = slot;
             prev = slot;
         };
         uint32_t inner = hi_rec + 1;
@@ -532,13 +534,13 @@ struct FrameBuilder {
             const uint32_t u = slotTri(q);
             const int cu = int(slotSide(q)), c1 = kSucc[cu], c2 = kSucc[c1];
             ensureBase(u);
-            RTri& A = r_tri[u];
+            RTri& A = rt[u];
             const uint32_t a = A.v[cu], b = A.v[c1], o = A.v[c2];
             const uint32_t B = uint32_t(r_tri_size++);
             const uint32_t a_half = a == lo ? lo_rec : hi_rec, b_half = a == lo ? hi_rec : lo_rec;
             if (A.depth == 0) ++out.refined_triangles;
             const uint8_t depth = uint8_t(A.depth + 1);
-            RTri& Bt = r_tri[B];
+            RTri& Bt = rt[B];
             Bt = RTri{{m, b, o}, {kUnset, kUnset, slotOf(u, c1)}, {b_half, A.edge[c1], inner}, A.src, depth,
                       kUnknown, -1};
             moveSlot(slotOf(u, c1), slotOf(B, 1));  // the side b -> o goes to B
@@ -561,8 +563,8 @@ struct FrameBuilder {
             stack.push_back(B);
             stack.push_back(u);
         }
-        r_tri[slotTri(lo_prev)].next[slotSide(lo_prev)] = lo_first;  // close the two cycles
-        r_tri[slotTri(hi_prev)].next[slotSide(hi_prev)] = hi_first;
+        rt[slotTri(lo_prev)].next[slotSide(lo_prev)] = lo_first;  // close the two cycles
+        rt[slotTri(hi_prev)].next[slotSide(hi_prev)] = hi_first;
     }
 
     // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
@@ -571,13 +573,13 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            const uint32_t v[3] = {r_tri[id].v[0], r_tri[id].v[1], r_tri[id].v[2]};
+            const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
             const Side s0 = side[v[0]];
             if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
-            if (r_tri[id].state == kPassed) continue;
-            if (r_tri[id].state == kUnknown) {
+            if (rt[id].state == kPassed) continue;
+            if (rt[id].state == kUnknown) {
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
                 const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
@@ -585,14 +587,14 @@ struct FrameBuilder {
                 const double xm[3] = {k0.xm, k1.xm, k2.xm};
                 const ChordError ce = chordErrorOfBubbles(world.motion, c, s, xm, settings.tolerance);
                 if (ce.bound <= settings.tolerance) {
-                    r_tri[id].state = kPassed;
+                    rt[id].state = kPassed;
                     continue;
                 }
-                r_tri[id].state = kFailed;
-                if (r_tri[id].longest < 0) r_tri[id].longest = int16_t(longestOf(v, e));
+                rt[id].state = kFailed;
+                if (rt[id].longest < 0) rt[id].longest = int16_t(longestOf(v, e));
             }
-            if (r_tri[id].depth >= r_max_depth) {
-                r_limited[r_tri[id].src] = 1;
+            if (rt[id].depth >= r_max_depth) {
+                r_limited[rt[id].src] = 1;
                 continue;
             }
             if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
@@ -630,10 +632,10 @@ struct FrameBuilder {
     }
     int longestSlot(uint32_t id) {
         ensureBase(id);
-        if (r_tri[id].longest >= 0) return r_tri[id].longest;
+        if (rt[id].longest >= 0) return rt[id].longest;
         const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
-        const int best = longestOf(r_tri[id].v, e);
-        r_tri[id].longest = int16_t(best);
+        const int best = longestOf(rt[id].v, e);
+        rt[id].longest = int16_t(best);
         return best;
     }
 
@@ -699,6 +701,7 @@ struct FrameBuilder {
     // edge midpoints (cut in batches), splits where a bound exceeds the tolerance, then the leaves
     // in mesh order. `live`: one flag per chunk (the cull), or null.
     void refineFrame(const std::vector<uint8_t>* live) {
+        rt = r_tri.get();
         r_nv = uint32_t(world.mesh.positions.size());
         r_nt = uint32_t(world.mesh.triangles.size());
         const size_t ne = world.edges.size();
@@ -821,10 +824,10 @@ struct FrameBuilder {
                 addOutput(src, {vertex_out[v[0]], vertex_out[v[1]], vertex_out[v[2]]});
             };
             for (size_t f = 0; f < r_nt; ++f) {
-                const uint32_t* v = (r_init.empty() || !r_init[f]) ? world.mesh.triangles[f].data() : r_tri[f].v;
+                const uint32_t* v = (r_init.empty() || !r_init[f]) ? world.mesh.triangles[f].data() : rt[f].v;
                 leaf(uint32_t(f), v);
             }
-            for (size_t id = r_nt; id < r_tri_size; ++id) leaf(r_tri[id].src, r_tri[id].v);
+            for (size_t id = r_nt; id < r_tri_size; ++id) leaf(rt[id].src, rt[id].v);
             return;
         }
         for (size_t f = 0; f < r_nt; ++f) {
@@ -834,11 +837,11 @@ struct FrameBuilder {
                 const uint32_t v[3] = {t[0], t[1], t[2]};
                 emitLeaf(uint32_t(f), v);
             } else {
-                emitLeaf(uint32_t(f), r_tri[f].v);
+                emitLeaf(uint32_t(f), rt[f].v);
             }
         }
         for (size_t id = r_nt; id < r_tri_size; ++id)
-            if (isLive(r_tri[id].src)) emitLeaf(r_tri[id].src, r_tri[id].v);
+            if (isLive(rt[id].src)) emitLeaf(rt[id].src, rt[id].v);
     }
 
     // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).
