@@ -716,8 +716,7 @@ struct FrameBuilder {
         r_time.resize(r_nv);
         cutRestLocalBatch(anchor, world.motion, world.mesh.positions.data(), r_nv, r_pos.data(), r_time.data());
         const bool caps = world.cap_a_real || world.cap_b_real;
-        if (caps) classifyVertices(live);
-        else side.assign(r_nv, Side::Inside);
+        if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
         // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
         // refinement; the others get the a-priori bound (chordErrorOfBubbles).
@@ -734,9 +733,11 @@ struct FrameBuilder {
             if (!isLive(f)) continue;
             const auto& t = world.mesh.triangles[f];
             if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
-            const Side s0 = side[t[0]];
-            if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
-            if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
+            if (caps) {
+                const Side s0 = side[t[0]];
+                if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
+                if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
+            }
             const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
             const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
             if (passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
