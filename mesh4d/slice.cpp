@@ -377,6 +377,7 @@ struct FrameBuilder {
     // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
     // ids edge midpoints made when an edge is split. `side` and `vertex_out` grow with them.
     uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
+    bool r_caps = false;          // a cap is real: points are classified and pieces clipped
     Vec3 r_now{0, 0, 0};          // the object's origin now, relative to the camera (nowBase)
     std::vector<Vec3>& r_pos;     // exact local image of every id (the batch cuts: mesh vertices first,
     std::vector<double>& r_time;  // the splits' points after the last split); its local emission time, -delta
@@ -449,18 +450,18 @@ struct FrameBuilder {
         const uint32_t id = uint32_t(r_terms.size());
         r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
         r_rest.push_back(rest);
-        Side s = Side::Inside;
-        if (world.cap_a_real || world.cap_b_real) {
+        // Without a real cap every point is inside and is given its output place in bulk
+        // (refineFrame): side and vertex_out stay the mesh's.
+        if (r_caps) {
             Event cap[2];
             for (int k = 0; k < 2; ++k) {
                 const Event ea = capOfId(a, k), eb = capOfId(b, k);
                 cap[k] = {0.5 * (ea.t + eb.t), (ea.x + eb.x) * 0.5};  // symmetric in a, b
                 r_cap.push_back(cap[k]);
             }
-            s = sideOf(cap[0], cap[1]);
+            side.push_back(sideOf(cap[0], cap[1]));
+            vertex_out.push_back(kUnset);
         }
-        side.push_back(s);
-        vertex_out.push_back(kUnset);
         return id;
     }
 
@@ -574,8 +575,10 @@ struct FrameBuilder {
             const uint32_t id = stack.back();
             stack.pop_back();
             const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
-            const Side s0 = side[v[0]];
-            if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
+            if (r_caps) {
+                const Side s0 = side[v[0]];
+                if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
+            }
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
             if (rt[id].state == kPassed) continue;
@@ -716,6 +719,7 @@ struct FrameBuilder {
         r_time.resize(r_nv);
         cutRestLocalBatch(anchor, world.motion, world.mesh.positions.data(), r_nv, r_pos.data(), r_time.data());
         const bool caps = world.cap_a_real || world.cap_b_real;
+        r_caps = caps;
         if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
         // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
@@ -817,6 +821,7 @@ struct FrameBuilder {
             out.positions.insert(out.positions.end(), r_pos.begin() + r_nv, r_pos.begin() + r_nv + n_new);
             out.emission_times.insert(out.emission_times.end(), r_time.begin() + r_nv, r_time.begin() + r_nv + n_new);
             out.rest_points.insert(out.rest_points.end(), r_rest.begin(), r_rest.begin() + n_new);
+            vertex_out.resize(r_nv + n_new);
             for (size_t k = 0; k < n_new; ++k) vertex_out[r_nv + k] = uint32_t(base + k);
             const size_t n_out = r_nt + (r_tri_size > r_nt ? r_tri_size - r_nt : 0);
             out.triangles.reserve(out.triangles.size() + n_out);

@@ -45,7 +45,7 @@
 // record order (each input triangle, or the piece of it that kept its record, then the pieces
 // the splits appended).
 // Cost: per output triangle about two edge bounds, one and a fifth triangle bounds, half a split
-// (its point's square root and the slot bookkeeping) and the output; about 1450 instructions
+// (its point's square root and the slot bookkeeping) and the output; about 1250 instructions
 // against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per output triangle").
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
