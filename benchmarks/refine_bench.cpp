@@ -16,11 +16,20 @@
 //   box:      the unit box passing 2 ls from the camera at 0.9c, seen at closest approach
 //             (docs/ACCURACY.md), size = its diagonal sqrt 3.
 //   sphere:   the 320-face icosphere of radius 1 passing 4 ls away at 0.9c, size = its diameter 2.
+//
+// Instruction counts (repeatable on a shared machine, unlike times): `refine_bench --count SCENE K`
+// makes one tolerance cut and one vertex cut of the matching uniform mesh, each in its own function
+// (countTolerance, countVertex), and prints both output sizes; run it under
+//   valgrind --tool=callgrind --toggle-collect='*countTolerance*' build/benchmarks/refine_bench --count 0 4
+// (or '*countVertex*') and divide the instructions by the triangles printed.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
+#include <string>
 
 #include "mesh4d/slice.h"
 #include "mesh4d/subdivide.h"
@@ -121,4 +130,34 @@ BENCHMARK(BM_PerTriangle)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 
-BENCHMARK_MAIN();
+namespace {
+[[gnu::noinline]] size_t countTolerance(const mesh4d::World4D& w, const mesh4d::ViewSurface& v, const mesh4d::SliceSettings& s) {
+    return mesh4d::sliceWorld(w, v, s).triangles.size();
+}
+[[gnu::noinline]] size_t countVertex(const mesh4d::World4D& w, const mesh4d::ViewSurface& v) {
+    return mesh4d::sliceWorld(w, v, mesh4d::SliceSettings{}).triangles.size();
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc == 4 && std::string(argv[1]) == "--count") {
+        const Scene sc = std::atoi(argv[2]) == 0 ? boxNear() : sphereMid();
+        const mesh4d::World4D w = mesh4d::extrude(sc.mesh, sc.motion, -100, 100, false, false);
+        mesh4d::SliceSettings tol;
+        tol.max_segments = 4096;
+        tol.tolerance = std::pow(10.0, -double(std::atoi(argv[3]))) * sc.size;
+        const size_t tris = countTolerance(w, sc.view, tol);
+        int level = 0;
+        while (double(sc.mesh.triangles.size()) * std::pow(4.0, level + 0.5) < double(tris)) ++level;
+        const mesh4d::World4D uw =
+            mesh4d::extrude(mesh4d::subdivideUniform(sc.mesh, level), sc.motion, -100, 100, false, false);
+        const size_t utris = countVertex(uw, sc.view);
+        std::printf("tolerance_triangles %zu\nvertex_triangles %zu\n", tris, utris);
+        return 0;
+    }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}

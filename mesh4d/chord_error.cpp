@@ -5,22 +5,8 @@
 
 namespace mesh4d {
 
-double bubbleMax(double c01, double c12, double c20) {
-    // a_k: coefficient of the edge opposite corner k.
-    const double a0 = c12, a1 = c20, a2 = c01;
-    double best = 0.25 * std::max({a0, a1, a2});  // edge middles
-    const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
-    const double den = w0 + w1 + w2;  // = 2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2
-    if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);
-    return best;
-}
 
 namespace {
-// |u|_M = sqrt((u.v)^2 + (1 - b^2) |u|^2).
-double normM(const Vec3& u, const Motion& m) {
-    const double uv = dot(u, m.velocity);
-    return std::sqrt(uv * uv + m.one_minus_beta2 * norm2(u));
-}
 // The corners' shape offsets (into s) and the least |x_i|_M.
 double cornerTerms(const ViewAnchor& anchor, const Motion& m, const Event corner[3], Vec3 s[3]) {
     double xm_min = INFINITY;
@@ -53,39 +39,14 @@ ChordError chordErrorOfTerms(const Motion& m, const double t_corner[3], const do
 
 ChordError displacedChordError(const Motion& m, double speed, const double t_corner[3], const double t_mid[3],
                                const Vec3 s[3], const double xm[3], double tolerance) {
-    ChordError r;
-    if (speed == 0) return r;  // no displacement: the map is affine
+    if (speed == 0) return {};  // no displacement: the map is affine
     // Delays (delta = -t) and the midpoint bubbles, |beta| (delta is convex: beta <= 0 up to rounding).
     double c[3];
     for (int e = 0; e < 3; ++e) {
         const double d0 = -t_corner[e], d1 = -t_corner[(e + 1) % 3], dm = -t_mid[e];
         c[e] = 4 * std::fabs(dm - 0.5 * (d0 + d1));
     }
-    const double Q = bubbleMax(c[0], c[1], c[2]);
-    r.quadratic = speed * Q;
-    // Over the tolerance on the bubbles alone: R only adds (callers compare the bound only).
-    if (!(r.quadratic <= tolerance)) {
-        r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
-        return r;
-    }
-    // The shape offsets' centroid, the M-radius r_M and the least |x_i|_M.
-    double xm_min = INFINITY;
-    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, xm[i]);
-    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
-    // The largest |s_i - centre|_M: one square root of the largest square (sqrt is monotonic and
-    // correctly rounded, so this is the largest of the three roots, bit for bit).
-    double q = 0;
-    for (int i = 0; i < 3; ++i) {
-        const Vec3 u = s[i] - centre;
-        const double uv = dot(u, m.velocity);
-        q = std::max(q, uv * uv + m.one_minus_beta2 * norm2(u));
-    }
-    const double rM = std::sqrt(q);
-    const double mlow = xm_min - 2 * rM;
-    const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
-    r.bound = speed * (Q + R);
-    if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
-    return r;
+    return chordErrorOfBubbles(m, speed, c, s, xm, tolerance);
 }
 
 double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Event corner[3]) {
@@ -102,24 +63,6 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
     if (!(mlow > 0)) return INFINITY;
     const double bound = m.beta * d2 / (6 * m.one_minus_beta2 * mlow);
     return bound == bound ? bound : INFINITY;
-}
-
-double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid) {
-    return edgeLengthOfTerms(m, a.t, b.t, mid.t, shapeOfEvent(m, a), shapeOfEvent(m, b), normMOfEvent(anchor, m, a),
-                             normMOfEvent(anchor, m, b));
-}
-
-double edgeLengthOfTerms(const Motion& m, double ta, double tb, double tmid, const Vec3& sa, const Vec3& sb, double xma,
-                         double xmb) {
-    const double c = 4 * std::fabs(-tmid + 0.5 * (ta + tb));
-    const double l = normM(sb - sa, m);
-    const double xm = std::min(xma, xmb) - l;
-    // m is floored at l: finite near the camera, where halving an edge must still shorten it
-    // (longest-edge bisection ends only if the halves and medians are shorter than their edge).
-    const double mf = std::max(xm, l);
-    const double third = mf > 0 ? 8 * l * l * l / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mf * mf) : 0.0;
-    const double length = c + third;
-    return length == length ? length : 0.0;
 }
 
 }  // namespace mesh4d

@@ -15,8 +15,9 @@
 // patch (each output point L(p) has the exact point F(p), and back).
 //
 // The bound, term by term. Let I2 be the quadratic interpolant of delta through the corners and
-// the three edge midpoints (the values the refinement computes anyway: one closed form per edge),
-// and beta_ij = delta(m_ij) - (delta_i + delta_j) / 2 <= 0 the midpoint bubbles. Then
+// the three edge midpoints, and beta_ij = delta(m_ij) - (delta_i + delta_j) / 2 <= 0 the midpoint
+// bubbles (measured by cuts in chordError; bounded from above without a cut by edgeBubble below,
+// which is what the refinement uses). Then
 //     delta - L delta = (I2 delta - L I2 delta) + (delta - I2 delta),
 //     I2 delta - L I2 delta = sum_{i<j} 4 beta_ij l_i l_j      (l the barycentrics),
 // whose largest magnitude over the triangle, Q, has a closed form (bubbleMax). The remainder is
@@ -65,7 +66,16 @@ inline double normMOfEvent(const ViewAnchor& anchor, const Motion& m, const Even
 // l_k proportional to a_k (a_i + a_j - a_k) ... (a_k the coefficient of the edge opposite corner
 // k), with value a0 a1 a2 / (2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2) when the three a
 // satisfy the triangle inequality (the point is inside then).
-double bubbleMax(double c01, double c12, double c20);
+
+inline double bubbleMax(double c01, double c12, double c20) {
+    // a_k: coefficient of the edge opposite corner k.
+    const double a0 = c12, a1 = c20, a2 = c01;
+    double best = 0.25 * std::max({a0, a1, a2});  // edge middles
+    const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
+    const double den = w0 + w1 + w2;  // = 2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2
+    if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);
+    return best;
+}
 
 struct ChordError {
     double bound = 0;      // b (Q + R): bound of |F - L| on the triangle, light-seconds (INFINITY if unbounded)
@@ -124,18 +134,120 @@ inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion&
     return xmin > 0 && 4 * d2 <= xmin * xmin && m.beta * d2 <= 3 * m.one_minus_beta2 * tolerance * xmin;
 }
 
-// The length of an edge in the map's own metric, which the refinement halves longest first
-// (Rivara's longest-edge bisection, with this length): its bubble coefficient 4 |beta| (the
-// second difference of delta along the edge, i.e. its squared length in the Hessian's metric)
-// plus the edge's share of the third-order term, 8 l_M^3 / (9 sqrt 3 (1 - b^2) m^2) with l_M its
-// M-length and m = max(min |x|_M of its ends minus l_M, l_M) (floored so that an edge reaching
-// the camera still has a finite length that halving reduces). A property of the edge alone, so
-// both triangles of an edge agree on it.
-double edgeLength(const ViewAnchor& anchor, const Motion& m, const Event& a, const Event& b, const Event& mid);
+// ---- The a-priori bound: the bubbles from the Hessian, no midpoint cut ----
+// The refinement decides its splits with this bound (slice.cpp): it needs only per-point terms
+// that are affine in the rest point or one square root away from it, so no exact cut is made for
+// a decision; only the output vertices are cut, in one batch after the last split.
+// Along an edge x(t) = x_a + t u (x: the point now relative to the camera, x = E + s, affine in
+// the rest point; u = s_b - s_a), let g(t) = delta(x(t)) and h(t) = g''(t) = u^T H u >= 0, H the
+// Hessian of delta (that of d):
+//     H = (M - (M x)(M x)^T / |x|_M^2) / ((1 - b^2) |x|_M),   M = v v^T + (1 - b^2) I,
+//     h = (|u|_M^2 - (u.w)^2) / ((1 - b^2) |x|_M),   w = M x / |x|_M.
+// The midpoint bubble is |beta| = integral over [0, 1] of G h, G the hat of height 1/4 at t = 1/2
+// (integral 1/8), symmetric about 1/2. Expanding h about t = 1/2, the first-order term integrates
+// to zero, and the rest is at most K4 (t - 1/2)^2 / 2 with K4 the bound of the fourth derivative:
+// for a norm |D^4 |x|_M [u]^4| <= 3 |u|_M^4 / |x|_M^3 (the Euclidean case in the coordinates where
+// |.|_M is Euclidean: max over the angle of 3 sin^2 |4 cos^2 - sin^2| / r^3), and the integral of
+// G (t - 1/2)^2 is 1/192, so
+//     c = 4 |beta| <= h(1/2) / 2 + l^4 / (32 (1 - b^2) m_e^3),
+// l = |u|_M, m_e = |x_mid|_M - l / 2 <= |x(t)|_M on the edge. Exact (h / 2) for a quadratic delta;
+// the correction is fourth order, smaller than h / 2 by about (l / |x|)^2 / 32. bubbleMax is
+// non-decreasing in every coefficient, so chordErrorOfBubbles with these c bounds |F - L| as
+// chordErrorOfTerms does with the measured bubbles, and is as tight.
+// Rounding: h is a difference of two terms of size |u|_M^2 / |x|_M; its rounding is a few ulps of
+// that, far below any tolerance the program accepts (as the bubbles' rounding above).
 
-// edgeLength from per-point terms: the event times of the ends and the midpoint, the ends' shape
-// offsets and |x|_M (see chordErrorOfTerms). Bit-identical to edgeLength.
-double edgeLengthOfTerms(const Motion& m, double ta, double tb, double tmid, const Vec3& sa, const Vec3& sb, double xma,
-                         double xmb);
+// The terms of one point for the a-priori bound: its shape offset s and |x|_M, x = E + s (E =
+// nowBase, the object's origin now, relative to the camera).
+struct PointTerms {
+    Vec3 s;
+    double xm = 0;
+};
+inline double normMOfShape(const Motion& m, const Vec3& E, const Vec3& s) {
+    const Vec3 x = E + s;
+    const double xv = dot(x, m.velocity);
+    return std::sqrt(xv * xv + m.one_minus_beta2 * norm2(x));
+}
+
+// The edge a -> b's coefficient bound c (above; INFINITY when the edge may reach the camera,
+// m_e <= 0) and its length in the map's metric for longest-edge bisection: h(1/2) / 2 plus the
+// edge's share of the third-order term, 8 l^3 / (9 sqrt 3 (1 - b^2) m^2) with m = m_e floored at
+// l (finite near the camera, and shrinking as the edge is halved). Callers pass the ends in a
+// fixed order (lower vertex id first) so both triangles of an edge get the same bits.
+struct EdgeBubble {
+    double c = 0;
+    double length = 0;
+    double xm_mid = 0;  // |x|_M of the edge's middle (normMOfShape of the mean of the ends' s)
+};
+// Valid at b = 0 too (M = I: the delay is the Euclidean distance), which a displaced bound needs
+// (displacedChordError: an object at rest under a shear).
+inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a, const PointTerms& b) {
+    EdgeBubble r;
+    const double k = m.one_minus_beta2;
+    const Vec3 x = E + (a.s + b.s) * 0.5;  // the midpoint now, relative to the camera
+    const double xv = dot(x, m.velocity);
+    const double xm2 = xv * xv + k * norm2(x);
+    const double xm = std::sqrt(xm2);
+    r.xm_mid = xm;
+    const Vec3 u = b.s - a.s;
+    const double uv = dot(u, m.velocity);
+    const double l2 = uv * uv + k * norm2(u);
+    const double uMx = uv * xv + k * dot(u, x);  // u^T M x = |x|_M (u.w)
+    // h(1/2) / 2 = (|u|_M^2 |x|_M^2 - (u^T M x)^2) / (2 (1 - b^2) |x|_M^3), >= 0 but for rounding.
+    const double half_h = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
+    const double l = std::sqrt(l2);
+    const double me = xm - 0.5 * l;
+    constexpr double kThird = 8 / (9 * 1.7320508075688772);  // 8 / (9 sqrt 3)
+    if (me > 0) {
+        const double inv = 1 / (k * me * me * me);  // 1 / ((1 - b^2) m_e^3)
+        r.c = half_h + l2 * l2 * inv / 32;
+        r.length = half_h + kThird * l * l2 * (me >= l ? me * inv : 1 / (k * l2));
+    } else {
+        r.c = INFINITY;
+        r.length = half_h + kThird * l / k;  // m floored at l
+    }
+    if (!(r.c == r.c)) r.c = INFINITY;
+    if (!(r.length == r.length)) r.length = 0;
+    return r;
+}
+
+// The bound of chordErrorOfTerms from the three edges' coefficients c (c[e] on corners e, e + 1)
+// instead of the measured bubbles, and the corners' shape offsets and |x|_M.
+// `speed` is the factor on the delay's error: the object's speed b for its own image, |w| for a
+// displaced one (displacedChordError).
+inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],
+                                      const double xm[3], double tolerance = INFINITY) {
+    ChordError r;
+    if (speed == 0) return r;
+    const double Q = bubbleMax(c[0], c[1], c[2]);
+    r.quadratic = speed * Q;
+    // Over the tolerance on the bubbles alone: R only adds (callers compare the bound only).
+    if (!(r.quadratic <= tolerance)) {
+        r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
+        return r;
+    }
+    // The shape offsets' centroid, the M-radius r_M and the least |x_i|_M.
+    double xm_min = INFINITY;
+    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, xm[i]);
+    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
+    // The largest |s_i - centre|_M: one square root of the largest square (sqrt is monotonic and
+    // correctly rounded, so this is the largest of the three roots, bit for bit).
+    double q = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[i] - centre;
+        const double uv = dot(u, m.velocity);
+        q = std::max(q, uv * uv + m.one_minus_beta2 * norm2(u));
+    }
+    const double rM = std::sqrt(q);
+    const double mlow = xm_min - 2 * rM;
+    const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
+    r.bound = speed * (Q + R);
+    if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
+    return r;
+}
+inline ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const Vec3 s[3], const double xm[3],
+                                      double tolerance = INFINITY) {
+    return chordErrorOfBubbles(m, m.beta, c, s, xm, tolerance);
+}
 
 }  // namespace mesh4d

@@ -51,44 +51,50 @@ int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t*
     return k;
 }
 
-// The terms of the bound (chord_error.h chordErrorOfTerms) of one point, side by side: what a
+// The terms of the a-priori bound of one point (chord_error.h PointTerms), side by side: what a
 // corner or an edge's end contributes is read from one place.
-struct VTerms {
-    Vec3 s;     // shape offset y + v delta (shapeOfEvent)
-    double xm;  // |x|_M (normMOfEvent)
-    double t;   // local emission time, -delta
-};
+using VTerms = PointTerms;
 
 struct REdge {
-    uint32_t mid;  // midpoint vertex once made, else kUnset
-    double len;    // edgeLength once known, else NaN
+    uint32_t mid;   // midpoint vertex once made, else kUnset
+    double len;     // EdgeBubble::length once known, else NaN
+    double c;       // EdgeBubble::c, known with len
+    double xm_mid;  // EdgeBubble::xm_mid, known with len (the midpoint's |x|_M, for its split)
 };
-// Triangles of the refinement: ids below r_nt are the mesh's triangles (records made when first
-// touched), later ids the halves made by splits, two by two. Each slot c is the edge from v[c]
-// to v[c + 1]; the slots on one edge form a cycle (next), as World4D::slot_next does for the
-// mesh, so that an edge is split in every triangle that has it: no T-junctions, however the
-// splits go.
+// Triangles of the refinement, the leaves only: ids below r_nt are the mesh's triangles (records
+// made when first touched), later ids pieces made by splits. A split keeps one half in the
+// record it halves (the one with the slot that does not move) and appends the other. Each slot c
+// is the edge from v[c] to v[c + 1]; the slots on one edge form a cycle (next), as
+// World4D::slot_next does for the mesh, so that an edge is split in every triangle that has it:
+// no T-junctions, however the splits go.
+enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2 };
 struct RTri {
     uint32_t v[3];
     uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
     uint32_t edge[3];  // the edge record of each slot
-    uint32_t child;    // the first of its two halves (the second is child + 1) once split, else kUnset
     uint32_t src;      // the mesh triangle it lies on
     uint8_t depth;     // bisections since the mesh triangle (at most 2 log2(max_segments) <= 60)
-    uint8_t failed;    // its bound is known to exceed the tolerance (it waits for a neighbour's split)
+    uint8_t state;     // kUnknown, or its bound is known to pass or to fail (it waits for a neighbour's split)
     int16_t longest;   // the slot of its longest edge once known, else -1
 };
+// A slot (triangle record, side) as one number: id << 2 | side (the mesh's World4D::slot_next
+// counts 3 id + side; meshSlot converts). At most 2^30 records.
+inline uint32_t slotOf(uint32_t id, int side) { return id << 2 | uint32_t(side); }
+inline uint32_t slotTri(uint32_t slot) { return slot >> 2; }
+inline uint32_t slotSide(uint32_t slot) { return slot & 3; }
+inline uint32_t meshSlot(uint32_t slot3) { return slotOf(slot3 / 3, int(slot3 % 3)); }
+constexpr int kSucc[3] = {1, 2, 0};  // the next corner
 
 // The refinement's working arrays, kept per thread from frame to frame: a frame reuses the pages the
 // previous one touched instead of faulting fresh ones in (the arrays are several times the size of
 // the output). Cleared, not freed, by each frame; freed after a frame that made them larger than
 // kScratchKeep bytes, so a single huge frame does not hold its memory for the program's life.
 struct RefineScratch {
-    std::vector<Vec3> pos, rest, e_pos;
-    std::vector<double> time, e_time;
+    std::vector<Vec3> pos, rest;
+    std::vector<double> time;
     std::vector<VTerms> terms;
     std::vector<Event> cap;
-    std::vector<uint8_t> e_done, init, limited;
+    std::vector<uint8_t> init, limited;
     std::vector<REdge> edges;
     std::unique_ptr<RTri[]> tri;
     size_t tri_cap = 0;
@@ -97,12 +103,12 @@ struct RefineScratch {
     std::vector<uint32_t> vertex_out;
 
     size_t bytes() const {
-        return (pos.capacity() + rest.capacity() + e_pos.capacity()) * sizeof(Vec3) +
-               (time.capacity() + e_time.capacity()) * sizeof(double) + terms.capacity() * sizeof(VTerms) +
+        return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
+               terms.capacity() * sizeof(VTerms) +
                cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
-               e_done.capacity() + init.capacity() + limited.capacity() + side.capacity();
+               init.capacity() + limited.capacity() + side.capacity();
     }
 };
 constexpr size_t kScratchKeep = size_t(256) << 20;
@@ -125,17 +131,18 @@ struct FrameBuilder {
     uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being clipped (rest clip)
     bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restPlan
     double rest_tolerance = 0;          // the tolerance restPlan keeps (settings.tolerance is 0 at rest)
+    double bound_speed = 0;             // boundSpeed(), once per frame
 
     FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
         : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)), scratch(threadScratch()),
           side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
-          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), e_pos(scratch.e_pos),
-          e_time(scratch.e_time), e_done(scratch.e_done), scratch_members(scratch.members), r_edges(scratch.edges),
+          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), scratch_members(scratch.members),
+          r_edges(scratch.edges),
           r_tri(scratch.tri), r_tri_cap(scratch.tri_cap), r_init(scratch.init), r_limited(scratch.limited) {
-        for (auto* a : {&r_pos, &r_rest, &e_pos}) a->clear();
-        for (auto* a : {&r_time, &e_time}) a->clear();
+        for (auto* a : {&r_pos, &r_rest}) a->clear();
+        r_time.clear();
         r_terms.clear();
-        for (auto* a : {&e_done, &r_init, &r_limited}) a->clear();
+        for (auto* a : {&r_init, &r_limited}) a->clear();
         side.clear();
         vertex_out.clear();
         r_cap.clear();
@@ -144,6 +151,7 @@ struct FrameBuilder {
         scratch.stack.clear();
         out.origin = anchor.origin;
         out.time_origin = anchor.time_origin;
+        bound_speed = boundSpeed();
     }
     ~FrameBuilder() {
         if (scratch.bytes() > kScratchKeep) scratch = RefineScratch();
@@ -151,15 +159,17 @@ struct FrameBuilder {
     FrameBuilder(const FrameBuilder&) = delete;
     FrameBuilder& operator=(const FrameBuilder&) = delete;
 
-    // A piece's bound (chord_error.h): displaced along the object's velocity u, along w = u -
-    // shear when the view shears its outputs (the finite model with a moving camera), or by
-    // settings.displacement when that is given (outputs mapped afterwards).
-    ChordError pieceBound(const double t_corner[3], const double t_mid[3], const Vec3 s[3], const double xm[3]) const {
-        if (settings.displacement >= 0)
-            return displacedChordError(world.motion, settings.displacement, t_corner, t_mid, s, xm, settings.tolerance);
-        if (!view.sheared()) return chordErrorOfTerms(world.motion, t_corner, t_mid, s, xm, settings.tolerance);
-        return displacedChordError(world.motion, norm(world.motion.velocity - view.shear), t_corner, t_mid, s, xm,
-                                   settings.tolerance);
+    // The factor a piece's bound multiplies the light delay's error by (chord_error.h
+    // chordErrorOfBubbles): the object's speed |u|; |w| = |u - shear| when the view shears its
+    // outputs (the finite model with a moving camera); settings.displacement when that is given
+    // (outputs mapped afterwards: reflections seen by a moving camera, pipeline/mirror.h).
+    double boundSpeed() const {
+        if (settings.displacement >= 0) return settings.displacement;
+        if (view.sheared()) return norm(world.motion.velocity - view.shear);
+        return world.motion.beta;
+    }
+    ChordError pieceBound(const double c[3], const Vec3 s[3], const double xm[3]) const {
+        return chordErrorOfBubbles(world.motion, bound_speed, c, s, xm, settings.tolerance);
     }
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
@@ -375,20 +385,20 @@ struct FrameBuilder {
 
     // ---- Step (refinement, tolerance > 0, moving, past cone): conforming bisection ----
     // Flat records, no allocation per piece: vertices as arrays indexed by id, edges and pieces as
-    // records in one array each, the midpoints' closed forms once per edge, the bound's per-point
-    // terms once per point.
+    // records in one array each. Every decision is made from the a-priori bound (chord_error.h
+    // edgeBubble, chordErrorOfBubbles): per point its terms (affine in the rest point but for one
+    // square root), per edge its coefficient, once each. No exact cut is made for a decision: the
+    // points the splits make are cut once, in one batch, after the last split.
     // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
-    // ids edge midpoints made when first needed. `side` and `vertex_out` grow with them.
+    // ids edge midpoints made when an edge is split. `side` and `vertex_out` grow with them.
     uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
-    std::vector<Vec3>& r_pos;     // exact local image of every id (mesh vertices: from the batch cut)
-    std::vector<double>& r_time;  // its local emission time, -delta
-    std::vector<VTerms>& r_terms; // its terms of the bound
+    bool r_caps = false;          // a cap is real: points are classified and pieces clipped
+    Vec3 r_now{0, 0, 0};          // the object's origin now, relative to the camera (nowBase)
+    std::vector<Vec3>& r_pos;     // exact local image of every id (the batch cuts: mesh vertices first,
+    std::vector<double>& r_time;  // the splits' points after the last split); its local emission time, -delta
+    std::vector<VTerms>& r_terms; // its terms of the bound (for mesh vertices: w only where a triangle needs it)
     std::vector<Vec3>& r_rest;    // rest point of ids >= r_nv
     std::vector<Event>& r_cap;    // cap events (2 per id >= r_nv) when a cap is real
-    // Midpoints of mesh edges: exact local images (cut in batches before the splits).
-    std::vector<Vec3>& e_pos;
-    std::vector<double>& e_time;
-    std::vector<uint8_t>& e_done;
     std::vector<uint32_t>& scratch_members;
 
     // Edges of the refinement: records below r_ne are the mesh's edges, later ones the halves and
@@ -400,6 +410,7 @@ struct FrameBuilder {
     // of which few triangles need refining touches only their pages (r_init says which base
     // records are made).
     std::unique_ptr<RTri[]>& r_tri;
+    RTri* rt = nullptr;  // r_tri.get(), kept in step by reserveTris
     size_t& r_tri_cap;
     size_t r_tri_size = 0;
     std::vector<uint8_t>& r_init;
@@ -408,7 +419,6 @@ struct FrameBuilder {
     size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
     std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
 
-    RTri& tri(uint32_t id) { return r_tri[id]; }
     Vec3 restOfId(uint32_t id) const { return id < r_nv ? world.mesh.positions[id] : r_rest[id - r_nv]; }
     Event capOfId(uint32_t id, int cap) const { return id < r_nv ? world.events[2 * id + cap] : r_cap[2 * (id - r_nv) + cap]; }
     Event eventOfId(uint32_t id) const { return {r_time[id], r_pos[id]}; }
@@ -420,164 +430,157 @@ struct FrameBuilder {
         std::unique_ptr<RTri[]> grown(new RTri[cap]);
         if (r_tri_size > 0) std::memcpy(static_cast<void*>(grown.get()), r_tri.get(), r_tri_size * sizeof(RTri));
         r_tri = std::move(grown);
+        rt = r_tri.get();
         r_tri_cap = cap;
     }
 
     void ensureBase(uint32_t id) {
         if (id >= r_nt || r_init[id]) return;
         r_init[id] = 1;
-        RTri& t = r_tri[id];
+        RTri& t = rt[id];
         for (int c = 0; c < 3; ++c) {
             t.v[c] = world.mesh.triangles[id][c];
-            t.next[c] = world.slot_next[3 * id + c];
+            t.next[c] = meshSlot(world.slot_next[3 * id + c]);
             t.edge[c] = world.triangle_edges[id][c];
         }
-        t.child = kUnset;
         t.src = id;
         t.depth = 0;
-        t.failed = 0;
+        t.state = kUnknown;
         t.longest = -1;
     }
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
     uint32_t nextOf(uint32_t p) const {
-        const uint32_t id = p / 3;
-        if (id < r_nt && !r_init[id]) return world.slot_next[p];
-        return r_tri[id].next[p % 3];
+        const uint32_t id = slotTri(p);
+        if (id < r_nt && !r_init[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
+        return rt[id].next[slotSide(p)];
     }
     void setNext(uint32_t p, uint32_t to) {
-        ensureBase(p / 3);
-        r_tri[p / 3].next[p % 3] = to;
+        ensureBase(slotTri(p));
+        rt[slotTri(p)].next[slotSide(p)] = to;
     }
 
-    uint32_t newVertex(const Vec3& rest, const Event& e, uint32_t a, uint32_t b) {
-        const uint32_t id = uint32_t(r_pos.size());
-        r_pos.push_back(e.x);
-        r_time.push_back(e.t);
-        r_terms.push_back({shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t});
+    // A split's point: its terms now, its exact image in the batch after the last split.
+    // xm: its |x|_M (edgeBubble made it, bit for bit normMOfShape of this shape offset).
+    uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b, double xm) {
+        const uint32_t id = uint32_t(r_terms.size());
+        r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
         r_rest.push_back(rest);
-        Side s = Side::Inside;
-        if (world.cap_a_real || world.cap_b_real) {
+        // Without a real cap every point is inside and is given its output place in bulk
+        // (refineFrame): side and vertex_out stay the mesh's.
+        if (r_caps) {
             Event cap[2];
             for (int k = 0; k < 2; ++k) {
                 const Event ea = capOfId(a, k), eb = capOfId(b, k);
                 cap[k] = {0.5 * (ea.t + eb.t), (ea.x + eb.x) * 0.5};  // symmetric in a, b
                 r_cap.push_back(cap[k]);
             }
-            s = sideOf(cap[0], cap[1]);
+            side.push_back(sideOf(cap[0], cap[1]));
+            vertex_out.push_back(kUnset);
         }
-        side.push_back(s);
-        vertex_out.push_back(kUnset);
         return id;
     }
 
-    double edgeLengthOf(uint32_t a, uint32_t b, uint32_t mid) const {
-        const VTerms &ta = r_terms[a], &tb = r_terms[b];
-        return edgeLengthOfTerms(world.motion, ta.t, tb.t, r_terms[mid].t, ta.s, tb.s, ta.xm, tb.xm);
+    // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
+    // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
+    const REdge& edgeOf(uint32_t id, int c) {
+        REdge& e = r_edges[rt[id].edge[c]];
+        if (e.len != e.len) {
+            const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
+            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
+            e.len = eb.length;
+            e.c = eb.c;
+            e.xm_mid = eb.xm_mid;
+        }
+        return e;
     }
 
-    // The midpoint vertex of slot c of triangle id (made once per edge): a mesh edge's from the
-    // batch cut, any other cut when first needed, with the edge's length.
+    // The midpoint vertex of slot c of triangle id (made once per edge, when the edge is split).
     uint32_t midVertex(uint32_t id, int c) {
-        if (id >= r_nt || r_init[id]) {  // the frequent case, kept small enough to inline
-            const uint32_t m = r_edges[r_tri[id].edge[c]].mid;
-            if (m != kUnset) return m;
-        }
-        return makeMidVertex(id, c);
-    }
-    [[gnu::noinline]] uint32_t makeMidVertex(uint32_t id, int c) {
-        ensureBase(id);
-        const uint32_t rec = r_tri[id].edge[c];
+        const uint32_t rec = rt[id].edge[c];
         if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
-        if (rec < r_ne) {
-            const Edge& ed = world.edges[rec];
-            const Vec3 rest = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
-            if (!e_done[rec]) {
-                const Event ev = cutRestLocal(anchor, world.motion, rest);
-                e_pos[rec] = ev.x;
-                e_time[rec] = ev.t;
-                e_done[rec] = 1;
-            }
-            return r_edges[rec].mid = newVertex(rest, {e_time[rec], e_pos[rec]}, ed.lo, ed.hi);
-        }
-        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
-        const Vec3 rest = (restOfId(a) + restOfId(b)) * 0.5;
-        const uint32_t m = newVertex(rest, cutRestLocal(anchor, world.motion, rest), a, b);
-        r_edges[rec] = {m, edgeLengthOf(a, b, m)};
-        return m;
+        const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
+        // A mesh edge's midpoint from its lo end, as the edge's other triangles would make it.
+        const uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        const Vec3 rest = (restOfId(lo) + restOfId(hi)) * 0.5;
+        const double xm = edgeOf(id, c).xm_mid;  // made with the edge's bound
+        return r_edges[rec].mid = newVertex(rest, lo, hi, xm);
     }
 
     // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
     // in the edge's cycle.
     void moveSlot(uint32_t from, uint32_t to) {
         const uint32_t nx = nextOf(from);
-        RTri& t = r_tri[to / 3];
+        RTri& t = rt[slotTri(to)];
         if (nx == from) {
-            t.next[to % 3] = to;
+            t.next[slotSide(to)] = to;
             return;
         }
-        t.next[to % 3] = nx;
+        t.next[slotSide(to)] = nx;
         uint32_t p = nx;
         while (nextOf(p) != from) p = nextOf(p);
         setNext(p, to);
     }
 
     // Halves the edge of slot c of triangle id at its midpoint, in every triangle around the edge:
-    // each becomes (a, m, o) and (m, b, o). The halves' slots on the edge form two new cycles, on
-    // two new edge records; each triangle's new inner edge (m, o) gets its own record.
+    // each (a, b, o) becomes A = (a, m, o), kept in its record (slot c + 2 stays in place), and
+    // B = (m, b, o), appended. The halves' slots on the edge form two new cycles, on two new edge
+    // records; each triangle's new inner edge (m, o) gets its own record.
     void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
-        const uint32_t lo = std::min(r_tri[id].v[c], r_tri[id].v[(c + 1) % 3]);
+        const uint32_t lo = std::min(rt[id].v[c], rt[id].v[kSucc[c]]);
         std::vector<uint32_t>& members = scratch_members;
         members.clear();
-        const uint32_t start = 3 * id + uint32_t(c);
+        const uint32_t start = slotOf(id, c);
         uint32_t p = start;
         do {
             members.push_back(p);
             p = nextOf(p);
         } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-        r_edges.push_back({kUnset, NAN});
-        r_edges.push_back({kUnset, NAN});
-        reserveTris(2 * members.size());
+        r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
+        reserveTris(members.size());
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
             if (first == kUnset) first = slot;
-            else r_tri[prev / 3].next[prev % 3] = slot;
+            else rt[slotTri(prev)].next[slotSide(prev)] = slot;
             prev = slot;
         };
+        uint32_t inner = hi_rec + 1;
         for (uint32_t q : members) {
-            const uint32_t u = q / 3;
-            const int cu = int(q % 3);
+            const uint32_t u = slotTri(q);
+            const int cu = int(slotSide(q)), c1 = kSucc[cu], c2 = kSucc[c1];
             ensureBase(u);
-            const RTri old = r_tri[u];
-            const uint32_t a = old.v[cu], b = old.v[(cu + 1) % 3], o = old.v[(cu + 2) % 3];
-            const uint32_t A = uint32_t(r_tri_size), B = A + 1;
-            const uint32_t inner = uint32_t(r_edges.size());
-            r_edges.push_back({kUnset, NAN});
+            RTri& A = rt[u];
+            const uint32_t a = A.v[cu], b = A.v[c1], o = A.v[c2];
+            const uint32_t B = uint32_t(r_tri_size++);
             const uint32_t a_half = a == lo ? lo_rec : hi_rec, b_half = a == lo ? hi_rec : lo_rec;
-            const uint8_t depth = uint8_t(old.depth + 1);
-            r_tri[A] = RTri{{a, m, o}, {kUnset, 3 * B + 2, kUnset}, {a_half, inner, old.edge[(cu + 2) % 3]}, kUnset,
-                            old.src, depth, 0, -1};
-            r_tri[B] = RTri{{m, b, o}, {kUnset, kUnset, 3 * A + 1}, {b_half, old.edge[(cu + 1) % 3], inner}, kUnset,
-                            old.src, depth, 0, -1};
-            r_tri_size += 2;
-            moveSlot(3 * u + uint32_t((cu + 2) % 3), 3 * A + 2);
-            moveSlot(3 * u + uint32_t((cu + 1) % 3), 3 * B + 1);
+            if (A.depth == 0) ++out.refined_triangles;
+            const uint8_t depth = uint8_t(A.depth + 1);
+            RTri& Bt = rt[B];
+            Bt = RTri{{m, b, o}, {kUnset, kUnset, slotOf(u, c1)}, {b_half, A.edge[c1], inner}, A.src, depth,
+                      kUnknown, -1};
+            moveSlot(slotOf(u, c1), slotOf(B, 1));  // the side b -> o goes to B
+            A.v[c1] = m;
+            A.next[c1] = slotOf(B, 2);
+            A.edge[cu] = a_half;
+            A.edge[c1] = inner;
+            A.depth = depth;
+            A.state = kUnknown;
+            A.longest = -1;
             if (a == lo) {
-                link(3 * A, lo_first, lo_prev);
-                link(3 * B, hi_first, hi_prev);
+                link(q, lo_first, lo_prev);
+                link(slotOf(B, 0), hi_first, hi_prev);
             } else {
-                link(3 * B, lo_first, lo_prev);
-                link(3 * A, hi_first, hi_prev);
+                link(slotOf(B, 0), lo_first, lo_prev);
+                link(q, hi_first, hi_prev);
             }
-            r_tri[u].child = A;
+            ++inner;
             ++r_leaves;  // one piece became two
-            if (u < r_nt) ++out.refined_triangles;
             stack.push_back(B);
-            stack.push_back(A);
+            stack.push_back(u);
         }
-        r_tri[lo_prev / 3].next[lo_prev % 3] = lo_first;  // close the two cycles
-        r_tri[hi_prev / 3].next[hi_prev % 3] = hi_first;
+        rt[slotTri(lo_prev)].next[slotSide(lo_prev)] = lo_first;  // close the two cycles
+        rt[slotTri(hi_prev)].next[slotSide(hi_prev)] = hi_first;
     }
 
     // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
@@ -586,25 +589,30 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            if (r_tri[id].child != kUnset) continue;  // split meanwhile, as a neighbour
-            const uint32_t v[3] = {r_tri[id].v[0], r_tri[id].v[1], r_tri[id].v[2]};
-            const Side s0 = side[v[0]];
-            if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
-            // A piece back on the stack after a neighbour's split has the same corners and
-            // midpoints as when it failed: its bound is not evaluated again.
-            if (!r_tri[id].failed) {
-                double t_mid[3];
-                for (int c = 0; c < 3; ++c) t_mid[c] = r_terms[midVertex(id, c)].t;
+            const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
+            if (r_caps) {
+                const Side s0 = side[v[0]];
+                if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
+            }
+            // A piece back on the stack unchanged (its record is reset when it is halved) keeps
+            // its verdict: its bound is not evaluated again.
+            if (rt[id].state == kPassed) continue;
+            if (rt[id].state == kUnknown) {
+                const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
+                const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
-                const double t_corner[3] = {k0.t, k1.t, k2.t};
                 const Vec3 s[3] = {k0.s, k1.s, k2.s};
                 const double xm[3] = {k0.xm, k1.xm, k2.xm};
-                const ChordError ce = pieceBound(t_corner, t_mid, s, xm);
-                if (ce.bound <= settings.tolerance) continue;
-                r_tri[id].failed = 1;
+                const ChordError ce = pieceBound(c, s, xm);
+                if (ce.bound <= settings.tolerance) {
+                    rt[id].state = kPassed;
+                    continue;
+                }
+                rt[id].state = kFailed;
+                if (rt[id].longest < 0) rt[id].longest = int16_t(longestOf(v, e));
             }
-            if (r_tri[id].depth >= r_max_depth) {
-                r_limited[r_tri[id].src] = 1;
+            if (rt[id].depth >= r_max_depth) {
+                r_limited[rt[id].src] = 1;
                 continue;
             }
             if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
@@ -612,8 +620,7 @@ struct FrameBuilder {
                 stack.clear();
                 return;
             }
-            splitLongestPath(id, stack);
-            if (r_tri[id].child == kUnset) stack.push_back(id);  // a coarser neighbour went first
+            if (!splitLongestPath(id, stack)) stack.push_back(id);  // a coarser neighbour went first
         }
     }
 
@@ -627,28 +634,26 @@ struct FrameBuilder {
             return lo != o.lo ? lo < o.lo : hi < o.hi;
         }
     };
-    Rank rankOf(uint32_t id, int c) {
-        const uint32_t a = r_tri[id].v[c], b = r_tri[id].v[(c + 1) % 3];
-        const uint32_t rec = r_tri[id].edge[c];
-        if (r_edges[rec].len != r_edges[rec].len) {
-            const uint32_t m = midVertex(id, c);  // sets the length of an edge made by a split
-            if (r_edges[rec].len != r_edges[rec].len) r_edges[rec].len = edgeLengthOf(a, b, m);
-        }
-        return {r_edges[rec].len, std::min(a, b), std::max(a, b)};
-    }
-    int longestSlot(uint32_t id) {
-        ensureBase(id);
-        if (r_tri[id].longest >= 0) return r_tri[id].longest;
+    // The slot of the longest of the three edges e[c] (lengths known) of the triangle on v.
+    static int longestOf(const uint32_t v[3], const REdge* const e[3]) {
         int best = 0;
-        Rank r = rankOf(id, 0);
+        Rank r{e[0]->len, std::min(v[0], v[1]), std::max(v[0], v[1])};
         for (int c = 1; c < 3; ++c) {
-            const Rank rc = rankOf(id, c);
+            const uint32_t a = v[c], b = v[kSucc[c]];
+            const Rank rc{e[c]->len, std::min(a, b), std::max(a, b)};
             if (r < rc) {
                 r = rc;
                 best = c;
             }
         }
-        r_tri[id].longest = int16_t(best);
+        return best;
+    }
+    int longestSlot(uint32_t id) {
+        ensureBase(id);
+        if (rt[id].longest >= 0) return rt[id].longest;
+        const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
+        const int best = longestOf(rt[id].v, e);
+        rt[id].longest = int16_t(best);
         return best;
     }
 
@@ -658,20 +663,22 @@ struct FrameBuilder {
     // strictly along it in the total order). One split per call. Angles stay bounded in the
     // map's metric, so the pieces follow the stretch (long across the motion where the map
     // bends along it) without slivers.
-    void splitLongestPath(uint32_t id, std::vector<uint32_t>& stack) {
+    // True when the edge halved is id's own (along the path lengths grow strictly, so no edge
+    // after the first is id's).
+    bool splitLongestPath(uint32_t id, std::vector<uint32_t>& stack) {
         uint32_t t = id;
         for (;;) {
             const int c = longestSlot(t);
-            const uint32_t start = 3 * t + uint32_t(c);
+            const uint32_t start = slotOf(t, c);
             uint32_t other = kUnset;
             for (uint32_t p = nextOf(start); p != start; p = nextOf(p))
-                if (longestSlot(p / 3) != int(p % 3)) {
-                    other = p / 3;
+                if (longestSlot(slotTri(p)) != int(slotSide(p))) {
+                    other = slotTri(p);
                     break;
                 }
             if (other == kUnset) {
                 splitEdge(t, c, stack);
-                return;
+                return t == id;
             }
             t = other;
         }
@@ -712,6 +719,7 @@ struct FrameBuilder {
     // edge midpoints (cut in batches), splits where a bound exceeds the tolerance, then the leaves
     // in mesh order. `live`: one flag per chunk (the cull), or null.
     void refineFrame(const std::vector<uint8_t>* live) {
+        rt = r_tri.get();
         r_nv = uint32_t(world.mesh.positions.size());
         r_nt = uint32_t(world.mesh.triangles.size());
         const size_t ne = world.edges.size();
@@ -726,25 +734,29 @@ struct FrameBuilder {
         r_time.resize(r_nv);
         cutRestLocalBatch(anchor, world.motion, world.mesh.positions.data(), r_nv, r_pos.data(), r_time.data());
         const bool caps = world.cap_a_real || world.cap_b_real;
-        if (caps) classifyVertices(live);
-        else side.assign(r_nv, Side::Inside);
+        r_caps = caps;
+        if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
-        // Step: the corners' bound (no midpoint needed) passes most triangles that need no
-        // refinement; the others get the full bound, from their edges' midpoints cut in batches.
+        // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
+        // refinement; the others get the a-priori bound (chordErrorOfBubbles).
         std::vector<uint32_t> candidates, failing;
         double expected_pieces = 0;
+        r_now = nowBase(view, world.motion);
         r_terms.resize(r_nv);  // the bound's terms, once per vertex
         for (size_t i = 0; i < r_nv; ++i) {
             const Event e{r_time[i], r_pos[i]};
-            r_terms[i] = {shapeOfEvent(world.motion, e), normMOfEvent(anchor, world.motion, e), e.t};
+            r_terms[i].s = shapeOfEvent(world.motion, e);
+            r_terms[i].xm = normMOfEvent(anchor, world.motion, e);
         }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             const auto& t = world.mesh.triangles[f];
             if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
-            const Side s0 = side[t[0]];
-            if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
-            if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
+            if (caps) {
+                const Side s0 = side[t[0]];
+                if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
+                if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
+            }
             const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
             const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
             // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
@@ -754,48 +766,21 @@ struct FrameBuilder {
             if (displaced || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
                 candidates.push_back(uint32_t(f));
         }
-        if (!candidates.empty()) {
-            e_done.assign(ne, 0);
-            e_pos.resize(ne);
-            e_time.resize(ne);
-            std::vector<uint32_t> which;
-            for (uint32_t f : candidates)
-                for (uint32_t e : world.triangle_edges[f])
-                    if (!e_done[e]) {
-                        e_done[e] = 1;
-                        which.push_back(e);
-                    }
-            constexpr size_t kBatch = 1024;  // rest points cut per call, kept in cache
-            Vec3 rest[kBatch], pos[kBatch];
-            double time[kBatch];
-            for (size_t k0 = 0; k0 < which.size(); k0 += kBatch) {
-                const size_t n = std::min(kBatch, which.size() - k0);
-                for (size_t k = 0; k < n; ++k) {
-                    const Edge& ed = world.edges[which[k0 + k]];
-                    rest[k] = (world.mesh.positions[ed.lo] + world.mesh.positions[ed.hi]) * 0.5;
-                }
-                cutRestLocalBatch(anchor, world.motion, rest, n, pos, time);
-                for (size_t k = 0; k < n; ++k) {
-                    e_pos[which[k0 + k]] = pos[k];
-                    e_time[which[k0 + k]] = time[k];
-                }
+        for (uint32_t f : candidates) {
+            double c[3], xc[3];
+            Vec3 sc[3];
+            for (int k = 0; k < 3; ++k) {
+                const Edge& ed = world.edges[world.triangle_edges[f][k]];
+                c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                const uint32_t v = world.mesh.triangles[f][k];
+                sc[k] = r_terms[v].s;
+                xc[k] = r_terms[v].xm;
             }
-            for (uint32_t f : candidates) {
-                double t_corner[3], t_mid[3], xc[3];
-                Vec3 sc[3];
-                for (int c = 0; c < 3; ++c) {
-                    const uint32_t v = world.mesh.triangles[f][c], e = world.triangle_edges[f][c];
-                    t_corner[c] = r_time[v];
-                    t_mid[c] = e_time[e];
-                    sc[c] = r_terms[v].s;
-                    xc[c] = r_terms[v].xm;
-                }
-                const double bound = pieceBound(t_corner, t_mid, sc, xc).bound;
-                if (bound > settings.tolerance) {
-                    failing.push_back(f);
-                    // About bound / T pieces once halved down to T (the error falls about as the area).
-                    expected_pieces += std::min(bound / settings.tolerance, 1e6);
-                }
+            const double bound = pieceBound(c, sc, xc).bound;
+            if (bound > settings.tolerance) {
+                failing.push_back(f);
+                // About bound / T pieces once halved down to T (the error falls about as the area).
+                expected_pieces += std::min(bound / settings.tolerance, 1e6);
             }
         }
         // Nothing to refine on a simple mesh that exists throughout: vertex mode's output.
@@ -812,12 +797,12 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_edges.assign(ne, REdge{kUnset, NAN});
+            r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
             // Room for the pieces and points the refinement is expected to make (growth would copy them).
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
             if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
-            reserveTris(r_nt + 2 * expect);  // records made on first touch (ensureBase)
+            reserveTris(r_nt + expect);  // records made on first touch (ensureBase)
             r_tri_size = r_nt;
             r_edges.reserve(ne + 2 * expect);
             for (auto* v : {&r_pos, &r_rest}) v->reserve(v->size() + expect);
@@ -838,32 +823,49 @@ struct FrameBuilder {
                 drain(stack);
             }
             for (uint8_t l : r_limited) out.limited_triangles += l;
+            // Step: the exact images of the splits' points, in one batch.
+            const size_t n_new = r_terms.size() - r_nv;
+            r_pos.resize(r_nv + n_new);
+            r_time.resize(r_nv + n_new);
+            cutRestLocalBatch(anchor, world.motion, r_rest.data(), n_new, r_pos.data() + r_nv, r_time.data() + r_nv);
         }
 
-        // Step: the leaves, mesh triangle by mesh triangle, each tree depth first.
-        std::vector<uint32_t>& stack = scratch.stack;
-        stack.clear();
+        // Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then
+        // the pieces the splits appended.
+        if (!caps) {
+            // Nothing clipped: every point a split made is a corner of some leaf, so the points
+            // follow the mesh's visible vertices in id order, copied in bulk.
+            const size_t base = out.positions.size(), n_new = r_terms.size() - r_nv;
+            out.positions.insert(out.positions.end(), r_pos.begin() + r_nv, r_pos.begin() + r_nv + n_new);
+            out.emission_times.insert(out.emission_times.end(), r_time.begin() + r_nv, r_time.begin() + r_nv + n_new);
+            out.rest_points.insert(out.rest_points.end(), r_rest.begin(), r_rest.begin() + n_new);
+            vertex_out.resize(r_nv + n_new);
+            for (size_t k = 0; k < n_new; ++k) vertex_out[r_nv + k] = uint32_t(base + k);
+            const size_t n_out = r_nt + (r_tri_size > r_nt ? r_tri_size - r_nt : 0);
+            out.triangles.reserve(out.triangles.size() + n_out);
+            out.source_triangles.reserve(out.source_triangles.size() + n_out);
+            auto leaf = [&](uint32_t src, const uint32_t* v) {
+                addOutput(src, {vertex_out[v[0]], vertex_out[v[1]], vertex_out[v[2]]});
+            };
+            for (size_t f = 0; f < r_nt; ++f) {
+                const uint32_t* v = (r_init.empty() || !r_init[f]) ? world.mesh.triangles[f].data() : rt[f].v;
+                leaf(uint32_t(f), v);
+            }
+            for (size_t id = r_nt; id < r_tri_size; ++id) leaf(rt[id].src, rt[id].v);
+            return;
+        }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
                 const auto& t = world.mesh.triangles[f];
                 const uint32_t v[3] = {t[0], t[1], t[2]};
                 emitLeaf(uint32_t(f), v);
-                continue;
-            }
-            stack.push_back(uint32_t(f));
-            while (!stack.empty()) {
-                const RTri& t = tri(stack.back());
-                stack.pop_back();
-                if (t.child != kUnset) {
-                    const uint32_t a = t.child, b = t.child + 1;
-                    stack.push_back(b);
-                    stack.push_back(a);
-                } else {
-                    emitLeaf(t.src, t.v);
-                }
+            } else {
+                emitLeaf(uint32_t(f), rt[f].v);
             }
         }
+        for (size_t id = r_nt; id < r_tri_size; ++id)
+            if (isLive(rt[id].src)) emitLeaf(rt[id].src, rt[id].v);
     }
 
     // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).

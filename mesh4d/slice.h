@@ -18,16 +18,20 @@
 // nearness (docs/DESIGN.md section 6). With a tolerance T > 0 the cut is refined where the exact
 // surface departs from the output, and only there ("Refinement" in slice.cpp):
 //   - each triangle is accepted when the bound of chord_error.h on |F - L| (the exact image
-//     against the linear interpolant of its exact corners) is <= T: first from its corners alone
-//     (no extra cut), else from the exact images of its three edge midpoints (one closed form per
-//     edge, shared by the edge's triangles) plus a third-order term. The bound is on the whole
-//     triangle (the quadratic interpolant's largest error, in closed form), so the measured error
-//     of a refined mesh is 0.5 to 1 times T;
+//     against the linear interpolant of its exact corners) is <= T: first, for the mesh's
+//     triangles, a bound from the corners alone; else the a-priori bound: per edge an upper bound
+//     c of its midpoint bubble from the Hessian of the delay at the edge's middle, with a
+//     fourth-order remainder (edgeBubble: one square root for that middle, no cut), and per
+//     triangle the largest value of the quadratic form those c give plus a third-order term
+//     (chordErrorOfBubbles). The bound is on the whole triangle, so the measured error of a
+//     refined mesh is 0.5 to 1 times T (docs/ACCURACY.md);
 //   - a triangle that fails is halved by longest-edge bisection (Rivara) in the map's own metric
-//     (edge lengths from the midpoint bubbles: chord_error.h edgeLength), so pieces are short
+//     (edge lengths from the same Hessian: chord_error.h EdgeBubble::length), so pieces are short
 //     across the direction the map bends and long along it, and only where it bends;
 //   - an edge is always halved in every triangle that has it (the cycle of slots around it,
 //     World4D::slot_next): no T-junctions, a watertight input stays watertight, genus is kept;
+//   - no decision needs an exact cut: the points the splits make are cut once each, in one batch
+//     after the last split (cutRestLocalBatch); the mesh's vertices were cut in one batch before;
 //   - a piece wholly before or after existing is not refined; a piece a real cap cuts is clipped
 //     at the exact crossings of its sides (keyed by the side's two vertices, so neighbours share
 //     them); the clip chords are measured by the tests, not bounded;
@@ -35,9 +39,14 @@
 //     that keep a neighbour conforming are never refused.
 // |F - L| bounds both one-sided distances between the output and the exact surface, so the
 // two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
-// no triangle needs refining, identical to vertex mode's.
-// Cost: per output triangle about two midpoint cuts, one and a half bounds and the bookkeeping of
-// the splits (flat records, no allocation per piece: docs/ACCURACY.md, "Cost per output triangle").
+// no triangle needs refining, identical to vertex mode's. Output order: the visible input
+// vertices in input order, then the splits' points (in the order they were made when nothing is
+// clipped, else with the clip points in the order the leaves first use them); the triangles in
+// record order (each input triangle, or the piece of it that kept its record, then the pieces
+// the splits appended).
+// Cost: per output triangle about two edge bounds, one and a fifth triangle bounds, half a split
+// (its point's square root and the slot bookkeeping) and the output; about 1250 instructions
+// against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per output triangle").
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
 // grew them past 256 MiB.

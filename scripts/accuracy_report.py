@@ -121,6 +121,21 @@ if os.path.exists(pt):
         per_tri.append(f"| {scene} | {parts.get('k')} | {b['triangles']:.0f} | {b['uniform_triangles']:.0f} | "
                        f"{b['tol_ns_per_tri']:.0f} | {b['vertex_ns_per_tri']:.1f} | {b['ratio']:.1f} |")
     per_tri.append("")
+ic = os.path.join(trade_dir, "instructions.csv")
+if os.path.exists(ic):
+    per_tri += ["Instructions (callgrind, which counts the same on a loaded machine): `refine_bench --count SCENE K` "
+                "cuts one frame at T = 10^-k x size and vertex mode on the uniform subdivision nearest in size, each "
+                "in its own function, counted with `valgrind --tool=callgrind --toggle-collect='*countTolerance*'` "
+                "(and `'*countVertex*'`).", "",
+                "| scene | k | output triangles at T | instructions / triangle | uniform triangles | "
+                "vertex mode, instructions / triangle | ratio |", "|---|---|---|---|---|---|---|"]
+    for r in csv.DictReader(open(ic)):
+        tol = int(r["tolerance_instructions"]) / int(r["tolerance_triangles"])
+        ver = int(r["vertex_instructions"]) / int(r["vertex_triangles"])
+        scene = "box" if r["scene"] == "0" else "sphere320"
+        per_tri.append(f"| {scene} | {r['k']} | {r['tolerance_triangles']} | {tol:.0f} | {r['vertex_triangles']} | "
+                       f"{ver:.1f} | {tol / ver:.1f} |")
+    per_tri.append("")
 end_to_end = []
 e2e = os.path.join(trade_dir, "end_to_end.md")
 if os.path.exists(e2e):

@@ -29,6 +29,29 @@ cmake --build "$build" --target performance_bench -j "$(nproc)" >/dev/null
 echo "== cost per output triangle: tolerance mode against vertex mode (refine_bench)"
 cmake --build "$build" --target refine_bench -j "$(nproc)" >/dev/null
 "$build/benchmarks/refine_bench" --benchmark_min_time=0.5 --benchmark_format=json > "$out/per_triangle.json"
+echo "== instructions per output triangle (callgrind: repeatable on a shared machine)"
+if command -v valgrind >/dev/null; then
+  echo "scene,k,tolerance_triangles,tolerance_instructions,vertex_triangles,vertex_instructions" > "$out/instructions.csv"
+  for k in 3 4 5; do
+    for scene in 0 1; do
+      counts=()
+      for fn in countTolerance countVertex; do
+        log=$(mktemp)
+        valgrind --tool=callgrind --callgrind-out-file=/dev/null --toggle-collect="*$fn*" \
+          "$build/benchmarks/refine_bench" --count "$scene" "$k" > "$log.out" 2> "$log"
+        counts+=("$(sed -n 's/.*Collected : \([0-9]*\).*/\1/p' "$log")")
+        tris=$(cat "$log.out")
+        rm -f "$log" "$log.out"
+      done
+      tt=$(echo "$tris" | awk '/tolerance_triangles/ {print $2}')
+      vt=$(echo "$tris" | awk '/vertex_triangles/ {print $2}')
+      echo "$scene,$k,$tt,${counts[0]},$vt,${counts[1]}" >> "$out/instructions.csv"
+    done
+  done
+else
+  echo "valgrind not found (scripts/setup.sh installs it): no instruction counts" >&2
+  rm -f "$out/instructions.csv"
+fi
 echo "== end to end at equal error (apparent render, every frame)"
 python3 "$root/scripts/trade_end_to_end.py" "$build" | tee "$out/end_to_end.md"
 python3 "$root/scripts/accuracy_report.py" "$out" "$root/docs"

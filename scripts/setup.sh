@@ -21,6 +21,7 @@ packages=(build-essential cmake pkg-config
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels libpng-dev
   libmeshoptimizer-dev  # EXT_meshopt_compression in the .glb (--compress meshopt)
   gnuplot-nox gltfpack  # gltfpack: the peer of benchmarks/load_bench; gnuplot draws `apparent trade`'s plot (DIR/trade.png) and docs/accuracy.png
+  valgrind  # callgrind counts the refinement's instructions per output triangle (scripts/accuracy_report.sh)
   libfreetype-dev fonts-dejavu-core ffmpeg)  # figure labels; raytrace/figure --video (and ffprobe in the tests)
 packages+=(libopenmpi-dev openmpi-bin)  # mpirun -n N apparent render (optional in CMake; the mpi_ranks test needs it)
 if [ "$mode" = test ]; then
