@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "robust.h"
+#include "worldline.h"
 
 namespace mesh4d {
 
@@ -94,8 +95,8 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
     // Events: both caps of every vertex's worldline.
     world.events.resize(2 * nv);
     for (size_t i = 0; i < nv; ++i) {
-        world.events[2 * i + 0] = labFromRest(motion, tau_a, mesh.positions[i]);
-        world.events[2 * i + 1] = labFromRest(motion, tau_b, mesh.positions[i]);
+        world.events[2 * i + 0] = worldlineEvent(motion, tau_a, mesh.positions[i]);
+        world.events[2 * i + 1] = worldlineEvent(motion, tau_b, mesh.positions[i]);
     }
 
     world.simple = true;
@@ -121,6 +122,13 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
 
 ProperTimeSpan spanSeen(const RestMesh& mesh, const Motion& motion, const ViewSurface& first, const ViewSurface& last) {
     ProperTimeSpan span{INFINITY, -INFINITY};
+    if (!isUniform(motion)) {  // worldline.h: the object's time s of each crossing
+        for (const Vec3& q : mesh.positions) {
+            span.lo = std::min(span.lo, crossWorldline(first, motion, q).s);
+            span.hi = std::max(span.hi, crossWorldline(last, motion, q).s);
+        }
+        return span;
+    }
     const Vec3 base_first = nowBase(first, motion), base_last = nowBase(last, motion);
     for (const Vec3& q : mesh.positions) {
         const double t_first = cutRestWorldline(first, motion, base_first, q).t;

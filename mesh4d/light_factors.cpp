@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "worldline.h"
+
 namespace mesh4d {
 
 double dopplerFactor(const Motion& m, ViewKind kind, const Vec3& apex, const Vec3& x) {
@@ -22,6 +24,15 @@ void addLightFactors(const World4D& world, const ViewSurface& view, ApparentMesh
     const size_t n = m->positions.size();
     m->doppler.resize(n);
     m->proper_time.resize(n);
+    if (!isUniform(world.motion)) {  // worldline.h: the crossing again, for its time s
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3& q = m->rest_points[i];
+            const double s = crossWorldline(view, world.motion, q).s;
+            m->doppler[i] = worldlineDoppler(world.motion, view.kind, view.apex, s, q, m->absolutePosition(i));
+            m->proper_time[i] = worldlineProperTime(world.motion, s, q);
+        }
+        return;
+    }
     for (size_t i = 0; i < n; ++i) {
         m->doppler[i] = dopplerFactor(world.motion, view.kind, view.apex, m->absolutePosition(i));
         m->proper_time[i] = properTimeAt(world.motion, m->rest_points[i], m->absoluteTime(i));

@@ -107,6 +107,7 @@ struct SliceSettings {
 };
 
 // Cuts `world` with `view`. Precondition: world.motion.beta < 1 when view.kind == PastCone.
+// A motion that is not uniform (worldline.h) is cut in vertex mode whatever the tolerance.
 // The result is empty when no part of the history meets the view surface.
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
 
@@ -114,7 +115,8 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
 // of the object's origin, radius R / (1 - b) on the cone (R = World4D::shape_radius: the shape
 // offset never lengthens q; the light delay changes by at most |delta e| / (1 - b) between two
 // points, so each point lies within |s| + b |s| / (1 - b) of the origin's image) and R on the
-// hyperplane. For view culling (pipeline/render.cpp, --cull-view).
+// hyperplane. For view culling (pipeline/render.cpp, --cull-view). A motion that is not uniform
+// (worldline.h) gets an infinite radius: it is never culled.
 struct BoundingSphere {
     Vec3 center;
     double radius = 0;

@@ -1,5 +1,11 @@
 #include "pipeline/physics.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "mesh4d/worldline.h"
+#include "pipeline/scene_fields.h"
+
 namespace apparent {
 
 mesh4d::Kinematics kinematicsOf(Model m) {
@@ -7,7 +13,7 @@ mesh4d::Kinematics kinematicsOf(Model m) {
                                                                  : mesh4d::Kinematics::Galilean;
 }
 
-mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
+static mesh4d::Motion uniformMotionOf(const ObjectSpec& s, Model model) {
     const mesh4d::Kinematics kin = kinematicsOf(model);
     switch (s.speed) {
         case ObjectSpec::Speed::Gamma:
@@ -18,6 +24,48 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
             break;
     }
     return mesh4d::makeMotion(kin, s.t0, s.position, s.velocity);
+}
+
+mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
+    mesh4d::Motion m = uniformMotionOf(s, model);
+    m.angular_velocity = s.angular_velocity;  // worldline.h: a spin about the origin, centre frame
+    return m;
+}
+
+Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance) {
+    const ObjectSpec& s = object.spec;
+    if (mesh4d::norm(s.angular_velocity) == 0) return Status::success();
+    const std::string field = scene.path + ": " + s.field_path + ".angular_velocity: ";
+    if (cameraMotionOf(scene).moving())
+        return Status::failure(field + "a spinning object needs a camera at rest (camera.velocity is not [0, 0, 0])");
+    if (tolerance > 0)
+        return Status::failure(field + "a spinning object is cut in vertex mode only: give --tolerance vertex (or the "
+                                       "scene's \"tolerance\": \"vertex\")");
+    // The fastest vertex (a point inside a triangle is never faster: the speed is convex in q).
+    const mesh4d::Motion m = motionOf(s, model);
+    double fastest = 0;
+    for (const mesh4d::Vec3& q : object.rest.positions)
+        fastest = std::max(fastest, m.kinematics == mesh4d::Kinematics::Lorentz ? mesh4d::spinSpeed(m, q)
+                                                                                : mesh4d::maxGalileanSpeed(m, q));
+    if (!std::isfinite(fastest))
+        return Status::failure(field + "the speed of a vertex is not finite");
+    if (model == Model::Instant) return Status::success();
+    if (!(fastest < 1))
+        return Status::failure(field + "a vertex would move at " + formatNumber(fastest) +
+                               (m.kinematics == mesh4d::Kinematics::Lorentz
+                                    ? " (|w x q| in the centre frame)"
+                                    : " (|velocity + w x q| in the lab, at the fastest angle)") +
+                               ", which must be < 1 (the speed of light) for model " + modelName(model));
+    return Status::success();
+}
+
+Status checkUniformMotions(const Scene& scene, const char* command) {
+    for (const ObjectSpec& s : scene.objects)
+        if (mesh4d::norm(s.angular_velocity) != 0)
+            return Status::failure(scene.path + ": " + s.field_path + ".angular_velocity: `apparent " + command +
+                                   "` draws uniform motion only (its 4D history is one slab of prisms per object); "
+                                   "use `apparent render` for spinning objects");
+    return Status::success();
 }
 
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene) {

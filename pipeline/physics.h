@@ -9,6 +9,7 @@
 #include "mesh4d/camera_frame.h"
 #include "mesh4d/extrude.h"
 #include "mesh4d/lightcone.h"
+#include "pipeline/prepared_object.h"
 #include "pipeline/scene.h"
 
 namespace apparent {
@@ -19,6 +20,16 @@ mesh4d::Kinematics kinematicsOf(Model model);
 // The motion of `object` under `model` in the lab. Precondition: the scene passed
 // checkSceneForModel.
 mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
+
+// What an object's motion beyond uniform (angular_velocity, mesh4d/worldline.h) needs, one line
+// naming file, field and problem when refused: a camera at rest, vertex mode (tolerance 0), and
+// every vertex slower than light: |w x q| < 1 in the centre frame (relativistic, contracted),
+// |velocity + w x q| < 1 in the lab at every angle (finite); instant has no limit.
+Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance);
+
+// For the 4D raytracer, which meets the prisms of one slab per object: every object in uniform
+// motion, else one line naming the first spinning object's angular_velocity.
+Status checkUniformMotions(const Scene& scene, const char* command);
 
 // The camera's worldline (scene camera.position and camera.velocity).
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene);

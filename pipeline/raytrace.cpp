@@ -182,6 +182,10 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& 
         err << "error: " << error << "\n";
         return kExitBadInput;
     }
+    if (Status s = checkUniformMotions(stage.scene, "raytrace"); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
     const bool video = !settings.video_path.empty();
     if (video && stage.models.size() != 1) {
         err << "error: --video: a video shows one model (" << stage.models.size()
@@ -351,6 +355,10 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     std::string error;
     if (!loadStage(stage_options, &stage, err, &error)) {
         err << "error: " << error << "\n";
+        return kExitBadInput;
+    }
+    if (Status s = checkUniformMotions(stage.scene, "figure"); !s.ok) {
+        err << "error: " << s.message << "\n";
         return kExitBadInput;
     }
     const Scene& scene = stage.scene;

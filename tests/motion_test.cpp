@@ -1,0 +1,363 @@
+// Motion beyond uniform (issue 18; mesh4d/worldline.h): spinning and rolling bodies, against
+// closed forms and against a computation written here that shares nothing with the code under
+// test (its own rotation, its own Lorentz boost as a matrix, its own root search by bisection).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mesh4d/extrude.h"
+#include "mesh4d/light_factors.h"
+#include "mesh4d/slice.h"
+#include "mesh4d/worldline.h"
+#include "quiet_stage.h"
+#include "pipeline/physics.h"
+#include "pipeline/worlds.h"
+
+using mesh4d::Event;
+using mesh4d::Motion;
+using mesh4d::Vec3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A closed cylinder of radius r about z, z in [-h, h], n segments: rings at -h and h, two hub
+// vertices. Vertex 0 is at angle 0 on the ring z = -h ... the ring z = h starts at n.
+mesh4d::RestMesh cylinder(double r, double h, int n) {
+    mesh4d::RestMesh m;
+    for (double z : {-h, h})
+        for (int k = 0; k < n; ++k) {
+            const double a = 2 * kPi * k / n;
+            m.positions.push_back({r * std::cos(a), r * std::sin(a), z});
+        }
+    const uint32_t hub_lo = uint32_t(m.positions.size());
+    m.positions.push_back({0, 0, -h});
+    m.positions.push_back({0, 0, h});
+    for (uint32_t k = 0; k < uint32_t(n); ++k) {
+        const uint32_t j = (k + 1) % n;
+        m.triangles.push_back({k, j + n, k + n});
+        m.triangles.push_back({k, j, j + n});
+        m.triangles.push_back({hub_lo, j, k});
+        m.triangles.push_back({hub_lo + 1, k + n, j + n});
+    }
+    return m;
+}
+
+mesh4d::ViewSurface cone(double t_c, const Vec3& apex) {
+    mesh4d::ViewSurface v;
+    v.kind = mesh4d::ViewKind::PastCone;
+    v.t_c = t_c;
+    v.apex = apex;
+    return v;
+}
+
+// Independent kinematics: the centre-frame helix of q (rotation about z by w s written out), the
+// Lorentz boost with velocity (b, 0, 0) as a matrix about the origin event (t0 = 0, X0), and the
+// crossing with the past cone by plain bisection on s.
+struct Independent {
+    double b = 0, w = 0;
+    Vec3 x0;
+    Event event(double s, const Vec3& q) const {
+        const double c = std::cos(w * s), sn = std::sin(w * s);
+        const double yx = c * q.x - sn * q.y, yy = sn * q.x + c * q.y, yz = q.z;
+        const double g = 1 / std::sqrt(1 - b * b);
+        return {g * (s + b * yx), {x0.x + g * (yx + b * s), x0.y + yy, x0.z + yz}};
+    }
+    Event cross(double t_c, const Vec3& C, const Vec3& q) const {
+        auto h = [&](double s) {
+            const Event e = event(s, q);
+            return (t_c - e.t) - std::hypot(e.x.x - C.x, e.x.y - C.y, e.x.z - C.z);
+        };
+        double lo = -1e3, hi = 1e3;
+        for (int i = 0; i < 200; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            if (h(mid) > 0) lo = mid; else hi = mid;
+        }
+        return event(0.5 * (lo + hi), q);
+    }
+};
+
+Motion spinMotion(mesh4d::Kinematics k, const Vec3& origin, const Vec3& v, const Vec3& w) {
+    Motion m = mesh4d::makeMotion(k, 0, origin, v);
+    m.angular_velocity = w;
+    return m;
+}
+
+}  // namespace
+
+// The crossing search against the independent bisection, a rolling wheel at b = 0.9 seen from the side.
+TEST(Motion, CrossingMatchesAnIndependentBisection) {
+    const Independent ind{0.9, -0.9, {-3, 0, 0}};
+    const Motion m = spinMotion(mesh4d::Kinematics::Lorentz, ind.x0, {0.9, 0, 0}, {0, 0, -0.9});
+    for (double t_c : {-2.0, 0.0, 3.5, 10.0})
+        for (const Vec3& q : {Vec3{1, 0, 0}, Vec3{0, -1, 0.05}, Vec3{-0.7, 0.7, -0.05}, Vec3{0, 0, 0}}) {
+            const Vec3 C{0, 0, 5};
+            const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(cone(t_c, C), m, q);
+            ASSERT_TRUE(c.ok);
+            const Event e = ind.cross(t_c, C, q);
+            EXPECT_NEAR(c.event.t, e.t, 1e-12 * (1 + std::fabs(e.t)));
+            EXPECT_NEAR(c.event.x.x, e.x.x, 1e-12 * (1 + std::fabs(e.x.x)));
+            EXPECT_NEAR(c.event.x.y, e.x.y, 1e-12);
+            EXPECT_NEAR(c.event.x.z, e.x.z, 1e-12);
+            // On the cone, to rounding.
+            EXPECT_NEAR(t_c - c.event.t, mesh4d::norm(c.event.x - C), 1e-13 * (t_c - c.event.t));
+        }
+}
+
+// Uniform motion keeps its closed forms: the worldline functions hand it to boost.h and lightcone.h.
+TEST(Motion, UniformMotionIsTheClosedForm) {
+    const Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 1, {2, 0, -3}, {0.6, 0.2, 0});
+    const Vec3 q{0.3, -0.4, 0.5};
+    const mesh4d::ViewSurface v = cone(4, {0, 0, 1});
+    const Event closed = mesh4d::cutRestWorldline(v, m, mesh4d::nowBase(v, m), q);
+    const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(v, m, q);
+    EXPECT_EQ(c.event.t, closed.t);
+    EXPECT_EQ(c.event.x, closed.x);
+    const Event e = mesh4d::worldlineEvent(m, 0.7, q), l = mesh4d::labFromRest(m, 0.7, q);
+    EXPECT_EQ(e.t, l.t);
+    EXPECT_EQ(e.x, l.x);
+    // The general Doppler form (d tau/ds over the received rate) equals 1 / (g (1 - v.n)).
+    const double d_general = mesh4d::worldlineDoppler(m, v.kind, v.apex, c.s, q, c.event.x);
+    const double d_uniform = mesh4d::dopplerFactor(m, v.kind, v.apex, c.event.x);
+    EXPECT_NEAR(d_general, d_uniform, 1e-14 * d_uniform);
+}
+
+// A cylinder spinning about its own axis, centre at rest, camera on the axis at distance D: every
+// output vertex lies on the rest surface, and the vertex at radius r, angle phi0 appears at angle
+// phi0 + w (t_c - sqrt(D^2 + r^2)) (the spoke spiral), in vertex mode, to 1e-9 relative.
+TEST(Motion, SpinningCylinderKeepsItsShapeAndDrawsTheSpokeSpiral) {
+    const double r = 1, h = 0.2, w = 0.9, D = 4;
+    const int n = 48;
+    const mesh4d::RestMesh mesh = cylinder(r, h, n);
+    const Motion m = spinMotion(mesh4d::Kinematics::Lorentz, {0, 0, 0}, {0, 0, 0}, {0, 0, w});
+    const mesh4d::World4D world = mesh4d::extrude(mesh, m, -100, 100, false, false);
+    for (double t_c : {0.0, 1.3, 7.25}) {
+        const mesh4d::ViewSurface view = cone(t_c, {0, 0, D});
+        const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+        ASSERT_EQ(out.positions.size(), mesh.positions.size());
+        ASSERT_EQ(out.triangles.size(), mesh.triangles.size());
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const Vec3 p = out.absolutePosition(i);
+            const Vec3& q = mesh.positions[i];
+            EXPECT_NEAR(std::hypot(p.x, p.y), std::hypot(q.x, q.y), 1e-12);  // on the rest surface
+            EXPECT_NEAR(p.z, q.z, 1e-15);
+            if (i >= size_t(2 * n)) continue;
+            const double rho = std::hypot(q.x, q.y), z = q.z;
+            const double phi0 = std::atan2(q.y, q.x);
+            const double expected = phi0 + w * (t_c - std::hypot(D - z, rho));
+            const double got = std::atan2(p.y, p.x);
+            const double diff = std::remainder(got - expected, 2 * kPi);
+            EXPECT_LE(std::fabs(diff), 1e-9 * std::fabs(expected) + 1e-15) << "vertex " << i << " t_c " << t_c;
+            EXPECT_NEAR(out.absoluteTime(i), t_c - std::hypot(D - z, rho), 1e-13 * (1 + std::fabs(t_c)));
+        }
+    }
+}
+
+// Rim clock: proper_time of a rim vertex advances by dt / gamma(w r) per lab second (centre at rest,
+// camera on the axis, so the delay is constant), and the transverse Doppler factor is 1 / gamma.
+TEST(Motion, RimClockRunsSlowByGammaOfTheRimSpeed) {
+    const double r = 1, w = 0.8, D = 3;
+    const mesh4d::RestMesh mesh = cylinder(r, 0.1, 24);
+    const Motion m = spinMotion(mesh4d::Kinematics::Lorentz, {0, 0, 0}, {0, 0, 0}, {0, 0, w});
+    const mesh4d::World4D world = mesh4d::extrude(mesh, m, -100, 100, false, false);
+    const double inv_gamma = std::sqrt(1 - (w * r) * (w * r));
+    double last = 0;
+    for (int k = 0; k < 4; ++k) {
+        const double t_c = 2.0 + 0.5 * k;
+        const mesh4d::ViewSurface view = cone(t_c, {0, 0, D});
+        mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+        mesh4d::addLightFactors(world, view, &out);
+        const double t_emit = t_c - std::hypot(D + 0.1, r);  // vertex 0: z = -0.1
+        EXPECT_NEAR(out.proper_time[0], t_emit * inv_gamma, 1e-12);
+        EXPECT_NEAR(out.doppler[0], inv_gamma, 1e-12);
+        EXPECT_NEAR(out.proper_time[2 * 24], (t_c - (D + 0.1)), 1e-12);  // the hub's clock: the centre's
+        if (k > 0) EXPECT_NEAR(out.proper_time[0] - last, 0.5 * inv_gamma, 1e-12);
+        last = out.proper_time[0];
+    }
+}
+
+// Rolling wheel (w R = |v| in the centre frame, b = 0.9): the contact point's lab velocity is 0 and
+// the top's 2v / (1 + v^2), from the worldlines (finite differences of the independent events too);
+// the frame-by-frame output matches the independent boost of the centre-frame helix to 1e-9; and
+// the rim clock reads t'' sqrt(1 - w^2 rho^2) at the emission event's centre-frame time t''.
+TEST(Motion, RollingWheelContactAtRestTopAtTwoVOverOnePlusVSquared) {
+    const double b = 0.9, R = 1;
+    const Independent ind{b, -b / R, {-4, 0, 0}};
+    const Motion m = spinMotion(mesh4d::Kinematics::Lorentz, ind.x0, {b, 0, 0}, {0, 0, -b / R});
+    for (double s : {0.0, 1.7, -3.2}) {
+        // The rest point at the bottom (0, -R) at centre-frame time s, and the one at the top.
+        const double a = -ind.w * s;  // q = R(-w s) of the point at the bottom (top) at time s
+        const Vec3 q_bottom{R * std::sin(a), -R * std::cos(a), 0};
+        const Vec3 q_top{-R * std::sin(a), R * std::cos(a), 0};
+        const Vec3 v_bottom = mesh4d::worldlineVelocity(m, s, q_bottom);
+        EXPECT_NEAR(mesh4d::norm(v_bottom), 0, 1e-15);
+        const Vec3 v_top = mesh4d::worldlineVelocity(m, s, q_top);
+        EXPECT_NEAR(v_top.x, 2 * b / (1 + b * b), 1e-15);
+        EXPECT_NEAR(v_top.y, 0, 1e-15);
+        // The same from the independent events by central differences.
+        const double ds = 1e-5;
+        const Event e0 = ind.event(s - ds, q_top), e1 = ind.event(s + ds, q_top);
+        EXPECT_NEAR((e1.x.x - e0.x.x) / (e1.t - e0.t), 2 * b / (1 + b * b), 1e-8);
+        const Event c0 = ind.event(s - ds, q_bottom), c1 = ind.event(s + ds, q_bottom);
+        EXPECT_NEAR((c1.x.x - c0.x.x) / (c1.t - c0.t), 0, 1e-8);
+    }
+    // Frames: vertex mode output against the independent crossing of every rest vertex.
+    const mesh4d::RestMesh mesh = cylinder(R, 0.05, 32);
+    const mesh4d::World4D world = mesh4d::extrude(mesh, m, -100, 100, false, false);
+    const Vec3 C{0, 0.5, 5};
+    for (double t_c : {2.0, 5.0, 8.5}) {
+        const mesh4d::ViewSurface view = cone(t_c, C);
+        mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+        mesh4d::addLightFactors(world, view, &out);
+        ASSERT_EQ(out.positions.size(), mesh.positions.size());
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const Vec3& q = mesh.positions[i];
+            const Event e = ind.cross(t_c, C, q);
+            const Vec3 p = out.absolutePosition(i);
+            EXPECT_NEAR(p.x, e.x.x, 1e-9);
+            EXPECT_NEAR(p.y, e.x.y, 1e-9);
+            EXPECT_NEAR(p.z, e.x.z, 1e-9);
+            EXPECT_NEAR(out.absoluteTime(i), e.t, 1e-9);
+            // t'' of the emission event: the independent inverse of t = g (s + b y_x), by bisection.
+            double lo = -1e3, hi = 1e3;
+            for (int it = 0; it < 200; ++it) {
+                const double mid = 0.5 * (lo + hi);
+                if (ind.event(mid, q).t < e.t) lo = mid; else hi = mid;
+            }
+            const double t2 = 0.5 * (lo + hi);
+            const double rho = std::hypot(q.x, q.y);
+            EXPECT_NEAR(out.proper_time[i], t2 * std::sqrt(1 - b * b * rho * rho), 1e-9);
+        }
+    }
+}
+
+// No NaN up to a rim speed of 1 - 1e-9, in every model, centre at rest and moving at 0.9.
+TEST(Motion, NoNaNUpToRimSpeedOneMinus1e9) {
+    const mesh4d::RestMesh mesh = cylinder(1, 0.1, 16);
+    for (double v : {0.0, 0.9})
+        for (mesh4d::Kinematics k : {mesh4d::Kinematics::Lorentz, mesh4d::Kinematics::Galilean})
+            for (mesh4d::ViewKind kind : {mesh4d::ViewKind::PastCone, mesh4d::ViewKind::Hyperplane}) {
+                if (k == mesh4d::Kinematics::Galilean && kind == mesh4d::ViewKind::PastCone && v > 0) continue;  // refused: > c
+                const Motion m = spinMotion(k, {0, 0, -3}, {v, 0, 0}, {0, 0, 1 - 1e-9});
+                const mesh4d::World4D world = mesh4d::extrude(mesh, m, -1e3, 1e3, false, false);
+                for (double t_c : {0.0, 2.5, 40.0}) {
+                    mesh4d::ViewSurface view = cone(t_c, {0, 0, 1});
+                    view.kind = kind;
+                    mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+                    mesh4d::addLightFactors(world, view, &out);
+                    ASSERT_EQ(out.positions.size(), mesh.positions.size());
+                    for (size_t i = 0; i < out.positions.size(); ++i) {
+                        ASSERT_TRUE(mesh4d::isFinite(out.positions[i]));
+                        ASSERT_TRUE(std::isfinite(out.emission_times[i]));
+                        ASSERT_TRUE(std::isfinite(out.doppler[i]) && out.doppler[i] > 0);
+                        ASSERT_TRUE(std::isfinite(out.proper_time[i]));
+                    }
+                }
+            }
+}
+
+// The instant model carries the spin (Galilean): x = X0 + R(w (t - t0)) q + v (t - t0) at t = t_c.
+TEST(Motion, InstantModelShowsTheCarriedSpin) {
+    const mesh4d::RestMesh mesh = cylinder(1, 0.1, 8);
+    const Motion m = spinMotion(mesh4d::Kinematics::Galilean, {1, 2, 3}, {0.5, 0, 0}, {0, 0, 2});
+    const mesh4d::World4D world = mesh4d::extrude(mesh, m, -10, 10, false, false);
+    mesh4d::ViewSurface view = cone(1.5, {0, 0, 0});
+    view.kind = mesh4d::ViewKind::Hyperplane;
+    const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+    for (size_t i = 0; i < out.positions.size(); ++i) {
+        const Vec3& q = mesh.positions[i];
+        const double a = 2 * 1.5, c = std::cos(a), s = std::sin(a);
+        const Vec3 expected{1 + c * q.x - s * q.y + 0.75, 2 + s * q.x + c * q.y, 3 + q.z};
+        const Vec3 p = out.absolutePosition(i);
+        EXPECT_NEAR(p.x, expected.x, 1e-14 * 8);
+        EXPECT_NEAR(p.y, expected.y, 1e-14 * 8);
+        EXPECT_NEAR(p.z, expected.z, 1e-14 * 8);
+    }
+}
+
+// An object that begins existing: the cap at centre-frame time s = 0 is flat (affine in q), and the
+// clip points lie on the true worldlines (their emission time is the crossing of their own).
+TEST(Motion, ExistenceCapClipsOnTheTrueWorldlines) {
+    const mesh4d::RestMesh mesh = cylinder(1, 0.1, 32);
+    const Motion m = spinMotion(mesh4d::Kinematics::Lorentz, {0, 0, 0}, {0.5, 0, 0}, {0, 0, 0.7});
+    const mesh4d::World4D world = mesh4d::extrude(mesh, m, 0, 100, true, false);
+    // A frame whose cone meets the cap: part of the wheel has begun existing.
+    const mesh4d::ViewSurface view = cone(3.2, {-3, 0, 0});
+    const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+    ASSERT_GT(out.clipped_triangles, 0u);
+    for (size_t i = 0; i < out.positions.size(); ++i) {
+        const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(view, m, out.rest_points[i]);
+        EXPECT_GE(c.s, -1e-9);  // never before the object exists
+        EXPECT_NEAR(mesh4d::norm(out.absolutePosition(i) - c.event.x), 0, 1e-12);
+    }
+}
+
+// The stage refuses what a spin cannot be: a vertex at or above c (file, field, speed), a tolerance
+// other than vertex mode, a moving camera, a spinning mirror; the raytracer refuses spin.
+TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
+    const std::string dir = ::testing::TempDir();
+    auto write = [&](const std::string& name, const std::string& body) {
+        const std::string path = dir + "/" + name;
+        FILE* f = std::fopen(path.c_str(), "w");
+        std::fputs(body.c_str(), f);
+        std::fclose(f);
+        return path;
+    };
+    const std::string mesh = std::string(APPARENT_SOURCE_DIR) + "/data/meshes/wheel.obj";
+    auto scene = [&](const std::string& object_extra, const std::string& top_extra) {
+        return "{\"camera\": {\"position\": [0, 0, 5]" + std::string(top_extra.empty() ? "" : ", ") + top_extra +
+               "}, \"frames\": {\"start\": 0, \"end\": 1, \"fps\": 2}, \"tolerance\": \"vertex\", "
+               "\"objects\": [{\"mesh\": \"" + mesh + "\"" + object_extra + "}]}";
+    };
+    apparent::Stage stage;
+    std::string error;
+    const std::string fast = write("fast.json", scene(", \"angular_velocity\": [0, 0, 1.0]", ""));
+    EXPECT_FALSE(apparent::loadQuietStage(fast, &stage, &error));
+    EXPECT_NE(error.find("fast.json: objects[0].angular_velocity: a vertex would move at 1"), std::string::npos) << error;
+    const std::string ok = write("ok.json", scene(", \"angular_velocity\": [0, 0, 0.99]", ""));
+    apparent::Stage s1;
+    EXPECT_TRUE(apparent::loadQuietStage(ok, &s1, &error)) << error;
+    // Finite: the carried rim adds to the velocity in the lab.
+    const std::string finite = write("finite.json", scene(", \"velocity\": [0.5, 0, 0], \"angular_velocity\": [0, 0, 0.6]", ""));
+    apparent::Stage s2;
+    EXPECT_TRUE(apparent::loadQuietStage(finite, &s2, &error, {apparent::Model::Relativistic})) << error;
+    EXPECT_FALSE(apparent::loadQuietStage(finite, &s2, &error, {apparent::Model::Finite}));
+    EXPECT_NE(error.find("a vertex would move at 1.1"), std::string::npos) << error;
+    apparent::Stage s3;
+    EXPECT_TRUE(apparent::loadQuietStage(finite, &s3, &error, {apparent::Model::Instant})) << error;
+    apparent::Stage s4;
+    const std::string moving = write("moving.json", scene(", \"angular_velocity\": [0, 0, 0.5]", "\"velocity\": [0.1, 0, 0]"));
+    EXPECT_FALSE(apparent::loadQuietStage(moving, &s4, &error));
+    EXPECT_NE(error.find("angular_velocity: a spinning object needs a camera at rest"), std::string::npos) << error;
+    apparent::Stage s5;
+    std::string tol = scene(", \"angular_velocity\": [0, 0, 0.5]", "");
+    tol.replace(tol.find("\"vertex\""), 8, "\"1e-3\"");
+    EXPECT_FALSE(apparent::loadQuietStage(write("tol.json", tol), &s5, &error));
+    EXPECT_NE(error.find("angular_velocity: a spinning object is cut in vertex mode only"), std::string::npos) << error;
+    apparent::Stage s6;
+    EXPECT_FALSE(apparent::loadQuietStage(write("mirror.json", scene(", \"mirror\": true, \"angular_velocity\": [0, 0, 0.5]", "")),
+                                          &s6, &error));
+    EXPECT_NE(error.find("angular_velocity: a mirror must be at rest (angular_velocity"), std::string::npos) << error;
+    apparent::Stage s7;
+    EXPECT_TRUE(apparent::loadQuietStage(ok, &s7, &error));
+    const apparent::Status rt = apparent::checkUniformMotions(s7.scene, "raytrace");
+    EXPECT_FALSE(rt.ok);
+    EXPECT_NE(rt.message.find("ok.json: objects[0].angular_velocity: `apparent raytrace` draws uniform motion only"),
+              std::string::npos);
+}
+
+// The shipped scenes load and render their first frame in the scene's model.
+TEST(Motion, ShippedWheelScenesBuildAndCut) {
+    for (const char* name : {"data/scenes/rolling_wheel.json", "data/scenes/spinning_wheel.json"}) {
+        apparent::Stage stage;
+        std::string error;
+        ASSERT_TRUE(apparent::loadQuietStage(name, &stage, &error)) << error;
+        const mesh4d::World4D world =
+            apparent::buildWorld(stage.objects[0], stage.scene.model, stage.scene, stage.first, stage.last_excl - 1);
+        const mesh4d::ApparentMesh out =
+            mesh4d::sliceWorld(world, apparent::viewForFrame(stage.scene, stage.scene.model, stage.first));
+        EXPECT_EQ(out.positions.size(), stage.objects[0].rest.positions.size()) << name;
+    }
+}
