@@ -221,6 +221,11 @@ double maxGalileanSpeed(const Motion& m, const Vec3& q) {
     return std::hypot(v_par, v_perp + rim);
 }
 
+double originProperTime(const Motion& m, double dt) {
+    if (!(dt > 0) || !accelerated(m)) return dt;
+    return originProperTimeAtLab(m, dt);
+}
+
 double horizonDistance(const Motion& m, const Vec3& q) {
     const double a = norm(m.acceleration);
     if (!(a > 0)) return INFINITY;

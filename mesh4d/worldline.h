@@ -101,6 +101,10 @@ double spinSpeed(const Motion& m, const Vec3& q);
 // (infinite without one); q has a worldline only where it is > 0.
 double horizonDistance(const Motion& m, const Vec3& q);
 
+// The origin's proper time (rapidity / |a|) at lab time t0 + dt on the lab path of an accelerated
+// motion (either kinematics: the path is the relativistic one), closed form; dt itself for dt <= 0.
+double originProperTime(const Motion& m, double dt);
+
 // The largest lab speed of rest point q over a turn, Galilean carry: |v + w x R q| maximised over
 // the angle, sqrt(v_par^2 + (|v_perp| + |w x q|)^2) with v_par the part of v along w.
 double maxGalileanSpeed(const Motion& m, const Vec3& q);

@@ -21,14 +21,19 @@ mesh4d::Kinematics kinematicsOf(Model model);
 // checkSceneForModel.
 mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
 
-// What an object's motion beyond uniform (angular_velocity, mesh4d/worldline.h) needs, one line
-// naming file, field and problem when refused: a camera at rest, vertex mode (tolerance 0), and
-// every vertex slower than light: |w x q| < 1 in the centre frame (relativistic, contracted),
-// |velocity + w x q| < 1 in the lab at every angle (finite); instant has no limit.
-Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance);
+// What an object's motion beyond uniform (angular_velocity or acceleration, mesh4d/worldline.h)
+// needs, one line naming file, field and problem when refused: not both; a camera at rest; vertex
+// mode (tolerance 0). Spin: |w| <= 1e12 rad/s, every vertex slower than light, |w x q| < 1 in the centre frame
+// (relativistic, contracted), |velocity + w x q| < 1 in the lab at every angle (finite); instant
+// has no limit. Acceleration: |a| in [1e-12, 1e12], every vertex ahead of the Born-rigid horizon
+// (q.a/|a| > -1/|a|), and the origin's rapidity at frames first_frame and last_frame within
+// kMaxRapidity (gamma 1e15, as the gamma field).
+constexpr double kMaxRapidity = 35.2;
+Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
+                         long long first_frame, long long last_frame);
 
 // For the 4D raytracer, which meets the prisms of one slab per object: every object in uniform
-// motion, else one line naming the first spinning object's angular_velocity.
+// motion, else one line naming the first spinning or accelerated object's field.
 Status checkUniformMotions(const Scene& scene, const char* command);
 
 // The camera's worldline (scene camera.position and camera.velocity).

@@ -285,6 +285,13 @@ void readAngularVelocity(FieldReader& r, const json& j, const std::string& path,
         r.fail(path + ".angular_velocity", "a mirror must be at rest (angular_velocity [0, 0, 0])");
 }
 
+// A constant proper acceleration of the origin (mesh4d/worldline.h), in the scene's axes.
+void readAcceleration(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.axisVec3(j, "acceleration", path, &obj->acceleration);
+    if (!r.failed() && obj->mirror && mesh4d::norm(obj->acceleration) != 0)
+        r.fail(path + ".acceleration", "a mirror must be at rest (acceleration [0, 0, 0])");
+}
+
 }  // namespace
 
 const std::vector<ObjectField>& objectFields() {
@@ -300,6 +307,7 @@ const std::vector<ObjectField>& objectFields() {
         {{"mirror"}, false, &readMirror},
         {{"exists"}, false, &readExists},
         {{"angular_velocity"}, false, &readAngularVelocity},
+        {{"acceleration"}, false, &readAcceleration},
     };
     return table;
 }

@@ -313,6 +313,14 @@ TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
     };
     apparent::Stage stage;
     std::string error;
+    {
+        apparent::Stage huge;  // a mesh of one point at the origin moves at 0 whatever w: |w| is bounded
+        std::string point = scene(", \"scale\": 1e-300, \"angular_velocity\": [0, 0, 1e300]", "");
+        EXPECT_FALSE(apparent::loadQuietStage(write("huge.json", point), &huge, &error));
+        EXPECT_NE(error.find("huge.json: objects[0].angular_velocity: |angular_velocity| = 1.0000000000000001e+300 must be <= 1e12 rad/s"),
+                  std::string::npos)
+            << error;
+    }
     const std::string fast = write("fast.json", scene(", \"angular_velocity\": [0, 0, 1.0]", ""));
     EXPECT_FALSE(apparent::loadQuietStage(fast, &stage, &error));
     EXPECT_NE(error.find("fast.json: objects[0].angular_velocity: a vertex would move at 1"), std::string::npos) << error;
@@ -348,9 +356,28 @@ TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
               std::string::npos);
 }
 
-// The shipped scenes load and render their first frame in the scene's model.
-TEST(Motion, ShippedWheelScenesBuildAndCut) {
-    for (const char* name : {"data/scenes/rolling_wheel.json", "data/scenes/spinning_wheel.json"}) {
+// The shipped scenes load and render their first frame in the scene's model; the rocket's measured
+// length in the contracted model at lab time 4 s is the Born-rigid closed form: tail and nose on the
+// hyperbolas (x + 1/a)^2 - t^2 = xi^2, xi = 1 and 3 (a = 0.5, tail and nose 1 ls from the origin),
+// so sqrt(9 + 16) - sqrt(1 + 16).
+TEST(Motion, ShippedScenesBuildAndCut) {
+    {
+        apparent::Stage stage;
+        std::string error;
+        ASSERT_TRUE(apparent::loadQuietStage("data/scenes/rocket.json", &stage, &error, {apparent::Model::Contracted}))
+            << error;
+        const mesh4d::World4D world = apparent::buildWorld(stage.objects[0], apparent::Model::Contracted, stage.scene,
+                                                           stage.first, stage.last_excl - 1);
+        const mesh4d::ApparentMesh out =
+            mesh4d::sliceWorld(world, apparent::viewAt(stage.scene, apparent::Model::Contracted, 4.0 + 6.0));
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            lo = std::min(lo, out.absolutePosition(i).x);
+            hi = std::max(hi, out.absolutePosition(i).x);
+        }
+        EXPECT_NEAR(hi - lo, 5 - std::sqrt(17.0), 1e-12);
+    }
+    for (const char* name : {"data/scenes/rolling_wheel.json", "data/scenes/spinning_wheel.json", "data/scenes/rocket.json"}) {
         apparent::Stage stage;
         std::string error;
         ASSERT_TRUE(apparent::loadQuietStage(name, &stage, &error)) << error;
@@ -359,5 +386,182 @@ TEST(Motion, ShippedWheelScenesBuildAndCut) {
         const mesh4d::ApparentMesh out =
             mesh4d::sliceWorld(world, apparent::viewForFrame(stage.scene, stage.scene.model, stage.first));
         EXPECT_EQ(out.positions.size(), stage.objects[0].rest.positions.size()) << name;
+    }
+}
+
+// ---- Constant proper acceleration (Born-rigid, from t0 on) ----
+
+namespace {
+
+Motion accelMotion(mesh4d::Kinematics k, const Vec3& v, const Vec3& a) {
+    Motion m = mesh4d::makeMotion(k, 0, {0, 0, 0}, v);
+    m.acceleration = a;
+    return m;
+}
+
+}  // namespace
+
+// Hyperbolic motion from rest: the origin's retarded event for a camera behind it on the line of
+// motion is the closed form of x(t) = (sqrt(1 + (a t)^2) - 1)/a: with k = t_c - L + 1/a (camera at
+// x = -L), t_e = k/2 - 1/(2 a^2 k); its clock reads asinh(a t_e)/a. Off the line, against a
+// bisection on that x(t).
+TEST(Motion, HyperbolicRetardedEventAndProperTimeAreTheClosedForms) {
+    const double a = 0.7, L = 3;
+    const Motion m = accelMotion(mesh4d::Kinematics::Lorentz, {0, 0, 0}, {a, 0, 0});
+    auto x_of = [&](double t) { return (std::sqrt(1 + (a * t) * (a * t)) - 1) / a; };
+    for (double t_c : {3.5, 5.0, 12.0, 40.0}) {
+        const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(cone(t_c, {-L, 0, 0}), m, {0, 0, 0});
+        ASSERT_TRUE(c.ok);
+        const double k = t_c - L + 1 / a;
+        const double t_e = k / 2 - 1 / (2 * a * a * k);
+        ASSERT_GT(t_e, 0);
+        EXPECT_NEAR(c.event.t, t_e, 1e-13 * t_c);
+        EXPECT_NEAR(c.event.x.x, x_of(t_e), 1e-13 * t_c);
+        EXPECT_NEAR(mesh4d::worldlineProperTime(m, c.s, {0, 0, 0}), std::asinh(a * t_e) / a, 1e-13 * t_c);
+        // Off the line of motion.
+        const Vec3 C{1, 4, -2};
+        const mesh4d::WorldlineCrossing o = mesh4d::crossWorldline(cone(t_c, C), m, {0, 0, 0});
+        double lo = -100, hi = t_c;
+        for (int i = 0; i < 200; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            const double h = (t_c - mid) - std::hypot(mid > 0 ? x_of(mid) - C.x : -C.x, C.y, C.z);
+            if (h > 0) lo = mid; else hi = mid;
+        }
+        EXPECT_NEAR(o.event.t, 0.5 * (lo + hi), 1e-12 * t_c);
+    }
+    // Before t0 the object rests (velocity 0): an early frame sees it at the origin.
+    const mesh4d::WorldlineCrossing early = mesh4d::crossWorldline(cone(1.0, {-L, 0, 0}), m, {0, 0, 0});
+    EXPECT_DOUBLE_EQ(early.event.t, 1.0 - L);
+    EXPECT_EQ(early.event.x, (Vec3{0, 0, 0}));
+}
+
+// Born-rigid: the point at q.k = d moves on the hyperbola (x + 1/a)^2 - t^2 = (1/a + d)^2 (proper
+// acceleration 1/(1/a + d)), its clock runs at (1 + a d) of the origin's, and the distance between
+// points at one instant of the momentary rest frame stays their rest distance.
+TEST(Motion, BornRigidBodyKeepsItsRestLength) {
+    const double a = 0.5;
+    const Motion m = accelMotion(mesh4d::Kinematics::Lorentz, {0, 0, 0}, {a, 0, 0});
+    for (double d : {-1.5, -0.3, 0.0, 2.0}) {
+        const Vec3 q{d, 0.25, 0};
+        for (double s : {0.3, 2.0, 6.0}) {
+            const Event e = mesh4d::worldlineEvent(m, s, q);
+            const double xi = 1 / a + d;
+            EXPECT_NEAR((e.x.x + 1 / a) * (e.x.x + 1 / a) - e.t * e.t, xi * xi, 1e-11 * xi * xi * std::cosh(a * s));
+            EXPECT_EQ(e.x.y, 0.25);
+            EXPECT_NEAR(mesh4d::worldlineProperTime(m, s, q), (1 + a * d) * s, 1e-14 * s);
+            // The momentary rest frame at origin time s is the line through the hyperbolas' centre
+            // (x, t) = (-1/a, 0) at rapidity a s: the two points at one s lie on it, their distance
+            // along it (invariant interval) is the rest distance.
+            const Event o = mesh4d::worldlineEvent(m, s, {0, 0, 0});
+            const double interval = std::sqrt((e.x.x - o.x.x) * (e.x.x - o.x.x) - (e.t - o.t) * (e.t - o.t));
+            EXPECT_NEAR(interval, std::fabs(d), 1e-12 * (1 + std::cosh(a * s)));
+        }
+    }
+}
+
+// With a start velocity the start-frame hyperbola is boosted: the origin's lab worldline against a
+// boost matrix applied here, and the crossing against a bisection on it; the Galilean carry follows
+// the same lab path with every point at the same lab offset.
+TEST(Motion, AcceleratedFromAMovingStartAgainstAnIndependentBoost) {
+    const double a = 0.4, b = 0.6, g = 1 / std::sqrt(1 - b * b);
+    const Motion m = accelMotion(mesh4d::Kinematics::Lorentz, {0, b, 0}, {a, 0, 0});
+    auto lab = [&](double s, double d) {  // origin (d = 0) or a point at q.k = d, start frame -> lab (boost along y)
+        const double xi = 1 / a + d;
+        const double T = s > 0 ? xi * std::sinh(a * s) : s;
+        const double X = s > 0 ? d + xi * (std::cosh(a * s) - 1) : d;
+        return Event{g * T, {X, g * b * T, 0}};
+    };
+    for (double s : {-1.0, 0.5, 3.0}) {
+        const Event e = mesh4d::worldlineEvent(m, s, {0, 0, 0}), f = lab(s, 0);
+        EXPECT_NEAR(e.t, f.t, 1e-13 * (1 + std::fabs(f.t)));
+        EXPECT_NEAR(e.x.x, f.x.x, 1e-13 * (1 + std::fabs(f.x.x)));
+        EXPECT_NEAR(e.x.y, f.x.y, 1e-13 * (1 + std::fabs(f.x.y)));
+    }
+    const Vec3 C{-2, 1, 3};
+    for (double t_c : {2.0, 6.0, 15.0})
+        for (double d : {0.0, 0.8}) {
+            const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(cone(t_c, C), m, {d, 0, 0});
+            double lo = -100, hi = 100;
+            for (int i = 0; i < 200; ++i) {
+                const double mid = 0.5 * (lo + hi);
+                const Event e = lab(mid, d);
+                const double h = (t_c - e.t) - std::hypot(e.x.x - C.x, e.x.y - C.y, e.x.z - C.z);
+                if (h > 0) lo = mid; else hi = mid;
+            }
+            const Event e = lab(0.5 * (lo + hi), d);
+            EXPECT_NEAR(c.event.t, e.t, 1e-12 * t_c);
+            EXPECT_NEAR(c.event.x.x, e.x.x, 1e-12 * t_c);
+            EXPECT_NEAR(c.event.x.y, e.x.y, 1e-12 * t_c);
+        }
+    // Galilean: x = x_origin(t) + q at lab time t = t0 + s.
+    const Motion gm = accelMotion(mesh4d::Kinematics::Galilean, {0, b, 0}, {a, 0, 0});
+    for (double s_o : {0.5, 3.0}) {
+        const Event o = lab(s_o, 0);
+        const Event e = mesh4d::worldlineEvent(gm, o.t, {0.3, -0.2, 0.1});
+        EXPECT_NEAR(e.t, o.t, 1e-15 * o.t);
+        EXPECT_NEAR(e.x.x, o.x.x + 0.3, 1e-12);
+        EXPECT_NEAR(e.x.y, o.x.y - 0.2, 1e-12);
+        EXPECT_NEAR(e.x.z, 0.1, 1e-15);
+        EXPECT_NEAR(mesh4d::originProperTime(gm, o.t), s_o, 1e-12);
+    }
+}
+
+// An accelerated body through the stage: refusals (behind the horizon, with a spin, rapidity past
+// the limit) and a rendered cut whose every vertex lies on the cone and on its own hyperbola.
+TEST(Motion, AcceleratedBodyThroughTheStage) {
+    const std::string dir = ::testing::TempDir();
+    auto write = [&](const std::string& name, const std::string& body) {
+        const std::string path = dir + "/" + name;
+        FILE* f = std::fopen(path.c_str(), "w");
+        std::fputs(body.c_str(), f);
+        std::fclose(f);
+        return path;
+    };
+    const std::string mesh = std::string(APPARENT_SOURCE_DIR) + "/data/meshes/box.obj";
+    auto scene = [&](const std::string& extra, double end) {
+        return "{\"camera\": {\"position\": [0, 0, 5]}, \"frames\": {\"start\": 0, \"end\": " + std::to_string(end) +
+               ", \"fps\": 2}, \"tolerance\": \"vertex\", \"objects\": [{\"mesh\": \"" + mesh + "\"" + extra + "}]}";
+    };
+    std::string error;
+    {
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(write("horizon.json", scene(", \"acceleration\": [4, 0, 0]", 2)), &st, &error));
+        EXPECT_NE(error.find("horizon.json: objects[0].acceleration: vertex "), std::string::npos) << error;
+        EXPECT_NE(error.find("horizon of a Born-rigid body"), std::string::npos) << error;
+    }
+    {
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(
+            write("both.json", scene(", \"acceleration\": [0.1, 0, 0], \"angular_velocity\": [0, 0, 0.1]", 2)), &st, &error));
+        EXPECT_NE(error.find("give angular_velocity or acceleration, not both"), std::string::npos) << error;
+    }
+    {
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(
+            write("fast.json", scene(", \"scale\": 1e-13, \"acceleration\": [1e12, 0, 0]", 1e4)), &st, &error));
+        EXPECT_NE(error.find("fast.json: objects[0].acceleration: the origin's rapidity |a| tau reaches"), std::string::npos)
+            << error;
+    }
+    apparent::Stage st;
+    ASSERT_TRUE(apparent::loadQuietStage(write("ok.json", scene(", \"acceleration\": [0.5, 0, 0]", 10)), &st, &error)) << error;
+    const mesh4d::World4D world = apparent::buildWorld(st.objects[0], apparent::Model::Relativistic, st.scene, 0, 19);
+    for (long long k : {0LL, 9LL, 19LL}) {
+        const mesh4d::ViewSurface view = apparent::viewForFrame(st.scene, apparent::Model::Relativistic, k);
+        mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+        mesh4d::addLightFactors(world, view, &out);
+        ASSERT_EQ(out.positions.size(), st.objects[0].rest.positions.size());
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            const Vec3 p = out.absolutePosition(i);
+            const double t = out.absoluteTime(i);
+            EXPECT_NEAR(view.t_c - t, mesh4d::norm(p - view.apex), 1e-12 * (1 + view.t_c));
+            const Vec3& q = out.rest_points[i];
+            const double xi = 2 + q.x;
+            if (t > 0) {
+                EXPECT_NEAR((p.x + 2) * (p.x + 2) - t * t, xi * xi, 1e-11 * (1 + t * t));
+                EXPECT_NEAR(out.proper_time[i], xi * std::asinh(t / xi), 1e-12 * (1 + t));  // proper acceleration 1/xi
+            } else {
+                EXPECT_EQ(p.x, q.x);
+            }
+        }
     }
 }
