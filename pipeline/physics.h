@@ -32,10 +32,6 @@ constexpr double kMaxRapidity = 35.2;
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame);
 
-// For the 4D raytracer, which meets the prisms of one slab per object: every object in uniform
-// motion, else one line naming the first spinning or accelerated object's field.
-Status checkUniformMotions(const Scene& scene, const char* command);
-
 // The camera's worldline (scene camera.position and camera.velocity).
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene);
 

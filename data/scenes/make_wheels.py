@@ -59,10 +59,11 @@ def main():
     rolling = {
         "_about": "A wheel of radius 1 ls rolls along the ground y = -1 at 0.9c (README, Spinning and rolling bodies): velocity [0.9, 0, 0] "
                   "with angular_velocity [0, 0, -0.9] in its centre frame (w R = |v|: the contact point is at rest in the "
-                  "lab, the top moves at 2v / (1 + v^2) = 0.9945c). It passes 5 ls in front of the camera at t = 5 s. "
+                  "lab, the top moves at 2v / (1 + v^2) = 0.9945c). It passes 5 ls in front of the camera at t = 5 s, "
+                  "seen there at t = 10 s. "
                   "Written by make_wheels.py.",
         "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 70, "instant_delay": 5},
-        "frames": {"start": 0, "end": 10, "fps": 10},
+        "frames": {"start": 0, "end": 16, "fps": 10},
         "model": "relativistic",
         "tolerance": "vertex",
         "objects": [{"name": "wheel", "mesh": "../meshes/wheel.obj", "position": [-4.5, 0, 0], "t0": 0,
