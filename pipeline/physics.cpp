@@ -92,6 +92,17 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
     return Status::success();
 }
 
+Status checkToleranceDial(const Scene& scene, const char* command) {
+    for (const ObjectSpec& s : scene.objects) {
+        const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
+        if (spin || accel)
+            return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +
+                                   ": `apparent " + command + "` sweeps the tolerance, which holds for uniform motion "
+                                   "only (spinning and accelerated objects are cut in vertex mode)");
+    }
+    return Status::success();
+}
+
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene) {
     return mesh4d::makeCameraMotion(scene.camera.position, scene.camera.velocity);
 }
