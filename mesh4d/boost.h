@@ -29,6 +29,13 @@ struct Motion {
     // as gamma or rapidity (makeMotionExact), else 1 - |v|^2 from the components of v with a
     // compensated sum (robust.h oneMinusNorm2: within 1 ulp, oblique velocities included).
     double one_minus_beta2 = 1;
+    // Motion beyond uniform (mesh4d/worldline.h, the one concept of motion): a spin about the
+    // origin at this angular velocity (rad/s, in the centre frame, whose time is tau above). Zero
+    // (the default): the uniform motion above, with its closed forms.
+    Vec3 angular_velocity;
+    // Constant proper acceleration of the origin from t0 on (mesh4d/worldline.h: Born-rigid
+    // hyperbolic motion, uniform before t0), in the frame of `velocity`. Zero: uniform.
+    Vec3 acceleration;
 };
 
 // Builds a Motion. Precondition: |velocity| < 1 when kinematics == Lorentz (callers validate).

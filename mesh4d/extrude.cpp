@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "robust.h"
+#include "worldline.h"
 
 namespace mesh4d {
 
@@ -94,8 +95,8 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
     // Events: both caps of every vertex's worldline.
     world.events.resize(2 * nv);
     for (size_t i = 0; i < nv; ++i) {
-        world.events[2 * i + 0] = labFromRest(motion, tau_a, mesh.positions[i]);
-        world.events[2 * i + 1] = labFromRest(motion, tau_b, mesh.positions[i]);
+        world.events[2 * i + 0] = worldlineEvent(motion, tau_a, mesh.positions[i]);
+        world.events[2 * i + 1] = worldlineEvent(motion, tau_b, mesh.positions[i]);
     }
 
     world.simple = true;
@@ -119,8 +120,64 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
     return world;
 }
 
+double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord) {
+    if (isUniform(motion)) return INFINITY;
+    // M: the largest second derivative of a vertex's own-frame worldline over the span; K: the
+    // largest difference of the first derivatives of two points of one triangle (extrude.h).
+    const double w = norm(motion.angular_velocity);
+    const double a = norm(motion.acceleration);
+    const double s_max = std::max(std::fabs(tau_a), std::fabs(tau_b));
+    const double ch = a > 0 ? std::cosh(a * s_max) : 1.0;
+    double M = 0, edge = 0;
+    for (const Vec3& q : mesh.positions)
+        M = std::max(M, a > 0 ? std::sqrt(2.0) * a * a * horizonDistance(motion, q) * ch : w * spinSpeed(motion, q));
+    for (const auto& t : mesh.triangles)
+        for (int c = 0; c < 3; ++c) edge = std::max(edge, norm(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]));
+    // An acceleration's E_i' - E_q' = |a| (xi_i - xi_q) (cosh, k sinh) is parallel to E_q': along
+    // the history, not off it, so it adds no distance to the history (K = 0).
+    const double K = a > 0 ? 0.0 : w * edge;
+    // M ds^2 / 2 + K ds = chord, the positive root without cancellation.
+    const double root = K + std::sqrt(K * K + 2 * M * chord);
+    if (!(root > 0)) return INFINITY;
+    return 2 * chord / root;
+}
+
+std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord,
+                                size_t max_slabs) {
+    std::vector<double> samples{tau_a};
+    double s = tau_a;
+    while (s < tau_b) {
+        // The step bounded at s alone, then over [s, s + that step] (never longer: the bound grows with |s|).
+        const double first = slabSpacing(mesh, motion, s, s, chord);
+        const double ds = slabSpacing(mesh, motion, s, std::min(tau_b, s + first), chord);
+        if (!(ds > 0) || samples.size() > max_slabs) return {};
+        s = ds >= tau_b - s ? tau_b : s + ds;
+        samples.push_back(s);
+    }
+    if (samples.size() - 1 > max_slabs) return {};
+    return samples;
+}
+
+std::vector<World4D> extrudeSlabs(const RestMesh& mesh, const Motion& motion, const std::vector<double>& samples,
+                                  bool cap_a_real, bool cap_b_real) {
+    std::vector<World4D> slabs;
+    if (samples.size() < 2) return slabs;
+    const size_t count = samples.size() - 1;
+    slabs.reserve(count);
+    for (size_t k = 0; k < count; ++k)
+        slabs.push_back(extrude(mesh, motion, samples[k], samples[k + 1], cap_a_real && k == 0, cap_b_real && k + 1 == count));
+    return slabs;
+}
+
 ProperTimeSpan spanSeen(const RestMesh& mesh, const Motion& motion, const ViewSurface& first, const ViewSurface& last) {
     ProperTimeSpan span{INFINITY, -INFINITY};
+    if (!isUniform(motion)) {  // worldline.h: the object's time s of each crossing
+        for (const Vec3& q : mesh.positions) {
+            span.lo = std::min(span.lo, crossWorldline(first, motion, q).s);
+            span.hi = std::max(span.hi, crossWorldline(last, motion, q).s);
+        }
+        return span;
+    }
     const Vec3 base_first = nowBase(first, motion), base_last = nowBase(last, motion);
     for (const Vec3& q : mesh.positions) {
         const double t_first = cutRestWorldline(first, motion, base_first, q).t;

@@ -96,6 +96,39 @@ inline std::array<uint32_t, 4> World4D::tet(size_t i) const { return prismTet(me
 World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
                 bool cap_a_real, bool cap_b_real);
 
+// Time slabs (issue 18, item 5): for a motion that is not uniform (worldline.h) the history over
+// [tau_a, tau_b] is cut at samples of the object's time s into slabs, each a World4D of prisms
+// between two samples, whose cap events lie on the true worldlines. slabSpacing is the largest step
+// ds for which every point of every slab's tetrahedra lies within `chord` (Euclidean, in the
+// object's own frame: the centre frame of a spin, the start frame of an acceleration) of the true
+// event of its rest point, or of the history near it (a shift along the history is no error). The argument: a point of a tetrahedron is sum l_i E_i(s_i) over its
+// vertices' events, s_i within one slab; the rest point q = sum l_i q_i has the event
+// E_q(s) = sum l_i E_i(s) at every s (events are affine in q at fixed s), so at s = sum l_i s_i the
+// difference is sum l_i [E_i'(s) - E_q'(s)] (s_i - s) plus Taylor remainders, at most
+//     K ds + M ds^2 / 2,
+// K bounding the part of |E_i' - E_q'| off the history over a triangle (spin: |w| L, L the longest
+// rest edge; acceleration: 0, since E_i' - E_q' = |a| (xi_i - xi_q)(cosh, k sinh) is parallel to
+// E_q', a shift along the history) and M bounding |E''| (spin: |w|^2 rho_max; acceleration:
+// sqrt(2) |a|^2 xi_max cosh(|a| s_max); s_max the largest |s| of the span). The first-order term is
+// the twist of a prism whose vertices move differently, which the tetrahedra cannot follow; the
+// second is the chord of each worldline. A boost or the Galilean carry stretches these distances by
+// at most gamma (1 + b) in the lab (callers divide the lab chord by it). Uniform motion needs one
+// slab: slabSpacing returns infinity.
+// ds over the interval [tau_a, tau_b] of s (s_max = max(|tau_a|, |tau_b|)).
+double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord);
+
+// The sample times tau_a = s_0 < s_1 < ... < s_n = tau_b, each step slabSpacing over its own
+// interval (steps shrink where the bound grows: an acceleration's cosh(|a| s)); empty when more
+// than max_slabs slabs would be needed.
+std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord,
+                                size_t max_slabs);
+
+// The history between consecutive samples, one World4D per slab; only the first slab's cap a and
+// the last's cap b can be real. Each slab holds its own copy of the mesh: memory grows with the
+// number of slabs (callers bound it).
+std::vector<World4D> extrudeSlabs(const RestMesh& mesh, const Motion& motion, const std::vector<double>& samples,
+                                  bool cap_a_real, bool cap_b_real);
+
 // The proper times at which the rest vertices' worldlines cross the first and the last view
 // surface of a sequence: [min over vertices at `first`, max over vertices at `last`]. Crossing
 // times grow monotonically with the camera time (a timelike worldline meets later cones later),

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "robust.h"
+#include "worldline.h"
 
 namespace mesh4d {
 
@@ -32,6 +33,15 @@ void addLightFactors(const World4D& world, const ViewSurface& view, ApparentMesh
     const size_t n = m->positions.size();
     m->doppler.resize(n);
     m->proper_time.resize(n);
+    if (!isUniform(world.motion)) {  // worldline.h: the crossing again, for its time s
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3& q = m->rest_points[i];
+            const double s = crossWorldline(view, world.motion, q).s;
+            m->doppler[i] = worldlineDoppler(world.motion, view.kind, view.apex, s, q, m->absolutePosition(i));
+            m->proper_time[i] = worldlineProperTime(world.motion, s, q);
+        }
+        return;
+    }
     for (size_t i = 0; i < n; ++i) {
         // Under a shear the outputs are in the camera's frame: back to the view's own (the lab).
         const Vec3 x = view.sheared() ? m->absolutePosition(i) + view.shear * m->absoluteTime(i) : m->absolutePosition(i);

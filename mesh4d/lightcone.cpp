@@ -5,6 +5,7 @@
 
 #include "exact_side.h"
 #include "robust.h"
+#include "worldline.h"
 
 namespace mesh4d {
 
@@ -43,6 +44,7 @@ Vec3 nowBase(const ViewSurface& view, const Motion& m) {
 }
 
 Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q) {
+    if (!isUniform(m)) return crossWorldline(view, m, q).event;
     const Vec3 e = now_base + shapeOffset(m, q);
     if (view.kind == ViewKind::Hyperplane) return {view.t_c, view.apex + e};
     const double d = retardedDelay(e, m.velocity, m.one_minus_beta2);
@@ -51,6 +53,15 @@ Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now
 
 ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m) {
     ViewAnchor a;
+    a.view = view;
+    if (!isUniform(m)) {
+        const Event origin = crossWorldline(view, m, Vec3{0, 0, 0}).event;
+        a.cone = view.kind == ViewKind::PastCone;
+        a.origin = origin.x;
+        a.time_origin = origin.t;
+        a.y0 = origin.x - view.apex;
+        return a;
+    }
     const Vec3 E = nowBase(view, m);
     if (view.kind == ViewKind::Hyperplane) {
         a.cone = false;
@@ -86,6 +97,10 @@ inline Event cutLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& s) 
 }  // namespace
 
 Event cutRestLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& q) {
+    if (!isUniform(m)) {
+        const Event e = crossWorldline(anchor.view, m, q).event;
+        return {e.t - anchor.time_origin, e.x - anchor.origin};
+    }
     return cutLocal(anchor, m, shapeOffset(m, q));
 }
 
@@ -124,7 +139,13 @@ void cutBatch(const ViewAnchor& anchor, const Motion& m, const Vec3* __restrict 
 void cutRestLocalBatch(const ViewAnchor& anchor, const Motion& m, const Vec3* q, size_t n, Vec3* positions,
                        double* times) {
     // shapeOffset inlined: q itself (Galilean, or at rest), or contracted along u by 1/gamma.
-    if (!anchor.cone) {
+    if (!isUniform(m)) {
+        for (size_t i = 0; i < n; ++i) {
+            const Event e = cutRestLocal(anchor, m, q[i]);
+            positions[i] = e.x;
+            times[i] = e.t;
+        }
+    } else if (!anchor.cone) {
         for (size_t i = 0; i < n; ++i) {
             positions[i] = shapeOffset(m, q[i]);
             times[i] = 0;

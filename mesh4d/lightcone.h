@@ -60,6 +60,8 @@ WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Ve
 // the large terms summed first and once (docs/DESIGN.md section 5's e). Anchoring at an event far
 // from t_c instead would make e a difference of large numbers, whose rounding the light delay
 // then multiplies by up to 2 gamma^2. `now_base` = (X0 - C) + v (t_c - t0), computed once a frame.
+// A motion that is not uniform (mesh4d/worldline.h) is sent to crossWorldline by this function,
+// viewAnchor, cutRestLocal and cutRestLocalBatch; uniform motion keeps the closed forms below.
 Vec3 nowBase(const ViewSurface& view, const Motion& m);
 Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q);
 
@@ -81,6 +83,9 @@ struct ViewAnchor {
     Vec3 y0;                 // Y0 (cone) or E (hyperplane), relative to the camera
     double S = 0;
     bool cone = true;
+    // A motion that is not uniform (worldline.h) is cut by crossWorldline on this view, its result
+    // taken relative to origin and time_origin (the crossing of the origin's worldline).
+    ViewSurface view;
 };
 ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m);
 // The cut of rest point q's worldline in the anchor's local coordinates: {-delta, s - v delta}.

@@ -11,6 +11,7 @@
 #include "chord_error.h"
 #include "exact_side.h"
 #include "robust.h"
+#include "worldline.h"
 
 namespace mesh4d {
 
@@ -1240,9 +1241,12 @@ ApparentMesh sliceUnsheared(const World4D& world, const ViewSurface& view, const
     const bool at_rest = world.motion.beta == 0 && !view.sheared() && !(settings.displacement > 0);
     // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
     // are refined (FrameBuilder::restPlan).
-    const bool rest_clip = view.kind == ViewKind::PastCone && at_rest && settings.tolerance > 0 &&
+    // A motion that is not uniform (worldline.h) is cut in vertex mode only: exact points on the
+    // true worldlines (lightcone.h sends each cut to crossWorldline); callers refuse a tolerance.
+    const bool uniform = isUniform(world.motion);
+    const bool rest_clip = uniform && view.kind == ViewKind::PastCone && at_rest && settings.tolerance > 0 &&
                            (world.cap_a_real || world.cap_b_real);
-    if (view.kind == ViewKind::Hyperplane || at_rest) settings.tolerance = 0;
+    if (view.kind == ViewKind::Hyperplane || at_rest || !uniform) settings.tolerance = 0;
     FrameBuilder b(world, view, settings);
     b.rest_clip = rest_clip;
     b.rest_tolerance = requested.tolerance;
@@ -1322,6 +1326,7 @@ Event exactApparentPoint(const World4D& world, const ViewSurface& view, const Ve
 
 BoundingSphere apparentBound(const World4D& world, const ViewSurface& view) {
     const ViewAnchor anchor = viewAnchor(view, world.motion);
+    if (!isUniform(world.motion)) return {anchor.origin, INFINITY};  // no bound derived: never culled
     const double b = world.motion.beta;
     double stretch = view.kind == ViewKind::PastCone ? (1 + b) / world.motion.one_minus_beta2 : 1.0;
     // Sheared, local points are s - w delta, w = u - shear, with |s| <= R and |delta| <= R / (1 - b).

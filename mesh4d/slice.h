@@ -129,6 +129,7 @@ struct SliceSettings {
 // Limit: an object at rest under a shear (or SliceSettings::displacement) is refined as a moving
 // one, so a real cap's clip curve wholly inside one triangle whose corners are all unseen (its
 // middle seen first) is not found: the search for those (restPlan) serves unsheared views.
+// A motion that is not uniform (worldline.h) is cut in vertex mode whatever the tolerance.
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
 
 // A sphere that holds every apparent point of `world` in `view`: centred on the apparent position
@@ -137,7 +138,8 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
 // points, so each point lies within |s| + b |s| / (1 - b) of the origin's image) and R on the
 // hyperplane. Under a shear (sliceWorld) the points are s - w delta, w = u - shear: radius
 // R (1 + |w| / (1 - b)), centred on the origin's sheared image. For view culling
-// (pipeline/render.cpp, --cull-view).
+// (pipeline/render.cpp, --cull-view). A motion that is not
+// uniform (worldline.h) gets an infinite radius: it is never culled.
 struct BoundingSphere {
     Vec3 center;
     double radius = 0;

@@ -1,5 +1,11 @@
 #include "pipeline/physics.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "mesh4d/worldline.h"
+#include "pipeline/scene_fields.h"
+
 namespace apparent {
 
 mesh4d::Kinematics kinematicsOf(Model m) {
@@ -7,7 +13,7 @@ mesh4d::Kinematics kinematicsOf(Model m) {
                                                                  : mesh4d::Kinematics::Galilean;
 }
 
-mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
+static mesh4d::Motion uniformMotionOf(const ObjectSpec& s, Model model) {
     const mesh4d::Kinematics kin = kinematicsOf(model);
     switch (s.speed) {
         case ObjectSpec::Speed::Gamma:
@@ -18,6 +24,83 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
             break;
     }
     return mesh4d::makeMotion(kin, s.t0, s.position, s.velocity);
+}
+
+mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
+    mesh4d::Motion m = uniformMotionOf(s, model);
+    m.angular_velocity = s.angular_velocity;  // worldline.h: a spin about the origin, centre frame
+    m.acceleration = s.acceleration;          // worldline.h: Born-rigid, from t0 on
+    return m;
+}
+
+Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
+                         long long first_frame, long long last_frame) {
+    const ObjectSpec& s = object.spec;
+    const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
+    if (!spin && !accel) return Status::success();
+    const std::string field = scene.path + ": " + s.field_path + (spin ? ".angular_velocity: " : ".acceleration: ");
+    const std::string what = spin ? "a spinning object" : "an accelerated object";
+    if (spin && accel)
+        return Status::failure(field + "give angular_velocity or acceleration, not both (not modelled together)");
+    if (cameraMotionOf(scene).moving())
+        return Status::failure(field + what + " needs a camera at rest (camera.velocity is not [0, 0, 0])");
+    if (tolerance > 0)
+        return Status::failure(field + what + " is cut in vertex mode only: give --tolerance vertex (or the "
+                                       "scene's \"tolerance\": \"vertex\")");
+    const mesh4d::Motion m = motionOf(s, model);
+    // The turned angle |w| s stays finite and meaningful over every time a scene can hold.
+    if (spin && !(mesh4d::norm(s.angular_velocity) <= 1e12))
+        return Status::failure(field + "|angular_velocity| = " + formatNumber(mesh4d::norm(s.angular_velocity)) +
+                               " must be <= 1e12 rad/s");
+    if (accel) {
+        // Born-rigid (mesh4d/worldline.h): every vertex ahead of the horizon, q.k > -1/|a|.
+        const double a = mesh4d::norm(s.acceleration);
+        if (!(a >= 1e-12 && a <= 1e12))
+            return Status::failure(field + "|acceleration| = " + formatNumber(a) + " must be in [1e-12, 1e12] (1/ls)");
+        for (size_t i = 0; i < object.rest.positions.size(); ++i)
+            if (!(mesh4d::horizonDistance(m, object.rest.positions[i]) > 0))
+                return Status::failure(field + "vertex " + std::to_string(i) + " lies " +
+                                       formatNumber(-mesh4d::dot(object.rest.positions[i], s.acceleration / a)) +
+                                       " behind the origin along the acceleration, at or beyond the horizon of a "
+                                       "Born-rigid body (1/|acceleration| = " + formatNumber(1 / a) + ")");
+        // The origin's rapidity at the frames' ends, within the limit of the gamma field (1e15).
+        for (long long k : {first_frame, last_frame}) {
+            const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(viewForFrame(scene, model, k), m, {0, 0, 0});
+            const double t_lab = c.event.t - s.t0;
+            const double sigma = m.kinematics == mesh4d::Kinematics::Lorentz ? c.s : mesh4d::originProperTime(m, t_lab);
+            if (!c.ok || !(std::fabs(a * sigma) <= kMaxRapidity))
+                return Status::failure(field + "the origin's rapidity |a| tau reaches " + formatNumber(a * sigma) +
+                                       " in frame " + std::to_string(k) + ", beyond " + formatNumber(kMaxRapidity) +
+                                       " (gamma 1e15, the limit of the gamma field)");
+        }
+        return Status::success();
+    }
+    // The fastest vertex (a point inside a triangle is never faster: the speed is convex in q).
+    double fastest = 0;
+    for (const mesh4d::Vec3& q : object.rest.positions)
+        fastest = std::max(fastest, m.kinematics == mesh4d::Kinematics::Lorentz ? mesh4d::spinSpeed(m, q)
+                                                                                : mesh4d::maxGalileanSpeed(m, q));
+    if (!std::isfinite(fastest))
+        return Status::failure(field + "the speed of a vertex is not finite");
+    if (model == Model::Instant) return Status::success();
+    if (!(fastest < 1))
+        return Status::failure(field + "a vertex would move at " + formatNumber(fastest) +
+                               (m.kinematics == mesh4d::Kinematics::Lorentz
+                                    ? " (|w x q| in the centre frame)"
+                                    : " (|velocity + w x q| in the lab, at the fastest angle)") +
+                               ", which must be < 1 (the speed of light) for model " + modelName(model));
+    return Status::success();
+}
+
+Status checkToleranceDial(const Scene& scene, const char* command) {
+    for (const ObjectSpec& s : scene.objects) {
+        const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
+        if (spin || accel)
+            return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +
+                                   ": `apparent " + command + "` sweeps the tolerance, which holds for uniform motion "
+                                   "only (spinning and accelerated objects are cut in vertex mode)");
+    }
+    return Status::success();
 }
 
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene) {

@@ -9,6 +9,7 @@
 #include "mesh4d/camera_frame.h"
 #include "mesh4d/extrude.h"
 #include "mesh4d/lightcone.h"
+#include "pipeline/prepared_object.h"
 #include "pipeline/scene.h"
 
 namespace apparent {
@@ -19,6 +20,21 @@ mesh4d::Kinematics kinematicsOf(Model model);
 // The motion of `object` under `model` in the lab. Precondition: the scene passed
 // checkSceneForModel.
 mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
+
+// What an object's motion beyond uniform (angular_velocity or acceleration, mesh4d/worldline.h)
+// needs, one line naming file, field and problem when refused: not both; a camera at rest; vertex
+// mode (tolerance 0). Spin: |w| <= 1e12 rad/s, every vertex slower than light, |w x q| < 1 in the centre frame
+// (relativistic, contracted), |velocity + w x q| < 1 in the lab at every angle (finite); instant
+// has no limit. Acceleration: |a| in [1e-12, 1e12], every vertex ahead of the Born-rigid horizon
+// (q.a/|a| > -1/|a|), and the origin's rapidity at frames first_frame and last_frame within
+// kMaxRapidity (gamma 1e15, as the gamma field).
+constexpr double kMaxRapidity = 35.2;
+Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
+                         long long first_frame, long long last_frame);
+
+// For commands that sweep the tolerance (`apparent trade`): every object in uniform motion, else one
+// line naming the first spinning or accelerated object's field (those are cut in vertex mode only).
+Status checkToleranceDial(const Scene& scene, const char* command);
 
 // The camera's worldline (scene camera.position and camera.velocity).
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene);

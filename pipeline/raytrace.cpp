@@ -16,8 +16,10 @@
 #include "exporters/video.h"
 #include "mesh4d/angles.h"
 #include "mesh4d/doppler_colour.h"
+#include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
+#include "mesh4d/worldline.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -68,6 +70,55 @@ mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scen
     return mesh4d::extrude(rest, direct.motion, tau_a, tau_b, real_a, real_b);
 }
 
+// Time slabs for a motion that is not uniform (mesh4d/extrude.h): each vertex's sampled worldline
+// within kSlabChordRelative of the object's bounding-box diagonal of its true one in the lab (the
+// own-frame chord divided by the boost's or carry's largest stretch, gamma (1 + b)); at most
+// kMaxSlabs slabs and kMaxSlabPrisms prisms over all slabs of one object.
+constexpr double kSlabChordRelative = 1e-3;
+constexpr size_t kMaxSlabs = 4096;
+constexpr size_t kMaxSlabPrisms = 20000000;
+
+// The sample times of w's slabs: {tau_a, tau_b} for uniform motion, empty beyond kMaxSlabs.
+std::vector<double> slabTimes(const mesh4d::World4D& w) {
+    if (mesh4d::isUniform(w.motion) || w.empty()) return {w.tau_a, w.tau_b};
+    mesh4d::EventBox box;
+    for (const Vec3& p : w.mesh.positions) box.addPoint(p);
+    const double g = 1 / std::sqrt(w.motion.one_minus_beta2);
+    const double chord = kSlabChordRelative * box.diagonal() / (g * (1 + w.motion.beta));
+    return mesh4d::slabSamples(w.mesh, w.motion, w.tau_a, w.tau_b, chord, kMaxSlabs);
+}
+
+// One line when an object would need more slabs than the limits allow.
+Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, long long first, long long last) {
+    for (Model model : models)
+        for (const PreparedObject& o : stage.objects) {
+            if (mesh4d::norm(o.spec.angular_velocity) == 0 && mesh4d::norm(o.spec.acceleration) == 0) continue;
+            const std::vector<double> times = slabTimes(traceWorld(o, model, stage.scene, stage.mirrors, first, last));
+            const size_t n = times.empty() ? kMaxSlabs + 1 : times.size() - 1;
+            if (n > kMaxSlabs || n * o.rest.triangles.size() > kMaxSlabPrisms)
+                return Status::failure(stage.scene.path + ": " + o.spec.field_path +
+                                       (mesh4d::norm(o.spec.angular_velocity) != 0 ? ".angular_velocity" : ".acceleration") +
+                                       ": the raytracer would need " + (n > kMaxSlabs ? "more than " + std::to_string(kMaxSlabs)
+                                                                                      : std::to_string(n)) +
+                                       " time slabs of " + std::to_string(o.rest.triangles.size()) + " prisms (limits " +
+                                       std::to_string(kMaxSlabs) + " slabs, " + std::to_string(kMaxSlabPrisms) +
+                                       " prisms) for model " + modelName(model) + ": trace fewer frames (--frames) or use `apparent render`");
+        }
+    return Status::success();
+}
+
+// What the raytracer needs of motions beyond uniform: slabs within the limits, and plain shading
+// (its Doppler factor is the uniform one; `render --shade doppler` has the worldline's).
+Status checkTracedMotions(const Stage& stage, const char* command, bool shade_doppler) {
+    for (const PreparedObject& o : stage.objects) {
+        const bool spin = mesh4d::norm(o.spec.angular_velocity) != 0, accel = mesh4d::norm(o.spec.acceleration) != 0;
+        if (shade_doppler && (spin || accel))
+            return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +
+                                   stage.scene.path + ": " + o.spec.field_path + (spin ? ".angular_velocity" : ".acceleration") +
+                                   " is not (use `apparent render --shade doppler`, or plain shading)");
+    }
+    return checkTraceSlabs(stage, stage.models, stage.first, stage.last_excl - 1);
+}
 
 }  // namespace
 
@@ -93,11 +144,24 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
     : scene_(scene), model_(model), mirrors_(mirrors), mirror_of_object_(objects.size(), -1) {
     for (size_t m = 0; m < mirrors_.size(); ++m) mirror_of_object_[mirrors_[m].object] = int32_t(m);
     // Step: build the static worlds once, then their per-prism trace data (which points into worlds_).
+    // A motion that is not uniform is traced through its time slabs (mesh4d/extrude.h), one world
+    // each, all owned by the object.
     worlds_.reserve(objects.size());
     for (size_t i = 0; i < objects.size(); ++i) {
         colors_.push_back(objectBaseColor(objects, i));
         lab_motions_.push_back(motionOf(objects[i].spec, model));
-        worlds_.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
+        mesh4d::World4D w = traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame);
+        motions_.push_back(w.motion);
+        const std::vector<double> times = slabTimes(w);
+        if (times.size() <= 2) {
+            worlds_.push_back(std::move(w));
+            owner_.push_back(uint32_t(i));
+            continue;
+        }
+        for (mesh4d::World4D& slab : mesh4d::extrudeSlabs(w.mesh, w.motion, times, w.cap_a_real, w.cap_b_real)) {
+            worlds_.push_back(std::move(slab));
+            owner_.push_back(uint32_t(i));
+        }
     }
     for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w, hierarchy));
 }
@@ -106,10 +170,10 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     Hit best;
     double s_max = INFINITY;
     for (size_t i = 0; i < traces_.size(); ++i) {
-        if (skip_mirrors && mirror_of_object_[i] >= 0) continue;
+        if (skip_mirrors && mirror_of_object_[owner_[i]] >= 0) continue;
         if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
             s_max = h->s;
-            best.object = int32_t(i);
+            best.object = int32_t(owner_[i]);
             best.hit = *h;
         }
     }
@@ -118,7 +182,7 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
 
 std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, const Vec3& receiver,
                                          const Vec3& receiver_velocity) const {
-    return shadeWith(h, worlds_[size_t(h.object)].motion, h.hit.event.x, kind, receiver, receiver_velocity);
+    return shadeWith(h, motions_[size_t(h.object)], h.hit.event.x, kind, receiver, receiver_velocity);
 }
 
 std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion& motion, const Vec3& emitted_at,
@@ -227,6 +291,12 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     stage_options.quiet = settings.quiet || sender;
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
+    if (!code) {
+        if (Status s = checkTracedMotions(stage, "raytrace", settings.shade_doppler); !s.ok) {
+            error = s.message;
+            code = kExitBadInput;
+        }
+    }
     const bool video = !settings.video_path.empty();
     if (!code && !sender && video && stage.models.size() != 1) {
         error = "--video: a video shows one model (" + std::to_string(stage.models.size()) +
@@ -419,6 +489,10 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     std::string error;
     if (!loadStage(stage_options, &stage, err, &error)) {
         err << "error: " << error << "\n";
+        return kExitBadInput;
+    }
+    if (Status s = checkTracedMotions(stage, "figure", settings.shade_doppler); !s.ok) {
+        err << "error: " << s.message << "\n";
         return kExitBadInput;
     }
     const Scene& scene = stage.scene;

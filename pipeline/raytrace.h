@@ -56,7 +56,10 @@ public:
     // --shade doppler (off by default): colours shifted by each hit's Doppler factor.
     void setShadeDoppler(bool on) { shade_doppler_ = on; }
 
+    // The traced worlds: one per object, or one per time slab of an object whose motion is not
+    // uniform (owners() gives each world's object).
     const std::vector<mesh4d::World4D>& worlds() const { return worlds_; }
+    const std::vector<uint32_t>& owners() const { return owner_; }
 
 private:
     struct Hit {
@@ -81,9 +84,11 @@ private:
     std::vector<MirrorPlane> mirrors_;
     std::vector<int32_t> mirror_of_object_;  // index into mirrors_, or -1
     std::vector<std::array<double, 4>> colors_;
-    std::vector<mesh4d::World4D> worlds_;
-    std::vector<mesh4d::Motion> lab_motions_;  // each object's lab motion (reflections' Doppler)
-    std::vector<mesh4d::TraceWorld> traces_;
+    std::vector<mesh4d::Motion> motions_;       // per object
+    std::vector<mesh4d::Motion> lab_motions_;   // each object's lab motion (reflections' Doppler)
+    std::vector<mesh4d::World4D> worlds_;       // per object, or per time slab of a motion that is not uniform
+    std::vector<uint32_t> owner_;               // the object of each world
+    std::vector<mesh4d::TraceWorld> traces_;    // per world
     bool shade_doppler_ = false;
 };
 

@@ -62,6 +62,12 @@ struct ObjectSpec {
     enum class Speed { Velocity, Gamma, Rapidity } speed = Speed::Velocity;
     mesh4d::Vec3 direction;            // unit vector (with Speed::Gamma or Speed::Rapidity)
     double gamma = 1, rapidity = 0;
+    // Spin (rad/s) in the object's centre frame about its origin, combined with the velocity
+    // (mesh4d/worldline.h); zero: uniform motion.
+    mesh4d::Vec3 angular_velocity;
+    // Constant proper acceleration of the origin from t0 on (1/ls, c = 1: light-seconds per second
+    // squared), Born-rigid, in the frame of `velocity` (mesh4d/worldline.h); zero: uniform.
+    mesh4d::Vec3 acceleration;
     mesh4d::Vec3 rotation_deg;         // rest-frame rotation, degrees, applied X then Y then Z
     mesh4d::Vec3 scale{1, 1, 1};       // rest-frame scale, applied before the rotation
     // Interval of existence on the object's own clock (0 at t0): proper time for the relativistic

@@ -276,6 +276,22 @@ void readExists(FieldReader& r, const json& j, const std::string& path, const Ob
     obj->exists_to = v[1];
 }
 
+// A spin about the object's origin, rad/s in its centre frame (mesh4d/worldline.h); an axial
+// vector, turned with the scene's axes as positions are (a rotation keeps axial vectors' rule).
+// Read after the mirror: a mirror must be at rest.
+void readAngularVelocity(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.axisVec3(j, "angular_velocity", path, &obj->angular_velocity);
+    if (!r.failed() && obj->mirror && mesh4d::norm(obj->angular_velocity) != 0)
+        r.fail(path + ".angular_velocity", "a mirror must be at rest (angular_velocity [0, 0, 0])");
+}
+
+// A constant proper acceleration of the origin (mesh4d/worldline.h), in the scene's axes.
+void readAcceleration(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    r.axisVec3(j, "acceleration", path, &obj->acceleration);
+    if (!r.failed() && obj->mirror && mesh4d::norm(obj->acceleration) != 0)
+        r.fail(path + ".acceleration", "a mirror must be at rest (acceleration [0, 0, 0])");
+}
+
 }  // namespace
 
 const std::vector<ObjectField>& objectFields() {
@@ -290,6 +306,8 @@ const std::vector<ObjectField>& objectFields() {
         {{"scale"}, false, &readScale},
         {{"mirror"}, false, &readMirror},
         {{"exists"}, false, &readExists},
+        {{"angular_velocity"}, false, &readAngularVelocity},
+        {{"acceleration"}, false, &readAcceleration},
     };
     return table;
 }

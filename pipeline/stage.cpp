@@ -109,6 +109,13 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
         return fail(scene.path + ": tolerance (or --tolerance): " + formatNumber(scene.tolerance) + " light-seconds is below the floor of " +
                     formatNumber(floor) + " (1e-6 of the largest object's size, " + formatNumber(largest) +
                     "; float32 output cannot show finer): use a coarser --tolerance, or 'vertex'");
+    // Step: motions beyond uniform (spin, acceleration): what they need, per model.
+    for (Model m : stage->models)
+        for (size_t i = 0; i < stage->objects.size(); ++i)
+            if (Status s = checkObjectMotion(stage->objects[i], m, scene, stage->tolerances[i], stage->first,
+                                             stage->last_excl - 1);
+                !s.ok)
+                return fail(s.message);
     return true;
 }
 

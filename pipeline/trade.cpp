@@ -182,6 +182,10 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
         err << "error: " << error << "\n";
         return kExitBadInput;
     }
+    if (Status s = checkToleranceDial(stage.scene, "trade"); !s.ok) {
+        err << "error: " << s.message << "\n";
+        return kExitBadInput;
+    }
     if (stage.models.size() != 1) {
         err << "error: --model: trade measures one model at a time\n";
         return kExitBadInput;

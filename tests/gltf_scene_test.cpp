@@ -145,6 +145,8 @@ TEST(GltfScene, EveryObjectFieldInExtrasGivesTheJsonObject) {
         {{"mirror", true}},
         {{"exists", {nullptr, 5}}, {"velocity", {0.1, 0, 0}}},
         {{"exists", {-1, 2.5}}, {"t0", 1}},
+        {{"angular_velocity", {0, 0.5, -0.25}}, {"velocity", {0.3, 0, 0}}},
+        {{"acceleration", {0.5, 0, 0.25}}, {"velocity", {0, 0.3, 0}}},
     };
     // Every key of the table that a node does not give itself is covered by a case above.
     for (const std::string& key : objectMarkerKeys()) {
@@ -177,6 +179,8 @@ TEST(GltfScene, EveryObjectFieldInExtrasGivesTheJsonObject) {
         EXPECT_EQ(g.exists_from, j.exists_from);
         EXPECT_EQ(g.exists_to, j.exists_to);
         EXPECT_EQ(g.mirror, j.mirror);
+        EXPECT_EQ(g.angular_velocity, j.angular_velocity);
+        EXPECT_EQ(g.acceleration, j.acceleration);
         EXPECT_NE(g.mesh_path.find("scene.gltf#thing"), std::string::npos) << g.mesh_path;
     }
     // Independently of the JSON reader: gamma = 1e7 along +z is b = sqrt(1 - 1e-14), and
