@@ -23,11 +23,9 @@ bool getU64(const std::string& in, size_t* at, uint64_t* v) {
 
 }  // namespace
 
-std::string serializeFrame(const EncodedFrame& frame) {
-    size_t size = 6 * 8;
-    for (const EncodedOutput& s : frame.sinks) size += 3 * 8 + s.bytes.size();
+std::string frameHeader(const EncodedFrame& frame) {
     std::string out;
-    out.reserve(size);
+    out.reserve((6 + 3 * frame.sinks.size()) * 8);
     putU64(&out, kFrameMagic);
     putU64(&out, uint64_t(frame.index));
     putU64(&out, frame.triangles);
@@ -38,34 +36,55 @@ std::string serializeFrame(const EncodedFrame& frame) {
         putU64(&out, uint64_t(s.least));
         putU64(&out, uint64_t(s.estimate));
         putU64(&out, s.bytes.size());
-        out += s.bytes;
     }
     return out;
 }
 
-bool deserializeFrame(const std::string& bytes, EncodedFrame* frame, std::string* error) {
+std::vector<std::string_view> frameParts(const EncodedFrame& frame, const std::string& header) {
+    std::vector<std::string_view> parts{header};
+    for (const EncodedOutput& s : frame.sinks) parts.emplace_back(s.bytes);
+    return parts;
+}
+
+bool frameFromParts(std::vector<std::string>* parts, EncodedFrame* frame, std::string* error) {
     size_t at = 0;
     uint64_t magic = 0, index = 0, over = 0, sinks = 0;
-    bool ok = getU64(bytes, &at, &magic) && magic == kFrameMagic && getU64(bytes, &at, &index) &&
-              getU64(bytes, &at, &frame->triangles) && getU64(bytes, &at, &frame->limited_triangles) &&
-              getU64(bytes, &at, &over) && getU64(bytes, &at, &sinks) && sinks <= bytes.size();
+    const std::string empty;
+    const std::string& head = parts->empty() ? empty : parts->front();
+    bool ok = getU64(head, &at, &magic) && magic == kFrameMagic && getU64(head, &at, &index) &&
+              getU64(head, &at, &frame->triangles) && getU64(head, &at, &frame->limited_triangles) &&
+              getU64(head, &at, &over) && getU64(head, &at, &sinks) && sinks + 1 == parts->size() &&
+              head.size() - at == 3 * 8 * sinks;
     frame->index = (long long)index;
     frame->over_budget = over != 0;
+    frame->sinks.clear();
     if (ok) frame->sinks.resize(size_t(sinks));
-    for (EncodedOutput& s : frame->sinks) {
+    for (size_t i = 0; ok && i < frame->sinks.size(); ++i) {
+        EncodedOutput& s = frame->sinks[i];
         uint64_t least = 0, estimate = 0, n = 0;
-        ok = ok && getU64(bytes, &at, &least) && getU64(bytes, &at, &estimate) && getU64(bytes, &at, &n) &&
-             n <= bytes.size() - at;
-        if (!ok) break;
+        ok = getU64(head, &at, &least) && getU64(head, &at, &estimate) && getU64(head, &at, &n) &&
+             n == (*parts)[i + 1].size();
         s.least = (long long)least;
         s.estimate = (long long)estimate;
-        s.bytes.assign(bytes, at, size_t(n));
-        at += size_t(n);
+        if (ok) s.bytes = std::move((*parts)[i + 1]);
     }
-    if (!ok || at != bytes.size()) {
+    if (!ok) {
         *error = "internal: a frame from another process is malformed (frame " + std::to_string(frame->index) + ")";
         return false;
     }
+    return true;
+}
+
+bool FrameGroup::receiveFrame(int from, std::string* bytes, int* code, std::string* error) {
+    std::vector<std::string> parts;
+    if (!receiveParts(from, &parts, code, error)) return false;
+    if (parts.size() != 1) {
+        *code = 1;
+        *error = "internal: rank " + std::to_string(from) + " sent " + std::to_string(parts.size()) +
+                 " parts where one picture was due";
+        return false;
+    }
+    *bytes = std::move(parts.front());
     return true;
 }
 

@@ -10,14 +10,16 @@
 // in the order the ranks make them (no part runs far ahead of the writer).
 //
 // The MPI protocol (FrameGroup below, one exchange per model's frame loop), rank r > 0:
-//   for each of its frames, in order: FRAME (the EncodedFrame; a synchronous send, so a rank holds
-//   at most its frame loop's tokens of frames: bounded memory), or, when it fails, ERROR (exit code and
+//   for each of its frames, in order: FRAME (the EncodedFrame as parts: its header, then each
+//   sink's bytes; a synchronous send, so a rank holds at most its frame loop's tokens of frames:
+//   bounded memory), or, when it fails, ERROR (exit code and
 //   the one-line message) instead, and no more frames; before each frame it checks for END from
 //   rank 0 and stops sending when it came; then DONE; then it waits for END(code).
 // Rank 0 receives the frames in frame order from their ranks (one at a time: bounded memory) and
 // writes them; at the end (the files committed), or as soon as it fails or receives an ERROR, it
 // sends END(code) to every rank and then drains each rank's messages up to its DONE (which
-// unblocks a rank stuck in a send).
+// unblocks a rank stuck in a send). Each part of a frame is received straight into the string
+// that keeps it (a sink's bytes are moved, never copied, into the EncodedFrame).
 // Every rank then leaves the loop with rank 0's code; rank 0 alone prints the message, after its
 // sinks removed their temporary files. A rank that dies (a signal, the OOM killer) is mpirun's to
 // handle: it ends the job; files are committed by rename only, so none is left truncated.
@@ -26,6 +28,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "exporters/frame_sink.h"
@@ -57,9 +60,12 @@ struct EncodedFrame {
     std::vector<EncodedOutput> sinks;
 };
 
-// The frame as bytes and back (false when `bytes` is not one: a message then).
-std::string serializeFrame(const EncodedFrame& frame);
-bool deserializeFrame(const std::string& bytes, EncodedFrame* frame, std::string* error);
+// The frame as the parts of one message: part 0 its header (number, triangle counts, budget flag,
+// each sink's least and estimate and the size of its bytes), then each sink's bytes, viewed.
+std::string frameHeader(const EncodedFrame& frame);
+std::vector<std::string_view> frameParts(const EncodedFrame& frame, const std::string& header);
+// And back: the sinks' bytes moved out of `parts` (false when they are not such parts: a message then).
+bool frameFromParts(std::vector<std::string>* parts, EncodedFrame* frame, std::string* error);
 
 // The processes of one run and the messages between them (MPI). The single-process group is
 // the default; main() installs the MPI group when the program runs under mpirun or srun.
@@ -74,13 +80,16 @@ public:
 
     // The frame protocol above. Rank r > 0:
     virtual bool stopRequested() { return false; }             // END has come
-    virtual void sendFrame(const std::string& /*bytes*/) {}
+    virtual void sendParts(const std::vector<std::string_view>& /*parts*/) {}
+    void sendFrame(const std::string& bytes) { sendParts({std::string_view(bytes)}); }  // one part
     virtual void sendError(int /*code*/, const std::string& /*message*/) {}
     virtual int finishSending() { return 0; }                   // DONE, then END's code
-    // Rank 0: frame k from rank `from`: the bytes, or false with the rank's code and message.
-    virtual bool receiveFrame(int /*from*/, std::string* /*bytes*/, int* /*code*/, std::string* /*error*/) {
+    // Rank 0: the next frame from rank `from`: its parts, or false with the rank's code and message.
+    virtual bool receiveParts(int /*from*/, std::vector<std::string>* /*parts*/, int* /*code*/, std::string* /*error*/) {
         return false;
     }
+    // The same for a frame sent by sendFrame (one part).
+    bool receiveFrame(int from, std::string* bytes, int* code, std::string* error);
     virtual void endFrames(int /*code*/) {}                     // END(code) to all, then up to every DONE
 };
 

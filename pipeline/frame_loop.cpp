@@ -311,13 +311,19 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
         for (; !stop && remote_next < until; ++remote_next) {
             const int from = FrameSplit{0, group.size()}.partOf(remote_next, first);
             if (from == 0) continue;
-            std::string bytes;
+            std::vector<std::string> parts;
             auto w = std::make_shared<Work>();
             w->encoded = std::make_unique<EncodedFrame>();
             const Clock::time_point wait_start = Clock::now();
-            const bool received = group.receiveFrame(from, &bytes, &failed_code, error);
+            const bool received = group.receiveParts(from, &parts, &failed_code, error);
             result->wait_seconds += since(wait_start);
-            if (!received || !deserializeFrame(bytes, w->encoded.get(), error)) {
+            // Unpacking the frame is rank 0's work on it: counted with its writing.
+            const Clock::time_point unpack_start = Clock::now();
+            const double unpack_cpu = threadCpuSeconds();
+            const bool unpacked = received && frameFromParts(&parts, w->encoded.get(), error);
+            result->write_seconds += since(unpack_start);
+            result->write_cpu_seconds += threadCpuSeconds() - unpack_cpu;
+            if (!unpacked) {
                 if (!failed_code) failed_code = 1;
                 stop = true;
                 return;
@@ -338,7 +344,8 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     auto inOrder = [&](WorkPtr w) {
         if (sender) {
             if (stop || (stop = group.stopRequested())) return;
-            group.sendFrame(serializeFrame(*w->encoded));
+            const std::string header = frameHeader(*w->encoded);
+            group.sendParts(frameParts(*w->encoded, header));
             return;
         }
         if (receiver) {

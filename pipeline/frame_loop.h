@@ -82,7 +82,8 @@ struct FrameLoopResult {
     int group_code = 0;
     // Where the time went (wall clock, seconds): cutting, converting and encoding the frames this
     // process cut, summed over its threads; writing (the sinks' add and finish, in order, one
-    // thread); with MPI, rank 0 waiting for frames of other ranks. render --verbose prints them.
+    // thread; with MPI also rank 0 unpacking each received frame); with MPI, rank 0 waiting for
+    // frames of other ranks (the receive itself). render --verbose prints them.
     double cut_seconds = 0, write_seconds = 0, wait_seconds = 0, loop_seconds = 0;
     // The same as the CPU time of the threads that did it (not slowed by other processes sharing
     // the cores; a nested parallel loop's work stolen by another thread is not counted).

@@ -15,13 +15,14 @@ int main(int argc, char** argv) {
     // Ctrl-C or SIGTERM: remove the temporary files in progress, exit 130 or 143 (atomic_file.h).
     apparent::installInterruptCleanup();
 #ifdef APPARENT_HAVE_MPI
-    // Under mpirun or srun: the ranks share the frames of render and raytrace; rank 0 alone
+    // Under mpirun or srun: the ranks share the frames of render, raytrace and figure; rank 0 alone
     // prints and runs the other commands (pipeline/mpi_group.h).
     if (apparent::launchedByMpi()) {
         apparent::startMpiGroup(&argc, &argv);
         if (apparent::mpiRankZero())
             return apparent::finishMpiGroup(apparent::runCommandLine(argc, argv, std::cout, std::cerr));
-        if (argc < 2 || (std::strcmp(argv[1], "render") != 0 && std::strcmp(argv[1], "raytrace") != 0))
+        if (argc < 2 || (std::strcmp(argv[1], "render") != 0 && std::strcmp(argv[1], "raytrace") != 0 &&
+                         std::strcmp(argv[1], "figure") != 0))
             return apparent::finishMpiGroup(0);
         // Not even a signal's line: mpirun reports a rank it lost, rank 0 everything else.
         if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, 2);

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <mpi.h>
@@ -17,7 +18,7 @@ namespace apparent {
 namespace {
 
 // Message tags of the protocol (distribute.h).
-constexpr int kTagFrame = 1;  // 8 bytes: the frame's size; its bytes follow in kTagChunk messages
+constexpr int kTagFrame = 1;  // 8 bytes per part: the parts' sizes; each part follows in kTagChunk messages
 constexpr int kTagChunk = 2;
 constexpr int kTagError = 3;  // int32 exit code, then the one-line message
 constexpr int kTagDone = 4;   // empty: no more frames from this rank
@@ -60,14 +61,16 @@ public:
         return flag != 0;
     }
 
-    void sendFrame(const std::string& bytes) override {
+    void sendParts(const std::vector<std::string_view>& parts) override {
         // Synchronous: it returns once rank 0 has started to receive this frame, so a rank is never
         // more than one frame ahead of the writer, however small its frames (a plain send of a
         // message under the eager limit would return at once and let frames pile up on rank 0).
-        const uint64_t n = bytes.size();
-        MPI_Ssend(&n, 8, MPI_BYTE, 0, kTagFrame, comm_);
-        for (size_t at = 0; at < bytes.size(); at += kChunk)
-            MPI_Send(bytes.data() + at, int(std::min(kChunk, bytes.size() - at)), MPI_BYTE, 0, kTagChunk, comm_);
+        std::vector<uint64_t> sizes;
+        for (const std::string_view& p : parts) sizes.push_back(p.size());
+        MPI_Ssend(sizes.data(), int(8 * sizes.size()), MPI_BYTE, 0, kTagFrame, comm_);
+        for (const std::string_view& p : parts)
+            for (size_t at = 0; at < p.size(); at += kChunk)
+                MPI_Send(p.data() + at, int(std::min(kChunk, p.size() - at)), MPI_BYTE, 0, kTagChunk, comm_);
     }
 
     void sendError(int code, const std::string& message) override {
@@ -85,11 +88,11 @@ public:
         return code;
     }
 
-    bool receiveFrame(int from, std::string* bytes, int* code, std::string* error) override {
+    bool receiveParts(int from, std::vector<std::string>* parts, int* code, std::string* error) override {
         MPI_Status status;
         MPI_Probe(from, MPI_ANY_TAG, comm_, &status);
         if (status.MPI_TAG == kTagFrame) {
-            receiveFrameBody(from, bytes);
+            receiveFrameBody(from, parts);
             return true;
         }
         if (status.MPI_TAG == kTagError) {
@@ -121,7 +124,7 @@ public:
                 MPI_Status status;
                 MPI_Probe(r, MPI_ANY_TAG, comm_, &status);
                 if (status.MPI_TAG == kTagFrame) {
-                    std::string discarded;
+                    std::vector<std::string> discarded;
                     receiveFrameBody(r, &discarded);
                 } else {
                     receiveBytes(r, status.MPI_TAG);
@@ -144,14 +147,19 @@ private:
         MPI_Recv(n ? &s[0] : nullptr, n, MPI_BYTE, from, tag, comm_, MPI_STATUS_IGNORE);
         return s;
     }
-    // The size message of a frame, then its pieces.
-    void receiveFrameBody(int from, std::string* bytes) {
-        uint64_t n = 0;
-        MPI_Recv(&n, 8, MPI_BYTE, from, kTagFrame, comm_, MPI_STATUS_IGNORE);
-        bytes->resize(size_t(n));
-        for (size_t at = 0; at < bytes->size(); at += kChunk)
-            MPI_Recv(&(*bytes)[at], int(std::min(kChunk, bytes->size() - at)), MPI_BYTE, from, kTagChunk, comm_,
-                     MPI_STATUS_IGNORE);
+    // The sizes message of a frame, then each part's pieces, received into the part's own string.
+    void receiveFrameBody(int from, std::vector<std::string>* parts) {
+        const std::string sizes = receiveBytes(from, kTagFrame);
+        parts->resize(sizes.size() / 8);
+        for (size_t i = 0; i < parts->size(); ++i) {
+            uint64_t n = 0;
+            std::memcpy(&n, sizes.data() + 8 * i, 8);
+            std::string& part = (*parts)[i];
+            part.resize(size_t(n));
+            for (size_t at = 0; at < part.size(); at += kChunk)
+                MPI_Recv(&part[at], int(std::min(kChunk, part.size() - at)), MPI_BYTE, from, kTagChunk, comm_,
+                         MPI_STATUS_IGNORE);
+        }
     }
 
     MPI_Comm comm_ = MPI_COMM_NULL;

@@ -8,7 +8,9 @@
 //   duplicate of MPI_COMM_WORLD, frames over 1 GiB in several messages).
 // - `raytrace`: the same split; rank r traces its frames and sends each picture to rank 0, which
 //   writes the PNG files and the video in frame order.
-// - Every other command (figure among them) runs on rank 0 alone (the other ranks return 0 at once).
+// - `figure`: the same split over its pictures (the sheet's panels, row by row; or the video's
+//   frames); rank 0 places them and writes the one PNG sheet or MP4.
+// - Every other command runs on rank 0 alone (the other ranks return 0 at once).
 // - Ranks other than 0 print nothing; rank 0 prints the progress and the summary, which says how
 //   many processes shared the frames.
 // Exit: every rank ends with rank 0's code (mpirun exits with it): the ranks meet in a final

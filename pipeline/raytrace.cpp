@@ -422,59 +422,124 @@ std::string cameraTimeLabel(const Scene& scene, long long k) {
 
 namespace {
 
+// Under mpirun (pipeline/distribute.h) a figure's pictures are shared as raytrace's frames are:
+// picture i (a panel of the sheet, or a frame of the video) is traced by rank i mod N, which
+// sends it to rank 0; rank 0 places or encodes them in order and writes the one output.
+// The group's side of a figure: `fail` ends the ranks' loop with a code (rank 0), `picture`
+// makes picture i here or receives it from its rank (false: failed, the code returned).
+struct FigureGroup {
+    FrameGroup& group = frameGroup();
+    bool sender = group.rank() > 0;
+    bool receiver = group.rank() == 0 && group.size() > 1;
+    FrameSplit split{group.rank(), group.size()};
+    std::ostream* err = nullptr;
+
+    int fail(int code, const std::string& message) {
+        if (receiver) group.endFrames(code);
+        *err << "error: " << message << "\n";
+        return code;
+    }
+    // Rank 0: picture i of `width` x `height` into *image, made by `make` here or received; the
+    // progress counts a received picture's rows (`rows` of them).
+    template <typename Make>
+    int picture(long long i, int width, int height, long long rows, TraceProgress* progress, RgbImage* image,
+                const Make& make) {
+        const int from = split.partOf(i, 0);
+        if (from == 0) {
+            *image = make(progress);
+            return kExitOk;
+        }
+        std::string bytes, error;
+        int remote = 0;
+        if (!group.receiveFrame(from, &bytes, &remote, &error)) return fail(remote ? remote : 1, error);
+        *image = RgbImage(width, height);
+        if (bytes.size() != image->rgb.size())
+            return fail(1, "internal: rank " + std::to_string(from) + " sent a picture of " + std::to_string(bytes.size()) +
+                               " bytes for picture " + std::to_string(i));
+        std::copy(bytes.begin(), bytes.end(), image->rgb.begin());
+        for (long long row = 0; row < rows; ++row) progress->rowDone();
+        return kExitOk;
+    }
+    // Rank r > 0: picture i made and sent when it is this rank's; false once rank 0 said END.
+    template <typename Make>
+    bool send(long long i, const Make& make) {
+        if (!split.owns(i, 0)) return true;
+        if (group.stopRequested()) return false;
+        const RgbImage image = make(nullptr);
+        group.sendFrame(std::string(image.rgb.begin(), image.rgb.end()));
+        return true;
+    }
+};
+
 // The side-by-side video of `figure --video`: one video frame per scene frame in the stage's range,
 // the models in columns under their names, the camera time (after the title) above.
-int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPainter* painter, std::ostream& log,
-                std::ostream& err) {
+int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPainter* painter, FigureGroup& fg,
+                std::ostream& log, std::ostream& err) {
     const Scene& scene = stage.scene;
     std::string error;
-    SheetText text;
+    SheetText base_text;
     if (painter)
-        for (Model m : stage.models) text.column_labels.push_back(modelName(m));
-    text.title = "t";  // a title band for the time, filled per frame
-    SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, text, painter != nullptr);
+        for (Model m : stage.models) base_text.column_labels.push_back(modelName(m));
+    base_text.title = "t";  // a title band for the time, filled per frame
+    const SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, base_text, painter != nullptr);
     std::vector<std::unique_ptr<SceneTracer>> tracers;
     for (Model m : stage.models) {
         tracers.push_back(std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1));
         tracers.back()->setShadeDoppler(settings.shade_doppler);
     }
-    VideoWriter writer;
-    if (!writer.open(settings.video_path, base.width, base.height, scene.frames.fps, &error)) {
-        err << "error: " << error << "\n";
-        return kExitOutputError;
-    }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    TraceProgress progress(err, !settings.quiet,
-                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height);
-    for (long long k = stage.first; k < stage.last_excl; ++k) {
+    // Video frame k: the title band with its time, then every model's panel.
+    long long k = stage.first;
+    auto make = [&](TraceProgress* progress) {
+        SheetText text = base_text;
         text.title = (settings.title.empty() ? "" : settings.title + "   ") + cameraTimeLabel(scene, k);
         SheetLayout layout = base;
         RgbImage sheet = drawSheet(text, painter, &layout);
         for (size_t m = 0; m < tracers.size(); ++m) {
-            progress.setLabel(std::string(modelName(stage.models[m])) + " frame " + std::to_string(k));
+            if (progress) progress->setLabel(std::string(modelName(stage.models[m])) + " frame " + std::to_string(k));
             TracedFrame frame;
-            arena.execute([&] { frame = tracers[m]->traceFrame(k, settings.width, settings.height, &progress); });
+            arena.execute([&] { frame = tracers[m]->traceFrame(k, settings.width, settings.height, progress); });
             placePanel(&sheet, layout, 0, int(m), frame.image);
         }
-        if (!writer.addFrame(sheet, &error)) {
-            err << "error: " << error << "\n";
-            return kExitOutputError;
-        }
+        return sheet;
+    };
+    if (fg.sender) {
+        for (; k < stage.last_excl && fg.send(k - stage.first, make); ++k) {}
+        return fg.group.finishSending();
     }
-    if (!writer.finish(&error)) {
-        err << "error: " << error << "\n";
-        return kExitOutputError;
+    VideoWriter writer;
+    if (!writer.open(settings.video_path, base.width, base.height, scene.frames.fps, &error))
+        return fg.fail(kExitOutputError, error);
+    TraceProgress progress(err, !settings.quiet,
+                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height);
+    for (; k < stage.last_excl; ++k) {
+        RgbImage sheet;
+        if (const int code = fg.picture(k - stage.first, base.width, base.height,
+                                        (long long)stage.models.size() * settings.height, &progress, &sheet, make))
+            return code;
+        if (!writer.addFrame(sheet, &error)) return fg.fail(kExitOutputError, error);
     }
+    if (!writer.finish(&error)) return fg.fail(kExitOutputError, error);
+    if (fg.receiver) fg.group.endFrames(0);
     progress.finish();
-    if (!settings.quiet)
+    if (!settings.quiet) {
         log << settings.video_path << ": " << writer.frames() << " frames of " << base.width << "x" << base.height
-            << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1 << "\n";
+            << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1;
+        if (fg.receiver) log << ", " << fg.group.size() << " processes shared the frames";
+        log << "\n";
+    }
     return kExitOk;
 }
 
 }  // namespace
 
-int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err) {
+int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& err_out) {
+    // Under mpirun the ranks share the pictures (FigureGroup above); the others print nothing.
+    FigureGroup fg;
+    std::ostringstream silent;
+    std::ostream& log = fg.sender ? silent : log_out;
+    std::ostream& err = fg.sender ? silent : err_out;
+    fg.err = &err;
     // Step: the stage, for the rows' models (instant, finite, relativistic unless --models) and
     // all frames (a video: the --frames range).
     const bool video = !settings.video_path.empty();
@@ -485,39 +550,35 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     stage_options.all_models = false;
     stage_options.frame_from = video && settings.frame_from >= 0 ? settings.frame_from : 0;
     stage_options.frame_to = video && settings.frame_from >= 0 ? settings.frame_to : -1;
-    stage_options.quiet = settings.quiet;
+    stage_options.quiet = settings.quiet || fg.sender;
     std::string error;
-    if (!loadStage(stage_options, &stage, err, &error)) {
-        err << "error: " << error << "\n";
-        return kExitBadInput;
-    }
-    if (Status s = checkTracedMotions(stage, "figure", settings.shade_doppler); !s.ok) {
-        err << "error: " << s.message << "\n";
-        return kExitBadInput;
+    int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
+    if (!code) {
+        if (Status s = checkTracedMotions(stage, "figure", settings.shade_doppler); !s.ok) {
+            error = s.message;
+            code = kExitBadInput;
+        }
     }
     const Scene& scene = stage.scene;
     const std::vector<Model>& rows = stage.models;
     // Step: the columns: --times, --frames A:B, or --columns evenly spaced.
     std::vector<long long> frames;
-    if (!video) {
+    if (!code && !video) {
         if (!settings.times.empty()) {
-            if (!framesAtTimes(scene, settings.times, &frames, &error)) {
-                err << "error: " << error << "\n";
-                return kExitBadInput;
-            }
+            if (!framesAtTimes(scene, settings.times, &frames, &error)) code = kExitBadInput;
         } else if (settings.frame_from >= 0) {
             const long long total = frameCount(scene.frames);
             const long long to = settings.frame_to < 0 ? total : settings.frame_to;
             if (settings.frame_from >= total || to > total) {
-                err << "error: --frames: " << settings.frame_from << ":" << to << " is outside the scene's " << total
-                    << " frames\n";
-                return kExitBadInput;
+                error = "--frames: " + std::to_string(settings.frame_from) + ":" + std::to_string(to) +
+                        " is outside the scene's " + std::to_string(total) + " frames";
+                code = kExitBadInput;
+            } else if (to - settings.frame_from > kMaxFigureColumns) {
+                error = "--frames: " + std::to_string(to - settings.frame_from) + " columns, more than " +
+                        std::to_string(kMaxFigureColumns);
+                code = kExitBadInput;
             }
-            if (to - settings.frame_from > kMaxFigureColumns) {
-                err << "error: --frames: " << to - settings.frame_from << " columns, more than " << kMaxFigureColumns << "\n";
-                return kExitBadInput;
-            }
-            for (long long k = settings.frame_from; k < to; ++k) frames.push_back(k);
+            for (long long k = settings.frame_from; !code && k < to; ++k) frames.push_back(k);
         } else {
             frames = figureFrames(scene, settings.columns);
         }
@@ -525,15 +586,16 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
     // Step: the font (labels and title) and ffmpeg (video), before any tracing.
     TextPainter painter;
     const bool with_text = settings.labels || !settings.title.empty();
-    if (with_text && !painter.open(kLabelFontPath, &error)) {
+    if (!code && with_text && !painter.open(kLabelFontPath, &error)) code = kExitBadInput;
+    if (!code && !fg.sender && video && findInPath("ffmpeg").empty()) {
+        error = ffmpegMissingMessage("--video");
+        code = kExitBadInput;
+    }
+    if ((code = fg.group.agree(code, &error))) {
         err << "error: " << error << "\n";
-        return kExitBadInput;
+        return code;
     }
-    if (video && findInPath("ffmpeg").empty()) {
-        err << "error: " << ffmpegMissingMessage("--video") << "\n";
-        return kExitBadInput;
-    }
-    if (video) return figureVideo(settings, stage, with_text ? &painter : nullptr, log, err);
+    if (video) return figureVideo(settings, stage, with_text ? &painter : nullptr, fg, log, err);
     // Step: lay out the sheet: a row per model, a column per frame, labels in bands left and above.
     SheetText text;
     text.title = settings.title;
@@ -542,33 +604,47 @@ int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err)
         for (long long k : frames) text.column_labels.push_back(cameraTimeLabel(scene, k));
     }
     SheetLayout layout(int(rows.size()), int(frames.size()), settings.width, settings.height, text, with_text);
-    RgbImage sheet = drawSheet(text, with_text ? &painter : nullptr, &layout);
+    RgbImage sheet = fg.sender ? RgbImage() : drawSheet(text, with_text ? &painter : nullptr, &layout);
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    TraceProgress progress(err, !settings.quiet, (long long)rows.size() * (long long)frames.size() * settings.height);
+    TraceProgress progress(err, !settings.quiet && !fg.sender,
+                           (long long)rows.size() * (long long)frames.size() * settings.height);
+    // Panel i = r * columns + c: row r's model at column c's frame.
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
         SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi);
         tracer.setShadeDoppler(settings.shade_doppler);
         for (size_t c = 0; c < frames.size(); ++c) {
-            progress.setLabel(std::string(modelName(rows[r])) + " frame " + std::to_string(frames[c]));
-            TracedFrame frame;
-            arena.execute([&] { frame = tracer.traceFrame(frames[c], settings.width, settings.height, &progress); });
-            placePanel(&sheet, layout, int(r), int(c), frame.image);
+            auto make = [&](TraceProgress* p) {
+                if (p) p->setLabel(std::string(modelName(rows[r])) + " frame " + std::to_string(frames[c]));
+                TracedFrame frame;
+                arena.execute([&] { frame = tracer.traceFrame(frames[c], settings.width, settings.height, p); });
+                return frame.image;
+            };
+            const long long i = (long long)(r * frames.size() + c);
+            if (fg.sender) {
+                if (!fg.send(i, make)) return fg.group.finishSending();
+                continue;
+            }
+            RgbImage panel;
+            if (const int failed = fg.picture(i, settings.width, settings.height, settings.height, &progress, &panel, make))
+                return failed;
+            placePanel(&sheet, layout, int(r), int(c), panel);
         }
     }
+    if (fg.sender) return fg.group.finishSending();
     progress.finish();
     const std::filesystem::path parent = std::filesystem::path(settings.out_path).parent_path();
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-    if (ec || !writePng(settings.out_path, sheet, &error)) {
-        err << "error: " << (ec ? settings.out_path + ": cannot create folder: " + ec.message() : error) << "\n";
-        return kExitOutputError;
-    }
+    if (ec || !writePng(settings.out_path, sheet, &error))
+        return fg.fail(kExitOutputError, ec ? settings.out_path + ": cannot create folder: " + ec.message() : error);
+    if (fg.receiver) fg.group.endFrames(0);
     if (!settings.quiet) {
         log << settings.out_path << ": " << sheet.width << "x" << sheet.height << ", rows";
         for (Model m : rows) log << " " << modelName(m);
         log << "; frames";
         for (long long k : frames) log << " " << k << " (t = " << frameTime(scene.frames, k) << " s)";
+        if (fg.receiver) log << "; " << fg.group.size() << " processes shared the frames";
         log << "\n";
     }
     return kExitOk;

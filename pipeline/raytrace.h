@@ -140,6 +140,8 @@ std::string cameraTimeLabel(const Scene& scene, long long k);
 // `apparent figure`: the paper's comparison sheet, a row per model, a column per frame, labelled
 // with model names and camera times, panels separated by 4-pixel grey lines; or with --video the
 // models side by side in an MP4 of every frame in --frames. Exit 2 for a missing font or ffmpeg.
+// Under mpirun the ranks share its pictures (the panels, or the video's frames) and rank 0 writes
+// the sheet or video, byte-identical to one process's (pipeline/mpi_group.h).
 int figure(const FigureSettings& settings, std::ostream& log, std::ostream& err);
 
 }  // namespace apparent

@@ -107,18 +107,25 @@ TEST(Shards, ParseShard) {
     expectOneLine(r, "--shard: '3/3'");
 }
 
-// A frame as it travels between processes comes back as it was; a cut or altered one is refused.
-TEST(Shards, FrameBytesRoundTrip) {
+// A frame as it travels between processes (its header and its sinks' bytes as the parts of one
+// message) comes back as it was, the sinks' bytes moved out of the parts; a cut or altered one is refused.
+TEST(Shards, FramePartsRoundTrip) {
     apparent::EncodedFrame f;
     f.index = 42;
     f.triangles = 1234;
     f.limited_triangles = 5;
     f.sinks.push_back({10, 20, std::string("ply bytes\0with a zero", 21)});
     f.sinks.push_back({0, 0, ""});
-    const std::string bytes = apparent::serializeFrame(f);
+    const std::string header = apparent::frameHeader(f);
+    const std::vector<std::string_view> views = apparent::frameParts(f, header);
+    ASSERT_EQ(views.size(), 3u);
+    EXPECT_EQ(views[1].data(), f.sinks[0].bytes.data());  // viewed, not copied, for sending
+    auto parts = [&] { return std::vector<std::string>(views.begin(), views.end()); };
+    std::vector<std::string> received = parts();
+    const char* payload = received[1].data();
     apparent::EncodedFrame g;
     std::string error;
-    ASSERT_TRUE(apparent::deserializeFrame(bytes, &g, &error)) << error;
+    ASSERT_TRUE(apparent::frameFromParts(&received, &g, &error)) << error;
     EXPECT_EQ(g.index, 42);
     EXPECT_EQ(g.triangles, 1234u);
     EXPECT_EQ(g.limited_triangles, 5u);
@@ -127,11 +134,26 @@ TEST(Shards, FrameBytesRoundTrip) {
     EXPECT_EQ(g.sinks[0].least, 10);
     EXPECT_EQ(g.sinks[0].estimate, 20);
     EXPECT_EQ(g.sinks[0].bytes, f.sinks[0].bytes);
+    EXPECT_EQ(g.sinks[0].bytes.data(), payload);  // moved out of the received part, not copied
     EXPECT_TRUE(g.sinks[1].bytes.empty());
     apparent::EncodedFrame h;
-    EXPECT_FALSE(apparent::deserializeFrame(bytes.substr(0, bytes.size() - 1), &h, &error));
-    EXPECT_FALSE(apparent::deserializeFrame(bytes + "x", &h, &error));
-    EXPECT_FALSE(apparent::deserializeFrame("", &h, &error));
+    std::vector<std::string> bad = parts();
+    bad[0].pop_back();  // a cut header
+    EXPECT_FALSE(apparent::frameFromParts(&bad, &h, &error));
+    bad = parts();
+    bad[0] += "x";  // a longer header
+    EXPECT_FALSE(apparent::frameFromParts(&bad, &h, &error));
+    bad = parts();
+    bad[1].pop_back();  // a sink's bytes not of the size the header gives
+    EXPECT_FALSE(apparent::frameFromParts(&bad, &h, &error));
+    bad = parts();
+    bad.pop_back();  // a part missing
+    EXPECT_FALSE(apparent::frameFromParts(&bad, &h, &error));
+    bad = parts();
+    bad.emplace_back("extra");  // one part too many
+    EXPECT_FALSE(apparent::frameFromParts(&bad, &h, &error));
+    bad.clear();
+    EXPECT_FALSE(apparent::frameFromParts(&bad, &h, &error));
 }
 
 // Shards 0/3, 1/3 and 2/3 as separate commands, then merge: every file byte-identical to one

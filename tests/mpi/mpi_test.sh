@@ -1,7 +1,7 @@
 #!/bin/bash
 # `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
-# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ; and
-# raytrace's PNG files and video), a
+# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ;
+# raytrace's PNG files and video; figure's sheet and video), a
 # failure on any rank ends the job with the one-process code and one line from rank 0 and no
 # output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
 # Usage: mpi_test.sh APPARENT SOURCE_DIR   (ctest sets OpenMPI's run-as-root variables for it)
@@ -40,6 +40,19 @@ out=$(mpi raytrace data/scenes/flanges.json --out "$work/rt3" --frames 90:100 --
 diff -r "$work/rt1" "$work/rt3" > /dev/null || fail "raytrace PNG files differ"
 cmp -s "$work/rt1.mp4" "$work/rt3.mp4" || fail "raytrace videos differ"
 case "$out" in *"3 processes shared the frames"*) ;; *) fail "raytrace summary without the process count: $out" ;; esac
+# figure too: its panels (7 of them: ranks own unequal shares) and its video's frames.
+"$apparent" figure data/scenes/flanges.json --out "$work/fig1.png" --columns 7 --models relativistic --size 96x54 \
+    --title "Flanges" --quiet || fail "figure, one process"
+out=$(mpi figure data/scenes/flanges.json --out "$work/fig3.png" --columns 7 --models relativistic --size 96x54 \
+    --title "Flanges" 2> "$work/stderr.txt") || fail "figure under mpirun: $out $(cat "$work/stderr.txt")"
+cmp -s "$work/fig1.png" "$work/fig3.png" || fail "figure sheets differ"
+case "$out" in *"3 processes shared the frames"*) ;; *) fail "figure summary without the process count: $out" ;; esac
+"$apparent" figure data/scenes/flanges.json --video "$work/fig1.mp4" --frames 90:98 --models instant,relativistic \
+    --size 96x54 --quiet || fail "figure --video, one process"
+out=$(mpi figure data/scenes/flanges.json --video "$work/fig3.mp4" --frames 90:98 --models instant,relativistic \
+    --size 96x54 2> "$work/stderr.txt") || fail "figure --video under mpirun: $out $(cat "$work/stderr.txt")"
+cmp -s "$work/fig1.mp4" "$work/fig3.mp4" || fail "figure videos differ"
+case "$out" in *"3 processes shared the frames"*) ;; *) fail "figure --video summary without the process count: $out" ;; esac
 
 # --quiet silences every rank.
 out=$(mpi render data/scenes/flanges.json --out "$work/quiet" --frames 0:20 --quiet 2>&1)
@@ -65,6 +78,16 @@ expect_failure 2 "$work/e1" render data/scenes/flanges.json --max-triangles 100
 expect_failure 2 "$work/e2" render data/fixtures/scene_mirror_not_planar.json
 expect_failure 3 "$work/e3" render data/scenes/flanges.json --format ply,glb --max-output-bytes 100000
 expect_failure 2 "$work/e4" raytrace data/scenes/flanges.json --model all --video "$work/e4.mp4"
+expect_failure 2 "$work/e5" figure data/scenes/flanges.json --times 1000
+# figure: rank 0 fails to write the sheet after every rank sent its panels: the one-process code and line.
+touch "$work/blocker"
+"$apparent" figure data/scenes/flanges.json --columns 4 --size 32x18 --out "$work/blocker/sheet.png" > "$work/one.txt" 2>&1
+one=$?
+mpi figure data/scenes/flanges.json --columns 4 --size 32x18 --out "$work/blocker/sheet.png" > /dev/null 2> "$work/mpi.txt"
+got=$?
+[ "$one" = 3 ] && [ "$got" = 3 ] || fail "figure write failure: one process $one, mpirun $got (3 expected)"
+[ "$(grep -cxF -- "$(grep '^error: ' "$work/one.txt")" "$work/mpi.txt")" = 1 ] && [ "$(grep -c '^error: ' "$work/mpi.txt")" = 1 ] ||
+    fail "figure write failure: not the one-process line once ($(cat "$work/mpi.txt"))"
 
 # Step: SIGKILL to rank 1 mid-run: mpirun exits non-zero; every file present is complete (the
 # one-process run's bytes for it), no temporary is left beside them.
