@@ -95,6 +95,10 @@ inline std::array<uint32_t, 4> World4D::tet(size_t i) const { return prismTet(me
 // Preconditions: tau_a < tau_b, every triangle index < mesh.positions.size().
 World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
                 bool cap_a_real, bool cap_b_real);
+// The same, the mesh handed to the world instead of copied (`mesh` is left empty): the world is
+// then its only copy, for a caller that needs the rest mesh no more (pipeline/worlds.h takeWorlds).
+World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_b, bool cap_a_real,
+                bool cap_b_real);
 
 // The proper times at which the rest vertices' worldlines cross the first and the last view
 // surface of a sequence: [min over vertices at `first`, max over vertices at `last`]. Crossing
