@@ -4,7 +4,7 @@
 //
 //   BM_LoadVsGltfpack/F/N  one process loads a torus of N triangles as `apparent` does before its
 //                          first frame (scene, mesh file, transform, the 4D history of one model:
-//                          pipeline/stage.h, pipeline/worlds.h); another runs
+//                          pipeline/stage.h, pipeline/worlds.h takeWorlds); another runs
 //                          `gltfpack -i FILE -o out.glb` on the same file (F = 0 OBJ, 2 .glb).
 //                          F = 1 loads the binary PLY of the same torus, compared with gltfpack on
 //                          its OBJ (gltfpack reads no PLY). Both are child processes measured alike
@@ -121,8 +121,9 @@ int loadChild(const std::string& scene) {
         std::fprintf(stderr, "%s\n", error.c_str());
         return 2;
     }
+    // As render's last (here only) model: the worlds take the stage's meshes (runLastFrameLoop).
     const std::vector<mesh4d::World4D> worlds =
-        apparent::buildWorlds(stage.objects, apparent::Model::Relativistic, stage.scene, stage.first, stage.last_excl - 1);
+        apparent::takeWorlds(&stage.objects, apparent::Model::Relativistic, stage.scene, stage.first, stage.last_excl - 1);
     return worlds.empty() || worlds[0].empty() ? 1 : 0;
 }
 

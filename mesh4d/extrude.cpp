@@ -6,10 +6,18 @@
 #include "robust.h"
 #include "worldline.h"
 
+#ifdef __GLIBC__
+#include <malloc.h>  // malloc_trim
+#endif
+
 namespace mesh4d {
 
-World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
-                bool cap_a_real, bool cap_b_real) {
+namespace {
+
+// extrude, with the mesh copied into the world from `mesh`, or moved from `*take` when given
+// (then `mesh` is `*take`).
+World4D extrudeMesh(const RestMesh& mesh, RestMesh* take, const Motion& motion, double tau_a, double tau_b,
+                    bool cap_a_real, bool cap_b_real) {
     World4D world;
     world.motion = motion;
     world.tau_a = tau_a;
@@ -52,6 +60,7 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         const auto& t = mesh.triangles[slot / 3];
         return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
     };
+    size_t edge_count = 0;  // one per group of equal (lo, hi)
     for (size_t v = 0; v < nv; ++v) {
         uint64_t* g = by_lo.data() + offset[v];
         uint64_t* const g_end = by_lo.data() + offset[v + 1];
@@ -71,11 +80,20 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
                 cycle_last = slot;
             }
             if (cycle_last != UINT32_MAX) world.slot_next[cycle_last] = cycle_first;
+            ++edge_count;
             g = e;
         }
     }
     std::vector<uint64_t>().swap(by_lo);
     std::vector<uint32_t>().swap(offset);
+    // The scratch's pages go back to the system (glibc keeps a freed block of this size in its
+    // heap, resident, and the events below do not fit into it): at 1M triangles the resident
+    // peak of a load fell from 111 to 98 MB (docs/PERFORMANCE.md). The edges' array is reserved
+    // at its size, so it is not grown by copies that leave holes of their own.
+#ifdef __GLIBC__
+    if (slots >= (size_t(1) << 20)) malloc_trim(0);  // 8 MB of scratch and more
+#endif
+    world.edges.reserve(edge_count);
     // Numbering in slot order: a slot's first slot is never after it, so it is numbered already.
     for (uint32_t slot = 0; slot < slots; ++slot) {
         if (first_slot(slot) == slot) {
@@ -89,35 +107,50 @@ World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double
         }
     }
 
-    // The mesh (its one copy) and the events, after the edges' scratch arrays are freed: the peak
-    // memory is the world itself.
-    world.mesh = mesh;
+    // The mesh (its one copy, or the caller's handed over) and the events, after the edges'
+    // scratch arrays are freed: the peak memory is the world itself.
+    if (take)
+        world.mesh = std::move(*take);
+    else
+        world.mesh = mesh;
+    const RestMesh& m = world.mesh;
     // Events: both caps of every vertex's worldline.
     world.events.resize(2 * nv);
     for (size_t i = 0; i < nv; ++i) {
-        world.events[2 * i + 0] = worldlineEvent(motion, tau_a, mesh.positions[i]);
-        world.events[2 * i + 1] = worldlineEvent(motion, tau_b, mesh.positions[i]);
+        world.events[2 * i + 0] = worldlineEvent(motion, tau_a, m.positions[i]);
+        world.events[2 * i + 1] = worldlineEvent(motion, tau_b, m.positions[i]);
     }
 
     world.simple = true;
     for (size_t i = 0; i < nv; ++i) {
-        if (world.vertex_used[i]) world.shape_radius = std::max(world.shape_radius, norm(mesh.positions[i]));
+        if (world.vertex_used[i]) world.shape_radius = std::max(world.shape_radius, norm(m.positions[i]));
         else world.simple = false;
     }
-    for (const auto& t : mesh.triangles)
+    for (const auto& t : m.triangles)
         if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) world.simple = false;
 
     // Runs of triangles with the 4D boxes of their cap events, for the per-frame cull.
-    for (uint32_t f0 = 0; f0 < mesh.triangles.size(); f0 += kChunkTriangles) {
+    for (uint32_t f0 = 0; f0 < m.triangles.size(); f0 += kChunkTriangles) {
         TriangleChunk c;
         c.first = f0;
-        c.last = uint32_t(std::min<size_t>(mesh.triangles.size(), size_t(f0) + kChunkTriangles));
+        c.last = uint32_t(std::min<size_t>(m.triangles.size(), size_t(f0) + kChunkTriangles));
         for (uint32_t f = c.first; f < c.last; ++f)
-            for (uint32_t v : mesh.triangles[f])
+            for (uint32_t v : m.triangles[f])
                 for (int cap = 0; cap < 2; ++cap) c.cap[cap].add(world.events[2 * v + cap]);
         world.chunks.push_back(c);
     }
     return world;
+}
+
+}  // namespace
+
+World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, bool cap_a_real,
+                bool cap_b_real) {
+    return extrudeMesh(mesh, nullptr, motion, tau_a, tau_b, cap_a_real, cap_b_real);
+}
+
+World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_b, bool cap_a_real, bool cap_b_real) {
+    return extrudeMesh(mesh, &mesh, motion, tau_a, tau_b, cap_a_real, cap_b_real);
 }
 
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord) {

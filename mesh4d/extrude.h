@@ -95,6 +95,10 @@ inline std::array<uint32_t, 4> World4D::tet(size_t i) const { return prismTet(me
 // Preconditions: tau_a < tau_b, every triangle index < mesh.positions.size().
 World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
                 bool cap_a_real, bool cap_b_real);
+// The same, the mesh handed to the world instead of copied (`mesh` is left empty): the world is
+// then its only copy, for a caller that needs the rest mesh no more (pipeline/worlds.h takeWorlds).
+World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_b, bool cap_a_real,
+                bool cap_b_real);
 
 // Time slabs (issue 18, item 5): for a motion that is not uniform (worldline.h) the history over
 // [tau_a, tau_b] is cut at samples of the object's time s into slabs, each a World4D of prisms

@@ -127,9 +127,13 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
     return info;
 }
 
-bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& settings,
-                  const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
-                  FrameLoopResult* result, std::string* error) {
+namespace {
+
+// runFrameLoop; with `take` (stage.objects itself, for the stage's last model) the rest meshes
+// are handed to the worlds when no mirror needs them afterwards.
+bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model, const FrameLoopSettings& settings,
+             const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
+             FrameLoopResult* result, std::string* error) {
     const Scene& scene = stage.scene;
     const long long first = stage.first, last_excl = stage.last_excl;
     using Clock = std::chrono::steady_clock;
@@ -142,7 +146,9 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     const bool receiver = settings.distributed && group.rank() == 0 && group.size() > 1;
     const FrameSplit split = settings.split;
     // Step: the static 4D worlds and the mirrors' reflections, once per model.
-    const std::vector<mesh4d::World4D> worlds = buildWorlds(stage.objects, model, scene, first, last_excl - 1);
+    const std::vector<mesh4d::World4D> worlds = take && stage.mirrors.empty()
+                                                    ? takeWorlds(take, model, scene, first, last_excl - 1)
+                                                    : buildWorlds(stage.objects, model, scene, first, last_excl - 1);
     const MirrorReflections reflections(scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
     SequenceInfo info = sequenceInfo(stage, model);
     reflections.describe(&info);
@@ -415,6 +421,20 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
     result->loop_seconds = since(loop_start);
     if (receiver) group.endFrames(0);
     return true;
+}
+
+}  // namespace
+
+bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& settings,
+                  const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
+                  FrameLoopResult* result, std::string* error) {
+    return runLoop(stage, nullptr, model, settings, sinks, budget, progress_out, result, error);
+}
+
+bool runLastFrameLoop(Stage* stage, Model model, const FrameLoopSettings& settings,
+                      const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
+                      FrameLoopResult* result, std::string* error) {
+    return runLoop(*stage, &stage->objects, model, settings, sinks, budget, progress_out, result, error);
 }
 
 }  // namespace apparent

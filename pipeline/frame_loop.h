@@ -103,4 +103,11 @@ bool runFrameLoop(const Stage& stage, Model model, const FrameLoopSettings& sett
                   const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
                   FrameLoopResult* result, std::string* error);
 
+// runFrameLoop for the last model run from `stage`: when no mirror needs them, the objects' rest
+// meshes are handed to the 4D worlds instead of copied (pipeline/worlds.h takeWorlds; every
+// stage->objects[i].rest is then left empty), so a large mesh is held once. Same outputs.
+bool runLastFrameLoop(Stage* stage, Model model, const FrameLoopSettings& settings,
+                      const std::vector<FrameSink*>& sinks, OutputBudget* budget, std::ostream& progress_out,
+                      FrameLoopResult* result, std::string* error);
+
 }  // namespace apparent

@@ -158,7 +158,10 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
             sinks.push_back(owned.back().get());
         }
         FrameLoopResult result;
-        const bool ran = runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error);
+        // The last model needs the stage's meshes no more: its worlds take them (held once).
+        const bool ran = loop.models_left == 1
+                             ? runLastFrameLoop(&stage, model, loop, sinks, &budget, err, &result, &error)
+                             : runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error);
         --loop.models_left;
         if (!ran && group.rank() > 0) return result.group_code;  // rank 0 reports it
         if (!ran) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
@@ -10,19 +11,20 @@ namespace apparent {
 
 using mesh4d::Vec3;
 
-mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
-                           long long last_frame) {
-    // In the frame the cut is made in (the camera's rest frame; the lab for finite): its motion
-    // and rest points.
-    const mesh4d::MotionInCameraFrame in_camera = cutMotionOf(object.spec, model, scene);
-    mesh4d::RestMesh rotated;
-    const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_camera, &rotated);
-    return extrudeSeen(object.spec, rest, in_camera.motion, viewForFrame(scene, model, first_frame),
-                       viewForFrame(scene, model, last_frame));
+namespace {
+
+// The rest mesh `*mesh` in the frame of the cut, rotated in place where that needs it (as
+// restInCameraFrame, without the copy).
+const mesh4d::RestMesh& rotateInCameraFrame(mesh4d::RestMesh* mesh, const mesh4d::MotionInCameraFrame& m) {
+    if (m.rotated)
+        for (Vec3& p : mesh->positions) p = mesh4d::apply(m.rotation, p);
+    return *mesh;
 }
 
-mesh4d::World4D extrudeSeen(const ObjectSpec& s, const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
-                            const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last) {
+// extrudeSeen; with `take` (then `rest` is *take) the mesh is handed to the world, not copied.
+mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& rest, mesh4d::RestMesh* take,
+                                const mesh4d::Motion& motion, const mesh4d::ViewSurface& first,
+                                const mesh4d::ViewSurface& last) {
     // Step: the proper-time span the requested frames can see, padded by the object's own light
     // crossing time so that rounding in the vertex crossings never reaches an artificial cap.
     const mesh4d::ProperTimeSpan seen = mesh4d::spanSeen(rest, motion, first, last);
@@ -44,7 +46,37 @@ mesh4d::World4D extrudeSeen(const ObjectSpec& s, const mesh4d::RestMesh& rest, c
         empty.motion = motion;
         return empty;
     }
+    if (take) return mesh4d::extrude(std::move(*take), motion, tau_a, tau_b, cap_a_real, cap_b_real);
     return mesh4d::extrude(rest, motion, tau_a, tau_b, cap_a_real, cap_b_real);
+}
+
+}  // namespace
+
+namespace {
+
+// buildWorld; with `take` (object.rest itself) the rest mesh is moved into the world, rotated in
+// place into the camera's frame where that needs it, instead of copied.
+mesh4d::World4D buildWorldFrom(const PreparedObject& object, mesh4d::RestMesh* take, Model model, const Scene& scene,
+                               long long first_frame, long long last_frame) {
+    // In the frame the cut is made in (the camera's rest frame; the lab for finite): its motion
+    // and rest points.
+    const mesh4d::MotionInCameraFrame in_camera = cutMotionOf(object.spec, model, scene);
+    mesh4d::RestMesh rotated;
+    const mesh4d::RestMesh& rest = take ? rotateInCameraFrame(take, in_camera) : restInCameraFrame(object.rest, in_camera, &rotated);
+    return extrudeSeenFrom(object.spec, rest, take, in_camera.motion, viewForFrame(scene, model, first_frame),
+                           viewForFrame(scene, model, last_frame));
+}
+
+}  // namespace
+
+mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
+                           long long last_frame) {
+    return buildWorldFrom(object, nullptr, model, scene, first_frame, last_frame);
+}
+
+mesh4d::World4D extrudeSeen(const ObjectSpec& s, const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
+                            const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last) {
+    return extrudeSeenFrom(s, rest, nullptr, motion, first, last);
 }
 
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
@@ -52,6 +84,17 @@ std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& obje
     std::vector<mesh4d::World4D> worlds;
     worlds.reserve(objects.size());
     for (const PreparedObject& o : objects) worlds.push_back(buildWorld(o, model, scene, first_frame, last_frame));
+    return worlds;
+}
+
+std::vector<mesh4d::World4D> takeWorlds(std::vector<PreparedObject>* objects, Model model, const Scene& scene,
+                                        long long first_frame, long long last_frame) {
+    std::vector<mesh4d::World4D> worlds;
+    worlds.reserve(objects->size());
+    for (PreparedObject& o : *objects) {
+        worlds.push_back(buildWorldFrom(o, &o.rest, model, scene, first_frame, last_frame));
+        o.rest = {};  // left valid and empty whether or not the world took it
+    }
     return worlds;
 }
 

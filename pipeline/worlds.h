@@ -30,6 +30,12 @@ mesh4d::World4D extrudeSeen(const ObjectSpec& spec, const mesh4d::RestMesh& rest
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
                                          long long first_frame, long long last_frame);
 
+// buildWorlds for the last use of the objects' rest meshes: each mesh is handed to its world (and
+// rotated there in place into the frame of the cut) instead of copied, so the world holds the
+// only copy; every objects[i].rest is left empty. The worlds are equal to buildWorlds'.
+std::vector<mesh4d::World4D> takeWorlds(std::vector<PreparedObject>* objects, Model model, const Scene& scene,
+                                        long long first_frame, long long last_frame);
+
 // View culling (--cull-view): whether a sphere may show in the camera's view, a circular cone
 // around the view axis whose half-angle reaches the corners of a kCullAspect:1 frame with the
 // camera's vertical field of view (wider than 16:9 and 21:9 screens; a 32:9 screen at the same

@@ -60,3 +60,49 @@ TEST(Render, ExistenceEndsBecomeRealCaps) {
     late.frames.end = 1001;
     EXPECT_TRUE(buildWorld(objects[0], Model::Relativistic, late, 0, 0).empty());
 }
+
+// takeWorlds (render's last model) hands each rest mesh to its world instead of copying it: the
+// worlds are those buildWorlds makes from the untouched meshes, bit for bit, also where the
+// camera's motion turns the rest points (Thomas-Wigner rotation, applied in place there), and
+// the objects' meshes are left empty.
+TEST(Render, TakeWorldsEqualsBuildWorlds) {
+    Scene scene;
+    std::vector<PreparedObject> objects;
+    ASSERT_NO_FATAL_FAILURE(loadPrepared("data/scenes/flanges.json", &scene, &objects));
+    Scene moving = scene;  // a camera moving across the flanges' motion: their rest points turn
+    moving.camera.velocity = {0, 0.6, 0};
+    ASSERT_TRUE(cutMotionOf(objects[0].spec, Model::Relativistic, moving).rotated);
+    for (const Scene* s : {&scene, &moving})
+        for (Model model : {Model::Finite, Model::Relativistic}) {
+            const std::vector<mesh4d::World4D> copied = buildWorlds(objects, model, *s, 20, 60);
+            std::vector<PreparedObject> taken_from = objects;
+            const std::vector<mesh4d::World4D> taken = takeWorlds(&taken_from, model, *s, 20, 60);
+            ASSERT_EQ(taken.size(), copied.size());
+            for (size_t i = 0; i < copied.size(); ++i) {
+                const mesh4d::World4D &a = copied[i], &b = taken[i];
+                EXPECT_TRUE(taken_from[i].rest.positions.empty() && taken_from[i].rest.triangles.empty());
+                ASSERT_FALSE(a.empty());
+                EXPECT_EQ(a.tau_a, b.tau_a);
+                EXPECT_EQ(a.tau_b, b.tau_b);
+                ASSERT_EQ(a.mesh.positions.size(), b.mesh.positions.size());
+                for (size_t v = 0; v < a.mesh.positions.size(); ++v) {
+                    EXPECT_EQ(a.mesh.positions[v].x, b.mesh.positions[v].x);
+                    EXPECT_EQ(a.mesh.positions[v].y, b.mesh.positions[v].y);
+                    EXPECT_EQ(a.mesh.positions[v].z, b.mesh.positions[v].z);
+                }
+                EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
+                ASSERT_EQ(a.events.size(), b.events.size());
+                for (size_t e = 0; e < a.events.size(); ++e) {
+                    EXPECT_EQ(a.events[e].t, b.events[e].t);
+                    EXPECT_EQ(a.events[e].x.x, b.events[e].x.x);
+                    EXPECT_EQ(a.events[e].x.y, b.events[e].x.y);
+                    EXPECT_EQ(a.events[e].x.z, b.events[e].x.z);
+                }
+                EXPECT_EQ(a.slot_next, b.slot_next);
+                EXPECT_EQ(a.triangle_edges, b.triangle_edges);
+                ASSERT_EQ(a.edges.size(), b.edges.size());
+                for (size_t e = 0; e < a.edges.size(); ++e) EXPECT_TRUE(a.edges[e].lo == b.edges[e].lo && a.edges[e].hi == b.edges[e].hi);
+                EXPECT_EQ(a.shape_radius, b.shape_radius);
+            }
+        }
+}
