@@ -346,7 +346,7 @@ TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
     fs::create_directories(box / "out/relativistic");
     std::ofstream(box / "victim.txt") << "precious";
     const std::string pid = std::to_string(::getpid());
-    for (const std::string name : {".relativistic.tmp-" + pid + ".glb", ".relativistic.glb.tmp-" + pid + ".bin",
+    for (const std::string& name : {".relativistic.tmp-" + pid + ".glb", ".relativistic.glb.tmp-" + pid + ".bin",
                                    "relativistic/.frame_00000.tmp-" + pid + ".ply",
                                    "relativistic/.frame_00000.tmp-" + pid + ".obj"})
         fs::create_symlink(box / "victim.txt", box / "out" / name);
