@@ -17,7 +17,7 @@
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 #include "run_command.h"
-#include "quiet_stage.h"
+#include "box_scene.h"
 
 using namespace apparent;
 using mesh4d::Event;
@@ -40,20 +40,11 @@ Event labFromCamera(const Event& e, const Vec3& v, const Vec3& p) {
     return {g * (e.t + mesh4d::dot(v, r)), p + r_perp + (r_par + v * e.t) * g};
 }
 
-struct Fixture {
-    fs::path dir;
-    Stage stage;
-};
+using Fixture = BoxScene;
 
 // Writes `scene_json` (objects may use box.obj) into a fresh folder and loads its stage.
 void loadScene(const std::string& name, const std::string& scene_json, Fixture* f) {
-    f->dir = fs::temp_directory_path() / ("apparent_camera_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(f->dir);
-    fs::create_directories(f->dir);
-    fs::copy_file(fs::path(APPARENT_SOURCE_DIR) / "data/meshes/box.obj", f->dir / "box.obj");
-    std::ofstream(f->dir / "scene.json") << scene_json;
-    std::string error;
-    ASSERT_TRUE(loadQuietStage((f->dir / "scene.json").string(), &f->stage, &error)) << error;
+    loadBoxScene("camera_" + name, scene_json, f);
 }
 
 // Checks every vertex of frame k of every object in vertex mode; returns the vertex count.

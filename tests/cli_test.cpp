@@ -27,22 +27,7 @@ namespace {
 using testcli::apparentRun;
 using testcli::CommandResult;
 using testcli::source;
-
-class TempDir {
-public:
-    TempDir() {
-        path_ = fs::temp_directory_path() /
-                ("apparent_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
-        fs::remove_all(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    std::string str() const { return path_.string(); }
-    fs::path operator/(const std::string& s) const { return path_ / s; }
-
-private:
-    fs::path path_;
-    static inline int counter_ = 0;
-};
+using testcli::TempDir;
 
 std::vector<std::string> listFiles(const fs::path& dir) {
     std::vector<std::string> names;

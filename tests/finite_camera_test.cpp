@@ -21,7 +21,7 @@
 #include "pipeline/physics.h"
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
-#include "quiet_stage.h"
+#include "box_scene.h"
 #include "run_command.h"
 #include "test_meshes.h"
 
@@ -55,19 +55,11 @@ Event exactImage(const Vec3& x0, double t0, const Vec3& u, const Vec3& q, double
     return shearIntoCamera(labEmission(x0 + q, t0, u, t_c, p + v * t_c), v);
 }
 
-struct Fixture {
-    fs::path dir;
-    Stage stage;
-};
+using Fixture = BoxScene;
 
+// Writes `scene_json` (objects may use box.obj) into a fresh folder and loads its stage.
 void loadScene(const std::string& name, const std::string& scene_json, Fixture* f) {
-    f->dir = fs::temp_directory_path() / ("apparent_finite_camera_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(f->dir);
-    fs::create_directories(f->dir);
-    fs::copy_file(fs::path(APPARENT_SOURCE_DIR) / "data/meshes/box.obj", f->dir / "box.obj");
-    std::ofstream(f->dir / "scene.json") << scene_json;
-    std::string error;
-    ASSERT_TRUE(loadQuietStage((f->dir / "scene.json").string(), &f->stage, &error)) << error;
+    loadBoxScene("finite_camera_" + name, scene_json, f);
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 // Runs the `apparent` command line in-process for the end-to-end tests.
 #pragma once
 
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "pipeline/cli.h"
 
@@ -28,5 +31,24 @@ inline CommandResult apparentRun(std::vector<std::string> args) {
     r.err = err.str();
     return r;
 }
+
+// A fresh folder under the system's temporary folder, removed with the object.
+class TempDir {
+public:
+    TempDir() {
+        path_ = std::filesystem::temp_directory_path() /
+                ("apparent_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
+        std::filesystem::remove_all(path_);
+    }
+    ~TempDir() { std::filesystem::remove_all(path_); }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    std::string str() const { return path_.string(); }
+    std::filesystem::path operator/(const std::string& s) const { return path_ / s; }
+
+private:
+    std::filesystem::path path_;
+    static inline int counter_ = 0;
+};
 
 }  // namespace testcli
