@@ -11,11 +11,15 @@
 // relative precision in 1/g^2.
 #pragma once
 
+#include <memory>
+
 #include "event.h"
 
 namespace mesh4d {
 
 enum class Kinematics { Galilean, Lorentz };
+
+struct KeyedMotion;  // keyframes.h
 
 struct Motion {
     Kinematics kinematics = Kinematics::Galilean;
@@ -36,6 +40,9 @@ struct Motion {
     // Constant proper acceleration of the origin from t0 on (mesh4d/worldline.h: Born-rigid
     // hyperbolic motion, uniform before t0), in the frame of `velocity`. Zero: uniform.
     Vec3 acceleration;
+    // A keyframed path (mesh4d/keyframes.h: the centre and the turn interpolated between lab keys,
+    // carried rigidly in the frame of `velocity`, the path's mean velocity). Null: none.
+    std::shared_ptr<const KeyedMotion> keyed;
 };
 
 // Builds a Motion. Precondition: |velocity| < 1 when kinematics == Lorentz (callers validate).

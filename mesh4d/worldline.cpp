@@ -1,5 +1,7 @@
 #include "worldline.h"
 
+#include "keyframes.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -66,7 +68,19 @@ Local rigidLocal(const Motion& m, double s, const Vec3& q) {
     return l;
 }
 
+// A keyframed path in its own frame (keyframes.h): T = s.
+Local keyedLocalEvent(const Motion& m, double s, const Vec3& q) {
+    const KeyedLocal k = keyedLocal(*m.keyed, s, q);
+    Local l;
+    l.T = s;
+    l.Y = k.y;
+    l.dY = k.dy;
+    l.dtau = k.dtau;
+    return l;
+}
+
 Local localEvent(const Motion& m, double s, const Vec3& q) {
+    if (m.keyed) return keyedLocalEvent(m, s, q);
     return accelerated(m) ? rigidLocal(m, s, q) : spinLocal(m, s, q);
 }
 
@@ -114,7 +128,11 @@ Rel relativeEvent(const Motion& m, double s, const Vec3& q, double t_c, const Ve
     Rel r;
     if (m.kinematics == Kinematics::Galilean) {
         r.e.t = (m.t0 - t_c) + s;
-        if (accelerated(m)) {
+        if (m.keyed) {  // carried in the lab along the path (keyframes.h)
+            const KeyedLocal l = keyedLocal(*m.keyed, s, q);
+            r.e.x = (m.origin - apex) + l.y;
+            r.rate.dx = l.dy;
+        } else if (accelerated(m)) {
             Vec3 disp, vel;
             originPath(m, s, &disp, &vel);
             r.e.x = (m.origin - apex) + (q + disp);
@@ -201,6 +219,7 @@ double spinSpeed(const Motion& m, const Vec3& q) { return norm(cross(m.angular_v
 
 double worldlineProperTime(const Motion& m, double s, const Vec3& q) {
     if (m.kinematics == Kinematics::Galilean || isUniform(m)) return s;
+    if (m.keyed) return keyedProperTime(*m.keyed, s, q);
     if (accelerated(m)) {
         if (!(s > 0)) return s;
         const double a = norm(m.acceleration);
@@ -252,6 +271,7 @@ WorldlineCrossing crossWorldline(const ViewSurface& view, const Motion& m, const
     Motion plain = m;
     plain.angular_velocity = {0, 0, 0};
     plain.acceleration = {0, 0, 0};
+    plain.keyed = nullptr;
     const Event plain_cut = cutRestWorldline(view, plain, nowBase(view, plain), q);
     double s = properTimeAt(plain, q, plain_cut.t);
     if (accelerated(m)) {

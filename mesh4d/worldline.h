@@ -47,6 +47,12 @@
 // the uniform closed form is exact. A body with both a spin and an acceleration is refused by the
 // callers (not modelled).
 //
+// Keyframed paths (issue 18, item 4): mesh4d/keyframes.h, the body carried rigidly along the
+// path in the frame of its mean velocity V = Motion::velocity (Lorentz: boosted about (t0, X0) as
+// the spin; Galilean: carried in the lab). s is that frame's time (Lorentz) or lab time since t0;
+// the clock integrates d tau = ds sqrt(1 - |dY/ds|^2) in closed form per segment. A keyframed
+// path with a spin or an acceleration is refused by the callers.
+//
 // The crossing with a view surface (past cone t = t_c - |x - C| or hyperplane t = t_c) is the root
 // of h(s) = (t_c - t(s)) - |x(s) - C| (cone) or t_c - t(s) (hyperplane). Along a timelike worldline
 // with t(s) increasing, h decreases strictly (dh/ds <= -(dt/ds)(1 - speed) < 0), so the root is
@@ -68,9 +74,9 @@
 
 namespace mesh4d {
 
-// True for uniform motion (no spin, no acceleration): boost.h's closed forms apply.
+// True for uniform motion (no spin, no acceleration, no keyframed path): boost.h's closed forms apply.
 inline bool isUniform(const Motion& m) {
-    return m.angular_velocity.x == 0 && m.angular_velocity.y == 0 && m.angular_velocity.z == 0 &&
+    return !m.keyed && m.angular_velocity.x == 0 && m.angular_velocity.y == 0 && m.angular_velocity.z == 0 &&
            m.acceleration.x == 0 && m.acceleration.y == 0 && m.acceleration.z == 0;
 }
 

@@ -9,6 +9,7 @@
 #include <tiny_gltf.h>
 
 #include "mesh4d/angles.h"
+#include "pipeline/gltf_animation.h"
 #include "pipeline/gltf_document.h"
 #include "pipeline/gltf_nodes.h"
 #include "pipeline/scene_fields.h"
@@ -26,7 +27,99 @@ struct ObjectNode {
     int node;
     Affine world;
     const json* extras;  // in the document
+    Affine parent;       // the world transform of the node's parent (identity for a root)
 };
+
+// A keyframed object (mesh4d/keyframes.h): the node's animated translation and rotation, composed
+// with its parent's transform as its static ones are, become the lab path; the pose at t0 is the
+// rest pose (obj->linear, obj->position) and each key's turn is relative to it.
+Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, const ObjectNode& o, const json& ex,
+                         const NodeAnimation& an, ObjectSpec* obj) {
+    const tinygltf::Node& node = model.nodes[size_t(o.node)];
+    const std::string where = "nodes[" + std::to_string(o.node) + "]";
+    const std::string field = an.translation.present ? an.translation.field : an.rotation.field;
+    auto fail = [&](const std::string& at, const std::string& problem) { return Status::failure(path + ": " + at + ": " + problem); };
+    if (node.matrix.size() == 16)
+        return fail(where + ".matrix", "an animated node must give translation, rotation and scale, not a matrix (glTF 2.0 section 3.11)");
+    // The velocity comes from the path; a spin or acceleration with it is not modelled.
+    for (const char* key : {"velocity", "direction", "gamma", "rapidity", "angular_velocity", "acceleration"})
+        if (ex.contains(key))
+            return fail(where + ".extras." + key, "the node's path is keyframed (" + field + "): its motion comes from the "
+                                                  "animation, remove " + key);
+    // Step: STEP keys are a jump, an infinite speed, unless they hold one value.
+    for (const AnimatedProperty* p : {&an.translation, &an.rotation}) {
+        if (!p->present || !p->step) continue;
+        for (size_t k = 1; k < p->times.size(); ++k) {
+            const bool same = p == &an.translation ? p->translations[k] == p->translations[k - 1]
+                                                   : (p->rotations[k].w == p->rotations[k - 1].w && p->rotations[k].x == p->rotations[k - 1].x &&
+                                                      p->rotations[k].y == p->rotations[k - 1].y && p->rotations[k].z == p->rotations[k - 1].z);
+            if (!same)
+                return fail(p->field, "STEP interpolation jumps at lab time " + formatNumber(p->times[k]) +
+                                          " s: an infinite speed (refused; use LINEAR)");
+        }
+    }
+    // Step: the parent's linear part must turn the node's turns into turns: a similarity c U.
+    const double* P = o.parent.m;
+    const Vec3 c0{P[0], P[1], P[2]}, c1{P[4], P[5], P[6]}, c2{P[8], P[9], P[10]};
+    const double scale2 = (mesh4d::norm2(c0) + mesh4d::norm2(c1) + mesh4d::norm2(c2)) / 3;
+    const double off = std::max({std::fabs(mesh4d::norm2(c0) - scale2), std::fabs(mesh4d::norm2(c1) - scale2), std::fabs(mesh4d::norm2(c2) - scale2),
+                                 std::fabs(mesh4d::dot(c0, c1)), std::fabs(mesh4d::dot(c1, c2)), std::fabs(mesh4d::dot(c0, c2))});
+    if (an.rotation.present && !(scale2 > 0 && off <= 1e-9 * scale2))
+        return fail(where, "an animated rotation under a parent whose transform shears or scales unequally is not a turn "
+                           "(apply the parent's scale in the authoring tool)");
+    const double c = std::sqrt(scale2);
+    const double det_sign = o.parent.det3() < 0 ? -1.0 : 1.0;
+    // Step: the key times of both channels, merged (a segment of either stays a segment).
+    std::vector<double> times = an.translation.times;
+    times.insert(times.end(), an.rotation.times.begin(), an.rotation.times.end());
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    const Vec3 t_static = node.translation.size() == 3 ? Vec3{node.translation[0], node.translation[1], node.translation[2]} : Vec3{};
+    const mesh4d::Quat r_static = node.rotation.size() == 4 ? mesh4d::Quat{node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]}
+                                                            : mesh4d::Quat{};
+    auto translation = [&](double t) { return an.translation.present ? translationAt(an.translation, t) : t_static; };
+    auto rotation = [&](double t) { return an.rotation.present ? rotationAt(an.rotation, t) : r_static; };
+    // The node's world transform at lab time t (its local TRS with the animated values).
+    auto worldAt = [&](double t) {
+        tinygltf::Node n = node;
+        const Vec3 tr = translation(t);
+        const mesh4d::Quat r = rotation(t);
+        n.translation = {tr.x, tr.y, tr.z};
+        n.rotation = {r.x, r.y, r.z, r.w};
+        return o.parent * localTransform(n);
+    };
+    // Step: the rest pose at t0, and the path: the centre and the turn relative to that pose (in
+    // the lab: the node's turn conjugated by the parent's rotation U = P / c).
+    const Affine rest = worldAt(obj->t0);
+    obj->position = rest.apply({0, 0, 0});
+    for (int col = 0; col < 3; ++col)
+        for (int row = 0; row < 3; ++row) obj->linear[size_t(col * 3 + row)] = rest.m[col * 4 + row];
+    const mesh4d::Quat r0_inv = mesh4d::conjugate(rotation(obj->t0));
+    auto keys = std::make_shared<mesh4d::KeyPath>();
+    for (double t : times) {
+        keys->times.push_back(t);
+        keys->positions.push_back(worldAt(t).apply({0, 0, 0}));
+        const mesh4d::Quat d = mesh4d::multiply(rotation(t), r0_inv);
+        const Vec3 v{d.x, d.y, d.z};
+        // U v = (P v) / c (det U < 0: a mirroring parent turns the other way, -U is the rotation).
+        const Vec3 pv = an.rotation.present ? Vec3{P[0] * v.x + P[4] * v.y + P[8] * v.z, P[1] * v.x + P[5] * v.y + P[9] * v.z,
+                                                   P[2] * v.x + P[6] * v.y + P[10] * v.z} / c * det_sign
+                                            : v;
+        keys->turns.push_back({d.w, pv.x, pv.y, pv.z});
+        if (!mesh4d::isFinite(keys->positions.back()))
+            return fail(field, "the path at lab time " + formatNumber(t) + " s is not finite");
+    }
+    // Step: the centre slower than light on every segment (the vertices are checked per model).
+    const mesh4d::KeyedSpeed fastest = mesh4d::fastestCentreSegment(*keys);
+    if (!(fastest.speed < 1))
+        return fail(field, "the path moves at " + formatNumber(fastest.speed) + " (light-seconds per second) from lab time " +
+                               formatNumber(fastest.lab_time) + " s, which must be < 1 (the speed of light)");
+    obj->speed = ObjectSpec::Speed::Velocity;
+    obj->velocity = mesh4d::meanVelocity(*keys);
+    obj->keys = keys;
+    obj->keys_field = field;
+    return Status::success();
+}
 
 }  // namespace
 
@@ -84,7 +177,9 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         if (!names.insert(node.name).second)
             return Status::failure(path + ": " + where + ".name: '" + node.name + "' names two object nodes");
         is_object[size_t(n)] = true;
-        objects.push_back({n, world, &ex});
+        Affine parent;
+        for (int a : ancestors) parent = parent * localTransform(model.nodes[size_t(a)]);
+        objects.push_back({n, world, &ex, parent});
         return Status::success();
     });
     if (!walked.ok) return walked;
@@ -149,8 +244,25 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
             for (int row = 0; row < 3; ++row) obj.linear[size_t(c * 3 + row)] = o.world.m[c * 4 + row];
         obj.field_path = "nodes[" + std::to_string(o.node) + "].extras";
         readObjectFields(r, *o.extras, obj.field_path, folder, ObjectSource::GltfNode, &obj);
+        // Step: a node whose translation or rotation is animated follows that path.
+        NodeAnimation an;
+        std::vector<std::pair<std::string, std::string>> animation_warnings;
+        if (!r.failed()) {
+            if (Status s = readNodeAnimation(path, model, o.node, &an, &animation_warnings); !s.ok) return s;
+            for (const auto& w : animation_warnings) r.warn(w.first, w.second);
+        }
+        if (!r.failed() && an.animated())
+            if (Status s = readKeyframedPath(path, model, o, *o.extras, an, &obj); !s.ok) return s;
         scene->objects.push_back(obj);
     }
+    // Step: channels that move no object node are not modelled: one warning each.
+    for (size_t ai = 0; ai < model.animations.size() && !r.failed(); ++ai)
+        for (size_t ci = 0; ci < model.animations[ai].channels.size(); ++ci) {
+            const int target = model.animations[ai].channels[ci].target_node;
+            if (target >= 0 && size_t(target) < is_object.size() && is_object[size_t(target)]) continue;
+            r.warn("animations[" + std::to_string(ai) + "].channels[" + std::to_string(ci) + "]",
+                   "animates nodes[" + std::to_string(target) + "], which is not an object node (no object fields in its extras): not modelled");
+        }
     scene->warnings = r.warnings();
     return status;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mesh4d/keyframes.h"
 #include "mesh4d/worldline.h"
 #include "pipeline/scene_fields.h"
 
@@ -30,12 +31,41 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     mesh4d::Motion m = uniformMotionOf(s, model);
     m.angular_velocity = s.angular_velocity;  // worldline.h: a spin about the origin, centre frame
     m.acceleration = s.acceleration;          // worldline.h: Born-rigid, from t0 on
+    // keyframes.h: the path carried in the frame of its mean velocity (s.velocity, m.velocity).
+    if (s.keys) m.keyed = mesh4d::makeKeyedMotion(*s.keys, m.kinematics == mesh4d::Kinematics::Lorentz, m.t0, m.origin, m.velocity);
     return m;
+}
+
+// A keyframed path's needs (physics.h).
+static Status checkKeyedMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance) {
+    const ObjectSpec& s = object.spec;
+    const std::string field = scene.path + ": " + s.keys_field + ": ";
+    if (mesh4d::norm(s.angular_velocity) != 0 || mesh4d::norm(s.acceleration) != 0)
+        return Status::failure(field + "a keyframed path with angular_velocity or acceleration is not modelled (give one)");
+    if (cameraMotionOf(scene).moving())
+        return Status::failure(field + "a keyframed object needs a camera at rest (camera.velocity is not [0, 0, 0])");
+    if (tolerance > 0)
+        return Status::failure(field + "a keyframed object is cut in vertex mode only: give --tolerance vertex (or the "
+                                       "scene's \"tolerance\": \"vertex\")");
+    if (model == Model::Instant) return Status::success();
+    // Every vertex slower than light over every segment (keyframes.h maxKeyedSpeed: the centre's
+    // speed and the turn's rim speed together, closed form).
+    const mesh4d::Motion m = motionOf(s, model);
+    for (size_t i = 0; i < object.rest.positions.size(); ++i) {
+        const mesh4d::KeyedSpeed v = mesh4d::maxKeyedSpeed(*m.keyed, object.rest.positions[i]);
+        if (!(v.speed < 1))
+            return Status::failure(field + "vertex " + std::to_string(i) + " would move at " + formatNumber(v.speed) +
+                                   (m.kinematics == mesh4d::Kinematics::Lorentz ? " (in the frame of the path's mean velocity)" : "") +
+                                   " at lab time " + formatNumber(v.lab_time) + " s, which must be < 1 (the speed of light) for model " +
+                                   modelName(model));
+    }
+    return Status::success();
 }
 
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
+    if (s.keys) return checkKeyedMotion(object, model, scene, tolerance);
     const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
     if (!spin && !accel) return Status::success();
     const std::string field = scene.path + ": " + s.field_path + (spin ? ".angular_velocity: " : ".acceleration: ");
@@ -94,6 +124,10 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
 
 Status checkToleranceDial(const Scene& scene, const char* command) {
     for (const ObjectSpec& s : scene.objects) {
+        if (s.keys)
+            return Status::failure(scene.path + ": " + s.keys_field + ": `apparent " + command +
+                                   "` sweeps the tolerance, which holds for uniform motion only (keyframed objects are "
+                                   "cut in vertex mode)");
         const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
         if (spin || accel)
             return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +

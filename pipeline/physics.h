@@ -27,7 +27,9 @@ mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
 // (relativistic, contracted), |velocity + w x q| < 1 in the lab at every angle (finite); instant
 // has no limit. Acceleration: |a| in [1e-12, 1e12], every vertex ahead of the Born-rigid horizon
 // (q.a/|a| > -1/|a|), and the origin's rapidity at frames first_frame and last_frame within
-// kMaxRapidity (gamma 1e15, as the gamma field).
+// kMaxRapidity (gamma 1e15, as the gamma field). A keyframed path (ObjectSpec::keys): no spin or
+// acceleration with it, a camera at rest, vertex mode, and every vertex slower than light over
+// every segment (not checked for instant), refused with the vertex, its speed and the lab time.
 constexpr double kMaxRapidity = 35.2;
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame);

@@ -111,6 +111,10 @@ Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, lon
 // (its Doppler factor is the uniform one; `render --shade doppler` has the worldline's).
 Status checkTracedMotions(const Stage& stage, const char* command, bool shade_doppler) {
     for (const PreparedObject& o : stage.objects) {
+        if (o.spec.keys)
+            return Status::failure(stage.scene.path + ": " + o.spec.keys_field + ": `apparent " + command +
+                                   "` traces uniform, spinning and accelerated motion; a keyframed path is cut by "
+                                   "`apparent render`");
         const bool spin = mesh4d::norm(o.spec.angular_velocity) != 0, accel = mesh4d::norm(o.spec.acceleration) != 0;
         if (shade_doppler && (spin || accel))
             return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +

@@ -4,10 +4,12 @@
 
 #include <array>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "mesh4d/event.h"
+#include "mesh4d/keyframes.h"
 #include "pipeline/status.h"
 
 namespace apparent {
@@ -80,6 +82,11 @@ struct ObjectSpec {
     // A planar mirror at rest: the raytracer bounces rays off it once, and the mesh pipeline adds
     // the retarded reflections it shows (docs/DESIGN.md section 8).
     bool mirror = false;
+    // A keyframed path (glTF animation channels of the object's node: mesh4d/keyframes.h), in the
+    // lab; null for none. `position` is then the centre at t0 on the path, `velocity` the path's
+    // mean velocity, and `linear` holds the pose at t0. keys_field names the channels, for messages.
+    std::shared_ptr<const mesh4d::KeyPath> keys;
+    std::string keys_field;
 };
 
 // The default tolerance, as a fraction of each object's bounding-box diagonal: an object that fills
