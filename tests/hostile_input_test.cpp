@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <iostream>
 #include <filesystem>
@@ -18,6 +19,7 @@
 
 #include "exporters/atomic_file.h"
 #include "exporters/ply.h"
+#include "keyed_gltf.h"
 #include "pipeline/cli.h"
 #include "run_command.h"
 #include "pipeline/json_limits.h"
@@ -722,4 +724,65 @@ TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
     r = apparentRun({"render", good, "--out", (box / "out").string(), "--threads", "10000000"});
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("--threads: 10000000 is outside 0 (all cores) .. 1024"), std::string::npos) << r.err;
+}
+
+// Issue 18, item 4: malformed animation channels on an object node of a glTF scene, each refused
+// with one line naming the file, the glTF path and the problem, and exit code 2
+// (pipeline/gltf_animation.h).
+TEST(HostileInput, MalformedAnimationsAreRefusedWithOneLine) {
+    Sandbox box;
+    fs::create_directories(box / "s");
+    using testkeys::Channel;
+    auto keys = [](std::vector<float> times, std::vector<float> values) {
+        Channel ch;
+        ch.times = std::move(times);
+        ch.values = std::move(values);
+        return ch;
+    };
+    struct Case {
+        const char* name;
+        Channel channel;
+        const char* expected;
+    };
+    std::vector<Case> cases;
+    {
+        Channel c = keys({0, 1}, {0, 0, -8, 0.5f, 0, -8});
+        c.output_accessor = 99;
+        cases.push_back({"bad_accessor", c, "bad_accessor.gltf: animations[0].samplers[0].output: accessor 99 out of range"});
+    }
+    cases.push_back({"decreasing", keys({0, 2, 1}, {0, 0, -8, 0.5f, 0, -8, 0.6f, 0, -8}),
+                     "decreasing.gltf: animations[0].samplers[0].input: key times must increase: key 2 at 1 s follows 2 s"});
+    cases.push_back({"counts", keys({0, 1, 2}, {0, 0, -8, 0.5f, 0, -8}), "counts.gltf: accessors[3].count: 2 values for 3 key times"});
+    cases.push_back({"nan_time", keys({0, NAN}, {0, 0, -8, 0.5f, 0, -8}), "nan_time.gltf: accessors[2]: element 1 is not finite"});
+    {
+        Channel c = keys({0, 1}, {0, 0, 0, 0, 0, 0});
+        c.path = "rotation";
+        c.output_type = "VEC3";
+        cases.push_back({"rotation_type", c, "rotation_type.gltf: accessors[3].type: expected VEC4"});
+    }
+    {
+        Channel c = keys({0, 1}, {0, 0, 0, 3, 0, 0, 0, 1});
+        c.path = "rotation";
+        cases.push_back({"long_quat", c, "long_quat.gltf: animations[0].samplers[0].output: key 0 is a quaternion of length 3"});
+    }
+    {
+        Channel c = keys({0, 1}, {0, 0, -8, 0.5f, 0, -8});
+        c.interpolation = "CUBICSPLINE";
+        cases.push_back({"cubic", c, "cubic.gltf: animations[0].samplers[0].interpolation: CUBICSPLINE is not modelled"});
+    }
+    {
+        Channel c = keys({0, 1}, {0, 0, -8, 0.5f, 0, -8});
+        c.interpolation = "STEP";
+        cases.push_back({"step", c, "step.gltf: animations[0].channels[0]: STEP interpolation jumps at lab time 1 s"});
+    }
+    for (const Case& k : cases) {
+        testkeys::KeyedGltf g;
+        g.channels.push_back(k.channel);
+        const std::string scene = g.write((box / "s").string(), k.name);
+        const CommandResult r = apparentRun({"render", scene, "--out", (box / "out").string()});
+        EXPECT_EQ(r.code, 2) << k.name << ": " << r.err;
+        EXPECT_NE(r.err.find(k.expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+        EXPECT_TRUE(filesUnder(box / "out").empty()) << k.name;
+    }
 }

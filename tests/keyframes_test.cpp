@@ -1,0 +1,276 @@
+// Keyframed paths (issue 18, item 4; mesh4d/keyframes.h, pipeline/gltf_animation.h): glTF
+// animation channels on an object node, through the whole stage, against the uniform and spin
+// models and against a path, a boost and a clock written out here.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "keyed_gltf.h"
+#include "mesh4d/keyframes.h"
+#include "mesh4d/light_factors.h"
+#include "mesh4d/slice.h"
+#include "mesh4d/worldline.h"
+#include "pipeline/physics.h"
+#include "pipeline/worlds.h"
+#include "quiet_stage.h"
+
+using apparent::Model;
+using mesh4d::Vec3;
+using testkeys::Channel;
+using testkeys::KeyedGltf;
+
+namespace {
+
+// Every frame's cut of the scene's one object: positions, emission times, clocks, rest points.
+struct Cut {
+    std::vector<double> t_c;
+    std::vector<std::vector<Vec3>> positions, rest;
+    std::vector<std::vector<double>> times, clocks;
+};
+
+Cut cutAll(const std::string& scene, Model model) {
+    Cut c;
+    apparent::Stage st;
+    std::string error;
+    EXPECT_TRUE(apparent::loadQuietStage(scene, &st, &error, {model})) << error;
+    if (st.objects.empty()) return c;
+    const mesh4d::World4D world = apparent::buildWorld(st.objects[0], model, st.scene, st.first, st.last_excl - 1);
+    for (long long k = st.first; k < st.last_excl; ++k) {
+        const mesh4d::ViewSurface view = apparent::viewForFrame(st.scene, model, k);
+        mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view);
+        mesh4d::addLightFactors(world, view, &out);
+        c.t_c.push_back(view.t_c);
+        c.positions.emplace_back();
+        c.times.emplace_back();
+        for (size_t i = 0; i < out.positions.size(); ++i) {
+            c.positions.back().push_back(out.absolutePosition(i));
+            c.times.back().push_back(out.absoluteTime(i));
+        }
+        c.rest.push_back(out.rest_points);
+        c.clocks.push_back(out.proper_time);
+    }
+    return c;
+}
+
+std::string dir() { return ::testing::TempDir(); }
+
+Channel translationKeys(const std::vector<float>& times, const std::vector<Vec3>& points) {
+    Channel ch;
+    ch.times = times;
+    for (const Vec3& p : points)
+        for (double v : {p.x, p.y, p.z}) ch.values.push_back(float(v));
+    return ch;
+}
+
+}  // namespace
+
+// Two keys at constant velocity are the uniform model with that velocity (keyframes.h: V = v, the
+// centre rests in F_V), in every model, to 1e-9 relative; the clocks too. Key positions are exact
+// in float32 (X0 + v t with these values).
+TEST(Keyframes, TwoKeysAtConstantSpeedAreTheUniformModel) {
+    for (const Vec3 v : {Vec3{0.6, 0, 0}, Vec3{0.5, 0.25, 0}, Vec3{0, 0, 0.75}}) {
+        const Vec3 x0{0, 0, -8};
+        KeyedGltf keyed;
+        keyed.channels.push_back(translationKeys({-40, 40}, {x0 - v * 40, x0 + v * 40}));
+        KeyedGltf uniform;
+        uniform.object_extras = {{"velocity", {v.x, v.y, v.z}}};
+        for (auto* g : {&keyed, &uniform}) g->scene_extras["frames"] = {{"start", 2}, {"end", 4}, {"fps", 4}};
+        const std::string kp = keyed.write(dir(), "two_keys"), up = uniform.write(dir(), "uniform");
+        for (Model model : {Model::Relativistic, Model::Finite, Model::Contracted, Model::Instant}) {
+            const Cut a = cutAll(kp, model), b = cutAll(up, model);
+            ASSERT_EQ(a.positions.size(), 8u);
+            ASSERT_EQ(a.positions.size(), b.positions.size());
+            for (size_t k = 0; k < a.positions.size(); ++k) {
+                ASSERT_EQ(a.positions[k].size(), 8u);
+                for (size_t i = 0; i < 8; ++i) {
+                    ASSERT_EQ(a.rest[k][i], b.rest[k][i]);
+                    const double scale = mesh4d::norm(b.positions[k][i]);
+                    EXPECT_NEAR(mesh4d::norm(a.positions[k][i] - b.positions[k][i]), 0, 1e-9 * scale)
+                        << apparent::modelName(model) << " frame " << k << " vertex " << i;
+                    EXPECT_NEAR(a.times[k][i], b.times[k][i], 1e-9 * scale);
+                    EXPECT_NEAR(a.clocks[k][i], b.clocks[k][i], 1e-9 * scale) << apparent::modelName(model);
+                }
+            }
+        }
+    }
+}
+
+// A path that turns a corner (0.6c along x, then 0.6c along y, from rest and back to rest) is
+// continuous, and each vertex is where the model says, computed here without the code under test:
+// with no turn, q's worldline is the centre's lab polyline shifted by the 4-vector D = L_V(0, q)
+// (the boost of q's rest-frame event at s = 0 with the mean velocity V = (0.3, 0.3, 0)), and q's
+// clock, 0 at D, reads 0.8 (t - D.t) while the centre moves at 0.6.
+TEST(Keyframes, CornerIsContinuousAndOnTheShiftedPath) {
+    KeyedGltf g;
+    g.channels.push_back(translationKeys({-20, 0, 20}, {{-12, 0, -6}, {0, 0, -6}, {0, 12, -6}}));
+    g.scene_extras["frames"] = {{"start", 2}, {"end", 10}, {"fps", 8}};
+    const std::string path = g.write(dir(), "corner");
+    auto centre = [](double t) {  // the lab path, written out
+        if (t <= -20) return Vec3{-12, 0, -6};
+        if (t <= 0) return Vec3{0.6 * t, 0, -6};
+        if (t <= 20) return Vec3{0, 0.6 * t, -6};
+        return Vec3{0, 12, -6};
+    };
+    const double b = 0.3 * std::sqrt(2.0), gam = 1 / std::sqrt(1 - b * b);
+    const Vec3 u{1 / std::sqrt(2.0), 1 / std::sqrt(2.0), 0};
+    for (Model model : {Model::Relativistic, Model::Finite}) {
+        const Cut c = cutAll(path, model);
+        ASSERT_EQ(c.positions.size(), 64u);
+        size_t straddles = 0;
+        for (size_t k = 0; k < c.positions.size(); ++k)
+            for (size_t i = 0; i < c.positions[k].size(); ++i) {
+                const Vec3 q = c.rest[k][i], p = c.positions[k][i];
+                const double t = c.times[k][i];
+                // On the past cone of the camera at the origin.
+                EXPECT_NEAR(c.t_c[k] - t, mesh4d::norm(p), 1e-12 * c.t_c[k]);
+                // On the shifted path (Lorentz), or the carried one (Galilean: D = (0, q)).
+                const bool lorentz = model == Model::Relativistic;
+                const double d_t = lorentz ? gam * 0.3 * (q.x + q.y) : 0.0;
+                const Vec3 d_x = lorentz ? q + u * ((gam - 1) * mesh4d::dot(q, u)) : q;
+                EXPECT_NEAR(mesh4d::norm(p - (centre(t - d_t) + d_x)), 0, 1e-12 * 20) << k << " " << i;
+                if (lorentz) EXPECT_NEAR(c.clocks[k][i], 0.8 * (t - d_t), 1e-12 * 20);
+                if (k == 0) continue;
+                // Continuity: a step no longer than the speed times the emission-time step, which is
+                // the frame step plus the change of the light delay.
+                const double t_prev = c.times[k - 1][i];
+                const double bound = 0.6 * ((c.t_c[k] - c.t_c[k - 1]) + std::fabs((c.t_c[k] - t) - (c.t_c[k - 1] - t_prev)));
+                EXPECT_LE(mesh4d::norm(p - c.positions[k - 1][i]), bound * (1 + 1e-9) + 1e-12) << k << " " << i;
+                if ((t_prev - d_t < 0) != (t - d_t < 0)) ++straddles;
+            }
+        EXPECT_GT(straddles, 0u) << "no frame pair straddles the corner";
+    }
+}
+
+// A rotation channel is a spin: keys turning about z at a constant rate give the spin model's
+// output (mesh4d/worldline.h, tested against an independent boost in motion_test.cpp), clocks
+// included (the rim runs at sqrt(1 - w^2 rho^2)). The rate is taken from the float32 keys.
+TEST(Keyframes, RotationKeysAreTheSpin) {
+    const double half = 1.5;
+    const float s = float(std::sin(half / 2)), c = float(std::cos(half / 2));
+    const double angle = 2 * std::atan2(double(s), double(c));  // the keys' angle from the floats
+    const double w = 2 * angle / 5.0;                            // from -angle at t = -2.5 to +angle at 2.5
+    KeyedGltf keyed;
+    Channel ch;
+    ch.path = "rotation";
+    ch.times = {-2.5f, 2.5f};
+    ch.values = {0, 0, -s, c, 0, 0, s, c};
+    keyed.channels.push_back(ch);
+    keyed.translation = {0, 0, -4};
+    KeyedGltf spin = keyed;
+    spin.channels.clear();
+    spin.object_extras = {{"angular_velocity", {0, 0, w}}};
+    for (auto* g : {&keyed, &spin}) g->scene_extras["frames"] = {{"start", 3}, {"end", 5}, {"fps", 5}};
+    const std::string kp = keyed.write(dir(), "turn"), sp = spin.write(dir(), "spin");
+    for (Model model : {Model::Relativistic, Model::Finite}) {
+        const Cut a = cutAll(kp, model), b = cutAll(sp, model);
+        ASSERT_EQ(a.positions.size(), 10u);
+        for (size_t k = 0; k < a.positions.size(); ++k)
+            for (size_t i = 0; i < 8; ++i) {
+                ASSERT_EQ(a.rest[k][i], b.rest[k][i]);
+                EXPECT_NEAR(mesh4d::norm(a.positions[k][i] - b.positions[k][i]), 0, 1e-9 * 4) << k << " " << i;
+                EXPECT_NEAR(a.clocks[k][i], b.clocks[k][i], 1e-9 * 4) << k << " " << i;
+            }
+    }
+}
+
+// The clock in closed form across a turning segment (keyframes.h: an elliptic integral) against a
+// plain midpoint sum of d tau = ds sqrt(1 - |dY/ds|^2) over the positions themselves, for a point
+// carried along a path that moves and turns at once.
+TEST(Keyframes, ClockOfAMovingTurningPointIsTheIntegral) {
+    mesh4d::KeyPath path;
+    path.times = {0, 4, 9};
+    path.positions = {{0, 0, 0}, {2, 0, 0}, {2, 2.5, 1}};
+    const double a1 = 1.2, a2 = 2.6;
+    path.turns = {{1, 0, 0, 0}, {std::cos(a1 / 2), 0, 0, std::sin(a1 / 2)}, {std::cos(a2 / 2), std::sin(a2 / 2) * 0.6, 0, std::sin(a2 / 2) * 0.8}};
+    const Vec3 V = mesh4d::meanVelocity(path);
+    const auto k = mesh4d::makeKeyedMotion(path, true, 1.0, mesh4d::keyedCentreAt(path, 1.0), V);
+    const Vec3 q{0.7, -0.4, 0.3};
+    ASSERT_LT(mesh4d::maxKeyedSpeed(*k, q).speed, 1);
+    for (double s_end : {-2.0, 0.5, 3.0, 6.5, 9.0, 12.0}) {
+        // Pieces between the keys (the worldline has a kink at each), 20000 chords each.
+        std::vector<double> cuts{0.0, s_end};
+        for (double sk : k->s)
+            if ((sk > 0 && sk < s_end) || (sk < 0 && sk > s_end)) cuts.push_back(sk);
+        std::sort(cuts.begin(), cuts.end());
+        double sum = 0;
+        for (size_t p = 0; p + 1 < cuts.size(); ++p)
+            for (int i = 0, n = 20000; i < n; ++i) {
+                const double s0 = cuts[p] + (cuts[p + 1] - cuts[p]) * i / n, s1 = cuts[p] + (cuts[p + 1] - cuts[p]) * (i + 1) / n;
+                const Vec3 d = mesh4d::keyedLocal(*k, s1, q).y - mesh4d::keyedLocal(*k, s0, q).y;
+                sum += std::sqrt((s1 - s0) * (s1 - s0) - mesh4d::norm2(d));
+            }
+        if (s_end < 0) sum = -sum;
+        EXPECT_NEAR(mesh4d::keyedProperTime(*k, s_end, q), sum, 1e-8 * (1 + std::fabs(s_end))) << s_end;
+    }
+}
+
+// Faster than light anywhere is refused with the time and the speed: the centre's path (every
+// model), and a vertex carried by the turn (the box's corner at rho = 0.707 turning at 3 rad/s).
+// A keyframed object needs vertex mode; its velocity comes from the path.
+TEST(Keyframes, RefusalsNameFileFieldTimeAndSpeed) {
+    std::string error;
+    {
+        KeyedGltf g;
+        g.channels.push_back(translationKeys({0, 1, 3}, {{0, 0, -8}, {0.5, 0, -8}, {3.5, 0, -8}}));
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "ftl"), &st, &error));
+        EXPECT_NE(error.find("ftl.gltf: animations[0].channels[0]: the path moves at 1.5 (light-seconds per second) from lab "
+                             "time 1 s, which must be < 1 (the speed of light)"),
+                  std::string::npos)
+            << error;
+    }
+    {
+        KeyedGltf g;
+        Channel ch;
+        ch.path = "rotation";
+        ch.times = {0, 1};
+        ch.values = {0, 0, 0, 1, 0, 0, float(std::sin(1.5)), float(std::cos(1.5))};
+        g.channels.push_back(ch);
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "rim"), &st, &error));
+        EXPECT_NE(error.find("rim.gltf: animations[0].channels[0]: vertex 0 would move at 2.12"), std::string::npos) << error;
+        EXPECT_NE(error.find(" at lab time "), std::string::npos) << error;
+        EXPECT_NE(error.find("must be < 1 (the speed of light) for model relativistic"), std::string::npos) << error;
+    }
+    {
+        KeyedGltf g;
+        g.channels.push_back(translationKeys({0, 1}, {{0, 0, -8}, {0.5, 0, -8}}));
+        g.scene_extras["tolerance"] = "1e-3";
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "tol"), &st, &error));
+        EXPECT_NE(error.find("tol.gltf: animations[0].channels[0]: a keyframed object is cut in vertex mode only"), std::string::npos)
+            << error;
+    }
+    {
+        KeyedGltf g;
+        g.channels.push_back(translationKeys({0, 1}, {{0, 0, -8}, {0.5, 0, -8}}));
+        g.object_extras = {{"velocity", {0.1, 0, 0}}};
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "both"), &st, &error));
+        EXPECT_NE(error.find("both.gltf: nodes[1].extras.velocity: the node's path is keyframed (animations[0].channels[0])"),
+                  std::string::npos)
+            << error;
+    }
+}
+
+// Scale channels and channels on nodes that are not objects are not modelled: one warning each.
+TEST(Keyframes, UnmodelledChannelsWarn) {
+    KeyedGltf g;
+    g.channels.push_back(translationKeys({0, 1}, {{0, 0, -8}, {0.5, 0, -8}}));
+    Channel scale = translationKeys({0, 1}, {{1, 1, 1}, {2, 2, 2}});
+    scale.path = "scale";
+    g.channels.push_back(scale);
+    apparent::Scene scene;
+    const apparent::Status st = apparent::loadScene(g.write(dir(), "scaled_keys"), &scene);
+    ASSERT_TRUE(st.ok) << st.message;
+    ASSERT_TRUE(scene.objects[0].keys);
+    size_t found = 0;
+    for (const std::string& w : scene.warnings)
+        if (w.find("scaled_keys.gltf: animations[0].channels[1].target.path: 'scale' of nodes[1] is not modelled") != std::string::npos)
+            ++found;
+    EXPECT_EQ(found, 1u);
+}
