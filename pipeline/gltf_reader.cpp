@@ -272,10 +272,6 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
     if (Status s = openGltf(path, limits, &doc); !s.ok) return s;
     warnings->other.insert(warnings->other.end(), doc->warnings.begin(), doc->warnings.end());
     const tinygltf::Model& model = doc->model;
-    // Skins and animations are not read: the meshes are taken as stored (their bind pose).
-    if (!model.skins.empty() || !model.animations.empty())
-        warnings->other.push_back(std::to_string(model.skins.size()) + " skins and " + std::to_string(model.animations.size()) +
-                                  " animations: skin and animation ignored: the bind pose is used");
 
     // Step: choose the roots: one named node (in its own frame), or the whole file's.
     std::vector<int> roots;
@@ -289,6 +285,16 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
     } else {
         roots = rootNodes(model);
     }
+    // Skins and animations are not read: the meshes are taken as stored (their bind pose). A node
+    // read in its own frame ("file.gltf#Node") leaves its own channels to the glTF scene, whose
+    // object nodes follow them (gltf_scene.h): those alone are no reason to warn.
+    bool animated = false;
+    for (const auto& a : model.animations)
+        for (const auto& ch : a.channels)
+            if (own_transform || std::find(roots.begin(), roots.end(), ch.target_node) == roots.end()) animated = true;
+    if (!model.skins.empty() || animated)
+        warnings->other.push_back(std::to_string(model.skins.size()) + " skins and " + std::to_string(model.animations.size()) +
+                                  " animations: skin and animation ignored: the bind pose is used");
     Reader reader(path, model, limits, out, warnings);
     // Step: count what the node instances add before reading any of it: a small file whose nodes
     // share children (a DAG) multiplies its meshes; the sum is what the limits bound.
