@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "keyframes.h"
 #include "robust.h"
 #include "worldline.h"
 
@@ -153,8 +154,28 @@ World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_
     return extrudeMesh(mesh, &mesh, motion, tau_a, tau_b, cap_a_real, cap_b_real);
 }
 
+// A keyframed path (keyframes.h) between two keys: straight in its own frame plus a turn at the
+// segment's rate, so the spin's bound with the fastest rate of the segments over [tau_a, tau_b]
+// (every |q| bounding its distance from any axis); without a turn the worldlines are straight
+// between keys, where slabSamples puts a sample.
+double keyedSlabSpacing(const RestMesh& mesh, const KeyedMotion& k, double tau_a, double tau_b, double chord) {
+    double w = 0;
+    for (size_t j = 1; j < k.s.size(); ++j)
+        if (k.s[j] > tau_a && k.s[j - 1] < tau_b) w = std::max(w, k.rate[j]);
+    if (!(w > 0)) return INFINITY;
+    double rho = 0, edge = 0;
+    for (const Vec3& q : mesh.positions) rho = std::max(rho, norm(q));
+    for (const auto& t : mesh.triangles)
+        for (int c = 0; c < 3; ++c) edge = std::max(edge, norm(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]));
+    const double M = w * w * rho, K = w * edge;
+    const double root = K + std::sqrt(K * K + 2 * M * chord);
+    if (!(root > 0)) return INFINITY;
+    return 2 * chord / root;
+}
+
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord) {
     if (isUniform(motion)) return INFINITY;
+    if (motion.keyed) return keyedSlabSpacing(mesh, *motion.keyed, tau_a, tau_b, chord);
     // M: the largest second derivative of a vertex's own-frame worldline over the span; K: the
     // largest difference of the first derivatives of two points of one triangle (extrude.h).
     const double w = norm(motion.angular_velocity);
@@ -182,9 +203,13 @@ std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, doub
     while (s < tau_b) {
         // The step bounded at s alone, then over [s, s + that step] (never longer: the bound grows with |s|).
         const double first = slabSpacing(mesh, motion, s, s, chord);
-        const double ds = slabSpacing(mesh, motion, s, std::min(tau_b, s + first), chord);
+        double end = tau_b;  // a keyframed path's next key: its worldlines bend there
+        if (motion.keyed)
+            for (double key : motion.keyed->s)
+                if (key > s && key < end) end = key;
+        const double ds = slabSpacing(mesh, motion, s, std::min(end, s + first), chord);
         if (!(ds > 0) || samples.size() > max_slabs) return {};
-        s = ds >= tau_b - s ? tau_b : s + ds;
+        s = ds >= end - s ? end : s + ds;
         samples.push_back(s);
     }
     if (samples.size() - 1 > max_slabs) return {};

@@ -117,7 +117,10 @@ World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_
 // the twist of a prism whose vertices move differently, which the tetrahedra cannot follow; the
 // second is the chord of each worldline. A boost or the Galilean carry stretches these distances by
 // at most gamma (1 + b) in the lab (callers divide the lab chord by it). Uniform motion needs one
-// slab: slabSpacing returns infinity.
+// slab: slabSpacing returns infinity. A keyframed path (keyframes.h) is straight between keys in
+// its own frame plus a turn: the spin's bound with the fastest turn rate of the segments in the
+// interval (rho_max bounded by max |q|), infinity without a turn; slabSamples puts a sample at
+// every key, where the worldlines bend.
 // ds over the interval [tau_a, tau_b] of s (s_max = max(|tau_a|, |tau_b|)).
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord);
 

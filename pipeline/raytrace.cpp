@@ -92,12 +92,13 @@ std::vector<double> slabTimes(const mesh4d::World4D& w) {
 Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, long long first, long long last) {
     for (Model model : models)
         for (const PreparedObject& o : stage.objects) {
-            if (mesh4d::norm(o.spec.angular_velocity) == 0 && mesh4d::norm(o.spec.acceleration) == 0) continue;
+            if (mesh4d::norm(o.spec.angular_velocity) == 0 && mesh4d::norm(o.spec.acceleration) == 0 && !o.spec.keys) continue;
             const std::vector<double> times = slabTimes(traceWorld(o, model, stage.scene, stage.mirrors, first, last));
             const size_t n = times.empty() ? kMaxSlabs + 1 : times.size() - 1;
             if (n > kMaxSlabs || n * o.rest.triangles.size() > kMaxSlabPrisms)
-                return Status::failure(stage.scene.path + ": " + o.spec.field_path +
-                                       (mesh4d::norm(o.spec.angular_velocity) != 0 ? ".angular_velocity" : ".acceleration") +
+                return Status::failure(stage.scene.path + ": " +
+                                       (o.spec.keys ? o.spec.keys_field
+                                                    : o.spec.field_path + (mesh4d::norm(o.spec.angular_velocity) != 0 ? ".angular_velocity" : ".acceleration")) +
                                        ": the raytracer would need " + (n > kMaxSlabs ? "more than " + std::to_string(kMaxSlabs)
                                                                                       : std::to_string(n)) +
                                        " time slabs of " + std::to_string(o.rest.triangles.size()) + " prisms (limits " +
@@ -111,10 +112,10 @@ Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, lon
 // (its Doppler factor is the uniform one; `render --shade doppler` has the worldline's).
 Status checkTracedMotions(const Stage& stage, const char* command, bool shade_doppler) {
     for (const PreparedObject& o : stage.objects) {
-        if (o.spec.keys)
-            return Status::failure(stage.scene.path + ": " + o.spec.keys_field + ": `apparent " + command +
-                                   "` traces uniform, spinning and accelerated motion; a keyframed path is cut by "
-                                   "`apparent render`");
+        if (shade_doppler && o.spec.keys)
+            return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +
+                                   stage.scene.path + ": " + o.spec.keys_field +
+                                   " (a keyframed path) is not (use `apparent render --shade doppler`, or plain shading)");
         const bool spin = mesh4d::norm(o.spec.angular_velocity) != 0, accel = mesh4d::norm(o.spec.acceleration) != 0;
         if (shade_doppler && (spin || accel))
             return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +

@@ -6,6 +6,7 @@
 
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
+#include "mesh4d/keyframes.h"
 
 namespace apparent {
 
@@ -33,7 +34,14 @@ mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& res
     // Interior points of a triangle can emit up to diag (1 + b) / (1 - b^2) = diag / (1 - b) later or
     // earlier than its vertices (the crossing time's slope along the surface is at most 1/(1 - b)).
     const double diag = box.diagonal();
-    const double pad = diag * (1 + motion.beta) / motion.one_minus_beta2 +
+    // A keyframed path: b is its fastest vertex's speed in its own frame (keyframes.h), not V's.
+    double b = motion.beta, one_minus_b2 = motion.one_minus_beta2;
+    if (motion.keyed) {
+        for (const Vec3& p : rest.positions) b = std::max(b, mesh4d::maxKeyedSpeed(*motion.keyed, p).speed);
+        b = std::min(b, 1 - 1e-9);  // the stage refused faster (finite, relativistic); instant has no limit
+        one_minus_b2 = (1 - b) * (1 + b);
+    }
+    const double pad = diag * (1 + b) / one_minus_b2 +
                        1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
     const double open_a = seen.lo - pad, open_b = seen.hi + pad;
     // Step: clip the span to the object's existence; only those ends are real caps.

@@ -5,13 +5,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "keyed_gltf.h"
 #include "mesh4d/keyframes.h"
+#include "mesh4d/boost.h"
+#include "mesh4d/extrude.h"
 #include "mesh4d/light_factors.h"
+#include "mesh4d/ray4d.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/worldline.h"
 #include "pipeline/physics.h"
@@ -273,4 +277,81 @@ TEST(Keyframes, UnmodelledChannelsWarn) {
         if (w.find("scaled_keys.gltf: animations[0].channels[1].target.path: 'scale' of nodes[1] is not modelled") != std::string::npos)
             ++found;
     EXPECT_EQ(found, 1u);
+}
+
+// The 4D raytracer meets a keyframed history through time slabs (mesh4d/extrude.h: a sample at
+// every key, the spin's bound within a turning segment): every hit, boosted back into the path's
+// frame by a boost written here and turned back by the path's pose there, lies on the plane of
+// the rest triangle it hit within the slabs' chord; one slab over the same span misses by far more.
+TEST(Keyframes, RaytracedHitsLieOnTheRestSurfaceThroughTimeSlabs) {
+    mesh4d::RestMesh box;
+    for (int i = 0; i < 8; ++i) box.positions.push_back({i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5});
+    const uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (const auto& f : faces) {
+        box.triangles.push_back({f[0], f[1], f[2]});
+        box.triangles.push_back({f[0], f[2], f[3]});
+    }
+    mesh4d::KeyPath path;
+    path.times = {-10, 0, 10};
+    path.positions = {{-4, 0, 0}, {0, 0, 0}, {0, 4, 0}};
+    path.turns = {{1, 0, 0, 0}, {std::cos(0.4), 0, 0, std::sin(0.4)}, {std::cos(1.0), 0, 0, std::sin(1.0)}};
+    const Vec3 V = mesh4d::meanVelocity(path), origin = mesh4d::keyedCentreAt(path, 0);
+    mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, origin, V);
+    m.keyed = mesh4d::makeKeyedMotion(path, true, 0, origin, V);
+    const Vec3 camera{0, 0, 6};
+    const double t_c = 6.5, chord = 1e-2;
+    mesh4d::ViewSurface view;
+    view.kind = mesh4d::ViewKind::PastCone;
+    view.t_c = t_c;
+    view.apex = camera;
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Vec3& q : box.positions) {
+        const double s = mesh4d::crossWorldline(view, m, q).s;
+        lo = std::min(lo, s - 0.5);
+        hi = std::max(hi, s + 0.5);
+    }
+    ASSERT_LT(lo, m.keyed->s[1]);  // the span holds the corner
+    ASSERT_GT(hi, m.keyed->s[1]);
+    const double b = mesh4d::norm(V), g = 1 / std::sqrt(1 - b * b);
+    const std::vector<double> samples = mesh4d::slabSamples(box, m, lo, hi, chord / (g * (1 + b)), 4096);
+    ASSERT_GT(samples.size(), 3u);
+    double worst[2] = {0, 0};
+    for (int pass = 0; pass < 2; ++pass) {
+        const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(box, m, pass == 0 ? samples : std::vector<double>{lo, hi}, false, false);
+        std::vector<mesh4d::TraceWorld> traces;
+        for (const auto& w : slabs) traces.push_back(mesh4d::prepareTrace(w));
+        int hits = 0;
+        for (int iy = -30; iy <= 30; ++iy)
+            for (int ix = -30; ix <= 30; ++ix) {
+                Vec3 d = Vec3{0.02 * ix, 0.02 * iy, -1};
+                d = d / mesh4d::norm(d);
+                mesh4d::Ray4D ray;
+                ray.origin = {t_c, camera};
+                ray.direction = d;
+                std::optional<mesh4d::WorldHit> best;
+                for (const auto& tr : traces)
+                    if (auto h = mesh4d::intersectWorld(tr, ray, best ? best->s : INFINITY)) best = h;
+                if (!best) continue;
+                ++hits;
+                // The boost into the frame of V about (0, origin), written out.
+                const double dt = best->event.t;
+                const Vec3 dx = best->event.x - origin, u = V / b;
+                const double T = g * (dt - mesh4d::dot(V, dx));
+                const Vec3 Y = dx + u * ((g - 1) * mesh4d::dot(dx, u)) - V * (g * dt);
+                // The pose there: centre P and turn R (columns from the unit vectors), q = R^T (Y - P).
+                const Vec3 P = mesh4d::keyedLocal(*m.keyed, T, {0, 0, 0}).y;
+                Vec3 q;
+                const Vec3 rel = Y - P;
+                const double qc[3] = {mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {1, 0, 0}).y - P, rel),
+                                      mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {0, 1, 0}).y - P, rel),
+                                      mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {0, 0, 1}).y - P, rel)};
+                q = {qc[0], qc[1], qc[2]};
+                const auto& t = box.triangles[best->triangle];
+                const Vec3 a = box.positions[t[0]], n_f = mesh4d::cross(box.positions[t[1]] - a, box.positions[t[2]] - a);
+                worst[pass] = std::max(worst[pass], std::fabs(mesh4d::dot(q - a, n_f / mesh4d::norm(n_f))));
+            }
+        if (pass == 0) EXPECT_GT(hits, 100);
+    }
+    EXPECT_LE(worst[0], 2 * chord);
+    EXPECT_GT(worst[1], 10 * chord);
 }
