@@ -46,6 +46,8 @@ Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, 
         if (ex.contains(key))
             return fail(where + ".extras." + key, "the node's path is keyframed (" + field + "): its motion comes from the "
                                                   "animation, remove " + key);
+    if (ex.contains("mirror") && ex["mirror"] == true)
+        return fail(where + ".extras.mirror", "a mirror must be at rest, and the node's path is keyframed (" + field + ")");
     // Step: STEP keys are a jump, an infinite speed, unless they hold one value.
     for (const AnimatedProperty* p : {&an.translation, &an.rotation}) {
         if (!p->present || !p->step) continue;

@@ -259,6 +259,14 @@ TEST(Keyframes, RefusalsNameFileFieldTimeAndSpeed) {
                   std::string::npos)
             << error;
     }
+    {
+        KeyedGltf g;
+        g.channels.push_back(translationKeys({0, 1}, {{0, 0, -8}, {0.5, 0, -8}}));
+        g.object_extras = {{"mirror", true}};
+        apparent::Stage st;
+        EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "mirror"), &st, &error));
+        EXPECT_NE(error.find("mirror.gltf: nodes[1].extras.mirror: a mirror must be at rest"), std::string::npos) << error;
+    }
 }
 
 // Scale channels and channels on nodes that are not objects are not modelled: one warning each.
@@ -354,4 +362,17 @@ TEST(Keyframes, RaytracedHitsLieOnTheRestSurfaceThroughTimeSlabs) {
     }
     EXPECT_LE(worst[0], 2 * chord);
     EXPECT_GT(worst[1], 10 * chord);
+}
+
+// The shipped scene (data/scenes/make_keyed_gltf.py) loads and every frame cuts every vertex; the
+// vertices move continuously (steps within the fastest speed, 0.8 + 0.11, times the emission step).
+TEST(Keyframes, ShippedSceneRenders) {
+    const Cut c = cutAll("data/scenes/keyed.gltf", Model::Relativistic);
+    ASSERT_EQ(c.positions.size(), 160u);
+    for (size_t k = 0; k < c.positions.size(); ++k) {
+        ASSERT_EQ(c.positions[k].size(), 8u);
+        if (k == 0) continue;
+        for (size_t i = 0; i < 8; ++i)
+            EXPECT_LE(mesh4d::norm(c.positions[k][i] - c.positions[k - 1][i]), 0.92 * std::fabs(c.times[k][i] - c.times[k - 1][i]) + 1e-12);
+    }
 }

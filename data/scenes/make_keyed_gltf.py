@@ -8,7 +8,7 @@ committed. The box (../meshes/box.obj) follows the path:
   t = 5 .. 10 s  from (0, -1, -6) to (0, 2, -6):  0.6c along +y (a corner at t = 5 s), still turning
   before t = 0 and after t = 10 s it rests at its end pose (glTF players hold the end values).
 
-The fastest vertex: 0.8c plus the turn's rim speed (pi/10 rad/s x 0.87 ls = 0.27c) stays below 1.
+The fastest vertex: 0.8c plus the turn's rim speed (pi/20 rad/s x 0.71 ls = 0.11c) stays below 1.
 The node's extras hold t0 = 0 (an object field, which makes the node an object) and the scene's
 extras set the vertex tolerance (keyframed objects are cut in vertex mode)."""
 import base64
