@@ -203,11 +203,6 @@ KeyedSpeed fastestCentreSegment(const KeyPath& path) {
     return out;
 }
 
-double keyedLabTime(const KeyedMotion& k, double s) {
-    if (!k.lorentz) return k.t0 + s;
-    return k.t0 + k.gamma * (s + dot(k.frame_velocity, keyedLocal(k, s, {0, 0, 0}).y));
-}
-
 KeyedSpeed maxKeyedSpeed(const KeyedMotion& k, const Vec3& q) {
     KeyedSpeed out;
     const size_t n = k.s.size();

@@ -122,8 +122,4 @@ KeyedSpeed fastestCentreSegment(const KeyPath& path);
 // slower than light in every frame.
 KeyedSpeed maxKeyedSpeed(const KeyedMotion& k, const Vec3& q);
 
-// The lab time at the object's time s of the centre (the inverse of the key map; exact, the centre's
-// worldline being straight per segment).
-double keyedLabTime(const KeyedMotion& k, double s);
-
 }  // namespace mesh4d

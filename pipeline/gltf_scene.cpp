@@ -83,11 +83,12 @@ Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, 
     auto rotation = [&](double t) { return an.rotation.present ? rotationAt(an.rotation, t) : r_static; };
     // The node's world transform at lab time t (its local TRS with the animated values).
     auto worldAt = [&](double t) {
-        tinygltf::Node n = node;
+        tinygltf::Node n;  // the transform's fields only
         const Vec3 tr = translation(t);
         const mesh4d::Quat r = rotation(t);
         n.translation = {tr.x, tr.y, tr.z};
         n.rotation = {r.x, r.y, r.z, r.w};
+        n.scale = node.scale;
         return o.parent * localTransform(n);
     };
     // Step: the rest pose at t0, and the path: the centre and the turn relative to that pose (in

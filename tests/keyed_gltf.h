@@ -28,6 +28,7 @@ struct KeyedGltf {
                                    {"frames", {{"start", 0}, {"end", 1}, {"fps", 10}}}};
     std::vector<double> translation{0, 0, -8};
     std::vector<double> rotation;  // x y z w; empty: none
+    std::vector<double> parent_rotation;  // x y z w; non-empty: the box is the child of a node so turned
     std::vector<Channel> channels;
 
     // Writes dir/name.gltf and dir/name.bin; returns the .gltf path.
@@ -73,7 +74,7 @@ struct KeyedGltf {
         json gltf = {
             {"asset", {{"version", "2.0"}}},
             {"scene", 0},
-            {"scenes", {{{"nodes", {0, 1}}, {"extras", scene_extras}}}},
+            {"scenes", {{{"nodes", {0, parent_rotation.empty() ? 1 : 2}}, {"extras", scene_extras}}}},
             {"nodes", {{{"name", "camera"}, {"camera", 0}}, box}},
             {"cameras", {{{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.01}, {"zfar", 1000}}}}}},
             {"meshes", {{{"name", "box"}, {"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
@@ -81,6 +82,8 @@ struct KeyedGltf {
             {"bufferViews", views},
             {"buffers", {{{"byteLength", blob.size()}, {"uri", name + ".bin"}}}},
         };
+        if (!parent_rotation.empty())
+            gltf["nodes"].push_back({{"name", "frame"}, {"rotation", parent_rotation}, {"children", {1}}});
         if (!channels.empty()) gltf["animations"] = {{{"channels", channels_json}, {"samplers", samplers}}};
         std::ofstream(dir + "/" + name + ".bin", std::ios::binary) << blob;
         const std::string path = dir + "/" + name + ".gltf";

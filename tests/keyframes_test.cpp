@@ -376,3 +376,35 @@ TEST(Keyframes, ShippedSceneRenders) {
             EXPECT_LE(mesh4d::norm(c.positions[k][i] - c.positions[k - 1][i]), 0.92 * std::fabs(c.times[k][i] - c.times[k - 1][i]) + 1e-12);
     }
 }
+
+// Keys under a turned parent are composed with the parent's transform as static values are: a
+// parent turned +90 degrees about x sends the child's local (a, b, c) to (a, -c, b), and a child's
+// turn about its local z is the lab turn about U z = -y (the turn conjugated by the parent's).
+TEST(Keyframes, KeysUnderATurnedParentAreInTheLab) {
+    const double h = std::sqrt(0.5);
+    KeyedGltf g;
+    g.parent_rotation = {h, 0, 0, h};
+    g.channels.push_back(translationKeys({0, 10}, {{0, 0, 6}, {2, 1, 6}}));
+    Channel turn;
+    turn.path = "rotation";
+    turn.times = {0, 10};
+    const double angle = 1.2;
+    turn.values = {0, 0, 0, 1, 0, 0, float(std::sin(angle / 2)), float(std::cos(angle / 2))};
+    g.channels.push_back(turn);
+    apparent::Scene scene;
+    const apparent::Status st = apparent::loadScene(g.write(dir(), "nested"), &scene);
+    ASSERT_TRUE(st.ok) << st.message;
+    ASSERT_EQ(scene.objects.size(), 1u);
+    const auto& keys = *scene.objects[0].keys;
+    ASSERT_EQ(keys.times.size(), 2u);
+    EXPECT_NEAR(mesh4d::norm(keys.positions[0] - Vec3{0, -6, 0}), 0, 1e-12);
+    EXPECT_NEAR(mesh4d::norm(keys.positions[1] - Vec3{2, -6, 1}), 0, 1e-12);
+    const mesh4d::Quat q = keys.turns[1];
+    const double s = std::sin(angle / 2), c = std::cos(angle / 2);
+    EXPECT_NEAR(q.w, c, 1e-7);
+    EXPECT_NEAR(q.x, 0, 1e-7);
+    EXPECT_NEAR(q.y, -s, 1e-7);
+    EXPECT_NEAR(q.z, 0, 1e-7);
+    // The rest pose at t0 = 0 is the parent's turn: the mesh's local z is the lab's -y.
+    EXPECT_NEAR(scene.objects[0].linear[7], -1, 1e-12);
+}
