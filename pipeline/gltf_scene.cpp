@@ -264,7 +264,8 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
             const int target = model.animations[ai].channels[ci].target_node;
             if (target >= 0 && size_t(target) < is_object.size() && is_object[size_t(target)]) continue;
             r.warn("animations[" + std::to_string(ai) + "].channels[" + std::to_string(ci) + "]",
-                   "animates nodes[" + std::to_string(target) + "], which is not an object node (no object fields in its extras): not modelled");
+                   target < 0 ? std::string("has no target node: not modelled")
+                              : "animates nodes[" + std::to_string(target) + "], which is not an object node (no object fields in its extras): not modelled");
         }
     scene->warnings = r.warnings();
     return status;

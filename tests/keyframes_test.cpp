@@ -136,7 +136,9 @@ TEST(Keyframes, CornerIsContinuousAndOnTheShiftedPath) {
                 const double d_t = lorentz ? gam * 0.3 * (q.x + q.y) : 0.0;
                 const Vec3 d_x = lorentz ? q + u * ((gam - 1) * mesh4d::dot(q, u)) : q;
                 EXPECT_NEAR(mesh4d::norm(p - (centre(t - d_t) + d_x)), 0, 1e-12 * 20) << k << " " << i;
-                if (lorentz) EXPECT_NEAR(c.clocks[k][i], 0.8 * (t - d_t), 1e-12 * 20);
+                if (lorentz) {
+                    EXPECT_NEAR(c.clocks[k][i], 0.8 * (t - d_t), 1e-12 * 20);
+                }
                 if (k == 0) continue;
                 // Continuity: a step no longer than the speed times the emission-time step, which is
                 // the frame step plus the change of the light delay.
@@ -358,7 +360,9 @@ TEST(Keyframes, RaytracedHitsLieOnTheRestSurfaceThroughTimeSlabs) {
                 const Vec3 a = box.positions[t[0]], n_f = mesh4d::cross(box.positions[t[1]] - a, box.positions[t[2]] - a);
                 worst[pass] = std::max(worst[pass], std::fabs(mesh4d::dot(q - a, n_f / mesh4d::norm(n_f))));
             }
-        if (pass == 0) EXPECT_GT(hits, 100);
+        if (pass == 0) {
+            EXPECT_GT(hits, 100);
+        }
     }
     EXPECT_LE(worst[0], 2 * chord);
     EXPECT_GT(worst[1], 10 * chord);
