@@ -74,8 +74,21 @@ Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, 
     // Step: the key times of both channels, merged (a segment of either stays a segment).
     std::vector<double> times = an.translation.times;
     times.insert(times.end(), an.rotation.times.begin(), an.rotation.times.end());
+    // A CUBICSPLINE channel is followed through LINEAR samples within 1e-6 of its spline
+    // (gltf_animation.h cubicSamples; relative to the largest keyed translation, at least 1).
+    for (const AnimatedProperty* p : {&an.translation, &an.rotation}) {
+        double scale = 1;
+        for (const Vec3& v : p->translations) scale = std::max(scale, mesh4d::norm(v));
+        const std::vector<double> samples = cubicSamples(*p, scale);
+        if (!samples.empty() && !std::isfinite(samples[0]))
+            return fail(p->field, "CUBICSPLINE: following the spline within 1e-6 would take more than " + std::to_string(kMaxKeys) +
+                                      " linear keys");
+        times.insert(times.end(), samples.begin(), samples.end());
+    }
     std::sort(times.begin(), times.end());
     times.erase(std::unique(times.begin(), times.end()), times.end());
+    if (times.size() > kMaxKeys)
+        return fail(field, "more than " + std::to_string(kMaxKeys) + " keys in all");
     const Vec3 t_static = node.translation.size() == 3 ? Vec3{node.translation[0], node.translation[1], node.translation[2]} : Vec3{};
     const mesh4d::Quat r_static = node.rotation.size() == 4 ? mesh4d::Quat{node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]}
                                                             : mesh4d::Quat{};

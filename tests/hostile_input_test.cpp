@@ -768,7 +768,12 @@ TEST(HostileInput, MalformedAnimationsAreRefusedWithOneLine) {
     {
         Channel c = keys({0, 1}, {0, 0, -8, 0.5f, 0, -8});
         c.interpolation = "CUBICSPLINE";
-        cases.push_back({"cubic", c, "cubic.gltf: animations[0].samplers[0].interpolation: CUBICSPLINE is not modelled"});
+        cases.push_back({"cubic", c, "cubic.gltf: accessors[3].count: 2 values for 2 key times (CUBICSPLINE: 3 per key, "});
+    }
+    {
+        Channel c = keys({0, 1}, {0, 0, -8, 0.5f, 0, -8});
+        c.interpolation = "HERMITE";
+        cases.push_back({"unknown", c, "unknown.gltf: animations[0].samplers[0].interpolation: 'HERMITE' (expected LINEAR, STEP or CUBICSPLINE)"});
     }
     {
         Channel c = keys({0, 1}, {0, 0, -8, 0.5f, 0, -8});

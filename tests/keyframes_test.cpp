@@ -412,3 +412,72 @@ TEST(Keyframes, KeysUnderATurnedParentAreInTheLab) {
     // The rest pose at t0 = 0 is the parent's turn: the mesh's local z is the lab's -y.
     EXPECT_NEAR(scene.objects[0].linear[7], -1, 1e-12);
 }
+
+// CUBICSPLINE (glTF 2.0 appendix C): tangents equal to a constant velocity give a straight line
+// at constant speed, the same keys and output as LINEAR; a curved spline is followed through
+// linear samples whose chords stay within 1e-6 x the keyed extent of the spline, written out here.
+TEST(Keyframes, CubicSplineIsFollowedWithinItsBound) {
+    const Vec3 x0{0, 0, -8}, v{0.5, 0.25, 0};
+    KeyedGltf linear;
+    linear.channels.push_back(translationKeys({-40, 40}, {x0 - v * 40, x0 + v * 40}));
+    KeyedGltf cubic = linear;
+    Channel& c = cubic.channels[0];
+    c.interpolation = "CUBICSPLINE";
+    const Vec3 a = x0 - v * 40, b = x0 + v * 40;
+    c.values = {0.5f, 0.25f, 0, float(a.x), float(a.y), float(a.z), 0.5f, 0.25f, 0,
+                0.5f, 0.25f, 0, float(b.x), float(b.y), float(b.z), 0.5f, 0.25f, 0};
+    for (auto* g : {&linear, &cubic}) g->scene_extras["frames"] = {{"start", 2}, {"end", 4}, {"fps", 4}};
+    const Cut l = cutAll(linear.write(dir(), "line_linear"), Model::Relativistic);
+    const Cut s = cutAll(cubic.write(dir(), "line_cubic"), Model::Relativistic);
+    ASSERT_EQ(l.positions.size(), 8u);
+    for (size_t k = 0; k < l.positions.size(); ++k) EXPECT_EQ(l.positions[k], s.positions[k]) << k;
+
+    // A curve: from (0, 0, -8) to (4, 0, -8) in 10 s, leaving along +y and arriving along +y.
+    KeyedGltf curved;
+    Channel ch;
+    ch.interpolation = "CUBICSPLINE";
+    ch.times = {0, 10};
+    ch.values = {0, 0, 0, 0, 0, -8, 0, 0.5f, 0, 0, 0.5f, 0, 4, 0, -8, 0, 0, 0};
+    curved.channels.push_back(ch);
+    apparent::Scene scene;
+    const apparent::Status st = apparent::loadScene(curved.write(dir(), "curve"), &scene);
+    ASSERT_TRUE(st.ok) << st.message;
+    const mesh4d::KeyPath& keys = *scene.objects[0].keys;
+    ASSERT_GT(keys.times.size(), 10u);
+    auto spline = [](double t) {  // Hermite with d = 10, p0 = (0, 0, -8), m0 = m1 = (0, 0.5, 0), p1 = (4, 0, -8)
+        const double f = t / 10, f2 = f * f, f3 = f2 * f;
+        const double h00 = 2 * f3 - 3 * f2 + 1, h10 = f3 - 2 * f2 + f, h01 = -2 * f3 + 3 * f2, h11 = f3 - f2;
+        return Vec3{4 * h01, 10 * 0.5 * (h10 + h11), -8 * (h00 + h01)};
+    };
+    double worst = 0;
+    for (size_t i = 0; i < keys.times.size(); ++i) {
+        EXPECT_NEAR(mesh4d::norm(keys.positions[i] - spline(keys.times[i])), 0, 1e-12) << i;
+        if (i + 1 < keys.times.size()) {
+            const double mid = 0.5 * (keys.times[i] + keys.times[i + 1]);
+            worst = std::max(worst, mesh4d::norm((keys.positions[i] + keys.positions[i + 1]) * 0.5 - spline(mid)));
+        }
+    }
+    EXPECT_LE(worst, 1e-6 * std::sqrt(80.0));
+    EXPECT_GT(worst, 0.1e-6 * std::sqrt(80.0));  // not more samples than the bound needs (within 10x)
+
+    // A rotation spline with zero tangents from (0, 0, 0, 1) to (0, 0, s, c): the components eased
+    // by h01 = 3f^2 - 2f^3, then normalised (appendix C); each sampled turn about z by 2 atan2(z, w).
+    KeyedGltf turning;
+    Channel r;
+    r.path = "rotation";
+    r.interpolation = "CUBICSPLINE";
+    r.times = {0, 10};
+    const float sz = float(std::sin(0.6)), cz = float(std::cos(0.6));
+    r.values = {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, sz, cz, 0, 0, 0, 0};
+    turning.channels.push_back(r);
+    apparent::Scene ts;
+    const apparent::Status tst = apparent::loadScene(turning.write(dir(), "turning"), &ts);
+    ASSERT_TRUE(tst.ok) << tst.message;
+    const mesh4d::KeyPath& tk = *ts.objects[0].keys;
+    ASSERT_GT(tk.times.size(), 2u);
+    for (size_t i = 0; i < tk.times.size(); ++i) {
+        const double f = tk.times[i] / 10, h = 3 * f * f - 2 * f * f * f;
+        const double z = h * double(sz), w = (1 - h) + h * double(cz);
+        EXPECT_NEAR(2 * std::atan2(tk.turns[i].z, tk.turns[i].w), 2 * std::atan2(z, w), 1e-12) << i;
+    }
+}
