@@ -1,6 +1,7 @@
 #include "pipeline/gltf_scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <set>
@@ -124,6 +125,8 @@ Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, 
         keys->turns.push_back({d.w, pv.x, pv.y, pv.z});
         if (!mesh4d::isFinite(keys->positions.back()))
             return fail(field, "the path at lab time " + formatNumber(t) + " s is not finite");
+        if (!(std::isfinite(d.w) && std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z)))
+            return fail(an.rotation.field, "the rotation at lab time " + formatNumber(t) + " s is not a turn (the spline passes through 0)");
     }
     // Step: the centre slower than light on every segment (the vertices are checked per model).
     const mesh4d::KeyedSpeed fastest = mesh4d::fastestCentreSegment(*keys);

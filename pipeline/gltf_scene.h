@@ -9,12 +9,13 @@
 //   object readers (scene_fields.h), with the same errors at "nodes[i].extras.<field>". Objects
 //   cannot nest.
 // - Keyframed paths: an object node whose translation or rotation is animated (LINEAR, STEP or
-//   CUBICSPLINE channels, gltf_animation.h; a spline through its cubicSamples) follows that path (mesh4d/keyframes.h): the keys, composed with the
-//   parent's transform as the static values are, give ObjectSpec::keys; the pose at t0 is the rest
-//   pose (position, linear) and the path's mean velocity is `velocity`. Refused: velocity,
-//   direction, gamma, rapidity, angular_velocity, acceleration or mirror in its extras, a matrix, a
-//   STEP jump, a turn under a parent that shears or scales unequally, the centre at >= c on any
-//   segment (the speed and the lab time). Channels on nodes that are not objects are warnings.
+//   CUBICSPLINE channels, gltf_animation.h; a spline through its cubicSamples) follows that path
+//   (mesh4d/keyframes.h): the keys, composed with the parent's transform as the static values
+//   are, give ObjectSpec::keys; the pose at t0 is the rest pose (position, linear) and the path's
+//   mean velocity is `velocity`. Refused: velocity, direction, gamma, rapidity, angular_velocity,
+//   acceleration or mirror in its extras, a matrix, a STEP jump, a turn under a parent that shears
+//   or scales unequally, a rotation spline through 0, the centre at >= c on any segment (the speed
+//   and the lab time). Channels on nodes that are not objects are warnings.
 // - Camera: the first node with a camera (glTF cameras look down local -Z, +Y up; yfov gives
 //   fov_deg); its extras may hold instant_delay.
 // - The scene's extras may hold frames, light, model and tolerance, as in the JSON file.
