@@ -97,6 +97,15 @@ struct MeshoptLayout {
 constexpr size_t kMeshoptNormalStride = 4;
 constexpr int kMeshoptNormalBits = 8;
 
+// Frame coherence (meshopt, gltf.h): a frame that is a morph target of its run's mesh stores one
+// record per vertex, its difference from the previous frame: int16 x, y, z, 0 (in steps) | float32
+// emission time | normalized int8 normal x, y, z, 0 (in 1/127). A run has at most
+// kMorphTargetsMost targets, and at most kMorphVertexTargets vertices x targets (three.js expands
+// each target to 32 bytes a vertex of float texture: 128 MB at most).
+constexpr size_t kMorphStride = 16;
+constexpr size_t kMorphTargetsMost = 63;
+constexpr size_t kMorphVertexTargets = size_t(1) << 22;
+
 // The emission time as meshopt stores it: rounded (half away from zero) to a multiple of the
 // largest power of two not above `step`, so that its low mantissa bits are zero and compress;
 // it stays a float32 that readers use as it is, within step / 2 seconds of the plain file's.
@@ -658,6 +667,12 @@ struct SequenceModel {
                 prev.vertices == data[o].vertexCount() && prev.indices == data[o].indices)
                 shared[o] = prev.accessor;
         }
+        // Step (meshopt): a frame that continues the open run becomes a morph target of its mesh.
+        if (compression == Compression::meshopt && meshopt && morphTarget(f, data, scale, *meshopt, shared, groups)) {
+            morph_nodes.push_back({b.model.nodes.size(), run.targets, runs.size() - 1});
+            node.mesh = run.mesh;
+            return endFrame(f, &node, origin, scale);
+        }
         // Step (meshopt): the frame's vertex and normal views, and one index view for the objects
         // that do not share, uint16 unless one of them has more than 65535 vertices.
         int vview = -1, nview = -1;
@@ -735,16 +750,148 @@ struct SequenceModel {
         // Sharing is between consecutive frames: an object not shown forgets its index list.
         for (size_t o = 0; o < f.objects.size(); ++o)
             if (!shown[o]) previous[o] = Previous();
+        // Step (meshopt): the frame opens a run when later frames may become its morph targets.
+        run.mesh = -1;
+        if (compression == Compression::meshopt && meshopt && meshopt->count > 0) startRun(f, data, scale, *meshopt, groups, node.mesh);
+        if (groups.empty()) return endFrame(f, &node, nullptr, scale);
+        return endFrame(f, &node, origin, scale);
+    }
+
+    // The frame node's transform, its scale channel's value and the frame's extras (any frame).
+    bool endFrame(const ExportFrame& f, tinygltf::Node* node, const double* origin, double scale) {
         // Reflections are relative to the same origin: their child nodes need no transform.
-        if (!groups.empty()) node.translation = {origin[0], origin[1], origin[2]};
+        if (origin) node->translation = {origin[0], origin[1], origin[2]};
         const double s = frames == 0 ? scale : 0.0;
-        node.scale = {s, s, s};
+        node->scale = {s, s, s};
         frame_scales.push_back(float(scale));
-        b.model.nodes.push_back(node);
+        b.model.nodes.push_back(*node);
         scene.nodes.push_back(int(b.model.nodes.size()) - 1);
         frame_times.push_back(tinygltf::Value(f.t_c));
         if (frames == 0) first_frame = f.index;
         ++frames;
+        return true;
+    }
+
+    // Frame coherence (gltf.h). The objects a frame shows, in order.
+    static std::vector<size_t> shownObjects(const ExportFrame& f) {
+        std::vector<size_t> objects;
+        for (size_t o = 0; o < f.objects.size(); ++o)
+            if (!f.objects[o].triangles.empty()) objects.push_back(o);
+        return objects;
+    }
+
+    // Opens a run at the frame just made (its mesh `mesh`) when its layout allows morph targets:
+    // records without --attributes or --shade doppler, no reflections. Keeps the frame's records
+    // and its normals as a reader decodes them (the octahedral view's int8 output, or the record's).
+    void startRun(const ExportFrame& f, const std::vector<PrimitiveData>& data, double step, const MeshoptFrame& mf,
+                  const std::vector<int>& groups, int mesh) {
+        if (layout.stride != 12 || groups.size() != 1 || groups[0] >= 0 || mesh < 0) return;
+        const size_t limit = std::min(kMorphTargetsMost, kMorphVertexTargets / mf.count);
+        if (limit == 0) return;
+        run.objects = shownObjects(f);
+        run.records.clear();
+        run.normals.clear();
+        for (const size_t o : run.objects) {
+            const PrimitiveData& d = data[o];
+            run.records.insert(run.records.end(), d.packed.begin(), d.packed.end());
+            if (mf.normals_inline)
+                run.normals.insert(run.normals.end(), d.packed_snorm.begin(), d.packed_snorm.end());
+            else
+                run.normals.insert(run.normals.end(), d.packed_normals.begin(), d.packed_normals.end());
+        }
+        if (run.records.size() != mf.count * 12 || run.normals.size() != mf.count * 4) return;
+        if (!mf.normals_inline) meshopt_decodeFilterOct(run.normals.data(), mf.count, kMeshoptNormalStride);
+        run.mesh = mesh;
+        run.step = step;
+        run.count = mf.count;
+        run.limit = limit;
+        run.targets = 0;
+        runs.push_back(0);
+    }
+
+    // Makes the frame a morph target of the open run's mesh when it continues the run: the same
+    // objects alone (no reflections), each with the previous frame's index list, the same step
+    // and vertex count, room for a target, and every difference from the previous frame held by
+    // the target's record (int16 steps, an emission time difference exact in float32, int8
+    // normal steps). Returns false, having changed nothing, otherwise.
+    bool morphTarget(const ExportFrame& f, const std::vector<PrimitiveData>& data, double step, const MeshoptFrame& mf,
+                     const std::vector<int>& shared, const std::vector<int>& groups) {
+        if (run.mesh < 0 || step != run.step || mf.count != run.count || run.targets >= run.limit) return false;
+        if (groups.size() != 1 || groups[0] >= 0) return false;
+        const std::vector<size_t> objects = shownObjects(f);
+        if (objects != run.objects) return false;
+        for (const size_t o : objects)
+            if (shared[o] < 0 || data[o].packed.size() != data[o].packed_snorm.size() * 3) return false;
+        std::vector<unsigned char>& rec = morph_records;
+        rec.assign(run.count * kMorphStride, 0);
+        std::vector<size_t> first;
+        int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+        size_t v = 0;
+        for (const size_t o : objects) {
+            const PrimitiveData& d = data[o];
+            first.push_back(v);
+            for (size_t i = 0; i < d.packed.size() / 12; ++i, ++v) {
+                if (v >= run.count) return false;
+                int16_t now[4], before[4], dq[4] = {0, 0, 0, 0};
+                std::memcpy(now, &d.packed[12 * i], 8);
+                std::memcpy(before, &run.records[12 * v], 8);
+                int8_t dn[4] = {0, 0, 0, 0};
+                for (int c = 0; c < 3; ++c) {
+                    const int dd = int(now[c]) - int(before[c]);
+                    if (dd < -32767 || dd > 32767) return false;
+                    dq[c] = int16_t(dd);
+                    lo[c] = std::min(lo[c], dd);
+                    hi[c] = std::max(hi[c], dd);
+                    const int dnc = int(int8_t(d.packed_snorm[4 * i + size_t(c)])) - int(int8_t(run.normals[4 * v + size_t(c)]));
+                    if (dnc < -127 || dnc > 127) return false;
+                    dn[c] = int8_t(dnc);
+                }
+                float t_now, t_before;
+                std::memcpy(&t_now, &d.packed[12 * i + 8], 4);
+                std::memcpy(&t_before, &run.records[12 * v + 8], 4);
+                const double dt = double(t_now) - double(t_before);
+                const float dt32 = float(dt);
+                if (double(dt32) != dt) return false;
+                unsigned char* r = &rec[kMorphStride * v];
+                std::memcpy(r, dq, 8);
+                std::memcpy(r + 8, &dt32, 4);
+                std::memcpy(r + 12, dn, 4);
+            }
+        }
+        if (v != run.count) return false;
+        // The target's view, and per primitive its three accessors.
+        std::vector<unsigned char> encoded(meshopt_encodeVertexBufferBound(run.count, kMorphStride));
+        encoded.resize(meshopt_encodeVertexBuffer(encoded.data(), encoded.size(), rec.data(), run.count, kMorphStride));
+        const int view = b.addMeshoptView(encoded, run.count, kMorphStride, false);
+        tinygltf::Mesh& mesh = b.model.meshes[size_t(run.mesh)];
+        for (size_t j = 0; j < objects.size(); ++j) {
+            const size_t nv = data[objects[j]].packed.size() / 12;
+            auto attribute = [&](size_t offset, int component, int type, bool normalized, std::vector<double> min_v,
+                                 std::vector<double> max_v) {
+                const int a = b.addAccessor(view, component, type, nv, std::move(min_v), std::move(max_v));
+                b.model.accessors[size_t(a)].byteOffset = first[j] * kMorphStride + offset;
+                b.model.accessors[size_t(a)].normalized = normalized;
+                return a;
+            };
+            // POSITION's bounds (required) are the whole frame's: a bound of every primitive's.
+            std::map<std::string, int> target;
+            target["POSITION"] = attribute(0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
+                                           {double(lo[0]), double(lo[1]), double(lo[2])},
+                                           {double(hi[0]), double(hi[1]), double(hi[2])});
+            target["_EMISSION_TIME"] = attribute(8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+            target["NORMAL"] = attribute(12, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_TYPE_VEC3, true, {}, {});
+            mesh.primitives[j].targets.push_back(target);
+        }
+        // The frame is now the run's reference for the next one.
+        v = 0;
+        for (const size_t o : objects) {
+            const PrimitiveData& d = data[o];
+            std::memcpy(&run.records[12 * v], d.packed.data(), d.packed.size());
+            std::memcpy(&run.normals[4 * v], d.packed_snorm.data(), d.packed_snorm.size());
+            v += d.packed.size() / 12;
+        }
+        ++run.targets;
+        runs.back() = run.targets;
         return true;
     }
 
@@ -866,6 +1013,13 @@ struct SequenceModel {
         nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_len));
         j["buffers"][0]["byteLength"] = b.sinkSize();
         b.meshoptJson(&j);
+        // The target frames' weights: the first `place` of the run's targets at 1 (cumulative
+        // differences), written as integers.
+        for (const MorphNode& m : morph_nodes) {
+            nlohmann::json w = nlohmann::json::array();
+            for (size_t t = 0; t < runs[m.run]; ++t) w.push_back(t < m.place ? 1 : 0);
+            j["nodes"][m.node]["weights"] = w;
+        }
         return j.dump();
     }
 
@@ -891,6 +1045,22 @@ struct SequenceModel {
         int mesh;
     };
     std::vector<Reflection> reflections;
+    // Frame coherence (meshopt): the open run (mesh < 0: none), each run's target count, and the
+    // frame nodes that are targets (node index, place in the run: its first `place` weights are 1).
+    struct Run {
+        int mesh = -1;
+        double step = 0;
+        size_t count = 0, targets = 0, limit = 0;
+        std::vector<size_t> objects;
+        std::vector<unsigned char> records;  // the last frame's records (int16 x, y, z, 0 | float32 time)
+        std::vector<unsigned char> normals;  // the last frame's normals as decoded (int8 x, y, z, w)
+    } run;
+    std::vector<size_t> runs;
+    struct MorphNode {
+        size_t node, place, run;
+    };
+    std::vector<MorphNode> morph_nodes;
+    std::vector<unsigned char> morph_records;  // scratch
 };
 
 size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
@@ -992,12 +1162,14 @@ namespace {
 // The meshopt quantization step of a frame of largest extent `extent` (gltf.h): from the
 // tolerance (T / sqrt(3)), from `bits` (E / (2^bits - 2)), or 14 bits over E in vertex mode; at
 // least E / 65534 so that every coordinate fits int16 (*clamped says when that decided). In
-// vertex mode 14 bits over E (E / 16382).
+// vertex mode at least 14 bits over E (Draco's and gltfpack's default): the largest power of two
+// not above E / 16382, so that frames of slightly different extents share the step and can be
+// morph targets of one another (gltf.h).
 double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
     const double finest = extent / 65534.0;
     double step = bits > 0        ? extent / (std::ldexp(1.0, bits) - 2)
                   : tolerance > 0 ? tolerance / std::sqrt(3.0)
-                                  : extent / 16382.0;  // vertex mode: 14 bits, Draco's and gltfpack's default
+                                  : std::ldexp(1.0, int(std::floor(std::log2(extent / 16382.0))));
     *clamped = step < finest;  // only a tolerance can ask for more than int16 holds
     if (*clamped) step = finest;
     if (!(step > 0)) step = 1;  // every point at the origin: any step is exact
