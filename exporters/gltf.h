@@ -42,8 +42,9 @@
 // reader gets origin + step * q. The step: with a tolerance T, T / sqrt(3), which bounds the
 // quantization error by T / 2 (each coordinate moves at most step / 2); in vertex mode (no
 // tolerance), at least 14 bits over the frame's largest extent E (Draco's and gltfpack's default):
-// step = the largest power of two not above E / 16382 (so that frames of slightly different
-// extents share it), error at most sqrt(3) / 2 * E / 16382 (about 5.3e-5 E); --meshopt-bits B
+// step = E / 16382 rounded down to a power of 2^(1/4) (at most 19% finer; so that frames of
+// slightly different extents share it), error at most sqrt(3) / 2 * E / 16382 (about 5.3e-5 E);
+// --meshopt-bits B
 // asks for step = E / (2^B - 2) instead (a warning says when its bound exceeds T). When E / step
 // would exceed int16 the step grows to E / 65534 and the warning says so too.
 // Frame coherence (meshopt): consecutive frames that show the same objects with the same index
