@@ -29,6 +29,8 @@
 #include "mesh4d/normals.h"
 
 #include <fcntl.h>
+#include <limits.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 namespace apparent {
@@ -279,13 +281,88 @@ void encodeDraco(const PrimitiveData& d, const GlbOptions& options, DracoCoded* 
 
 // Where the BIN chunk goes while frames arrive: a spill file (so memory does not grow with the
 // frame count), or nowhere (counting only, for the size without Draco).
+// The first frame is held instead (`holding`): data that lies in the frame's own buffers (kept
+// alive by `pinned`; `borrowable` lists them) stays where it is, anything else is copied into
+// `own`, and `pieces` lists the chunk in order. A lone frame is then written once, in place after
+// the JSON chunk by finish(), without a spill file; a second frame first sends the held data to
+// the spill file (spill()), which is opened only then.
 struct BinSink {
-    int fd = -1;        // -1: count only
+    bool counting = false;  // count only
+    std::string dir;        // the spill file's folder
+    int fd = -1;            // the spill file (-1: not opened yet)
     size_t size = 0;
     std::string error;  // the first write error
+    bool holding = false;
+    struct Piece {
+        const char* data;  // borrowed bytes, or nullptr: at `offset` in `own`
+        size_t offset, n;
+    };
+    std::vector<Piece> pieces;
+    std::string own;
+    std::vector<std::pair<const char*, const char*>> borrowable;
+    std::shared_ptr<const void> pinned;
+
     void write(const void* data, size_t n) {
-        if (fd >= 0 && error.empty() && !writeAll(fd, data, n, &error)) error = "cannot write: " + error;
         size += n;
+        if (counting || n == 0) return;
+        if (holding) {
+            const char* p = static_cast<const char*>(data);
+            for (const auto& [lo, hi] : borrowable)
+                if (p >= lo && p + n <= hi) {
+                    pieces.push_back({p, 0, n});
+                    return;
+                }
+            pieces.push_back({nullptr, own.size(), n});
+            own.append(p, n);
+            return;
+        }
+        if (fd < 0 && error.empty()) fd = openAnonymousFile(dir, &error);
+        if (fd >= 0 && error.empty() && !writeAll(fd, data, n, &error)) error = "cannot write: " + error;
+    }
+    // The held data to the spill file; every write goes there from now on.
+    void spill() {
+        if (!holding) return;
+        holding = false;
+        // The spill file has no name (atomic_file.h): nothing is left behind, even after SIGKILL.
+        if (fd < 0 && error.empty()) fd = openAnonymousFile(dir, &error);
+        for (const Piece& piece : pieces) {
+            const char* p = piece.data ? piece.data : own.data() + piece.offset;
+            if (fd >= 0 && error.empty() && !writeAll(fd, p, piece.n, &error)) error = "cannot write: " + error;
+        }
+        pieces = {};
+        own = {};
+        borrowable.clear();
+        pinned.reset();
+    }
+    // Writes the held data to `out` (finish() of a lone frame); false with the message in *werr.
+    bool writeHeld(int out, std::string* werr) const {
+        std::vector<iovec> iov;
+        iov.reserve(pieces.size());
+        for (const Piece& piece : pieces)
+            iov.push_back({const_cast<char*>(piece.data ? piece.data : own.data() + piece.offset), piece.n});
+        for (size_t i = 0; i < iov.size(); i += IOV_MAX) {
+            const size_t count = std::min<size_t>(IOV_MAX, iov.size() - i);
+            size_t total = 0;
+            for (size_t k = i; k < i + count; ++k) total += iov[k].iov_len;
+            const ssize_t w = ::writev(out, &iov[i], int(count));
+            if (w == ssize_t(total)) continue;
+            if (w < 0 && errno != EINTR) {
+                *werr = std::strerror(errno);
+                return false;
+            }
+            // Short write or interrupted: the rest of this batch one piece at a time.
+            size_t done = w > 0 ? size_t(w) : 0;
+            for (size_t k = i; k < i + count; ++k) {
+                const size_t len = iov[k].iov_len;
+                if (done >= len) {
+                    done -= len;
+                    continue;
+                }
+                if (!writeAll(out, static_cast<char*>(iov[k].iov_base) + done, len - done, werr)) return false;
+                done = 0;
+            }
+        }
+        return true;
     }
 };
 
@@ -1067,7 +1144,27 @@ size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
 
 }  // namespace
 
-struct GlbFrameData : PreparedFrame {
+struct GlbFrameData : PreparedFrame, std::enable_shared_from_this<GlbFrameData> {
+    // The buffers whose bytes may go into the file as they are (BinSink::borrowable).
+    std::vector<std::pair<const char*, const char*>> buffers() const {
+        std::vector<std::pair<const char*, const char*>> out;
+        auto add = [&](const auto& v) {
+            if (v.empty()) return;
+            const char* p = reinterpret_cast<const char*>(v.data());
+            out.emplace_back(p, p + v.size() * sizeof(v[0]));
+        };
+        add(meshopt.encoded);
+        add(meshopt.encoded_normals);
+        for (const PrimitiveData& d : data) {
+            for (const auto* v : {&d.positions, &d.normals, &d.emission, &d.doppler, &d.proper_time, &d.colors}) add(*v);
+            add(d.indices);
+            add(d.packed);
+            add(d.packed_normals);
+            add(d.packed_snorm);
+            add(d.draco.bytes);
+        }
+        return out;
+    }
     // For a frame of `objects` objects, keeping every vector's capacity.
     void reset(size_t objects) {
         origin[0] = origin[1] = origin[2] = 0;
@@ -1127,9 +1224,9 @@ std::shared_ptr<FramePool> processFramePool() {
 struct GlbSequenceWriter::Impl {
     Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
         : path(p), info(i), options(o), model(info, options, &sink) {
-        // The spill file has no name (atomic_file.h): nothing is left behind, even after SIGKILL.
-        const std::string dir = std::filesystem::path(p).parent_path().string();
-        sink.fd = openAnonymousFile(dir, &sink.error);
+        sink.dir = std::filesystem::path(p).parent_path().string();
+        sink.holding = true;  // the first frame (BinSink)
+        count_only.counting = true;
         if (options.draco || options.meshopt) {
             GlbOptions plain_options = options;
             plain_options.draco = plain_options.meshopt = false;
@@ -1339,6 +1436,14 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     const double* origin = prepared.origin;
     m.stats.max_quantization_error = std::max(m.stats.max_quantization_error, prepared.max_quantization_error);
     m.stats.meshopt_range_clamped = m.stats.meshopt_range_clamped || prepared.clamped;
+    // Step: the first frame is held (its own buffers kept, BinSink), a second one sends it to the
+    // spill file.
+    if (m.model.frames > 0) {
+        m.sink.spill();
+    } else if (m.sink.holding) {
+        m.sink.pinned = prepared.weak_from_this().lock();  // none (addEncoded's frame): copied instead
+        if (m.sink.pinned) m.sink.borrowable = prepared.buffers();
+    }
     // Step: into the model (binary data to the spill file), and into the counted plain twin.
     if (!m.model.addFrame(f, data, origin, prepared.step > 0 ? prepared.step : 1.0, &prepared.meshopt, &m.stats,
                           error)) {
@@ -1411,9 +1516,14 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
     put32(&head, 0x004E4942);  // BIN
     std::string werr;
     bool ok = writeAll(fd, head.data(), head.size(), &werr);
+    // A lone frame: the BIN chunk from where it is held, written once.
+    size_t off = 0;
+    if (m.sink.holding) {
+        ok = ok && m.sink.writeHeld(fd, &werr);
+        off = bin;
+    }
     // The BIN chunk by copy_file_range (the kernel copies between the two files' pages, no trip
     // through a user buffer); where it cannot (another file system, an old kernel), by pread and write.
-    size_t off = 0;
     while (ok && off < bin) {
         loff_t in = loff_t(off);
         const ssize_t r = ::copy_file_range(m.sink.fd, &in, fd, nullptr, bin - off, 0);
