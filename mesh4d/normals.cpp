@@ -105,17 +105,26 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     const double cos_half = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
     w->uniform.assign(nv, 0);
     w->vertex_normal.resize(nv);
+    // Raw pointers: the stores to `uniform` (bytes, which may alias anything) would otherwise
+    // reload every vector's data pointer in the inner loops.
+    const Vec3* const area_p = area.data();
+    const double* const length_p = length.data();
+    const uint32_t* const start_p = start.data();
+    const uint32_t* const faces_p = faces.data();
+    unsigned char* const uniform_p = w->uniform.data();
+    Vec3* const vertex_normal_p = w->vertex_normal.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v < r.end(); ++v) {
-            if (start[v] == start[v + 1]) continue;
+            const uint32_t first = start_p[v], end = start_p[v + 1];
+            if (first == end) continue;
             // The sum of the area vectors in CSR order (what every corner would sum).
             Vec3 sum{0, 0, 0};
-            for (uint32_t a = start[v]; a < start[v + 1]; ++a) sum += area[faces[a]];
+            for (uint32_t a = first; a < end; ++a) sum += area_p[faces_p[a]];
             const double bound = cos_half * std::sqrt(dot(sum, sum));  // the sufficient test alone (margin above)
             bool all = bound > 0;
-            for (uint32_t a = start[v]; a < start[v + 1] && all; ++a) {
-                const uint32_t f = faces[a];
-                all = length[f] > 0 && dot(area[f], sum) >= bound * length[f];
+            for (uint32_t a = first; a < end && all; ++a) {
+                const uint32_t f = faces_p[a];
+                all = length_p[f] > 0 && dot(area_p[f], sum) >= bound * length_p[f];
             }
             if (!all) {
                 all = true;
@@ -132,21 +141,21 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
                 }
             }
             if (!all) continue;
-            w->uniform[v] = 1;
-            w->vertex_normal[v] = sum;  // normalized below, two at a time
+            uniform_p[v] = 1;
+            vertex_normal_p[v] = sum;  // normalized below, two at a time
         }
         // sum / norm(sum), or not uniform after all where the sum is zero (each corner then
         // falls back to its own face).
         for (size_t v = r.begin(); v < r.end(); v += 2) {
             const size_t b = std::min(v + 1, r.end() - 1);  // an odd end repeats its last vertex
-            const Vec3 s0 = w->vertex_normal[v], s1 = w->vertex_normal[b];
+            const Vec3 s0 = vertex_normal_p[v], s1 = vertex_normal_p[b];
             Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, length;
             unitPair(x, y, z, &ux, &uy, &uz, &length);
             for (int k = 0; k < 2; ++k) {
                 const size_t i = k == 0 ? v : b;
-                if (!w->uniform[i]) continue;
-                if (!(length[k] > 0)) w->uniform[i] = 0;
-                else w->vertex_normal[i] = {ux[k], uy[k], uz[k]};
+                if (!uniform_p[i]) continue;
+                if (!(length[k] > 0)) uniform_p[i] = 0;
+                else vertex_normal_p[i] = {ux[k], uy[k], uz[k]};
             }
         }
     });
