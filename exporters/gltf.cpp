@@ -553,13 +553,16 @@ private:
     std::vector<std::pair<int, MeshoptView>> meshopt_views;
     size_t fallback_size = 0;
 
+    // Per coordinate, in vertex order (the same bits as any order but for the sign of a zero).
     static void bounds(const std::vector<float>& xyz, std::vector<double>* lo, std::vector<double>* hi) {
-        lo->assign(3, INFINITY);
-        hi->assign(3, -INFINITY);
-        for (size_t i = 0; i < xyz.size(); ++i) {
-            (*lo)[i % 3] = std::min((*lo)[i % 3], double(xyz[i]));
-            (*hi)[i % 3] = std::max((*hi)[i % 3], double(xyz[i]));
-        }
+        double l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i + 3 <= xyz.size(); i += 3)
+            for (int c = 0; c < 3; ++c) {
+                l[c] = std::min(l[c], double(xyz[i + size_t(c)]));
+                h[c] = std::max(h[c], double(xyz[i + size_t(c)]));
+            }
+        lo->assign(l, l + 3);
+        hi->assign(h, h + 3);
     }
 };
 
