@@ -2,7 +2,8 @@
 //
 // Layout (glTF 2.0):
 // - node 0 "camera": a perspective camera placed and aimed like the scene camera;
-// - node 1 + k "frame_NNNNN": mesh k, frame k, one primitive per visible object with that
+// - node 1 + k "frame_NNNNN": mesh k (with meshopt the mesh of its run, see frame coherence
+//   below), frame k, one primitive per visible object with that
 //   object's material; its translation is the frame's local origin (the centre of its bounding
 //   box, as JSON doubles) and POSITION is float32 relative to it, so scenes far from the world
 //   origin keep their precision. Each primitive has NORMAL (area-weighted) and a float
@@ -40,10 +41,29 @@
 // node's scale is its step (the animation shows it with scale = step, hides it with 0), so a
 // reader gets origin + step * q. The step: with a tolerance T, T / sqrt(3), which bounds the
 // quantization error by T / 2 (each coordinate moves at most step / 2); in vertex mode (no
-// tolerance), 14 bits over the frame's largest extent E (Draco's and gltfpack's default): step =
-// E / 16382, error at most sqrt(3) / 2 * E / 16382 (about 5.3e-5 E); --meshopt-bits B asks for
-// step = E / (2^B - 2) instead (a warning says when its bound exceeds T). When E / step would exceed int16 the step
-// grows to E / 65534 and the warning says so too.
+// tolerance), at least 14 bits over the frame's largest extent E (Draco's and gltfpack's default):
+// step = E / 16382 rounded down to a power of 2^(1/4) (at most 19% finer; so that frames of
+// slightly different extents share it), error at most sqrt(3) / 2 * E / 16382 (about 5.3e-5 E);
+// --meshopt-bits B
+// asks for step = E / (2^B - 2) instead (a warning says when its bound exceeds T). When E / step
+// would exceed int16 the step grows to E / 65534 and the warning says so too.
+// Frame coherence (meshopt): consecutive frames that show the same objects with the same index
+// lists, the same step and no reflections form a run: its first frame's mesh is written as above,
+// and each later frame is a morph target of that mesh (glTF 2.0 morph targets with
+// KHR_mesh_quantization) holding its difference from the frame before: POSITION int16 (not
+// normalized) steps, NORMAL normalized int8 (from the previous frame's int8 normal as a reader
+// decodes it), _EMISSION_TIME float32 (exact: the difference of two rounded times), one
+// interleaved 16-byte record per vertex in one compressed view. Frame node k refers to its run's
+// mesh with weights 1 for the run's first p targets and 0 for the rest (p: its place in the run;
+// the first frame has none), so a reader gets its vertices exactly as if written alone: positions
+// the same integers, emission times the same float32, normals within 0.5 / 127 per component
+// (the run's first frame: the octahedral bound). A run ends at a frame that differs in any of
+// these, whose differences do not fit (int16 steps, int8 normals, a time difference not exact in
+// float32), after 63 targets, or when vertices x targets would pass 2^22 (three.js expands each
+// target to 32 bytes a vertex of float texture: at most 128 MB). Not with --attributes or
+// --shade doppler (their values stay bit for bit in each frame's own record). three.js, and so
+// model-viewer, apply the weights; viewers that ignore _EMISSION_TIME in targets see the first
+// frame's emission times.
 // Index buffers are shared: a primitive whose index list (and vertex count) equals that of the
 // same object in the previous frame refers to that frame's index accessor (plain and meshopt;
 // Draco codes indices with the vertices). In vertex mode with nothing clipped, each object then
@@ -89,6 +109,9 @@ struct GlbStats {
 // is left behind whatever ends the process), only the JSON-side
 // description (a few hundred bytes per frame) stays in memory, and finish() assembles the file
 // under a temporary name (the BIN chunk placed by copy_file_range) and renames it into place.
+// The first frame's data waits in its own buffers instead (the prepared frame is kept; frames
+// from addEncoded() are copied) until a second frame comes: a lone frame's file is then written
+// once, in place after its JSON chunk, with no spill file at all.
 // Memory does not grow with the frame data: besides the JSON side it keeps the previous frame's
 // index lists (to share equal ones). Frame buffers come from a pool shared by every writer of
 // the process (at most max(4, 2 x cores) kept), so neither the frames of a sequence nor a lone

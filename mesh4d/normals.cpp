@@ -47,16 +47,17 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     const double cos_crease = std::cos(crease_deg * kPi / 180.0);
     const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();
 
-    // Step: face area vectors and unit normals (parallel); faces around each vertex (CSR layout).
-    w->face.resize(nf);
+    // Step: face area vectors and their lengths (parallel); faces around each vertex (CSR layout).
+    // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s hypot (the
+    // output normals below still use norm()); unit() gives it where needed, the same bits each time.
+    w->area.resize(nf);
+    w->length.resize(nf);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t f = r.begin(); f < r.end(); ++f) {
             const auto& t = mesh.triangles[f];
             const Vec3 a = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
-            // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s
-            // hypot (the output normals below still use norm()).
-            const double len2 = dot(a, a);
-            w->face[f] = {a, len2 > 0 ? a / std::sqrt(len2) : Vec3{0, 0, 0}};
+            w->area[f] = a;
+            w->length[f] = std::sqrt(dot(a, a));
         }
     });
     const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
@@ -74,51 +75,65 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         for (size_t f = 0; f < nf; ++f)
             for (uint32_t v : mesh.triangles[f]) w->faces[w->fill[v]++] = uint32_t(f);
     }
-    const std::vector<CreaseWork::Face>& face = w->face;
+    const std::vector<Vec3>& area = w->area;
+    const std::vector<double>& length = w->length;
     const std::vector<uint32_t>& start = w->start;
     const std::vector<uint32_t>& faces = w->faces;
+    // Face f's unit normal (zero for a face of zero area, which is within no angle of another).
+    auto unit = [&](size_t f) { return length[f] > 0 ? area[f] / length[f] : Vec3{0, 0, 0}; };
 
     // The normal of the corner of face f at vertex v: the faces around v within the crease angle
     // of f, summed in CSR order.
     auto cornerNormal = [&](size_t f, uint32_t v) {
         Vec3 sum{0, 0, 0};
+        const Vec3 uf = unit(f);
         for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
             const uint32_t g = faces[k];
-            if (g == f || dot(face[g].unit, face[f].unit) >= cos_crease) sum += face[g].area;
+            if (g == f || dot(unit(g), uf) >= cos_crease) sum += area[g];
         }
-        return unitOr(sum, unitOr(face[f].area, {0, 0, 1}));
+        return unitOr(sum, unitOr(area[f], {0, 0, 1}));
     };
 
     // Step (parallel): a vertex whose faces are all within the crease angle of one another gives
     // every corner the same sum, so one normal (the sum of all its faces, in the same order);
     // unless that sum is zero, where each corner falls back to its own face.
     // Quick sufficient test first: when every face is within half the crease angle (less a margin
-    // far above rounding) of their mean direction, every pair is within the crease angle (angles
-    // obey the triangle inequality); otherwise every pair is tested.
+    // far above rounding) of one direction, every pair is within the crease angle (angles obey the
+    // triangle inequality); otherwise every pair is tested. The direction is the sum of the area
+    // vectors (what the vertex's normal is made of), so the test reads each face's area vector and
+    // length once: dot(a_f, s) >= cos_half |a_f| |s|.
     const double cos_half = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
     w->uniform.assign(nv, 0);
     w->vertex_normal.resize(nv);
+    // Raw pointers: the stores to `uniform` (bytes, which may alias anything) would otherwise
+    // reload every vector's data pointer in the inner loops.
+    const Vec3* const area_p = area.data();
+    const double* const length_p = length.data();
+    const uint32_t* const start_p = start.data();
+    const uint32_t* const faces_p = faces.data();
+    unsigned char* const uniform_p = w->uniform.data();
+    Vec3* const vertex_normal_p = w->vertex_normal.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v < r.end(); ++v) {
-            if (start[v] == start[v + 1]) continue;
-            // The mean direction, and the sum of the area vectors in CSR order (what every corner
-            // would sum), in one pass.
-            Vec3 mean{0, 0, 0}, sum{0, 0, 0};
-            for (uint32_t a = start[v]; a < start[v + 1]; ++a) {
-                mean += face[faces[a]].unit;
-                sum += face[faces[a]].area;
+            const uint32_t first = start_p[v], end = start_p[v + 1];
+            if (first == end) continue;
+            // The sum of the area vectors in CSR order (what every corner would sum).
+            Vec3 sum{0, 0, 0};
+            for (uint32_t a = first; a < end; ++a) sum += area_p[faces_p[a]];
+            const double bound = cos_half * std::sqrt(dot(sum, sum));  // the sufficient test alone (margin above)
+            bool all = bound > 0;
+            for (uint32_t a = first; a < end && all; ++a) {
+                const uint32_t f = faces_p[a];
+                all = length_p[f] > 0 && dot(area_p[f], sum) >= bound * length_p[f];
             }
-            const double len = std::sqrt(dot(mean, mean));  // feeds the sufficient test alone (margin above)
-            bool all = len > 0;
-            for (uint32_t a = start[v]; a < start[v + 1] && all; ++a)
-                all = dot(face[faces[a]].unit, mean) >= cos_half * len;
             if (!all) {
                 all = true;
                 for (uint32_t a = start[v]; a < start[v + 1] && all; ++a) {
                     const uint32_t f = faces[a];
+                    const Vec3 uf = unit(f);
                     for (uint32_t b = start[v]; b < start[v + 1]; ++b) {
                         const uint32_t g = faces[b];
-                        if (g != f && !(dot(face[g].unit, face[f].unit) >= cos_crease)) {
+                        if (g != f && !(dot(unit(g), uf) >= cos_crease)) {
                             all = false;
                             break;
                         }
@@ -126,21 +141,21 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
                 }
             }
             if (!all) continue;
-            w->uniform[v] = 1;
-            w->vertex_normal[v] = sum;  // normalized below, two at a time
+            uniform_p[v] = 1;
+            vertex_normal_p[v] = sum;  // normalized below, two at a time
         }
         // sum / norm(sum), or not uniform after all where the sum is zero (each corner then
         // falls back to its own face).
         for (size_t v = r.begin(); v < r.end(); v += 2) {
             const size_t b = std::min(v + 1, r.end() - 1);  // an odd end repeats its last vertex
-            const Vec3 s0 = w->vertex_normal[v], s1 = w->vertex_normal[b];
+            const Vec3 s0 = vertex_normal_p[v], s1 = vertex_normal_p[b];
             Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, length;
             unitPair(x, y, z, &ux, &uy, &uz, &length);
             for (int k = 0; k < 2; ++k) {
                 const size_t i = k == 0 ? v : b;
-                if (!w->uniform[i]) continue;
-                if (!(length[k] > 0)) w->uniform[i] = 0;
-                else w->vertex_normal[i] = {ux[k], uy[k], uz[k]};
+                if (!uniform_p[i]) continue;
+                if (!(length[k] > 0)) uniform_p[i] = 0;
+                else vertex_normal_p[i] = {ux[k], uy[k], uz[k]};
             }
         }
     });

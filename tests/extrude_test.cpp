@@ -146,3 +146,33 @@ TEST(Extrude, EdgeNumberingAndSlotCyclesFollowTheTriangleOrder) {
     for (const auto& [e, slots] : slots_of)
         for (size_t k = 0; k < slots.size(); ++k) EXPECT_EQ(w.slot_next[slots[k]], slots[(k + 1) % slots.size()]) << e;
 }
+
+// The per-frame cull's triangle chunks: each chunk's two cap boxes are exactly the EventBox of
+// its triangles' cap events (extrude takes them two doubles at a time; here EventBox::add, one
+// event after another), the chunks cover the triangles in order, kChunkTriangles each.
+TEST(Extrude, ChunkBoxesAreTheBoxesOfTheirTrianglesEvents) {
+    const RestMesh mesh = testmesh::icosphere(3, 1.5);  // 1280 triangles: five chunks, the last partial
+    const Motion m = makeMotion(Kinematics::Lorentz, 1.0, {3, -1, -20}, {0.5, 0.2, -0.1});
+    const World4D w = extrude(mesh, m, -3.0, 4.0, true, false);
+    ASSERT_EQ(w.chunks.size(), (mesh.triangles.size() + kChunkTriangles - 1) / kChunkTriangles);
+    for (size_t k = 0; k < w.chunks.size(); ++k) {
+        const TriangleChunk& c = w.chunks[k];
+        EXPECT_EQ(c.first, k * kChunkTriangles);
+        EXPECT_EQ(c.last, std::min<size_t>(mesh.triangles.size(), (k + 1) * kChunkTriangles));
+        for (int cap = 0; cap < 2; ++cap) {
+            EventBox want;
+            for (uint32_t f = c.first; f < c.last; ++f)
+                for (uint32_t v : mesh.triangles[f]) want.add(w.events[2 * v + cap]);
+            const EventBox& got = c.cap[cap];
+            EXPECT_EQ(got.t_lo, want.t_lo) << k << " " << cap;
+            EXPECT_EQ(got.t_hi, want.t_hi) << k << " " << cap;
+            EXPECT_EQ(got.lo.x, want.lo.x);
+            EXPECT_EQ(got.lo.y, want.lo.y);
+            EXPECT_EQ(got.lo.z, want.lo.z);
+            EXPECT_EQ(got.hi.x, want.hi.x);
+            EXPECT_EQ(got.hi.y, want.hi.y);
+            EXPECT_EQ(got.hi.z, want.hi.z);
+            EXPECT_LT(got.t_lo, got.t_hi);  // not the empty box
+        }
+    }
+}

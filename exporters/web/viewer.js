@@ -156,6 +156,7 @@ async function loadModel(m) {
   scene.background = new THREE.Color(VIEW_BG);
   scene.add(gltf.scene);
   m.scene = scene;
+  m.parser = gltf.parser;
 
   // frame nodes, in frame order
   gltf.scene.traverse((o) => {
@@ -319,6 +320,27 @@ function visibleOf(m) {
   if (!m.loaded) return [];
   return m.frames.filter((f) => isShown(f.object)).map((f) => ({ name: f.name, vertices: f.vertices,
     reflected: f.children.filter((c) => isShown(c.object)).reduce((n, c) => n + c.vertices, 0) }));
+}
+
+function shownBounds(m) {
+  if (!m.loaded) return null;
+  const box = new THREE.Box3(), v = new THREE.Vector3();
+  let vertices = 0;
+  for (const f of m.frames) {
+    if (!isShown(f.object)) continue;
+    f.object.updateWorldMatrix(true, true);
+    const visit = (o) => {
+      if (o !== f.object && m.parser.associations.get(o)?.nodes !== undefined) return; // a reflection node
+      if (o.isMesh && o.geometry?.attributes?.position) {
+        const n = o.geometry.attributes.position.count;
+        for (let i = 0; i < n; ++i) box.expandByPoint(o.getVertexPosition(i, v).applyMatrix4(o.matrixWorld));
+        vertices += n;
+      }
+      for (const c of o.children) visit(c);
+    };
+    visit(f.object);
+  }
+  return vertices ? { min: box.min.toArray(), max: box.max.toArray(), vertices } : null;
 }
 
 function frameIndexAt(m, t) {
@@ -541,6 +563,9 @@ window.apparentViewer = {
   // { model: [{ name: 'frame_00100', vertices: 16, reflected: 40 }, ...] } for the frame nodes shown right now
   // (reflected: the vertices of its reflection child nodes shown with it)
   visibleFrames: () => Object.fromEntries(models.map((m) => [m.name, visibleOf(m)])),
+  // { model: { min: [x, y, z], max: [x, y, z], vertices } } world-space bounds of the frame nodes shown right now (their
+  // own meshes, morph targets applied as three.js draws them: Mesh.getVertexPosition), or null when none is shown
+  frameBounds: () => Object.fromEntries(models.map((m) => [m.name, shownBounds(m)])),
   // { model: {x, y, width, height} } CSS pixels of each model's drawing area, relative to the page viewport
   viewports: () => Object.fromEntries(models.map((m) => {
     const r = m.slot.getBoundingClientRect();

@@ -12,7 +12,9 @@
 //   - with "frames" selected and paused, at currentTime = (k + 0.5) / fps for several k (0, 1, 3n/4, n-1, the
 //     shot frame and a quarter of it; or --frames): the element screenshot shows geometry, and the pixels that show
 //     geometry all belong to frame node k (its own mesh or its reflection child nodes). model-viewer's public
-//     surfaceFromPoint(x, y) names the glTF mesh under a pixel, and the file maps meshes to frame nodes; the
+//     surfaceFromPoint(x, y) names the glTF mesh under a pixel, and the file maps meshes to frame nodes (a mesh
+//     whose morph targets make a run of frames, --compress meshopt, stands for each of them: that three.js, which
+//     model-viewer loads with, draws each frame's own shape is checked by tests/web/viewer_test.js --plain); the
 //     expectation is also evaluated from the file's own animation data (tests/web/glb.js);
 //   - the screenshot at t = --shot-time (default 10 s, taken mid-frame) shows geometry (non-background pixels), and
 //     differs from the one at a quarter of that time;
@@ -159,15 +161,19 @@ async function main() {
     d.fps = Number(d.extras.fps) > 0 ? Number(d.extras.fps) : d.duration > 0 ? d.frames.length / d.duration : NaN;
     f.draco = d.frames.some((x) => x.draco);
     f.meshopt = (d.json.extensionsRequired || []).includes('EXT_meshopt_compression');
-    // glTF mesh index -> frame node (what surfaceFromPoint reports is the mesh index)
-    f.meshToFrame = new Map();
+    // glTF mesh index -> frame nodes using it (what surfaceFromPoint reports is the mesh index): one frame, or with
+    // --compress meshopt's frame coherence the frames of a run, morph targets of one mesh (exporters/gltf.h)
     // (a frame's reflection child nodes, "frame_NNNNN mirror M", belong to it too)
+    f.meshToFrames = new Map();
     d.frames.forEach((fr, k) => {
       for (const ni of [fr.index, ...fr.children.map((c) => c.index)]) {
         const m = d.json.nodes[ni].mesh;
-        if (m !== undefined) f.meshToFrame.set(m, k);
+        if (m === undefined) continue;
+        if (!f.meshToFrames.has(m)) f.meshToFrames.set(m, []);
+        f.meshToFrames.get(m).push(k);
       }
     });
+    f.morph = (d.json.meshes || []).some((me) => me.primitives.some((p) => (p.targets || []).length > 0));
   }
   if (!files.some((f) => f.draco)) warn('no KHR_draco_mesh_compression file among the inputs: Draco not checked');
   if (!files.some((f) => !f.draco && !f.meshopt)) warn('no plain (uncompressed) file among the inputs');
@@ -216,7 +222,7 @@ async function main() {
     for (const f of files) {
       const d = f.d, n = d.frames.length;
       console.log(`\n== ${f.label}: ${n} frame nodes, fps ${d.fps}, ${d.duration} s${f.draco ? ', Draco' : ''}` +
-        `${f.meshopt ? ', meshopt' : ''}`);
+        `${f.meshopt ? ', meshopt' : ''}${f.morph ? ', morph targets' : ''}`);
       let info;
       try {
         info = await page.evaluate((src) => window.mvTest.load(src), f.url);
@@ -274,7 +280,10 @@ async function main() {
         if (!check(fg.length >= 50, `${f.label} frame #${k} (t=${t.toFixed(3)}): geometry on screen`,
           `${fg.length} non-background pixels`)) continue;
         const hits = await page.evaluate((pts) => window.mvTest.probe(pts), spread(fg, 40));
-        const hitFrames = hits.filter((h) => h.mesh !== null).map((h) => f.meshToFrame.get(h.mesh));
+        const hitFrames = hits.filter((h) => h.mesh !== null).map((h) => {
+          const ks = f.meshToFrames.get(h.mesh);
+          return ks === undefined ? undefined : ks.includes(k) ? k : ks[0];
+        });
         const others = [...new Set(hitFrames.filter((x) => x !== k))];
         check(hitFrames.length >= 0.5 * hits.length,
           `${f.label} frame #${k}: model-viewer's surfaceFromPoint hits geometry at the drawn pixels`,

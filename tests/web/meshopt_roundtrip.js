@@ -21,7 +21,11 @@
 //   - with --attributes / --shade doppler: _DOPPLER and _PROPER_TIME equal the plain file's float32 bit for bit, and
 //     COLOR_0 (normalized uint16) is within 0.5/65535 (plus float32 rounding) of the plain file's float colour;
 //   - the triangles, each written as its three corners' rounded emission times, are the same multiset as the plain
-//     file's.
+//     file's;
+//   - frame coherence (gltf.h): where a frame node's mesh has morph targets, its vertices are the base's plus the
+//     targets times the node's weights (0 or 1), the targets' POSITION int16 (not normalized, with bounds), NORMAL
+//     normalized int8, _EMISSION_TIME float32; the sums go through every check above (the emission time rounded to
+//     float32 once, at the end).
 // Prints the largest position error against the bound. Exit 0 when all passed, 1 on a failed check, 2 on usage.
 'use strict';
 
@@ -95,7 +99,8 @@ function readAccessor(json, views, index) {
 }
 
 const f32 = new Float32Array(1), u32 = new Uint32Array(f32.buffer);
-const bits = (x) => { f32[0] = x; return u32[0]; };
+// -0 and +0 as one key (a morph target's sum gives +0 where the rounding gave -0: the same time)
+const bits = (x) => { f32[0] = x === 0 ? 0 : x; return u32[0]; };
 
 async function main() {
   await MeshoptDecoder.ready;
@@ -112,7 +117,7 @@ async function main() {
   const shownScale = new Map();
   for (const ch of mo.channels) shownScale.set(ch.node, Math.max(...ch.values.map((v) => v[0])));
 
-  let worst = 0, worstRatio = 0, vertices = 0, primitives = 0, worstNormal = 0, attributeVertices = 0;
+  let worst = 0, worstRatio = 0, vertices = 0, primitives = 0, worstNormal = 0, attributeVertices = 0, morphed = 0;
   const pairs = [];
   for (let k = 0; k < Math.min(plain.frames.length, mo.frames.length); ++k) {
     const pf = plain.frames[k], mf = mo.frames[k];
@@ -145,6 +150,34 @@ async function main() {
       const anrm = readAccessor(pj, pviews, a.attributes.NORMAL), bnrm = readAccessor(mj, mviews, b.attributes.NORMAL);
       const atim = readAccessor(pj, pviews, a.attributes._EMISSION_TIME), btim = readAccessor(mj, mviews, b.attributes._EMISSION_TIME);
       const aidx = readAccessor(pj, pviews, a.indices).map((e) => e[0]), bidx = readAccessor(mj, mviews, b.indices).map((e) => e[0]);
+      // frame coherence: a frame node whose mesh has morph targets adds the targets with its weights
+      const targets = b.targets || [];
+      const weights = mn.weights || [];
+      if (targets.length) {
+        ++morphed;
+        check(weights.length === 0 || weights.length === targets.length, `${where}: ${weights.length} weights for ${targets.length} targets`);
+        check(weights.every((w) => w === 0 || w === 1), `${where}: weights are 0 or 1 (${weights})`);
+      }
+      targets.forEach((target, t) => {
+        const tpAcc = mj.accessors[target.POSITION], tnAcc = mj.accessors[target.NORMAL], ttAcc = mj.accessors[target._EMISSION_TIME];
+        check(tpAcc && tpAcc.componentType === 5122 && !tpAcc.normalized && tpAcc.min && tpAcc.max,
+          `${where} target ${t}: POSITION is int16, not normalized, with bounds`);
+        check(tnAcc && tnAcc.componentType === 5120 && tnAcc.normalized, `${where} target ${t}: NORMAL is normalized int8`);
+        check(ttAcc && ttAcc.componentType === 5126, `${where} target ${t}: _EMISSION_TIME is float32`);
+        if (!weights[t]) return;
+        const tp = readAccessor(mj, mviews, target.POSITION), tn = readAccessor(mj, mviews, target.NORMAL);
+        const tt = readAccessor(mj, mviews, target._EMISSION_TIME);
+        if (!check(tp.length === bpos.length && tn.length === bpos.length && tt.length === bpos.length,
+          `${where} target ${t}: ${tp.length} vertices, the base has ${bpos.length}`)) return;
+        for (let i = 0; i < bpos.length; ++i) {
+          for (let c = 0; c < 3; ++c) {
+            bpos[i][c] += weights[t] * tp[i][c];
+            bnrm[i][c] += weights[t] * tn[i][c];
+          }
+          btim[i][0] += weights[t] * tt[i][0];
+        }
+      });
+      if (targets.length) for (const e of btim) e[0] = Math.fround(e[0]);
       // the optional attributes: present in both files or in neither
       const extra = {};
       for (const name of ['_DOPPLER', '_PROPER_TIME', 'COLOR_0']) {
@@ -208,7 +241,7 @@ async function main() {
       vertices += bpos.length;
     }
   }
-  console.log(`meshopt_roundtrip: ${meshoptFile}: ${primitives} primitives, ${vertices} vertices; largest position ` +
+  console.log(`meshopt_roundtrip: ${meshoptFile}: ${primitives} primitives (${morphed} with morph targets), ${vertices} vertices; largest position ` +
     `error ${worst.toExponential(3)} ls, ${(100 * worstRatio).toFixed(1)}% of the stated bound; largest normal component ` +
     `error ${(worstNormal * 127).toFixed(2)}/127; ${attributeVertices} vertices with attributes checked; ${passed} checks passed, ` +
     `${failures} failed`);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Renders the default scene (plain, Draco, meshopt, and Draco with --shade doppler) and checks each with three.js in headless
-# Chromium (tests/web/viewer_test.js).
+# Chromium (tests/web/viewer_test.js); then the 20480-face icosphere in vertex mode with --compress meshopt, whose frames
+# are morph targets (exporters/gltf.h), against its plain export (--plain: the shown frame's bounds as three.js draws it).
 # Usage: run_viewer_test.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
 apparent=$1
@@ -16,3 +17,8 @@ node tests/web/viewer_test.js "$out/plain"
 node tests/web/viewer_test.js "$out/draco"
 node tests/web/viewer_test.js "$out/meshopt"
 node tests/web/viewer_test.js "$out/doppler"
+sphere="$src/data/scenes/trade/sphere20480.json"
+"$apparent" render "$sphere" --out "$out/sphere-plain" --model relativistic --quiet
+"$apparent" render "$sphere" --out "$out/sphere-meshopt" --model relativistic --compress meshopt --quiet
+grep -q '"targets"' "$out/sphere-meshopt/relativistic.glb" || { echo "run_viewer_test: $sphere: no morph targets" >&2; exit 1; }
+node tests/web/viewer_test.js "$out/sphere-meshopt" --models relativistic --frames 0,1,2,20,39 --shot-time 4 --plain "$out/sphere-plain"

@@ -2,7 +2,7 @@
 // Headless-browser test of the web viewer (exporters/web/).
 //
 //   node tests/web/viewer_test.js OUTDIR [--screenshot PATH] [--models a,b,c] [--frames 0,50,100,199]
-//                                        [--shot-time SECONDS] [--chromium PATH] [--keep-profile]
+//                                        [--shot-time SECONDS] [--chromium PATH] [--keep-profile] [--plain DIR]
 //
 // OUTDIR holds <model>.glb for every model (plain or KHR_draco_mesh_compression). The test serves the repository
 // root and OUTDIR (as /out/) on 127.0.0.1, opens the viewer in Debian Chromium (headless, SwiftShader WebGL) via
@@ -16,7 +16,12 @@
 //   - a screenshot at t = --shot-time (default 10 s) has a meaningful number of non-background pixels in every
 //     model's viewport;
 //   - for files with COLOR_0 (render --shade doppler): the viewer found the Doppler colours, and switching to
-//     plain colours changes the picture where objects move (relativistic) but not where D = 1 (instant).
+//     plain colours changes the picture where objects move (relativistic) but not where D = 1 (instant);
+//   - with --plain DIR (the plain export of the same render; OUTDIR a --compress meshopt one, whose frames may be
+//     morph targets of an earlier frame's mesh, exporters/gltf.h): at each checked time the world-space bounds of
+//     the shown frame as three.js draws it (Mesh.getVertexPosition: morph targets applied) equal those of the plain
+//     file's frame (its POSITION bounds plus the node translation) within half a quantization step per coordinate
+//     (the shown scale) plus float32 rounding.
 // Exit 0 when everything passed, 1 on a failed check, 2 on a usage or setup problem (nothing is skipped).
 'use strict';
 
@@ -32,7 +37,7 @@ const elapsed = () => `${((Date.now() - t0) / 1000).toFixed(1)} s`;
 function usage(msg) {
   if (msg) console.error(`viewer_test: ${msg}`);
   console.error('usage: node tests/web/viewer_test.js OUTDIR [--screenshot PATH] [--models a,b,c] ' +
-    '[--frames 0,50,100,199] [--shot-time SECONDS] [--chromium PATH] [--keep-profile]');
+    '[--frames 0,50,100,199] [--shot-time SECONDS] [--chromium PATH] [--keep-profile] [--plain DIR]');
   process.exit(2);
 }
 
@@ -43,7 +48,7 @@ function setupFail(msg) {
 
 // ------------------------------------------------------------------ arguments
 const opts = { outdir: null, screenshot: null, models: ['instant', 'finite', 'relativistic'], frames: null,
-  shotTime: 10, chromium: process.env.CHROMIUM || '/usr/bin/chromium', keepProfile: false };
+  shotTime: 10, chromium: process.env.CHROMIUM || '/usr/bin/chromium', keepProfile: false, plain: null };
 {
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; ++i) {
@@ -55,6 +60,7 @@ const opts = { outdir: null, screenshot: null, models: ['instant', 'finite', 're
     else if (a === '--shot-time') opts.shotTime = Number(val());
     else if (a === '--chromium') opts.chromium = val();
     else if (a === '--keep-profile') opts.keepProfile = true;
+    else if (a === '--plain') opts.plain = path.resolve(val());
     else if (a === '-h' || a === '--help') usage();
     else if (a.startsWith('-')) usage(`unknown option ${a}`);
     else if (!opts.outdir) opts.outdir = path.resolve(a);
@@ -110,6 +116,36 @@ const sameVis = (a, b) => a.length === b.length &&
   a.every((x, i) => x.name === b[i].name && x.vertices === b[i].vertices && (x.reflected || 0) === (b[i].reflected || 0));
 const byName = (v) => [...v].sort((x, y) => (x.name < y.name ? -1 : x.name > y.name ? 1 : 0));
 
+// ------------------------------------------------------------------ --plain: the shown frame's bounds against the plain file
+const plainFiles = {};
+function checkBounds(m, frame, got, label) {
+  if (!plainFiles[m]) plainFiles[m] = describe(path.join(opts.plain, `${m}.glb`));
+  const pj = plainFiles[m].json, d = filesForBounds[m];
+  const pn = pj.nodes.find((n) => n.name === frame.name), mn = d.json.nodes[frame.index];
+  if (!check(pn && pn.mesh !== undefined, `${label}: the plain file has ${frame.name} with a mesh`)) return;
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  const tr = pn.translation || [0, 0, 0];
+  for (const p of pj.meshes[pn.mesh].primitives) {
+    const a = pj.accessors[p.attributes.POSITION];
+    for (let c = 0; c < 3; ++c) { lo[c] = Math.min(lo[c], a.min[c] + tr[c]); hi[c] = Math.max(hi[c], a.max[c] + tr[c]); }
+  }
+  const channel = d.channels.find((ch) => ch.node === frame.index);
+  const step = channel ? Math.max(...channel.values.map((v) => v[0])) : 1;
+  const morph = (d.json.meshes[mn.mesh].primitives[0].targets || []).length > 0 && (mn.weights || []).some((w) => w);
+  if (!check(got, `${label}: three.js shows ${frame.name} with vertices`)) return;
+  let worst = 0, allowed = 0;
+  for (let c = 0; c < 3; ++c) {
+    const slack = step / 2 + (Math.abs(lo[c]) + Math.abs(hi[c]) + 1) * 2 ** -22;
+    allowed = Math.max(allowed, slack);
+    worst = Math.max(worst, Math.abs(got.min[c] - lo[c]) - slack, Math.abs(got.max[c] - hi[c]) - slack);
+  }
+  if (check(worst <= 0, `${label}: three.js bounds of ${frame.name}${morph ? ' (morph targets)' : ''} match the plain file's`,
+    `three.js ${JSON.stringify(got)}, plain min ${lo} max ${hi}, allowed ${allowed}`)) {
+    console.log(`  ok   ${label}: bounds of ${frame.name}${morph ? ' (morph targets applied)' : ''} within ${allowed.toExponential(2)} of the plain file's`);
+  }
+}
+const filesForBounds = {};
+
 // ------------------------------------------------------------------ main
 async function main() {
   // 1. what the files say (independent of three.js)
@@ -123,6 +159,7 @@ async function main() {
       throw new Error(`cannot read ${path.join(opts.outdir, m + '.glb')}: ${e.message}`);
     }
     files[m] = d;
+    filesForBounds[m] = d;
     // frames per second: scene extras, else (e.g. after draco_transcoder, which drops extras) frames / duration
     d.fps = Number(d.extras.fps) > 0 ? Number(d.extras.fps) : d.duration > 0 ? d.frames.length / d.duration : NaN;
     const draco = d.frames.some((f) => f.draco);
@@ -234,7 +271,10 @@ async function main() {
         groups.get(t).push(m);
       }
       for (const [t, ms] of groups) {
-        const seen = await page.evaluate((tt) => { window.apparentViewer.setTime(tt); return window.apparentViewer.visibleFrames(); }, t);
+        const { seen, bounds } = await page.evaluate((tt) => {
+          window.apparentViewer.setTime(tt);
+          return { seen: window.apparentViewer.visibleFrames(), bounds: window.apparentViewer.frameBounds() };
+        }, t);
         lastSeen = seen;
         for (const m of ms) {
           const d = files[m];
@@ -247,6 +287,7 @@ async function main() {
           const ok2 = check(sameVis(got, expect), `${m} @ ${tc.label} (t=${t.toFixed(4)}): viewer shows the file's frame`,
             `viewer ${fmtVis(got)}, file ${fmtVis(expect)}`);
           if (ok1 && ok2) console.log(`  ok   ${m} @ ${tc.label} (t=${t.toFixed(4)}): ${fmtVis(got)}`);
+          if (opts.plain && ok1) checkBounds(m, want, bounds[m], `${m} @ ${tc.label}`);
         }
       }
     }
