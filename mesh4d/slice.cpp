@@ -905,7 +905,8 @@ struct FrameBuilder {
         }
         // Step: the templates, in record order.
         clear(scratch.edge_first, r_edges.size(), 0xff);  // kUnset
-        const size_t expect = size_t(std::min(estimate, 1e8));
+        // (The estimate counts 3 per leaf: about 1 is made.)
+        const size_t expect = size_t(std::min(std::max(0.0, estimate - 2.0 * double(r_tri_size)), 1e8));
         out.triangles.reserve(out.triangles.size() + expect);
         out.source_triangles.reserve(out.source_triangles.size() + expect);
         r_rest.reserve(r_rest.size() + expect / 2 + 16);
