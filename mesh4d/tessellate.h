@@ -16,10 +16,12 @@
 //   - otherwise (N raised to 3 when it is 2): the grid points with all three grid coordinates
 //     >= 1 (an inner grid of level N - 3; for N = 3 the centre alone) keep the grid's triangles,
 //     and the ring between them and the sides is stitched: at a corner whose two sides both have
-//     inner points, the corner's ear (P_k's two neighbours on its sides); then the two closed
-//     loops (side points, inner-grid boundary) are zipped by their place along the sides (grid
-//     point (i, 1) of side 0 sits at i / N, beside side point i of an n = N side: with every
-//     n[k] = N the ring is the grid's outer row).
+//     inner points and whose ear's chord passes between the corner and the inner grid
+//     (n[k-1] + n[k] > N), the corner's ear (P_k's two neighbours on its sides); then the two
+//     closed loops (side points, inner-grid boundary) are zipped: each step joins the next point
+//     of one loop, by the shorter diagonal in the form's metric (a triangle that would turn over
+//     is never taken), else by their places along the sides (an inner point's place: its
+//     projection on its side in the form's metric).
 // The bound. The caller gives a quadratic form c(d) on steps d = (dl1, dl2) in the parameter plane
 // that bounds the error of the linear interpolant on any triangle inside the piece:
 // error <= bubbleMax(c(e01), c(e12), c(e20)) (chord_error.h, PieceForm), and a limit. Grid
