@@ -16,6 +16,9 @@
 //   box:      the unit box passing 2 ls from the camera at 0.9c, seen at closest approach
 //             (docs/ACCURACY.md), size = its diagonal sqrt 3.
 //   sphere:   the 320-face icosphere of radius 1 passing 4 ls away at 0.9c, size = its diameter 2.
+//   plate:    a flange-like plate (2 x 4 ls, 4 triangles about its centre) 18.675 ls away at 0.866c,
+//             seen at closest approach, size = its diagonal sqrt 20: pieces far from the camera,
+//             which the refinement fills with templates (mesh4d/tessellate.h).
 //
 // Instruction counts (repeatable on a shared machine, unlike times): `refine_bench --count SCENE K`
 // makes one tolerance cut and one vertex cut of the matching uniform mesh, each in its own function
@@ -61,6 +64,16 @@ Scene sphereMid() {
             {mesh4d::ViewKind::PastCone, 4.0, {0, 0, 0}}, 2.0};
 }
 
+Scene plateFar() {
+    mesh4d::RestMesh plate;
+    plate.positions = {{-1, -2, 0}, {1, -2, 0}, {1, 2, 0}, {-1, 2, 0}, {0, 0, 0}};
+    plate.triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+    return {plate, mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0.0, {0, 0, -18.675}, {0.866, 0, 0}),
+            {mesh4d::ViewKind::PastCone, 18.675, {0, 0, 0}}, std::sqrt(20.0)};
+}
+
+Scene sceneOf(long i) { return i == 0 ? boxNear() : i == 1 ? sphereMid() : plateFar(); }
+
 double threadSeconds() {
     timespec ts{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -88,9 +101,9 @@ int repeatsFor(const mesh4d::World4D& w, const mesh4d::ViewSurface& view, const 
     return std::max(1, std::min(100000, int(2e-3 / std::max(more, 1e-9))));
 }
 
-// range(0): 0 = box, 1 = sphere; range(1): k, T = 10^-k x size.
+// range(0): 0 = box, 1 = sphere, 2 = plate; range(1): k, T = 10^-k x size.
 void BM_PerTriangle(benchmark::State& state) {
-    const Scene sc = state.range(0) == 0 ? boxNear() : sphereMid();
+    const Scene sc = sceneOf(state.range(0));
     const mesh4d::World4D w = mesh4d::extrude(sc.mesh, sc.motion, -100, 100, false, false);
     mesh4d::SliceSettings tol;
     tol.max_segments = 4096;
@@ -125,7 +138,7 @@ void BM_PerTriangle(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_PerTriangle)
-    ->ArgsProduct({{0, 1}, {2, 3, 4, 5}})
+    ->ArgsProduct({{0, 1, 2}, {2, 3, 4, 5}})
     ->ArgNames({"scene", "k"})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
@@ -141,7 +154,7 @@ namespace {
 
 int main(int argc, char** argv) {
     if (argc == 4 && std::string(argv[1]) == "--count") {
-        const Scene sc = std::atoi(argv[2]) == 0 ? boxNear() : sphereMid();
+        const Scene sc = sceneOf(std::atoi(argv[2]));
         const mesh4d::World4D w = mesh4d::extrude(sc.mesh, sc.motion, -100, 100, false, false);
         mesh4d::SliceSettings tol;
         tol.max_segments = 4096;

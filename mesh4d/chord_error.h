@@ -250,4 +250,62 @@ inline ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const 
     return chordErrorOfBubbles(m, m.beta, c, s, xm, tolerance);
 }
 
+
+// ---- The whole-piece bound: one quadratic form for every triangle inside a piece ----
+// The refinement fills each piece it stops bisecting with a template (tessellate.h) of many
+// triangles; this bounds them all at once, from the piece's own terms.
+// On the piece, for any direction u, with c the centroid (x_c = E + the shape offsets' mean) and
+// x any point of the piece,
+//     u^T H(x) u <= u^T H(x_c) u + K |u|_M^2,   K = (2 / sqrt 3) r_M / ((1 - b^2) m^2):
+// u^T (H(x) - H(x_c)) u is the integral of D^3 delta [u, u, x - x_c] along the segment, and a
+// symmetric trilinear form's norm is its largest value on one unit vector (Banach), here
+// (2 / sqrt 3) / ((1 - b^2) |x|_M^2) in the metric M (the norm's third derivative, as above);
+// |x - x_c|_M <= r_M (the largest M-distance from the centroid to a corner) and
+// |x|_M >= m = |x_c|_M - r_M on the piece. So H(x) <= A = H(x_c) + K M everywhere on the piece
+// (as quadratic forms). For a triangle S with corners x_i inside the piece and p in S,
+//     L delta(p) - delta(p) = sum_i l_i integral_0^1 (1 - t) (x_i - p)^T H (x_i - p) dt
+//                          <= (1/2) sum_i l_i |x_i - p|_A^2 = sum_{i<j} l_i l_j c_ij,
+// c_ij = |x_i - x_j|_A^2 / 2 (the first-order terms cancel: sum_i l_i (x_i - p) = 0), and delta is
+// convex, so 0 <= L delta - delta <= bubbleMax(c01, c12, c20) on S:
+//     |F - L| <= speed bubbleMax(c(S's edges)),   c(e) = e^T A e / 2 = e^T H(x_c) e / 2 + K |e|_M^2 / 2.
+// A is one form for the whole piece: a triangle of the piece scaled by 1/n has the bound of the
+// piece over n^2. The price is K, relative to H(x_c) about r_M / |x|: `centre` holds the
+// coefficients without it, so the caller can tell how much the piece's size costs (pieces small
+// against their distance from the camera get the template; larger ones are bisected first).
+struct PieceForm {
+    double c[3] = {INFINITY, INFINITY, INFINITY};  // c(e) of side e (s[e] -> s[e + 1]) with A
+    double centre[3] = {0, 0, 0};                  // the same with H(x_c) alone (K = 0)
+    bool finite = false;                           // false when the piece may reach the camera (m <= 0)
+};
+inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
+    PieceForm r;
+    const double k = m.one_minus_beta2;
+    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
+    const Vec3 x = E + centre;
+    const double xv = dot(x, m.velocity);
+    const double xm2 = xv * xv + k * norm2(x);
+    const double xm = std::sqrt(xm2);
+    double q = 0;  // r_M^2
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[i] - centre;
+        const double uv = dot(u, m.velocity);
+        q = std::max(q, uv * uv + k * norm2(u));
+    }
+    const double rM = std::sqrt(q);
+    const double mlow = xm - rM;
+    if (!(mlow > 0)) return r;
+    const double K = 2 / 1.7320508075688772 * rM / (k * mlow * mlow);
+    for (int e = 0; e < 3; ++e) {
+        const Vec3 u = s[(e + 1) % 3] - s[e];
+        const double uv = dot(u, m.velocity);
+        const double l2 = uv * uv + k * norm2(u);
+        const double uMx = uv * xv + k * dot(u, x);
+        r.centre[e] = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
+        r.c[e] = r.centre[e] + 0.5 * K * l2;
+    }
+    r.finite = r.c[0] == r.c[0] && r.c[1] == r.c[1] && r.c[2] == r.c[2] && r.c[0] < INFINITY &&
+               r.c[1] < INFINITY && r.c[2] < INFINITY;
+    return r;
+}
+
 }  // namespace mesh4d

@@ -11,6 +11,7 @@
 #include "chord_error.h"
 #include "exact_side.h"
 #include "robust.h"
+#include "tessellate.h"
 #include "worldline.h"
 
 namespace mesh4d {
@@ -68,7 +69,9 @@ struct REdge {
 // is the edge from v[c] to v[c + 1]; the slots on one edge form a cycle (next), as
 // World4D::slot_next does for the mesh, so that an edge is split in every triangle that has it:
 // no T-junctions, however the splits go.
-enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2 };
+// kCoarse: its bound fails, but its whole-piece form (chord_error.h pieceForm) is tight enough
+// that a template fills it (tessellate.h) instead of further bisection.
+enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3 };
 struct RTri {
     uint32_t v[3];
     uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
@@ -102,6 +105,12 @@ struct RefineScratch {
     std::vector<uint32_t> members, stack;
     std::vector<Side> side;
     std::vector<uint32_t> vertex_out;
+    // The templates (refineFrame without a real cap): the coarse pieces' forms, each record's
+    // form (index, or kUnset), each edge record's segment count and first point, one piece's
+    // local triangles and its local-to-global point map.
+    std::vector<PieceForm> forms;
+    std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
+    std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
         return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
@@ -109,7 +118,10 @@ struct RefineScratch {
                cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
-               init.capacity() + limited.capacity() + side.capacity();
+               init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
+               (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity()) *
+                   sizeof(uint32_t) +
+               local.capacity() * sizeof(std::array<uint32_t, 3>);
     }
 };
 constexpr size_t kScratchKeep = size_t(256) << 20;
@@ -394,6 +406,7 @@ struct FrameBuilder {
     // ids edge midpoints made when an edge is split. `side` and `vertex_out` grow with them.
     uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
     bool r_caps = false;          // a cap is real: points are classified and pieces clipped
+    bool r_templates = false;     // no real cap: pieces whose form is tight are filled by templates
     Vec3 r_now{0, 0, 0};          // the object's origin now, relative to the camera (nowBase)
     std::vector<Vec3>& r_pos;     // exact local image of every id (the batch cuts: mesh vertices first,
     std::vector<double>& r_time;  // the splits' points after the last split); its local emission time, -delta
@@ -597,7 +610,7 @@ struct FrameBuilder {
             }
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
-            if (rt[id].state == kPassed) continue;
+            if (rt[id].state == kPassed || rt[id].state == kCoarse) continue;
             if (rt[id].state == kUnknown) {
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
                 const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
@@ -607,6 +620,13 @@ struct FrameBuilder {
                 const ChordError ce = pieceBound(c, s, xm);
                 if (ce.bound <= settings.tolerance) {
                     rt[id].state = kPassed;
+                    continue;
+                }
+                // (The form is worth making only for a piece that needs a level of kMinLevel or
+                // more: its bubbles alone say about how much.)
+                if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
+                    coarseForm(id, s, false)) {
+                    rt[id].state = kCoarse;
                     continue;
                 }
                 rt[id].state = kFailed;
@@ -685,6 +705,240 @@ struct FrameBuilder {
         }
     }
 
+    // ---- Templates (no real cap): the pieces the bisection leaves, each filled at once ----
+    // The bisection above stops at a piece whose bound passes (kPassed) or that a template fills
+    // better (kCoarse, coarseForm): its whole-piece form (chord_error.h pieceForm: one quadratic
+    // form A >= the delay's Hessian all over the piece) asks for a level n >= kMinLevel,
+    //     n = the least integer with speed bubbleMax(A's sides) / n^2 <= T,
+    // the piece is not much worse shaped in A's metric than an equilateral triangle (area over
+    // bound at least kShapeShare of the equilateral's: the template's triangles have the piece's
+    // shape), and A is nearly the form at its centroid (within kCoarseSlack) or the n^2
+    // triangles of the template are fewer than the two halves are expected to need (each half
+    // asks for half the centroid's need, its excess of A over the centroid's form shrunk by
+    // sqrt 2, its level rounded up by kRounding on average).
+    // The grid triangles of a piece at level n (the piece scaled by 1/n) are within T
+    // (chord_error.h PieceForm). Each edge record gets the largest level of the pieces around
+    // it, and both sides cut it into that many equal segments: no T-junctions, and the counts
+    // depend on the pieces alone (deterministic). The template (tessellate.h) fills the piece:
+    // grid triangles inside, a stitched ring along sides cut more finely than its level, every
+    // ring triangle checked against A (the piece's level is raised until they pass: in the limit
+    // the ring's triangles shrink to the sides' segments, each shorter than a grid edge of the
+    // piece's first level). A piece that passed as a whole (and the mesh's triangles that needed
+    // nothing) keeps level 1: its sides' extra points are fanned and, the delay being convex,
+    // every triangle inside it is within its own bound.
+    // The template makes no record per output triangle; where it is not used (a level below
+    // kMinLevel, or a form far from the centroid's: large pieces near the camera) the bisection
+    // goes on to pieces that pass, which adapts more finely (docs/ACCURACY.md: the constants are
+    // the ones that keep every trade ratio of the bisection alone).
+    static constexpr double kMinLevel = 2;
+    static constexpr double kShapeShare = 0.3;
+    static constexpr double kEquilateral = 2.598076211353316;  // 3 sqrt(3) / 2: area / bubbleMax of an equilateral triangle
+    static constexpr double kCoarseSlack = 1.1;
+    static constexpr double kRounding = 0.3;
+    static constexpr double kTemplateShare = 0.5;  // least share of the leaves the templates' triangles must make (refineFrame)
+
+    // The form of piece id (its corners' shape offsets s) when it is finite and (unless `force`:
+    // the depth limit stopped the piece) the piece is better filled by a template (above); kept
+    // in scratch.forms, indexed by scratch.form_of[id].
+    bool coarseForm(uint32_t id, const Vec3 s[3], bool force) {
+        std::vector<uint32_t>& form_of = scratch.form_of;
+        if (form_of.size() <= id) form_of.resize(std::max<size_t>(r_tri_size, size_t(id) + 1), kUnset);
+        form_of[id] = kUnset;
+        const PieceForm pf = pieceForm(world.motion, r_now, s);
+        if (!pf.finite) return false;
+        if (!force) {
+            const double whole = bubbleMax(pf.c[0], pf.c[1], pf.c[2]);
+            const double centre = bubbleMax(pf.centre[0], pf.centre[1], pf.centre[2]);
+            {  // the template's triangles against the halves' (above)
+                const double xa = std::sqrt(bound_speed * whole / settings.tolerance);
+                const double xc2 = bound_speed * centre / settings.tolerance;
+                const double infl = whole / centre;
+                const double cost_t = std::ceil(xa) * std::ceil(xa);
+                const double child = 0.5 * xc2 * (1 + (infl - 1) / 1.4142135623730951);
+                const double cost_b = 2 * std::max(1.0, (std::sqrt(child) + kRounding) * (std::sqrt(child) + kRounding));
+                if (!(cost_t <= cost_b) && !(whole <= kCoarseSlack * centre)) return false;
+            }
+            // Its shape in the form's metric: area over bound, against the equilateral's (the
+            // template's triangles are the piece's shape, scaled).
+            const double cuv = 0.5 * (pf.c[0] + pf.c[2] - pf.c[1]);
+            const double area = std::sqrt(std::max(0.0, pf.c[0] * pf.c[2] - cuv * cuv));
+            if (!(area >= kShapeShare * kEquilateral * whole)) return false;
+            if (!(bound_speed * whole >= kMinLevel * kMinLevel * settings.tolerance)) return false;
+        }
+        form_of[id] = uint32_t(scratch.forms.size());
+        scratch.forms.push_back(pf);
+        return true;
+    }
+
+    // The least level n >= 1 with speed bubbleMax(c) / n^2 <= T, at most `cap`.
+    uint32_t formLevel(const PieceForm& pf, uint32_t cap) const {
+        const double need = bound_speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]) / settings.tolerance;
+        if (!(need <= double(cap) * double(cap))) return r_level_scale < 1 ? std::max(1u, uint32_t(cap * r_level_scale)) : cap;
+        uint32_t n = std::max(1u, uint32_t(std::ceil(std::sqrt(need))));
+        while (double(n) * double(n) < need) ++n;
+        if (r_level_scale < 1) n = std::max(1u, uint32_t(double(n) * r_level_scale));
+        return std::min(n, cap);
+    }
+
+    // The first id of the count - 1 points that cut edge record e (ends a, b) into equal
+    // segments, made once, from the lower id end: point i of the edge is lo + (hi - lo) i / count.
+    uint32_t edgePoints(uint32_t e, uint32_t a, uint32_t b, uint32_t count) {
+        uint32_t& first = scratch.edge_first[e];
+        if (first != kUnset) return first;
+        first = uint32_t(r_nv + r_rest.size());
+        const Vec3 lo = restOfId(std::min(a, b)), hi = restOfId(std::max(a, b));
+        for (uint32_t i = 1; i < count; ++i) {
+            const double t = double(i) / double(count);
+            r_rest.push_back(lo * (1 - t) + hi * t);
+        }
+        return first;
+    }
+
+    // Fills one leaf (corners v, edge records e, on mesh triangle src) with its template at
+    // level N (form: the piece's form, or null for a piece within the bound as a whole) and
+    // appends the triangles. base: the output index of the first new point.
+    void fillLeaf(uint32_t src, const uint32_t v[3], const uint32_t e[3], uint32_t N, const PieceForm* form,
+                  bool unsplit, size_t base, uint32_t cap) {
+        auto outOf = [&](uint32_t g) { return g < r_nv ? vertex_out[g] : uint32_t(base + (g - r_nv)); };
+        const uint32_t* count = scratch.edge_count.data();  // segments - 1
+        const int n[3] = {int(count[e[0]]) + 1, int(count[e[1]]) + 1, int(count[e[2]]) + 1};
+        if (N == 1 && n[0] == 1 && n[1] == 1 && n[2] == 1) {
+            addOutput(src, {outOf(v[0]), outOf(v[1]), outOf(v[2])});
+            return;
+        }
+        TessForm tf;
+        if (form) {
+            tf.cu = form->c[0];
+            tf.cv = form->c[2];
+            tf.cuv = 0.5 * (form->c[0] + form->c[2] - form->c[1]);
+            tf.limit = settings.tolerance / bound_speed;
+        }
+        std::vector<std::array<uint32_t, 3>>& local = scratch.local;
+        int level = int(N);
+        for (;;) {
+            const TessLayout probe(level, n);
+            const bool checked = form && probe.level() > 1;
+            if (probe.tessellate(checked ? &tf : nullptr, local)) break;
+            if (probe.level() >= int(cap)) {  // the ring cannot be made to pass: limited
+                r_limited[src] = 1;
+                probe.tessellate(nullptr, local);
+                break;
+            }
+            level = probe.level() + 1;
+        }
+        const TessLayout lay(level, n);
+        // Step: the leaf's points: corners, its sides' shared points, its own inner points.
+        std::vector<uint32_t>& map = scratch.local_map;
+        map.resize(lay.count());
+        for (int k = 0; k < 3; ++k) map[size_t(k)] = v[k];
+        for (int k = 0; k < 3; ++k) {
+            if (n[k] == 1) continue;
+            const uint32_t a = v[k], b = v[kSucc[k]];
+            const uint32_t first = edgePoints(e[k], a, b, uint32_t(n[k]));
+            for (int i = 1; i < n[k]; ++i)
+                map[lay.sideFirst(k) + uint32_t(i - 1)] = first + uint32_t(a < b ? i - 1 : n[k] - i - 1);
+        }
+        if (lay.innerCount() > 0) {
+            const Vec3 p0 = restOfId(v[0]), p1 = restOfId(v[1]), p2 = restOfId(v[2]);
+            uint32_t id = uint32_t(r_nv + r_rest.size());
+            const int L = lay.level();
+            auto add = [&](double l1, double l2) { r_rest.push_back(p0 * (1 - l1 - l2) + p1 * l1 + p2 * l2); };
+            if (L == 1) {
+                add(1.0 / 3, 1.0 / 3);
+            } else {
+                for (int j = 1; j + 2 <= L; ++j)
+                    for (int i = 1; i + j + 1 <= L; ++i) add(double(i) / L, double(j) / L);
+            }
+            for (uint32_t p = lay.innerFirst(); p < lay.count(); ++p) map[p] = id++;
+        }
+        for (const auto& t : local) addOutput(src, {outOf(map[t[0]]), outOf(map[t[1]]), outOf(map[t[2]])});
+        if (unsplit && local.size() > 1) ++out.refined_triangles;
+    }
+
+    // Every leaf in record order filled by its template. When the templates would pass
+    // settings.max_triangles, every level is scaled down until they fit and over_budget is set
+    // (the tolerance is not met then, and the rings are not checked); false (nothing emitted)
+    // when even the leaves alone do not fit: they are emitted as they are.
+    double r_level_scale = 1;
+    bool templateLeaves() {
+        const uint32_t cap = uint32_t(std::max(settings.max_segments, 2));
+        std::vector<uint32_t>& count = scratch.edge_count;  // per edge record: its segments - 1
+        auto clear = [](std::vector<uint32_t>& v, size_t n, int byte) {
+            v.resize(n);
+            std::memset(v.data(), byte, n * sizeof(uint32_t));
+        };
+        std::vector<uint32_t>& form_of = scratch.form_of;
+        if (form_of.size() < r_tri_size) form_of.resize(r_tri_size, kUnset);
+        // Step: each record's level, and each edge's count (the largest level around it).
+        // The estimate bounds the output: a leaf makes at most N^2 + 2 + the extra segments of its
+        // sides (tessellate.h), an edge is on about two leaves.
+        double estimate = 0;
+        r_level_scale = 1;
+        auto levelPass = [&](uint32_t id) {
+            RTri& t = rt[id];
+            if (t.state == kFailed) {  // the depth limit stopped it: its template is what it gets
+                const Vec3 s[3] = {r_terms[t.v[0]].s, r_terms[t.v[1]].s, r_terms[t.v[2]].s};
+                coarseForm(id, s, true);
+            } else if (t.state != kCoarse) {
+                return;
+            }
+            if (form_of[id] == kUnset) return;
+            const uint32_t n = formLevel(scratch.forms[form_of[id]], cap);
+            estimate += double(n) * double(n);
+            for (int c = 0; c < 3; ++c) count[t.edge[c]] = std::max(count[t.edge[c]], n - 1);
+        };
+        auto levels = [&] {
+            estimate = 3.0 * double(r_nt) + 3.0 * double(r_tri_size - r_nt);
+            clear(count, r_edges.size(), 0);
+            for (uint32_t f = 0; f < r_nt; ++f)
+                if (r_init[f]) levelPass(f);
+            for (uint32_t id = r_nt; id < r_tri_size; ++id) levelPass(id);
+            for (uint32_t c : count) estimate += 2.0 * double(c);
+        };
+        levels();
+        for (int round = 0; settings.max_triangles > 0 && estimate > double(settings.max_triangles); ++round) {
+            out.over_budget = true;
+            const double leaves = 3.0 * double(r_tri_size);
+            if (round == 8 || double(settings.max_triangles) <= leaves) return false;
+            r_level_scale *= 0.95 * std::sqrt((double(settings.max_triangles) - leaves) / (estimate - leaves));
+            levels();
+        }
+        // Step: the templates, in record order.
+        clear(scratch.edge_first, r_edges.size(), 0xff);  // kUnset
+        // (The estimate counts 3 per leaf: about 1 is made.)
+        const size_t expect = size_t(std::min(std::max(0.0, estimate - 2.0 * double(r_tri_size)), 1e8));
+        out.triangles.reserve(out.triangles.size() + expect);
+        out.source_triangles.reserve(out.source_triangles.size() + expect);
+        r_rest.reserve(r_rest.size() + expect / 2 + 16);
+        const size_t base = out.positions.size();
+        auto fillRecord = [&](uint32_t id) {
+            const RTri& t = rt[id];
+            const bool formed = (t.state == kCoarse || t.state == kFailed) && form_of[id] != kUnset;
+            const PieceForm* pf = formed ? &scratch.forms[form_of[id]] : nullptr;
+            const uint32_t v[3] = {t.v[0], t.v[1], t.v[2]}, e[3] = {t.edge[0], t.edge[1], t.edge[2]};
+            fillLeaf(t.src, v, e, pf ? formLevel(*pf, cap) : 1, out.over_budget ? nullptr : pf, t.depth == 0, base, cap);
+        };
+        for (uint32_t f = 0; f < r_nt; ++f) {
+            if (r_init[f]) {
+                fillRecord(f);
+                continue;
+            }
+            const auto& tri = world.mesh.triangles[f];
+            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;  // no area: dropped
+            const auto& te = world.triangle_edges[f];
+            if ((count[te[0]] | count[te[1]] | count[te[2]]) == 0) {  // untouched, no finer neighbour
+                out.triangles.push_back({vertex_out[tri[0]], vertex_out[tri[1]], vertex_out[tri[2]]});
+                out.source_triangles.push_back(f);
+                continue;
+            }
+            const uint32_t v[3] = {tri[0], tri[1], tri[2]};
+            const uint32_t e[3] = {te[0], te[1], te[2]};
+            fillLeaf(f, v, e, 1, nullptr, true, base, cap);
+        }
+        for (uint32_t id = r_nt; id < r_tri_size; ++id) fillRecord(id);
+        return true;
+    }
+
     uint32_t outId(uint32_t id) {
         if (vertex_out[id] == kUnset) vertex_out[id] = emit(eventOfId(id), restOfId(id));
         return vertex_out[id];
@@ -736,6 +990,9 @@ struct FrameBuilder {
         cutRestLocalBatch(anchor, world.motion, world.mesh.positions.data(), r_nv, r_pos.data(), r_time.data());
         const bool caps = world.cap_a_real || world.cap_b_real;
         r_caps = caps;
+        r_templates = !caps;
+        scratch.forms.clear();
+        scratch.form_of.clear();
         if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
         // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
@@ -823,9 +1080,41 @@ struct FrameBuilder {
                 stack.push_back(f);
                 drain(stack);
             }
+            // Step: templates only where they make most of the output: else the few coarse
+            // pieces are bisected on like the rest (the templates' pass over every leaf would
+            // cost more than it saves).
+            if (r_templates && !scratch.forms.empty() && !out.over_budget) {
+                const uint32_t cap = uint32_t(std::max(settings.max_segments, 2));
+                double templated = 0;
+                auto share = [&](uint32_t id) {
+                    if (rt[id].state == kCoarse) templated += std::pow(double(formLevel(scratch.forms[scratch.form_of[id]], cap)), 2);
+                };
+                for (uint32_t f = 0; f < r_nt; ++f)
+                    if (r_init[f]) share(f);
+                for (uint32_t id = r_nt; id < uint32_t(r_tri_size); ++id) share(id);
+                if (templated < kTemplateShare * double(r_leaves)) {
+                    r_templates = false;
+                    auto resume = [&](uint32_t id) {
+                        if (rt[id].state != kCoarse) return;
+                        rt[id].state = kUnknown;
+                        stack.push_back(id);
+                    };
+                    for (uint32_t f = 0; f < r_nt; ++f)
+                        if (r_init[f]) resume(f);
+                    for (uint32_t id = r_nt; id < uint32_t(r_tri_size); ++id) resume(id);
+                    drain(stack);
+                    scratch.forms.clear();
+                }
+            }
+        }
+        // Step (no real cap): the leaves filled by their templates.
+        // (Without a coarse piece every leaf is its own output triangle: emitted below as they are.)
+        const bool templated =
+            r_templates && !failing.empty() && !out.over_budget && !scratch.forms.empty() && templateLeaves();
+        if (!failing.empty()) {
             for (uint8_t l : r_limited) out.limited_triangles += l;
-            // Step: the exact images of the splits' points, in one batch.
-            const size_t n_new = r_terms.size() - r_nv;
+            // Step: the exact images of the new points (splits' and templates'), in one batch.
+            const size_t n_new = r_rest.size();
             r_pos.resize(r_nv + n_new);
             r_time.resize(r_nv + n_new);
             cutRestLocalBatch(anchor, world.motion, r_rest.data(), n_new, r_pos.data() + r_nv, r_time.data() + r_nv);
@@ -836,10 +1125,11 @@ struct FrameBuilder {
         if (!caps) {
             // Nothing clipped: every point a split made is a corner of some leaf, so the points
             // follow the mesh's visible vertices in id order, copied in bulk.
-            const size_t base = out.positions.size(), n_new = r_terms.size() - r_nv;
+            const size_t base = out.positions.size(), n_new = r_rest.size();
             out.positions.insert(out.positions.end(), r_pos.begin() + r_nv, r_pos.begin() + r_nv + n_new);
             out.emission_times.insert(out.emission_times.end(), r_time.begin() + r_nv, r_time.begin() + r_nv + n_new);
             out.rest_points.insert(out.rest_points.end(), r_rest.begin(), r_rest.begin() + n_new);
+            if (templated) return;  // the triangles are made
             vertex_out.resize(r_nv + n_new);
             for (size_t k = 0; k < n_new; ++k) vertex_out[r_nv + k] = uint32_t(base + k);
             const size_t n_out = r_nt + (r_tri_size > r_nt ? r_tri_size - r_nt : 0);

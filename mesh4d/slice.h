@@ -36,17 +36,28 @@
 //     at the exact crossings of its sides (keyed by the side's two vertices, so neighbours share
 //     them); the clip chords are measured by the tests, not bounded;
 //   - a piece is halved at most 2 log2(max_segments) times (counted in limited_triangles); splits
-//     that keep a neighbour conforming are never refused.
+//     that keep a neighbour conforming are never refused;
+//   - without a real cap, a piece that needs a level n >= 2 of even splitting, whose whole-piece
+//     bound (chord_error.h pieceForm: one quadratic form over the whole piece) is close to the
+//     map's at its centroid and whose shape in that form is not far from equilateral, is not
+//     bisected further but filled by a template (tessellate.h): the regular grid of level n
+//     (each triangle within T by the form), stitched along its sides to the equal segments its
+//     neighbours share (each edge cut into the largest level of the pieces around it; every
+//     stitched triangle checked against the form). When such pieces would make less than half
+//     of the output, they are bisected like the rest (slice.cpp, "Templates").
 // |F - L| bounds both one-sided distances between the output and the exact surface, so the
 // two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
 // no triangle needs refining, identical to vertex mode's. Output order: the visible input
 // vertices in input order, then the splits' points (in the order they were made when nothing is
-// clipped, else with the clip points in the order the leaves first use them); the triangles in
-// record order (each input triangle, or the piece of it that kept its record, then the pieces
-// the splits appended).
-// Cost: per output triangle about two edge bounds, one and a fifth triangle bounds, half a split
-// (its point's square root and the slot bookkeeping) and the output; about 1250 instructions
-// against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per output triangle").
+// clipped, else with the clip points in the order the leaves first use them), then the templates'
+// points (per edge, then per piece, in the order the pieces are filled); the triangles in record
+// order (each input triangle, or the piece of it that kept its record, then the pieces the splits
+// appended; a templated piece gives its template's triangles in its place).
+// Cost: per output triangle of the bisection about two edge bounds, one and a fifth triangle
+// bounds, half a split (its point's square root and the slot bookkeeping) and the output; about
+// 1250 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per
+// output triangle"). A templated piece costs one form and its grid: a few tens of instructions
+// per output triangle besides its share of the batched cut.
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
 // grew them past 256 MiB.

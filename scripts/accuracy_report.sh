@@ -33,7 +33,7 @@ echo "== instructions per output triangle (callgrind: repeatable on a shared mac
 if command -v valgrind >/dev/null; then
   echo "scene,k,tolerance_triangles,tolerance_instructions,vertex_triangles,vertex_instructions" > "$out/instructions.csv"
   for k in 3 4 5; do
-    for scene in 0 1; do
+    for scene in 0 1 2; do
       counts=()
       for fn in countTolerance countVertex; do
         log=$(mktemp)
