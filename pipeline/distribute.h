@@ -3,7 +3,8 @@
 // - job-array shards (`render --shard I/N`, pipeline/shards.h): N independent processes, each
 //   renders its part of the frames; `apparent merge` assembles the .glb afterwards;
 // - MPI (`mpirun -n N apparent render ...`, pipeline/mpi_group.cpp): rank r cuts and encodes its
-//   part, rank 0 writes every output in frame order.
+//   part, rank 0 writes every output in frame order (the .glb's frame data by reference when the
+//   ranks share the output folder: shareFrameSpills below).
 // The split is interleaved: frame k (of frames [first, last)) belongs to part (k - first) mod N.
 // Neighbouring frames cost about the same (the scene changes smoothly), so every part gets an
 // even share of the work whatever the cost profile along the sequence, and rank 0 receives frames
@@ -77,6 +78,8 @@ public:
     // Every rank calls it with its own status (code 0: fine): returns the code of the lowest rank
     // that failed, and on rank 0 its message in `error` (the failing rank's own line), else 0.
     virtual int agree(int code, std::string* error) { (void)error; return code; }
+    // Every rank calls it: rank 0's `text`, on every rank.
+    virtual std::string broadcast(const std::string& text) { return text; }
 
     // The frame protocol above. Rank r > 0:
     virtual bool stopRequested() { return false; }             // END has come
@@ -92,6 +95,16 @@ public:
     bool receiveFrame(int from, std::string* bytes, int* code, std::string* error);
     virtual void endFrames(int /*code*/) {}                     // END(code) to all, then up to every DONE
 };
+
+// Frames by reference (exporters/frame_spill.h), set up once per run before the frame loops: every
+// rank creates its frame spill in `dir` (".apparent-frames-TOKEN.RANK", TOKEN random, broadcast by
+// rank 0), rank 0 opens every rank's file by name and then unlinks every name, so that nothing is
+// left behind from here on whatever ends the job. True on every rank when every spill is in place:
+// a rank's .glb frames then travel as descriptions, their data written by the rank that cut them
+// and copied into the file by rank 0 at the end. False on every rank, the reason in `why` on rank
+// 0, when a rank cannot create its file or rank 0 cannot see it (the folder is not on a file system
+// every rank shares): the frames then travel whole, as to a writer without spills. Collective.
+bool shareFrameSpills(const std::string& dir, std::string* why);
 
 // The group of this process (single until setFrameGroup installs another).
 FrameGroup& frameGroup();

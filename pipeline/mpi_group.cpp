@@ -55,6 +55,14 @@ public:
         return agreed;
     }
 
+    std::string broadcast(const std::string& text) override {
+        uint64_t n = text.size();
+        MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm_);
+        std::string out = rank_ == 0 ? text : std::string(size_t(n), '\0');
+        MPI_Bcast(n ? &out[0] : nullptr, int(n), MPI_CHAR, 0, comm_);
+        return out;
+    }
+
     bool stopRequested() override {
         int flag = 0;
         MPI_Iprobe(0, kTagEnd, comm_, &flag, MPI_STATUS_IGNORE);
