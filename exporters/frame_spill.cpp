@@ -84,6 +84,69 @@ bool spillFrameData(const std::vector<iovec>& pieces, std::vector<FileSpan>* spa
     return true;
 }
 
+bool placeHere(const std::string& path, const std::vector<Placement>& placements, std::string* error) {
+    if (placements.empty()) return true;
+    const int out = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (out < 0) {
+        *error = "cannot open " + path + ": " + std::strerror(errno);
+        return false;
+    }
+    std::string why;
+    std::vector<char> chunk;
+    for (const Placement& p : placements) {
+        const int in = p.from.source == spill().source && spill().fd >= 0 ? spill().fd : frameSource(p.from.source);
+        if (in < 0) {
+            why = "frame data of an unknown process (" + std::to_string(p.from.source) + ")";
+            break;
+        }
+        // Step: copy_file_range at both offsets; what it leaves (another file system), by pread and pwrite.
+        uint64_t done = 0;
+        while (done < p.from.length) {
+            loff_t from = loff_t(p.from.offset + done), to = loff_t(p.to + done);
+            const ssize_t r = ::copy_file_range(in, &from, out, &to, size_t(p.from.length - done), 0);
+            if (r < 0 && errno == EINTR) continue;
+            if (r <= 0) break;
+            done += uint64_t(r);
+        }
+        if (done < p.from.length && chunk.empty()) chunk.resize(size_t(1) << 20);
+        while (why.empty() && done < p.from.length) {
+            const ssize_t r = ::pread(in, chunk.data(), size_t(std::min<uint64_t>(chunk.size(), p.from.length - done)),
+                                      off_t(p.from.offset + done));
+            if (r < 0 && errno == EINTR) continue;
+            if (r <= 0) {
+                why = std::string("cannot read back frame data: ") + (r < 0 ? std::strerror(errno) : "end of file");
+                break;
+            }
+            size_t put = 0;
+            while (why.empty() && put < size_t(r)) {
+                const ssize_t w = ::pwrite(out, chunk.data() + put, size_t(r) - put, off_t(p.to + done + put));
+                if (w < 0 && errno == EINTR) continue;
+                if (w <= 0) why = std::string("cannot write: ") + (w < 0 ? std::strerror(errno) : "nothing written");
+                else put += size_t(w);
+            }
+            done += put;
+        }
+        if (!why.empty()) break;
+    }
+    if (why.empty() && ::fsync(out) != 0) why = std::string("cannot write: ") + std::strerror(errno);
+    if (::close(out) != 0 && why.empty()) why = std::string("cannot write: ") + std::strerror(errno);
+    if (!why.empty()) *error = why;
+    return why.empty();
+}
+
+namespace {
+FramePlacer& placer() {
+    static FramePlacer p;
+    return p;
+}
+}  // namespace
+
+void setFramePlacer(FramePlacer p) { placer() = std::move(p); }
+
+bool placeFrameData(const std::string& path, const std::vector<Placement>& placements, std::string* error) {
+    return placer() ? placer()(path, placements, error) : placeHere(path, placements, error);
+}
+
 void addFrameSource(int source, int fd) {
     std::lock_guard<std::mutex> lock(sources().mutex);
     auto [it, added] = sources().fds.emplace(source, fd);

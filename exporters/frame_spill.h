@@ -2,7 +2,8 @@
 // frame's binary data to the writing process, the process that cut the frame writes it to a file
 // of its own, its frame spill, and sends only where it lies (FileSpan). The writing process reads
 // those files through the table of frame sources and copies the pieces into the output with
-// copy_file_range (the kernel copies; no user buffer). One spill per process, shared by every
+// copy_file_range (the kernel copies; no user buffer), or has their processes copy them into it
+// (placeFrameData). One spill per process, shared by every
 // sink and sequence of the run; source ids are the processes' ranks.
 // - encode side: installFrameSpill(fd, source) once; then spillFrameData() from any thread: each
 //   call reserves its range with one atomic add and writes it with pwritev, so frames cut at once
@@ -17,6 +18,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <sys/uio.h>
 #include <vector>
@@ -37,6 +39,23 @@ bool frameSpillInstalled();
 // Writes the pieces one after another at a fresh range of the spill and returns one span per
 // piece (contiguous); false with errno's message when the write fails.
 bool spillFrameData(const std::vector<iovec>& pieces, std::vector<FileSpan>* spans, std::string* error);
+
+// Where a range of frame data goes in an output file: at byte `to`.
+struct Placement {
+    FileSpan from;
+    uint64_t to = 0;
+};
+// Copies every placement from its source (this process's spill, or a file of the table below)
+// into the file at `path`, opened by name and written at the offsets (copy_file_range; pread and
+// pwrite where it cannot), then synced; false with the reason (errno's message).
+bool placeHere(const std::string& path, const std::vector<Placement>& placements, std::string* error);
+// How the writer places frame data at the end: placeHere() unless another placer is installed.
+// Under MPI rank 0 installs one that has each rank copy its own frames' ranges, all at once
+// (pipeline/distribute.h): rank 0 then writes only the file's head and its own frames.
+using FramePlacer = std::function<bool(const std::string& path, const std::vector<Placement>& placements,
+                                       std::string* error)>;
+void setFramePlacer(FramePlacer placer);
+bool placeFrameData(const std::string& path, const std::vector<Placement>& placements, std::string* error);
 
 // The writing side: the file of source `source` (the table owns `fd`), -1 when not known.
 void addFrameSource(int source, int fd);

@@ -1076,6 +1076,7 @@ size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
 // copies between the two files' pages, no trip through a user buffer); where it cannot (another
 // file system, an old kernel), by pread and write. False with a message.
 bool copyRange(int in, uint64_t offset, uint64_t n, int out, std::string* error) {
+    if (n == 0) return true;
     if (in < 0) {
         *error = "internal: frame data from an unknown process";
         return false;
@@ -1461,26 +1462,31 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
     put32(&head, uint32_t(padded4(bin)));
     put32(&head, 0x004E4942);  // BIN
     std::string werr;
-    bool ok = writeAll(fd, head.data(), head.size(), &werr);
-    // The BIN chunk: the spill file, or with frames by reference its pieces in order (ranges of
-    // this spill and of the other processes' frame spills, and runs of zeros).
-    std::vector<FileSpan> whole;
-    const std::vector<FileSpan>* pieces = &m.sink.pieces;
+    bool ok = true;
     if (!m.sink.in_pieces) {
-        whole.push_back({BinSink::kLocal, 0, bin});
-        pieces = &whole;
-    }
-    static const char zeros[4] = {0, 0, 0, 0};
-    for (size_t i = 0; ok && i < pieces->size(); ++i) {
-        const FileSpan& p = (*pieces)[i];
-        if (p.source == BinSink::kZeros) {
-            ok = writeAll(fd, zeros, size_t(p.length), &werr);  // alignment: at most 3 bytes
-            continue;
+        // The BIN chunk copied from the spill file after the head.
+        static const char zeros[4] = {0, 0, 0, 0};
+        ok = writeAll(fd, head.data(), head.size(), &werr) && copyRange(m.sink.fd, 0, bin, fd, &werr) &&
+             writeAll(fd, zeros, padded4(bin) - bin, &werr);
+    } else {
+        // Frames by reference: the file at its whole size (zeros: the alignment runs and the
+        // chunk's padding), the head, this spill's pieces, then every other range placed at its
+        // offset by placeFrameData() (under MPI each rank copies its own frames, all at once).
+        ok = ::ftruncate(fd, off_t(total)) == 0;
+        if (!ok) werr = std::strerror(errno);
+        ok = ok && writeAll(fd, head.data(), head.size(), &werr);
+        std::vector<Placement> placements;
+        uint64_t at = head.size();
+        for (const FileSpan& p : m.sink.pieces) {
+            if (p.source == BinSink::kLocal) {
+                ok = ok && (::lseek(fd, off_t(at), SEEK_SET) >= 0 || (werr = std::strerror(errno), false)) && copyRange(m.sink.fd, p.offset, p.length, fd, &werr);
+            } else if (p.source != BinSink::kZeros) {
+                placements.push_back({p, at});
+            }
+            at += p.length;
         }
-        const int in = p.source == BinSink::kLocal ? m.sink.fd : frameSource(p.source);
-        ok = copyRange(in, p.offset, p.length, fd, &werr);
+        ok = ok && placeFrameData(out.tempPath(), placements, &werr);
     }
-    if (ok) ok = writeAll(fd, zeros, padded4(bin) - bin, &werr);
     if (ok && ::fsync(fd) != 0) { werr = std::strerror(errno); ok = false; }
     if (!ok) {
         *error = m.path + ": cannot write: " + werr;

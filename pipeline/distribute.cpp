@@ -139,6 +139,10 @@ bool shareFrameSpills(const std::string& dir, std::string* why) {
         return false;
     }
     installFrameSpill(fd, group.rank());
+    if (group.rank() == 0)
+        setFramePlacer([](const std::string& path, const std::vector<Placement>& placements, std::string* e) {
+            return frameGroup().placeOnRanks(path, placements, e);
+        });
     return true;
 }
 

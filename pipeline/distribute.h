@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "exporters/frame_sink.h"
+#include "exporters/frame_spill.h"
 
 namespace apparent {
 
@@ -94,6 +95,13 @@ public:
     // The same for a frame sent by sendFrame (one part).
     bool receiveFrame(int from, std::string* bytes, int* code, std::string* error);
     virtual void endFrames(int /*code*/) {}                     // END(code) to all, then up to every DONE
+    // Rank 0, frames by reference (exporters/frame_spill.h): each rank copies the placements from
+    // its own spill into the file at `path` (PLACE to every rank concerned, while it waits for END
+    // after DONE; rank 0's own at the same time), and answers PLACED with its status. False with
+    // the first failing rank's message.
+    virtual bool placeOnRanks(const std::string& path, const std::vector<Placement>& placements, std::string* error) {
+        return placeHere(path, placements, error);
+    }
 };
 
 // Frames by reference (exporters/frame_spill.h), set up once per run before the frame loops: every
@@ -101,7 +109,8 @@ public:
 // rank 0), rank 0 opens every rank's file by name and then unlinks every name, so that nothing is
 // left behind from here on whatever ends the job. True on every rank when every spill is in place:
 // a rank's .glb frames then travel as descriptions, their data written by the rank that cut them
-// and copied into the file by rank 0 at the end. False on every rank, the reason in `why` on rank
+// and, when rank 0 assembles the file, copied into it by that rank (placeOnRanks, installed here
+// as rank 0's frame placer). False on every rank, the reason in `why` on rank
 // 0, when a rank cannot create its file or rank 0 cannot see it (the folder is not on a file system
 // every rank shares): the frames then travel whole, as to a writer without spills. Collective.
 bool shareFrameSpills(const std::string& dir, std::string* why);

@@ -205,6 +205,8 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
               << perFrame(result.write_cpu_seconds, result.frames_written) << " ms; " << result.frames_written
               << " frames, " << 100 * result.write_seconds / wall << "% of the loop" << (distributed ? " on rank 0" : "")
               << ")";
+            t << "; of the writing, the files' assembly " << 1e3 * result.finish_seconds << " ms (CPU "
+              << 1e3 * result.finish_cpu_seconds << " ms)";
             if (distributed) t << "; rank 0 waited " << result.wait_seconds << " s for other ranks";
             log << t.str() << "\n";
         }
