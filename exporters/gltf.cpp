@@ -1755,8 +1755,7 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
               getText(&in, &spill_error) && in.get(&objects) && objects <= bytes.size();
     f.index = index;
     if (ok && !spill_error.empty()) {
-        *error = impl_->path + ": frame " + std::to_string(index) + ": cannot write its data where it was made: " +
-                 spill_error;
+        *error = impl_->path + ": spill file: cannot write: " + spill_error;  // as a writer's own spill says
         return false;
     }
     if (ok) f.objects.resize(size_t(objects));
