@@ -85,9 +85,10 @@ struct PrimitiveData {
 };
 
 // 128 bits of an index list, for sharing index buffers between frames made by different
-// processes (two 64-bit lanes of multiply-xorshift over the 32-bit indices, each finished by
-// MurmurHash3's fmix64). Not cryptographic: two different lists of the same length share a
-// hash with a chance of about 2^-128 unless made to.
+// processes: four independent lanes of multiply-xorshift over the list as 64-bit words (two
+// indices each; the lanes are independent, so their multiplications overlap),
+// folded and finished by MurmurHash3's fmix64. Not cryptographic: two different lists of the
+// same length share a hash with a chance of about 2^-128 unless made to.
 void indexHash(const std::vector<uint32_t>& indices, uint64_t out[2]) {
     auto fmix = [](uint64_t k) {
         k ^= k >> 33;
@@ -96,15 +97,21 @@ void indexHash(const std::vector<uint32_t>& indices, uint64_t out[2]) {
         k *= 0xc4ceb9fe1a85ec53ULL;
         return k ^ (k >> 33);
     };
-    uint64_t a = 0x9e3779b97f4a7c15ULL ^ indices.size(), b = 0x243f6a8885a308d3ULL + indices.size();
-    for (const uint32_t i : indices) {
-        a = (a ^ i) * 0x100000001b3ULL;
-        a ^= a >> 29;
-        b = (b + i) * 0xd6e8feb86659fd93ULL;
-        b ^= b >> 32;
-    }
-    out[0] = fmix(a);
-    out[1] = fmix(b ^ out[0]);
+    static constexpr uint64_t kMul[4] = {0x9e3779b97f4a7c15ULL, 0xd6e8feb86659fd93ULL, 0xbf58476d1ce4e5b9ULL,
+                                         0x94d049bb133111ebULL};
+    uint64_t lane[4] = {0x243f6a8885a308d3ULL, 0x13198a2e03707344ULL, 0xa4093822299f31d0ULL, 0x082efa98ec4e6c89ULL};
+    auto mix = [](uint64_t h, uint64_t w, uint64_t mul) {
+        h = (h ^ w) * mul;
+        return h ^ (h >> 29);
+    };
+    const uint32_t* p = indices.data();
+    const size_t n = indices.size();
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8)
+        for (size_t l = 0; l < 4; ++l) lane[l] = mix(lane[l], uint64_t(p[i + 2 * l]) | uint64_t(p[i + 2 * l + 1]) << 32, kMul[l]);
+    for (; i < n; ++i) lane[i % 4] = mix(lane[i % 4], p[i], kMul[i % 4]);
+    out[0] = fmix(lane[0] ^ fmix(lane[1]) ^ n);
+    out[1] = fmix(lane[2] ^ fmix(lane[3]) ^ out[0]);
 }
 
 // A frame's meshopt vertex streams: every shown object's packed vertices in object order, encoded

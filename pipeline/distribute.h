@@ -21,6 +21,11 @@
 // sends END(code) to every rank and then drains each rank's messages up to its DONE (which
 // unblocks a rank stuck in a send). Each part of a frame is received straight into the string
 // that keeps it (a sink's bytes are moved, never copied, into the EncodedFrame).
+// Frames by reference (shareFrameSpills below, the .glb only): a FRAME then holds the frame's
+// description, its data being in the sending rank's frame spill; when rank 0 assembles the .glb it
+// sends each rank concerned PLACE (the temporary file's name and where each of the rank's ranges
+// goes), which the rank, between its DONE and END, answers with PLACED (its status) after copying
+// them in.
 // Every rank then leaves the loop with rank 0's code; rank 0 alone prints the message, after its
 // sinks removed their temporary files. A rank that dies (a signal, the OOM killer) is mpirun's to
 // handle: it ends the job; files are committed by rename only, so none is left truncated.
