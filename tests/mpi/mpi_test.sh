@@ -1,6 +1,7 @@
 #!/bin/bash
 # `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
-# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ;
+# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt, its frames by
+# reference, diff -r also finding any scratch file left; PLY; OBJ;
 # raytrace's PNG files and video; figure's sheet and video), a
 # failure on any rank ends the job with the one-process code and one line from rank 0 and no
 # output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
@@ -28,6 +29,8 @@ for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
         out=$(mpi render "$scene" --out "$work/three" $options 2> "$work/stderr.txt") ||
             fail "mpirun: $scene $options: $out $(cat "$work/stderr.txt")"
         diff -r "$work/one" "$work/three" > /dev/null || fail "outputs differ: $scene $options"
+        # The .glb's frames went by reference (the ranks share the folder: no fallback warning).
+        ! grep -q "goes through rank 0 instead" "$work/stderr.txt" || fail "frames not by reference: $(cat "$work/stderr.txt")"
         case "$out" in *"3 processes shared the frames"*) ;; *) fail "summary without the process count: $out" ;; esac
         [ "$(echo "$out" | grep -c '^relativistic: ')" = 1 ] || fail "not one summary line (rank 0 alone): $out"
     done
