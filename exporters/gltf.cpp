@@ -87,8 +87,9 @@ struct PrimitiveData {
 // 128 bits of an index list, for sharing index buffers between frames made by different
 // processes: four independent lanes of multiply-xorshift over the list as 64-bit words (two
 // indices each; the lanes are independent, so their multiplications overlap),
-// folded and finished by MurmurHash3's fmix64. Not cryptographic: two different lists of the
-// same length share a hash with a chance of about 2^-128 unless made to.
+// folded and finished by MurmurHash3's fmix64. Not cryptographic: lists made to collide could
+// share a hash (the file would then stay valid: a shared list has the same length and vertex
+// count, only the other frame's triangles); lists of real frames are not expected to.
 void indexHash(const std::vector<uint32_t>& indices, uint64_t out[2]) {
     auto fmix = [](uint64_t k) {
         k ^= k >> 33;
