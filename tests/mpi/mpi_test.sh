@@ -35,6 +35,25 @@ for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
         [ "$(echo "$out" | grep -c '^relativistic: ')" = 1 ] || fail "not one summary line (rank 0 alone): $out"
     done
 done
+# A folder rank 0 cannot see from the other ranks (ranks 1 and 2 in a mount namespace of their own
+# with a tmpfs over it): one warning, the .glb's frames travel whole, the same bytes.
+if unshare -m true 2> /dev/null; then
+    rm -rf "$work/one" "$work/apart"
+    mkdir -p "$work/apart"
+    common=(render data/scenes/flanges.json --frames 40:80 --format glb,ply)
+    "$apparent" "${common[@]}" --out "$work/one" --quiet || fail "one process: ${common[*]}"
+    printf '#!/bin/sh\nexec unshare -m sh -c '"'"'mount -t tmpfs none "$0" && exec "$@"'"'"' "$@"\n' > "$work/apart.sh"
+    chmod +x "$work/apart.sh"
+    timeout 300 mpirun --oversubscribe -n 1 "$apparent" "${common[@]}" --out "$work/apart" : \
+        -n 2 "$work/apart.sh" "$work/apart" "$apparent" "${common[@]}" --out "$work/apart" > /dev/null 2> "$work/stderr.txt" ||
+        fail "mpirun, folder not shared: $(cat "$work/stderr.txt")"
+    diff -r "$work/one" "$work/apart" > /dev/null || fail "outputs differ: folder not shared"
+    grep -q "is not visible on rank 0.*goes through rank 0 instead" "$work/stderr.txt" ||
+        fail "no warning for a folder not shared: $(cat "$work/stderr.txt")"
+else
+    echo "folder not shared: skipped (unshare -m not permitted here)"
+fi
+
 # raytrace splits its frames the same way: the PNG files and the video identical.
 "$apparent" raytrace data/scenes/flanges.json --out "$work/rt1" --frames 90:100 --size 160x90 --video "$work/rt1.mp4" \
     --quiet || fail "raytrace, one process"
