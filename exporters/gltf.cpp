@@ -1493,7 +1493,9 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
             }
             at += p.length;
         }
-        ok = ok && placeFrameData(out.tempPath(), placements, &werr);
+        std::error_code ec;  // an absolute name: other processes open it too
+        const std::filesystem::path temp = std::filesystem::absolute(out.tempPath(), ec);
+        ok = ok && placeFrameData(ec ? out.tempPath() : temp.string(), placements, &werr);
     }
     if (ok && ::fsync(fd) != 0) { werr = std::strerror(errno); ok = false; }
     if (!ok) {
