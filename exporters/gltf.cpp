@@ -23,6 +23,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "exporters/atomic_file.h"
+#include "exporters/frame_spill.h"
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
 #include "mesh4d/doppler_colour.h"
@@ -65,8 +66,56 @@ struct PrimitiveData {
     std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
     DracoCoded draco;  // with Draco: the coding, made by prepare()
-    size_t vertexCount() const { return emission.size(); }
+    // A frame made by another process whose arrays stay in its frame spill (frames by reference,
+    // exporters/frame_spill.h): where they lie, and what add() needs of them. The vectors above
+    // are then empty (draco.bytes too; the rest of DracoCoded is filled).
+    struct Remote {
+        bool on = false;
+        FileSpan positions, normals, emission, doppler, proper_time, colors, indices, draco;
+        FileSpan ordered;  // meshopt frames of two objects or more (for a partly shared index stream)
+        uint64_t vertices = 0, index_count = 0, packed_vertices = 0, ordered_count = 0;
+        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // POSITION's bounds (of the float32 values)
+        uint64_t index_hash[2] = {0, 0};              // indexHash(indices)
+    } remote;
+    size_t vertexCount() const { return remote.on ? size_t(remote.vertices) : emission.size(); }
+    size_t indexCount() const { return remote.on ? size_t(remote.index_count) : indices.size(); }
+    size_t packedVertices(size_t stride) const { return remote.on ? size_t(remote.packed_vertices) : packed.size() / stride; }
+    size_t orderedCount() const { return remote.on ? size_t(remote.ordered_count) : ordered->size(); }
+    // Whether the optional attribute (`local` here, `span` by reference) is there.
+    template <class V>
+    bool has(const V& local, const FileSpan& span) const { return remote.on ? span.length > 0 : !local.empty(); }
 };
+
+// 128 bits of an index list, for sharing index buffers between frames made by different
+// processes: four independent lanes of multiply-xorshift over the list as 64-bit words (two
+// indices each; the lanes are independent, so their multiplications overlap),
+// folded and finished by MurmurHash3's fmix64. Not cryptographic: lists made to collide could
+// share a hash (the file would then stay valid: a shared list has the same length and vertex
+// count, only the other frame's triangles); lists of real frames are not expected to.
+void indexHash(const std::vector<uint32_t>& indices, uint64_t out[2]) {
+    auto fmix = [](uint64_t k) {
+        k ^= k >> 33;
+        k *= 0xff51afd7ed558ccdULL;
+        k ^= k >> 33;
+        k *= 0xc4ceb9fe1a85ec53ULL;
+        return k ^ (k >> 33);
+    };
+    static constexpr uint64_t kMul[4] = {0x9e3779b97f4a7c15ULL, 0xd6e8feb86659fd93ULL, 0xbf58476d1ce4e5b9ULL,
+                                         0x94d049bb133111ebULL};
+    uint64_t lane[4] = {0x243f6a8885a308d3ULL, 0x13198a2e03707344ULL, 0xa4093822299f31d0ULL, 0x082efa98ec4e6c89ULL};
+    auto mix = [](uint64_t h, uint64_t w, uint64_t mul) {
+        h = (h ^ w) * mul;
+        return h ^ (h >> 29);
+    };
+    const uint32_t* p = indices.data();
+    const size_t n = indices.size();
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8)
+        for (size_t l = 0; l < 4; ++l) lane[l] = mix(lane[l], uint64_t(p[i + 2 * l]) | uint64_t(p[i + 2 * l + 1]) << 32, kMul[l]);
+    for (; i < n; ++i) lane[i % 4] = mix(lane[i % 4], p[i], kMul[i % 4]);
+    out[0] = fmix(lane[0] ^ fmix(lane[1]) ^ n);
+    out[1] = fmix(lane[2] ^ fmix(lane[3]) ^ out[0]);
+}
 
 // A frame's meshopt vertex streams: every shown object's packed vertices in object order, encoded
 // as one EXT_meshopt_compression ATTRIBUTES view, and their normals either as another view
@@ -78,6 +127,10 @@ struct MeshoptFrame {
     size_t stride = 0;               // bytes per record (MeshoptLayout::stride, + 4 with inline normals)
     bool normals_inline = false;
     std::vector<size_t> first;       // per object, its first vertex in the stream
+    // A frame by reference (PrimitiveData::Remote): the two streams in the other process's spill,
+    // and the index stream of every shown object (none shared), made there.
+    bool remote = false;
+    FileSpan remote_encoded, remote_normals, remote_indices;
 };
 constexpr size_t kMeshoptViewJsonBytes = 200;
 
@@ -283,24 +336,31 @@ void encodeDraco(const PrimitiveData& d, const GlbOptions& options, DracoCoded* 
 // frame count), or nowhere (counting only, for the size without Draco).
 // The first frame is held instead (`holding`): data that lies in the frame's own buffers (kept
 // alive by `pinned`; `borrowable` lists them) stays where it is, anything else is copied into
-// `own`, and `pieces` lists the chunk in order. A lone frame is then written once, in place after
+// `own`, and `held` lists the chunk in order. A lone frame is then written once, in place after
 // the JSON chunk by finish(), without a spill file; a second frame first sends the held data to
 // the spill file (spill()), which is opened only then.
+// With frames by reference (MPI, exporters/frame_spill.h) the chunk becomes a list of `pieces`
+// instead: ranges of this sink's spill file, of other processes' frame spills and runs of zeros,
+// copied into the .glb by finish(). A reference ends the holding (the held data is spilled first).
 struct BinSink {
+    static constexpr int32_t kZeros = -3, kLocal = -2;  // FileSpan::source of pieces not from a spill
     bool counting = false;  // count only
     std::string dir;        // the spill file's folder
     int fd = -1;            // the spill file (-1: not opened yet)
     size_t size = 0;
     std::string error;  // the first write error
     bool holding = false;
-    struct Piece {
+    struct Held {
         const char* data;  // borrowed bytes, or nullptr: at `offset` in `own`
         size_t offset, n;
     };
-    std::vector<Piece> pieces;
+    std::vector<Held> held;
     std::string own;
     std::vector<std::pair<const char*, const char*>> borrowable;
     std::shared_ptr<const void> pinned;
+    bool in_pieces = false;
+    std::vector<FileSpan> pieces;
+    size_t local = 0;  // bytes written to fd
 
     void write(const void* data, size_t n) {
         size += n;
@@ -309,27 +369,29 @@ struct BinSink {
             const char* p = static_cast<const char*>(data);
             for (const auto& [lo, hi] : borrowable)
                 if (p >= lo && p + n <= hi) {
-                    pieces.push_back({p, 0, n});
+                    held.push_back({p, 0, n});
                     return;
                 }
-            pieces.push_back({nullptr, own.size(), n});
+            held.push_back({nullptr, own.size(), n});
             own.append(p, n);
             return;
         }
+        toSpill(data, n);
+    }
+    // Appends to the spill file (opened on first use), and to the pieces when there are pieces.
+    void toSpill(const void* data, size_t n) {
+        // The spill file has no name (atomic_file.h): nothing is left behind, even after SIGKILL.
         if (fd < 0 && error.empty()) fd = openAnonymousFile(dir, &error);
         if (fd >= 0 && error.empty() && !writeAll(fd, data, n, &error)) error = "cannot write: " + error;
+        if (in_pieces) piece({kLocal, local, n});
+        local += n;
     }
     // The held data to the spill file; every write goes there from now on.
     void spill() {
         if (!holding) return;
         holding = false;
-        // The spill file has no name (atomic_file.h): nothing is left behind, even after SIGKILL.
-        if (fd < 0 && error.empty()) fd = openAnonymousFile(dir, &error);
-        for (const Piece& piece : pieces) {
-            const char* p = piece.data ? piece.data : own.data() + piece.offset;
-            if (fd >= 0 && error.empty() && !writeAll(fd, p, piece.n, &error)) error = "cannot write: " + error;
-        }
-        pieces = {};
+        for (const Held& h : held) toSpill(h.data ? h.data : own.data() + h.offset, h.n);
+        held = {};
         own = {};
         borrowable.clear();
         pinned.reset();
@@ -337,9 +399,8 @@ struct BinSink {
     // Writes the held data to `out` (finish() of a lone frame); false with the message in *werr.
     bool writeHeld(int out, std::string* werr) const {
         std::vector<iovec> iov;
-        iov.reserve(pieces.size());
-        for (const Piece& piece : pieces)
-            iov.push_back({const_cast<char*>(piece.data ? piece.data : own.data() + piece.offset), piece.n});
+        iov.reserve(held.size());
+        for (const Held& h : held) iov.push_back({const_cast<char*>(h.data ? h.data : own.data() + h.offset), h.n});
         for (size_t i = 0; i < iov.size(); i += IOV_MAX) {
             const size_t count = std::min<size_t>(IOV_MAX, iov.size() - i);
             size_t total = 0;
@@ -364,6 +425,34 @@ struct BinSink {
         }
         return true;
     }
+    void pad(size_t n) {
+        static const char zeros[4] = {0, 0, 0, 0};
+        if (!in_pieces) return write(zeros, n);
+        piece({kZeros, 0, n});
+        size += n;
+    }
+    // Bytes of another process's frame spill (counted only without pieces: the plain twin).
+    void reference(const FileSpan& s) {
+        if (!counting) {
+            spill();
+            if (!in_pieces) startPieces();
+            piece(s);
+        }
+        size += s.length;
+    }
+    // From here on a list of pieces; what the file holds so far is the first.
+    void startPieces() {
+        in_pieces = true;
+        if (local > 0) pieces.push_back({kLocal, 0, local});
+    }
+    void piece(const FileSpan& s) {
+        if (s.length == 0) return;
+        FileSpan* last = pieces.empty() ? nullptr : &pieces.back();
+        if (last && last->source == s.source && (s.source == kZeros || last->offset + last->length == s.offset))
+            last->length += s.length;
+        else
+            pieces.push_back(s);
+    }
 };
 
 class GlbBuilder {
@@ -379,16 +468,16 @@ public:
     size_t sinkSize() const { return sink_->size; }
 
     int addView(const void* data, size_t n, int target) {
-        static const char zeros[4] = {0, 0, 0, 0};
-        if (sink_->size % 4) sink_->write(zeros, 4 - sink_->size % 4);  // 4-byte alignment for float/uint32
-        tinygltf::BufferView v;
-        v.buffer = 0;
-        v.byteOffset = sink_->size;
-        v.byteLength = n;
-        v.target = target;
-        sink_->write(data, n);
-        model.bufferViews.push_back(v);
-        return int(model.bufferViews.size()) - 1;
+        return newView(n, target, [&] { sink_->write(data, n); });
+    }
+    // The same of bytes in a frame source (frames by reference).
+    int addView(const FileSpan& span, int target) {
+        return newView(size_t(span.length), target, [&] { sink_->reference(span); });
+    }
+    // A view of `local` (this process's vector) or, for a frame by reference, of `span`.
+    template <class V>
+    int addView(const PrimitiveData& d, const V& local, const FileSpan& span, int target) {
+        return d.remote.on ? addView(span, target) : addView(local.data(), local.size() * sizeof(local[0]), target);
     }
 
     int addAccessor(int view, int component, int type, size_t count, std::vector<double> min_v = {},
@@ -408,27 +497,33 @@ public:
     tinygltf::Primitive plainPrimitive(const PrimitiveData& d, int shared_indices) {
         tinygltf::Primitive prim;
         std::vector<double> lo, hi;
-        bounds(d.positions, &lo, &hi);
-        prim.attributes["POSITION"] = addAccessor(addView(d.positions.data(), d.positions.size() * 4, kArray),
+        if (d.remote.on) {
+            lo.assign(d.remote.lo, d.remote.lo + 3);
+            hi.assign(d.remote.hi, d.remote.hi + 3);
+        } else {
+            bounds(d.positions, &lo, &hi);
+        }
+        const PrimitiveData::Remote& r = d.remote;
+        prim.attributes["POSITION"] = addAccessor(addView(d, d.positions, r.positions, kArray),
                                                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount(), lo, hi);
-        prim.attributes["NORMAL"] = addAccessor(addView(d.normals.data(), d.normals.size() * 4, kArray),
+        prim.attributes["NORMAL"] = addAccessor(addView(d, d.normals, r.normals, kArray),
                                                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount());
-        prim.attributes["_EMISSION_TIME"] = addAccessor(addView(d.emission.data(), d.emission.size() * 4, kArray),
+        prim.attributes["_EMISSION_TIME"] = addAccessor(addView(d, d.emission, r.emission, kArray),
                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
                                                         d.vertexCount());
-        if (!d.doppler.empty())
-            prim.attributes["_DOPPLER"] = addAccessor(addView(d.doppler.data(), d.doppler.size() * 4, kArray),
+        if (d.has(d.doppler, r.doppler))
+            prim.attributes["_DOPPLER"] = addAccessor(addView(d, d.doppler, r.doppler, kArray),
                                                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
-        if (!d.proper_time.empty())
-            prim.attributes["_PROPER_TIME"] = addAccessor(addView(d.proper_time.data(), d.proper_time.size() * 4, kArray),
+        if (d.has(d.proper_time, r.proper_time))
+            prim.attributes["_PROPER_TIME"] = addAccessor(addView(d, d.proper_time, r.proper_time, kArray),
                                                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
-        if (!d.colors.empty())
-            prim.attributes["COLOR_0"] = addAccessor(addView(d.colors.data(), d.colors.size() * 4, kArray),
+        if (d.has(d.colors, r.colors))
+            prim.attributes["COLOR_0"] = addAccessor(addView(d, d.colors, r.colors, kArray),
                                                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount());
         prim.indices = shared_indices >= 0
                            ? shared_indices
-                           : addAccessor(addView(d.indices.data(), d.indices.size() * 4, kElements),
-                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, d.indices.size());
+                           : addAccessor(addView(d, d.indices, r.indices, kElements),
+                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, d.indexCount());
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         return prim;
     }
@@ -440,7 +535,7 @@ public:
     tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, size_t stride, int vview,
                                          int nview, size_t first_vertex, int indices) {
         tinygltf::Primitive prim;
-        const size_t nv = d.packed.size() / layout.stride;
+        const size_t nv = d.packedVertices(layout.stride);
         auto attribute = [&](int view, size_t view_stride, size_t offset, int component, int type, bool normalized,
                              std::vector<double> lo, std::vector<double> hi) {
             const int a = addAccessor(view, component, type, nv, std::move(lo), std::move(hi));
@@ -458,13 +553,13 @@ public:
                                                            TINYGLTF_TYPE_VEC3, true, {}, {});
         prim.attributes["_EMISSION_TIME"] =
             attribute(vview, stride, 8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
-        if (layout.doppler >= 0 && !d.doppler.empty())
+        if (layout.doppler >= 0 && d.has(d.doppler, d.remote.doppler))
             prim.attributes["_DOPPLER"] = attribute(vview, stride, size_t(layout.doppler), TINYGLTF_COMPONENT_TYPE_FLOAT,
                                                     TINYGLTF_TYPE_SCALAR, false, {}, {});
-        if (layout.proper_time >= 0 && !d.proper_time.empty())
+        if (layout.proper_time >= 0 && d.has(d.proper_time, d.remote.proper_time))
             prim.attributes["_PROPER_TIME"] = attribute(vview, stride, size_t(layout.proper_time),
                                                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
-        if (layout.color >= 0 && !d.colors.empty())
+        if (layout.color >= 0 && d.has(d.colors, d.remote.colors))
             prim.attributes["COLOR_0"] = attribute(vview, stride, size_t(layout.color), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
                                                    TINYGLTF_TYPE_VEC3, true, {}, {});
         prim.indices = indices;
@@ -477,10 +572,19 @@ public:
     // `octahedral`: the view's data went through the OCTAHEDRAL filter.
     int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices,
                        bool octahedral = false) {
-        static const char zeros[4] = {0, 0, 0, 0};
-        if (sink_->size % 4) sink_->write(zeros, 4 - sink_->size % 4);
-        MeshoptView mv{sink_->size, encoded.size(), stride, count, indices, octahedral};
-        sink_->write(encoded.data(), encoded.size());
+        return newMeshoptView(encoded.size(), count, stride, indices, octahedral,
+                              [&] { sink_->write(encoded.data(), encoded.size()); });
+    }
+    // The same of an encoded stream in a frame source (frames by reference).
+    int addMeshoptView(const FileSpan& encoded, size_t count, size_t stride, bool indices, bool octahedral = false) {
+        return newMeshoptView(size_t(encoded.length), count, stride, indices, octahedral,
+                              [&] { sink_->reference(encoded); });
+    }
+    template <class Write>
+    int newMeshoptView(size_t length, size_t count, size_t stride, bool indices, bool octahedral, const Write& write) {
+        if (sink_->size % 4) sink_->pad(4 - sink_->size % 4);
+        MeshoptView mv{sink_->size, length, stride, count, indices, octahedral};
+        write();
         tinygltf::BufferView v;
         v.buffer = 1;
         v.byteOffset = fallback_size;
@@ -529,7 +633,7 @@ public:
         if (c.ids[5] >= 0) prim->attributes["COLOR_0"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
         prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, size_t(c.faces) * 3);
         prim->mode = TINYGLTF_MODE_TRIANGLES;
-        const int view = addView(c.bytes.data(), c.bytes.size(), 0);
+        const int view = d.remote.on ? addView(d.remote.draco, 0) : addView(c.bytes.data(), c.bytes.size(), 0);
         tinygltf::Value::Object attrs{{"POSITION", tinygltf::Value(c.ids[0])},
                                       {"NORMAL", tinygltf::Value(c.ids[1])},
                                       {"_EMISSION_TIME", tinygltf::Value(c.ids[2])}};
@@ -542,6 +646,20 @@ public:
     }
 
 private:
+    // A new view of `n` bytes that `write` puts into the sink, 4-byte aligned for float/uint32.
+    template <class Write>
+    int newView(size_t n, int target, const Write& write) {
+        if (sink_->size % 4) sink_->pad(4 - sink_->size % 4);
+        tinygltf::BufferView v;
+        v.buffer = 0;
+        v.byteOffset = sink_->size;
+        v.byteLength = n;
+        v.target = target;
+        write();
+        model.bufferViews.push_back(v);
+        return int(model.bufferViews.size()) - 1;
+    }
+
     static constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
     static constexpr int kElements = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
     GlbOptions options_;
@@ -664,6 +782,43 @@ std::vector<double> cameraRotation(const ExportCamera& cam) {
 
 tinygltf::Value number(double v) { return tinygltf::Value(v); }
 
+// A frame's meshopt index stream: the objects' vertex-cache-ordered lists, one after another.
+void encodeIndexStream(const std::vector<unsigned int>& all, size_t most_vertices, std::vector<unsigned char>* out) {
+    out->resize(meshopt_encodeIndexBufferBound(all.size(), most_vertices));
+    out->resize(meshopt_encodeIndexBuffer(out->data(), out->size(), all.data(), all.size()));
+}
+
+// Reads `span` of its frame source into `out` (appended); false with a message.
+bool readSpan(const FileSpan& span, void* out, std::string* error) {
+    const int fd = frameSource(span.source);
+    size_t done = 0;
+    while (fd >= 0 && done < span.length) {
+        const ssize_t r = ::pread(fd, static_cast<char*>(out) + done, size_t(span.length) - done, off_t(span.offset + done));
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) break;
+        done += size_t(r);
+    }
+    if (done == span.length) return true;
+    *error = "cannot read frame data of process " + std::to_string(span.source) +
+             (fd < 0 ? std::string(": not known") : ": " + std::string(std::strerror(errno)));
+    return false;
+}
+
+// Appends the object's vertex-cache-ordered indices (read back from its spill when by reference).
+bool appendOrdered(const PrimitiveData& d, std::vector<unsigned int>* all, std::string* error) {
+    if (!d.remote.on) {
+        all->insert(all->end(), d.ordered->begin(), d.ordered->end());
+        return true;
+    }
+    if (d.remote.ordered.length != 4 * d.remote.ordered_count) {
+        *error = "internal: a partly shared index stream without the objects' lists";
+        return false;
+    }
+    const size_t at = all->size();
+    all->resize(at + size_t(d.remote.ordered_count));
+    return readSpan(d.remote.ordered, all->data() + at, error);
+}
+
 // The glTF model of a sequence, built frame by frame: JSON-side objects in `model`, binary data
 // streamed to the sink. Two run side by side with Draco: the real one and a plain one that only
 // counts, for the size without Draco.
@@ -744,7 +899,7 @@ struct SequenceModel {
         for (size_t o = 0; o < f.objects.size(); ++o) {
             const Previous& prev = previous[o];
             if (compression != Compression::draco && !f.objects[o].triangles.empty() && prev.accessor >= 0 &&
-                prev.vertices == data[o].vertexCount() && prev.indices == data[o].indices)
+                prev.same(data[o]))
                 shared[o] = prev.accessor;
         }
         // Step (meshopt): a frame that continues the open run becomes a morph target of its mesh.
@@ -758,34 +913,48 @@ struct SequenceModel {
         int vview = -1, nview = -1;
         std::vector<int> meshopt_indices(f.objects.size(), -1);
         if (compression == Compression::meshopt && meshopt && meshopt->count > 0) {
-            vview = b.addMeshoptView(meshopt->encoded, meshopt->count, meshopt->stride, false);
+            vview = meshopt->remote ? b.addMeshoptView(meshopt->remote_encoded, meshopt->count, meshopt->stride, false)
+                                    : b.addMeshoptView(meshopt->encoded, meshopt->count, meshopt->stride, false);
             if (!meshopt->normals_inline)
-                nview = b.addMeshoptView(meshopt->encoded_normals, meshopt->count, kMeshoptNormalStride, false, true);
+                nview = meshopt->remote ? b.addMeshoptView(meshopt->remote_normals, meshopt->count, kMeshoptNormalStride,
+                                                           false, true)
+                                        : b.addMeshoptView(meshopt->encoded_normals, meshopt->count, kMeshoptNormalStride,
+                                                           false, true);
             size_t size = 2, count = 0, most = 0;
+            bool none_shared = true;
+            std::vector<size_t> first(f.objects.size(), 0);
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty() && shared[o] < 0) {
-                    most = std::max(most, data[o].packed.size() / layout.stride);
-                    count += data[o].ordered->size();
+                    most = std::max(most, data[o].packedVertices(layout.stride));
+                    first[o] = count;
+                    count += data[o].orderedCount();
+                } else if (!f.objects[o].triangles.empty()) {
+                    none_shared = false;
                 }
             if (most > 65535) size = 4;
             if (count > 0) {
-                std::vector<unsigned int> all;
-                all.reserve(count);
-                std::vector<size_t> first(f.objects.size(), 0);
-                for (size_t o = 0; o < f.objects.size(); ++o)
-                    if (!f.objects[o].triangles.empty() && shared[o] < 0) {
-                        first[o] = all.size();
-                        all.insert(all.end(), data[o].ordered->begin(), data[o].ordered->end());
-                    }
-                std::vector<unsigned char> encoded(meshopt_encodeIndexBufferBound(all.size(), most));
-                encoded.resize(meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), all.data(), all.size()));
-                const int iview = b.addMeshoptView(encoded, all.size(), size, true);
+                int iview = -1;
+                if (meshopt->remote && none_shared) {
+                    // Every shown object's indices: the stream the other process encoded.
+                    iview = b.addMeshoptView(meshopt->remote_indices, count, size, true);
+                } else {
+                    // Some objects share theirs (by reference: their lists read back from the spill).
+                    std::vector<unsigned int> all;
+                    all.reserve(count);
+                    for (size_t o = 0; o < f.objects.size(); ++o)
+                        if (!f.objects[o].triangles.empty() && shared[o] < 0 &&
+                            !appendOrdered(data[o], &all, error))
+                            return false;
+                    std::vector<unsigned char> encoded;
+                    encodeIndexStream(all, most, &encoded);
+                    iview = b.addMeshoptView(encoded, all.size(), size, true);
+                }
                 for (size_t o = 0; o < f.objects.size(); ++o)
                     if (!f.objects[o].triangles.empty() && shared[o] < 0) {
                         const int a = b.addAccessor(iview,
                                                     size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
                                                               : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                                    TINYGLTF_TYPE_SCALAR, data[o].ordered->size());
+                                                    TINYGLTF_TYPE_SCALAR, data[o].orderedCount());
                         b.model.accessors[a].byteOffset = first[o] * size;
                         meshopt_indices[o] = a;
                     }
@@ -812,11 +981,7 @@ struct SequenceModel {
                 } else {
                     prim = b.plainPrimitive(data[o], shared[o]);
                 }
-                if (compression != Compression::draco && shared[o] < 0) {
-                    prev.accessor = prim.indices;
-                    prev.vertices = data[o].vertexCount();
-                    prev.indices = data[o].indices;
-                }
+                if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o]);
                 shown[o] = true;
                 prim.material = o < info.objects.size() ? int(o) : -1;
                 mesh.primitives.push_back(prim);
@@ -1113,10 +1278,31 @@ struct SequenceModel {
     size_t frames = 0;
     enum class Compression { none, draco, meshopt } compression = Compression::none;
     // Per object, its index list in the previous frame and the accessor holding it (-1: none).
+    // Frames by reference compare the lists' hashes (indexHash), frames of this process the lists.
     struct Previous {
         int accessor = -1;
         size_t vertices = 0;
         std::vector<uint32_t> indices;
+        bool remote = false;
+        uint64_t count = 0, hash[2] = {0, 0};
+        bool same(const PrimitiveData& d) const {
+            if (vertices != d.vertexCount() || remote != d.remote.on) return false;
+            if (!remote) return indices == d.indices;
+            return count == d.remote.index_count && hash[0] == d.remote.index_hash[0] && hash[1] == d.remote.index_hash[1];
+        }
+        void take(int accessor_, const PrimitiveData& d) {
+            accessor = accessor_;
+            vertices = d.vertexCount();
+            remote = d.remote.on;
+            if (remote) {
+                indices.clear();
+                count = d.remote.index_count;
+                hash[0] = d.remote.index_hash[0];
+                hash[1] = d.remote.index_hash[1];
+            } else {
+                indices = d.indices;
+            }
+        }
     };
     std::vector<Previous> previous;
     struct Reflection {
@@ -1144,6 +1330,37 @@ struct SequenceModel {
 };
 
 size_t padded4(size_t n) { return (n + 3) / 4 * 4; }
+
+// Appends `n` bytes of `in` from `offset` to `out` (at its position) by copy_file_range (the kernel
+// copies between the two files' pages, no trip through a user buffer); where it cannot (another
+// file system, an old kernel), by pread and write. False with a message.
+bool copyRange(int in, uint64_t offset, uint64_t n, int out, std::string* error) {
+    if (n == 0) return true;
+    if (in < 0) {
+        *error = "internal: frame data from an unknown process";
+        return false;
+    }
+    uint64_t off = 0;
+    while (off < n) {
+        loff_t at = loff_t(offset + off);
+        const ssize_t r = ::copy_file_range(in, &at, out, nullptr, size_t(n - off), 0);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) break;  // the fallback below takes over from `off`
+        off += uint64_t(r);
+    }
+    std::vector<char> chunk(off < n ? size_t(1) << 20 : 0);
+    while (off < n) {
+        const ssize_t r = ::pread(in, chunk.data(), size_t(std::min<uint64_t>(chunk.size(), n - off)), off_t(offset + off));
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) {
+            *error = std::string("cannot read back the spill file: ") + std::strerror(r < 0 ? errno : EIO);
+            return false;
+        }
+        if (!writeAll(out, chunk.data(), size_t(r), error)) return false;
+        off += uint64_t(r);
+    }
+    return true;
+}
 
 }  // namespace
 
@@ -1177,6 +1394,7 @@ struct GlbFrameData : PreparedFrame, std::enable_shared_from_this<GlbFrameData> 
         meshopt.encoded_normals.clear();
         meshopt.count = 0;
         meshopt.first.clear();
+        meshopt.remote = false;
         data.resize(objects);
         for (PrimitiveData& p : data) {
             for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
@@ -1187,6 +1405,7 @@ struct GlbFrameData : PreparedFrame, std::enable_shared_from_this<GlbFrameData> 
             p.packed.clear();
             p.packed_normals.clear();
             p.packed_snorm.clear();
+            p.remote = PrimitiveData::Remote();
         }
         far = max_extent = max_float_error = max_quantization_error = 0;
     }
@@ -1238,6 +1457,20 @@ struct GlbSequenceWriter::Impl {
     }
     ~Impl() {
         if (sink.fd >= 0) ::close(sink.fd);
+        releaseUsed();
+    }
+    // Frames by reference: the ranges of the frame sources this sequence used, freed once read.
+    void use(const FileSpan& s) {
+        if (s.length == 0) return;
+        auto [it, added] = used.emplace(s.source, std::make_pair(s.offset, s.offset + s.length));
+        if (!added) {
+            it->second.first = std::min(it->second.first, s.offset);
+            it->second.second = std::max(it->second.second, s.offset + s.length);
+        }
+    }
+    void releaseUsed() {
+        for (const auto& [source, range] : used) releaseFrameData({source, range.first, range.second - range.first});
+        used.clear();
     }
 
     std::string path;
@@ -1249,6 +1482,7 @@ struct GlbSequenceWriter::Impl {
     GlbStats stats;
     double far = 0;
     std::shared_ptr<FramePool> pool = processFramePool();
+    std::map<int32_t, std::pair<uint64_t, uint64_t>> used;  // per frame source: [first, end) read from it
 };
 
 GlbSequenceWriter::GlbSequenceWriter(const std::string& path, const SequenceInfo& info, const GlbOptions& options)
@@ -1518,42 +1752,43 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
     put32(&head, uint32_t(padded4(bin)));
     put32(&head, 0x004E4942);  // BIN
     std::string werr;
-    bool ok = writeAll(fd, head.data(), head.size(), &werr);
-    // A lone frame: the BIN chunk from where it is held, written once.
-    size_t off = 0;
-    if (m.sink.holding) {
-        ok = ok && m.sink.writeHeld(fd, &werr);
-        off = bin;
-    }
-    // The BIN chunk by copy_file_range (the kernel copies between the two files' pages, no trip
-    // through a user buffer); where it cannot (another file system, an old kernel), by pread and write.
-    while (ok && off < bin) {
-        loff_t in = loff_t(off);
-        const ssize_t r = ::copy_file_range(m.sink.fd, &in, fd, nullptr, bin - off, 0);
-        if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) break;  // the fallback below takes over from `off`
-        off += size_t(r);
-    }
-    std::vector<char> chunk(off < bin ? size_t(1) << 20 : 0);
-    while (ok && off < bin) {
-        const ssize_t r = ::pread(m.sink.fd, chunk.data(), std::min(chunk.size(), bin - off), off_t(off));
-        if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) {
-            werr = std::string("cannot read back the spill file: ") + std::strerror(r < 0 ? errno : EIO);
-            ok = false;
-            break;
+    bool ok = true;
+    if (!m.sink.in_pieces) {
+        // The BIN chunk copied from the spill file after the head (copy_file_range: the kernel
+        // copies between the two files' pages; pread and write where it cannot).
+        static const char zeros[4] = {0, 0, 0, 0};
+        // A lone frame: from where it is held, written once (no spill file).
+        ok = writeAll(fd, head.data(), head.size(), &werr) &&
+             (m.sink.holding ? m.sink.writeHeld(fd, &werr) : copyRange(m.sink.fd, 0, bin, fd, &werr)) &&
+             writeAll(fd, zeros, padded4(bin) - bin, &werr);
+    } else {
+        // Frames by reference: the file at its whole size (zeros: the alignment runs and the
+        // chunk's padding), the head, this spill's pieces, then every other range placed at its
+        // offset by placeFrameData() (under MPI each rank copies its own frames, all at once).
+        ok = ::ftruncate(fd, off_t(total)) == 0;
+        if (!ok) werr = std::strerror(errno);
+        ok = ok && writeAll(fd, head.data(), head.size(), &werr);
+        std::vector<Placement> placements;
+        uint64_t at = head.size();
+        for (const FileSpan& p : m.sink.pieces) {
+            if (p.source == BinSink::kLocal) {
+                ok = ok && (::lseek(fd, off_t(at), SEEK_SET) >= 0 || (werr = std::strerror(errno), false)) && copyRange(m.sink.fd, p.offset, p.length, fd, &werr);
+            } else if (p.source != BinSink::kZeros) {
+                placements.push_back({p, at});
+            }
+            at += p.length;
         }
-        ok = writeAll(fd, chunk.data(), size_t(r), &werr);
-        off += size_t(r);
+        std::error_code ec;  // an absolute name: other processes open it too
+        const std::filesystem::path temp = std::filesystem::absolute(out.tempPath(), ec);
+        ok = ok && placeFrameData(ec ? out.tempPath() : temp.string(), placements, &werr);
     }
-    static const char zeros[4] = {0, 0, 0, 0};
-    if (ok) ok = writeAll(fd, zeros, padded4(bin) - bin, &werr);
     if (ok && ::fsync(fd) != 0) { werr = std::strerror(errno); ok = false; }
     if (!ok) {
         *error = m.path + ": cannot write: " + werr;
         return false;
     }
     if (!out.commit(error)) return false;
+    m.releaseUsed();
     m.stats.bytes = size_t(total);
     if (stats) *stats = m.stats;
     return true;
@@ -1692,10 +1927,204 @@ private:
 };
 
 constexpr uint32_t kFrameBytesMagic = 0x31464741;  // "AGF1": apparent glb frame, version 1
+constexpr uint32_t kFrameRefMagic = 0x31524741;    // "AGR1": the same by reference (frame_spill.h)
+
+void putSpan(FrameBytesOut* out, const FileSpan& s) {
+    out->put(s.source);
+    out->put(s.offset);
+    out->put(s.length);
+}
+bool getSpan(FrameBytesIn* in, FileSpan* s) { return in->get(&s->source) && in->get(&s->offset) && in->get(&s->length); }
+
+void putText(FrameBytesOut* out, const std::string& text) { out->putVector(std::vector<char>(text.begin(), text.end())); }
+bool getText(FrameBytesIn* in, std::string* text) {
+    std::vector<char> v;
+    if (!in->getVector(&v)) return false;
+    text->assign(v.begin(), v.end());
+    return true;
+}
 
 }  // namespace
 
+// A frame by reference: its arrays written to this process's frame spill in the order the file
+// takes them (plainPrimitive's views; meshopt's streams), the frame's description with their spans.
+std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const GlbFrameData& d) const {
+    const bool meshopt = impl_->options.meshopt;
+    const size_t record = MeshoptLayout(impl_->options).stride;
+    size_t shown = 0;
+    for (const auto& o : f.objects) shown += o.triangles.empty() ? 0 : 1;
+    // Step (meshopt): the index stream of every shown object, as add() makes it when none shares.
+    std::vector<unsigned char> all_indices;
+    if (meshopt && d.meshopt.count > 0) {
+        std::vector<unsigned int> all;
+        size_t most = 0;
+        for (size_t o = 0; o < f.objects.size(); ++o)
+            if (!f.objects[o].triangles.empty() && d.data[o].ordered) {
+                all.insert(all.end(), d.data[o].ordered->begin(), d.data[o].ordered->end());
+                most = std::max(most, d.data[o].packed.size() / record);
+            }
+        if (!all.empty()) encodeIndexStream(all, most, &all_indices);
+    }
+    // Step: the pieces, in order.
+    std::vector<iovec> pieces;
+    auto piece = [&](const auto& v) {
+        pieces.push_back({const_cast<void*>(static_cast<const void*>(v.data())), v.size() * sizeof(v[0])});
+    };
+    piece(d.meshopt.encoded);
+    piece(d.meshopt.encoded_normals);
+    piece(all_indices);
+    for (size_t o = 0; o < d.data.size(); ++o) {
+        const PrimitiveData& p = d.data[o];
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) piece(*v);
+        piece(p.indices);
+        piece(p.draco.bytes);
+        static const std::vector<uint32_t> none;
+        piece(meshopt && shown > 1 && p.ordered ? *p.ordered : none);  // a partly shared stream is made from them
+    }
+    std::vector<FileSpan> spans;
+    std::string spill_error;
+    if (!spillFrameData(pieces, &spans, &spill_error)) spans.assign(pieces.size(), FileSpan());
+    // Step: the description.
+    std::string bytes;
+    FrameBytesOut out(&bytes);
+    out.put(kFrameRefMagic);
+    out.put(int64_t(f.index));
+    out.put(f.t_c);
+    putText(&out, spill_error);
+    out.put(uint64_t(f.objects.size()));
+    for (const auto& o : f.objects) out.put(uint8_t(o.triangles.empty() ? 0 : 1));
+    for (int c = 0; c < 3; ++c) out.put(d.origin[c]);
+    out.put(d.step);
+    out.put(uint8_t(d.clamped));
+    for (double v : {d.far, d.max_extent, d.max_float_error, d.max_quantization_error}) out.put(v);
+    out.put(uint64_t(d.meshopt.count));
+    out.put(uint64_t(d.meshopt.stride));
+    out.put(uint8_t(d.meshopt.normals_inline));
+    out.putVector(d.meshopt.first);
+    size_t k = 0;
+    for (int i = 0; i < 3; ++i) putSpan(&out, spans[k++]);
+    out.put(uint64_t(d.data.size()));
+    for (const PrimitiveData& p : d.data) {
+        for (int i = 0; i < 9; ++i) putSpan(&out, spans[k++]);
+        uint64_t hash[2] = {0, 0};
+        indexHash(p.indices, hash);
+        std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
+        for (size_t i = 0; i < p.positions.size(); ++i) {
+            lo[i % 3] = std::min(lo[i % 3], double(p.positions[i]));
+            hi[i % 3] = std::max(hi[i % 3], double(p.positions[i]));
+        }
+        out.put(uint64_t(p.vertexCount()));
+        out.put(uint64_t(p.indices.size()));
+        out.put(uint64_t(p.packed.size() / record));
+        out.put(uint64_t(p.ordered ? p.ordered->size() : 0));
+        for (int c = 0; c < 3; ++c) out.put(lo[size_t(c)]);
+        for (int c = 0; c < 3; ++c) out.put(hi[size_t(c)]);
+        out.put(hash[0]);
+        out.put(hash[1]);
+        for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmin[c]));
+        for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmax[c]));
+        const DracoCoded& dc = p.draco;
+        out.put(dc.points);
+        out.put(dc.faces);
+        for (int c = 0; c < 3; ++c) out.put(dc.lo[c]);
+        for (int c = 0; c < 3; ++c) out.put(dc.hi[c]);
+        for (int32_t id : dc.ids) out.put(id);
+        out.put(dc.quantization_error);
+        putText(&out, dc.error);
+    }
+    return bytes;
+}
+
+// The frame of encodeByReference() for add(): its description, the arrays left where they are.
+bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* error) {
+    FrameBytesIn in(bytes);
+    uint32_t magic = 0;
+    int64_t index = 0;
+    uint64_t objects = 0, count = 0, stride = 0, primitives = 0;
+    uint8_t clamped = 0, normals_inline = 0;
+    std::string spill_error;
+    ExportFrame f;
+    GlbFrameData d;
+    MeshoptFrame& mf = d.meshopt;
+    bool ok = in.get(&magic) && magic == kFrameRefMagic && in.get(&index) && in.get(&f.t_c) &&
+              getText(&in, &spill_error) && in.get(&objects) && objects <= bytes.size();
+    f.index = index;
+    if (ok && !spill_error.empty()) {
+        *error = impl_->path + ": spill file: cannot write: " + spill_error;  // as a writer's own spill says
+        return false;
+    }
+    if (ok) f.objects.resize(size_t(objects));
+    for (size_t o = 0; ok && o < f.objects.size(); ++o) {
+        uint8_t shown = 0;
+        ok = in.get(&shown);
+        if (shown) f.objects[o].triangles.push_back({0, 0, 0});
+    }
+    for (int c = 0; ok && c < 3; ++c) ok = in.get(&d.origin[c]);
+    ok = ok && in.get(&d.step) && in.get(&clamped) && in.get(&d.far) && in.get(&d.max_extent) &&
+         in.get(&d.max_float_error) && in.get(&d.max_quantization_error) && in.get(&count) && in.get(&stride) &&
+         in.get(&normals_inline) && in.getVector(&mf.first) && getSpan(&in, &mf.remote_encoded) &&
+         getSpan(&in, &mf.remote_normals) && getSpan(&in, &mf.remote_indices) && in.get(&primitives) &&
+         primitives == objects;
+    d.clamped = clamped != 0;
+    mf.count = size_t(count);
+    mf.stride = size_t(stride);
+    mf.normals_inline = normals_inline != 0;
+    mf.remote = true;
+    if (ok) d.data.resize(size_t(primitives));
+    for (size_t o = 0; ok && o < d.data.size(); ++o) {
+        PrimitiveData& p = d.data[o];
+        PrimitiveData::Remote& r = p.remote;
+        r.on = true;
+        for (FileSpan* s : {&r.positions, &r.normals, &r.emission, &r.doppler, &r.proper_time, &r.colors, &r.indices,
+                            &r.draco, &r.ordered})
+            ok = ok && getSpan(&in, s);
+        ok = ok && in.get(&r.vertices) && in.get(&r.index_count) && in.get(&r.packed_vertices) &&
+             in.get(&r.ordered_count);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&r.lo[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&r.hi[c]);
+        ok = ok && in.get(&r.index_hash[0]) && in.get(&r.index_hash[1]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmin[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmax[c]);
+        DracoCoded& dc = p.draco;
+        ok = ok && in.get(&dc.points) && in.get(&dc.faces);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.lo[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.hi[c]);
+        for (int a = 0; ok && a < 6; ++a) ok = in.get(&dc.ids[a]);
+        ok = ok && in.get(&dc.quantization_error) && getText(&in, &dc.error);
+        // What add() takes of the spans: whole vertices and triangles, every source known.
+        const uint64_t nv = r.vertices;
+        auto optional = [nv](const FileSpan& s, uint64_t per) { return s.length == 0 || s.length == per * nv; };
+        ok = ok && r.positions.length == 12 * nv && r.normals.length == 12 * nv && r.emission.length == 4 * nv &&
+             optional(r.doppler, 4) && optional(r.proper_time, 4) && optional(r.colors, 12) &&
+             r.indices.length == 4 * r.index_count && r.index_count % 3 == 0 &&
+             (r.ordered.length == 0 || r.ordered.length == 4 * r.ordered_count);
+        for (const FileSpan* s : {&r.positions, &r.normals, &r.emission, &r.doppler, &r.proper_time, &r.colors,
+                                  &r.indices, &r.draco, &r.ordered})
+            if (ok && s->length > 0) {
+                ok = frameSource(s->source) >= 0;
+                impl_->use(*s);
+            }
+    }
+    for (const FileSpan* s : {&mf.remote_encoded, &mf.remote_normals, &mf.remote_indices})
+        if (ok && s->length > 0) {
+            ok = frameSource(s->source) >= 0;
+            impl_->use(*s);
+        }
+    ok = ok && in.atEnd() && (mf.first.empty() || mf.first.size() == d.data.size());
+    if (!ok) {
+        *error = impl_->path + ": frame data from another process is malformed (frame " + std::to_string(index) + ")";
+        return false;
+    }
+    return add(f, d, error);
+}
+
 std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d) const {
+    // Frames by reference, but for meshopt frames that may be morph targets (records without
+    // --attributes or --shade doppler): frame coherence (SequenceModel::morphTarget) takes the
+    // differences of their records from the previous frame's, so rank 0 needs the records; they
+    // travel whole.
+    const bool morph_capable = impl_->options.meshopt && MeshoptLayout(impl_->options).stride == 12;
+    if (frameSpillInstalled() && !morph_capable) return encodeByReference(f, d);
     std::string bytes;
     FrameBytesOut out(&bytes);
     out.put(kFrameBytesMagic);
@@ -1739,6 +2168,9 @@ std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& 
 }
 
 bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error) {
+    uint32_t form = 0;
+    if (bytes.size() >= 4) std::memcpy(&form, bytes.data(), 4);
+    if (form == kFrameRefMagic) return addByReference(bytes, error);
     // Step: the frame as add() reads it: its number, time and which objects show (one stand-in
     // triangle each: add() looks at nothing else of the cut mesh), and the prepared data.
     FrameBytesIn in(bytes);

@@ -117,7 +117,8 @@ struct GlbStats {
 // the process (at most max(4, 2 x cores) kept), so neither the frames of a sequence nor a lone
 // frame written after another allocate again once the frames stop growing; prepare()'s scratch
 // (crease split, meshopt orders) is pooled apart, one set per prepare() running at once, not
-// one per frame held in flight. The disk briefly holds the binary data twice.
+// one per frame held in flight. The disk briefly holds the binary data twice (frames by
+// reference: in the frame spills, until finish() has copied them).
 struct GlbFrameData;  // one frame converted for the file (GlbSequenceWriter::prepare)
 
 class GlbSequenceWriter {
@@ -139,6 +140,14 @@ public:
     // written, frames in order: the file is the same bytes as add(frame, prepare(frame)) gives.
     // Cross-frame decisions (shared index buffers, Draco coding) are made by addEncoded(), so they
     // come out as in one process. addEncoded() refuses malformed bytes with a message.
+    // Frames by reference (exporters/frame_spill.h: under MPI, when every rank's frame spill is
+    // visible to rank 0): once this process has a frame spill, encode() writes the frame's arrays
+    // there (the order the file takes them) and returns only the frame's description with where
+    // they lie (a few hundred bytes: counts, bounds, a 128-bit hash per index list for sharing);
+    // addEncoded() of it keeps them where they are, and finish() copies them into the file with
+    // copy_file_range. The writing process then handles no frame data except, with meshopt, a
+    // frame whose objects share their index lists only in part: their lists are read back and
+    // their stream encoded there. Either form gives the same file.
     std::string encode(const ExportFrame& frame, const GlbFrameData& prepared) const;
     bool addEncoded(const std::string& bytes, std::string* error);
     // Writes the file; a .glb cannot exceed 4 GiB (refused with a message). With `check`, the
@@ -146,6 +155,8 @@ public:
     bool finish(GlbStats* stats, std::string* error, const FrameSink::OutputCheck& check = nullptr);
 
 private:
+    std::string encodeByReference(const ExportFrame& frame, const GlbFrameData& prepared) const;
+    bool addByReference(const std::string& bytes, std::string* error);
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

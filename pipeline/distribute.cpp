@@ -1,7 +1,15 @@
 #include "pipeline/distribute.h"
 
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <random>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "exporters/frame_spill.h"
 
 namespace apparent {
 
@@ -85,6 +93,56 @@ bool FrameGroup::receiveFrame(int from, std::string* bytes, int* code, std::stri
         return false;
     }
     *bytes = std::move(parts.front());
+    return true;
+}
+
+bool shareFrameSpills(const std::string& dir, std::string* why) {
+    FrameGroup& group = frameGroup();
+    // Step: one name per rank, from a token rank 0 draws (names of other runs cannot clash).
+    std::string token;
+    if (group.rank() == 0) {
+        std::random_device random;
+        const char* hex = "0123456789abcdef";
+        for (int i = 0; i < 16; ++i) token.push_back(hex[random() % 16]);
+    }
+    token = group.broadcast(token);
+    auto name = [&](int rank) {
+        return (std::filesystem::path(dir) / (".apparent-frames-" + token + "." + std::to_string(rank))).string();
+    };
+    // Step: every rank its own file.
+    const std::string mine = name(group.rank());
+    const int fd = ::open(mine.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    std::string error = fd < 0 ? mine + ": cannot create: " + std::strerror(errno) : std::string();
+    int code = group.agree(fd < 0 ? 1 : 0, &error);
+    // Step: rank 0 opens them all, then no name is left.
+    if (code == 0 && group.rank() == 0) {
+        for (int r = 0; r < group.size(); ++r) {
+            const std::string path = name(r);
+            const int other = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+            if (other >= 0) {
+                addFrameSource(r, other);
+            } else if (code == 0) {
+                code = 1;
+                error = path + ": rank " + std::to_string(r) + "'s frame file is not visible on rank 0 (" +
+                        std::strerror(errno) + "): the output folder is not shared by every rank";
+            }
+        }
+        for (int r = 0; r < group.size(); ++r) ::unlink(name(r).c_str());
+    }
+    code = group.agree(code, &error);
+    if (code != 0) {
+        if (fd >= 0) {
+            ::close(fd);
+            ::unlink(mine.c_str());  // a rank whose file rank 0 never opened
+        }
+        *why = error;
+        return false;
+    }
+    installFrameSpill(fd, group.rank());
+    if (group.rank() == 0)
+        setFramePlacer([](const std::string& path, const std::vector<Placement>& placements, std::string* e) {
+            return frameGroup().placeOnRanks(path, placements, e);
+        });
     return true;
 }
 

@@ -3,7 +3,8 @@
 // - job-array shards (`render --shard I/N`, pipeline/shards.h): N independent processes, each
 //   renders its part of the frames; `apparent merge` assembles the .glb afterwards;
 // - MPI (`mpirun -n N apparent render ...`, pipeline/mpi_group.cpp): rank r cuts and encodes its
-//   part, rank 0 writes every output in frame order.
+//   part, rank 0 writes every output in frame order (the .glb's frame data by reference when the
+//   ranks share the output folder: shareFrameSpills below).
 // The split is interleaved: frame k (of frames [first, last)) belongs to part (k - first) mod N.
 // Neighbouring frames cost about the same (the scene changes smoothly), so every part gets an
 // even share of the work whatever the cost profile along the sequence, and rank 0 receives frames
@@ -20,6 +21,11 @@
 // sends END(code) to every rank and then drains each rank's messages up to its DONE (which
 // unblocks a rank stuck in a send). Each part of a frame is received straight into the string
 // that keeps it (a sink's bytes are moved, never copied, into the EncodedFrame).
+// Frames by reference (shareFrameSpills below, the .glb only): a FRAME then holds the frame's
+// description, its data being in the sending rank's frame spill; when rank 0 assembles the .glb it
+// sends each rank concerned PLACE (the temporary file's name and where each of the rank's ranges
+// goes), which the rank, between its DONE and END, answers with PLACED (its status) after copying
+// them in.
 // Every rank then leaves the loop with rank 0's code; rank 0 alone prints the message, after its
 // sinks removed their temporary files. A rank that dies (a signal, the OOM killer) is mpirun's to
 // handle: it ends the job; files are committed by rename only, so none is left truncated.
@@ -32,6 +38,7 @@
 #include <vector>
 
 #include "exporters/frame_sink.h"
+#include "exporters/frame_spill.h"
 
 namespace apparent {
 
@@ -77,6 +84,8 @@ public:
     // Every rank calls it with its own status (code 0: fine): returns the code of the lowest rank
     // that failed, and on rank 0 its message in `error` (the failing rank's own line), else 0.
     virtual int agree(int code, std::string* error) { (void)error; return code; }
+    // Every rank calls it: rank 0's `text`, on every rank.
+    virtual std::string broadcast(const std::string& text) { return text; }
 
     // The frame protocol above. Rank r > 0:
     virtual bool stopRequested() { return false; }             // END has come
@@ -91,7 +100,25 @@ public:
     // The same for a frame sent by sendFrame (one part).
     bool receiveFrame(int from, std::string* bytes, int* code, std::string* error);
     virtual void endFrames(int /*code*/) {}                     // END(code) to all, then up to every DONE
+    // Rank 0, frames by reference (exporters/frame_spill.h): each rank copies the placements from
+    // its own spill into the file at `path` (PLACE to every rank concerned, while it waits for END
+    // after DONE; rank 0's own at the same time), and answers PLACED with its status. False with
+    // the first failing rank's message.
+    virtual bool placeOnRanks(const std::string& path, const std::vector<Placement>& placements, std::string* error) {
+        return placeHere(path, placements, error);
+    }
 };
+
+// Frames by reference (exporters/frame_spill.h), set up once per run before the frame loops: every
+// rank creates its frame spill in `dir` (".apparent-frames-TOKEN.RANK", TOKEN random, broadcast by
+// rank 0), rank 0 opens every rank's file by name and then unlinks every name, so that nothing is
+// left behind from here on whatever ends the job. True on every rank when every spill is in place:
+// a rank's .glb frames then travel as descriptions, their data written by the rank that cut them
+// and, when rank 0 assembles the file, copied into it by that rank (placeOnRanks, installed here
+// as rank 0's frame placer). False on every rank, the reason in `why` on rank
+// 0, when a rank cannot create its file or rank 0 cannot see it (the folder is not on a file system
+// every rank shares): the frames then travel whole, as to a writer without spills. Collective.
+bool shareFrameSpills(const std::string& dir, std::string* why);
 
 // The group of this process (single until setFrameGroup installs another).
 FrameGroup& frameGroup();

@@ -416,8 +416,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         for (const std::string& path : result->summaries[s].completed)
             if (!budget->count(path, error)) return fail(kExitOutputError);
     }
-    result->write_seconds += since(finish_start);
-    result->write_cpu_seconds += threadCpuSeconds() - finish_cpu;
+    result->finish_seconds = since(finish_start);
+    result->finish_cpu_seconds = threadCpuSeconds() - finish_cpu;
+    result->write_seconds += result->finish_seconds;
+    result->write_cpu_seconds += result->finish_cpu_seconds;
     result->loop_seconds = since(loop_start);
     if (receiver) group.endFrames(0);
     return true;

@@ -88,6 +88,8 @@ struct FrameLoopResult {
     // The same as the CPU time of the threads that did it (not slowed by other processes sharing
     // the cores; a nested parallel loop's work stolen by another thread is not counted).
     double cut_cpu_seconds = 0, write_cpu_seconds = 0;
+    // Of the writing, the sinks' finish (the .glb's assembly), wall clock and CPU.
+    double finish_seconds = 0, finish_cpu_seconds = 0;
     long long frames_cut = 0, frames_written = 0;
 };
 

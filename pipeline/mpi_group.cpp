@@ -24,6 +24,8 @@ constexpr int kTagError = 3;  // int32 exit code, then the one-line message
 constexpr int kTagDone = 4;   // empty: no more frames from this rank
 constexpr int kTagEnd = 5;    // int32: rank 0's code for the loop
 constexpr int kTagAgree = 6;  // the message of the lowest failing rank, for rank 0
+constexpr int kTagPlace = 7;  // the temporary file's path, then (source, offset, length, to) per placement
+constexpr int kTagPlaced = 8; // int32 status (0: placed), then the message
 constexpr size_t kChunk = size_t(1) << 30;  // MPI counts are int: frames go in pieces of 1 GiB
 
 class MpiFrameGroup final : public FrameGroup {
@@ -55,6 +57,14 @@ public:
         return agreed;
     }
 
+    std::string broadcast(const std::string& text) override {
+        uint64_t n = text.size();
+        MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm_);
+        std::string out = rank_ == 0 ? text : std::string(size_t(n), '\0');
+        MPI_Bcast(n ? &out[0] : nullptr, int(n), MPI_CHAR, 0, comm_);
+        return out;
+    }
+
     bool stopRequested() override {
         int flag = 0;
         MPI_Iprobe(0, kTagEnd, comm_, &flag, MPI_STATUS_IGNORE);
@@ -83,9 +93,60 @@ public:
 
     int finishSending() override {
         MPI_Send(nullptr, 0, MPI_BYTE, 0, kTagDone, comm_);
+        // Until END: rank 0 may have this rank place its frames' data into a file (placeOnRanks).
+        for (;;) {
+            MPI_Status status;
+            MPI_Probe(0, MPI_ANY_TAG, comm_, &status);
+            if (status.MPI_TAG != kTagPlace) break;
+            const std::string job = receiveBytes(0, kTagPlace);
+            std::string path, error;
+            std::vector<Placement> placements;
+            bool ok = parsePlace(job, &path, &placements);
+            if (!ok) error = "internal: a malformed placement from rank 0";
+            ok = ok && placeHere(path, placements, &error);
+            std::string reply(4, '\0');
+            const int32_t c = ok ? 0 : 1;
+            std::memcpy(&reply[0], &c, 4);
+            reply += error.substr(0, size_t(1) << 20);
+            MPI_Send(reply.data(), int(reply.size()), MPI_CHAR, 0, kTagPlaced, comm_);
+        }
         int32_t code = 0;
         MPI_Recv(&code, 1, MPI_INT32_T, 0, kTagEnd, comm_, MPI_STATUS_IGNORE);
         return code;
+    }
+
+    bool placeOnRanks(const std::string& path, const std::vector<Placement>& placements, std::string* error) override {
+        // Step: each rank's placements to it (sources are ranks), then rank 0's own, then the answers.
+        std::vector<std::vector<Placement>> by_rank(static_cast<size_t>(size_));
+        for (const Placement& p : placements) {
+            if (p.from.source < 0 || p.from.source >= size_) {
+                *error = "internal: frame data of an unknown rank (" + std::to_string(p.from.source) + ")";
+                return false;
+            }
+            by_rank[size_t(p.from.source)].push_back(p);
+        }
+        std::vector<int> asked;
+        for (int r = 1; r < size_; ++r) {
+            if (by_rank[size_t(r)].empty()) continue;
+            std::string job;
+            putU64(&job, path.size());
+            job += path;
+            for (const Placement& p : by_rank[size_t(r)])
+                for (uint64_t v : {uint64_t(uint32_t(p.from.source)), p.from.offset, p.from.length, p.to}) putU64(&job, v);
+            MPI_Send(job.data(), int(job.size()), MPI_BYTE, r, kTagPlace, comm_);
+            asked.push_back(r);
+        }
+        bool ok = placeHere(path, by_rank[0], error);
+        for (const int r : asked) {
+            const std::string reply = receiveBytes(r, kTagPlaced);
+            int32_t c = 1;
+            if (reply.size() >= 4) std::memcpy(&c, reply.data(), 4);
+            if (c != 0 && ok) {
+                *error = (reply.size() > 4 ? reply.substr(4) : std::string("failed")) + " (rank " + std::to_string(r) + ")";
+                ok = false;
+            }
+        }
+        return ok;
     }
 
     bool receiveParts(int from, std::vector<std::string>* parts, int* code, std::string* error) override {
@@ -137,6 +198,31 @@ public:
     }
 
 private:
+    static void putU64(std::string* out, uint64_t v) {
+        for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));
+    }
+    static uint64_t getU64(const std::string& in, size_t at) {
+        uint64_t v = 0;
+        for (int i = 0; i < 8; ++i) v |= uint64_t(uint8_t(in[at + size_t(i)])) << (8 * i);
+        return v;
+    }
+    // A PLACE message (placeOnRanks) back into its path and placements.
+    static bool parsePlace(const std::string& job, std::string* path, std::vector<Placement>* placements) {
+        if (job.size() < 8) return false;
+        const uint64_t n = getU64(job, 0);
+        if (n > job.size() - 8 || (job.size() - 8 - n) % 32 != 0) return false;
+        *path = job.substr(8, size_t(n));
+        for (size_t at = 8 + size_t(n); at < job.size(); at += 32) {
+            Placement p;
+            p.from.source = int32_t(uint32_t(getU64(job, at)));
+            p.from.offset = getU64(job, at + 8);
+            p.from.length = getU64(job, at + 16);
+            p.to = getU64(job, at + 24);
+            placements->push_back(p);
+        }
+        return true;
+    }
+
     // A whole message of `tag` from `from` (its size probed first).
     std::string receiveBytes(int from, int tag) {
         MPI_Status status;

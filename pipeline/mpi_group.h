@@ -5,7 +5,10 @@
 // - `render`: every rank loads the stage (the ranks agree on it: the first failure's code and
 //   message, printed by rank 0), rank r cuts and encodes frames k with k - first = r mod N, rank 0
 //   writes every output in frame order (the protocol of distribute.h: MPI_Send / MPI_Recv on a
-//   duplicate of MPI_COMM_WORLD, frames over 1 GiB in several messages).
+//   duplicate of MPI_COMM_WORLD, frames over 1 GiB in several messages). The .glb's frame data
+//   stays with the rank that made it when rank 0 can open every rank's frame spill in the output
+//   folder (shareFrameSpills): rank 0 takes the frames' descriptions and each rank copies its own
+//   data into the file at the end.
 // - `raytrace`: the same split; rank r traces its frames and sends each picture to rank 0, which
 //   writes the PNG files and the video in frame order.
 // - `figure`: the same split over its pictures (the sheet's panels, row by row; or the video's

@@ -5,10 +5,13 @@
 # with one thread per rank, side by side in one run. Prints a Markdown table: wall time, speed-up
 # against one process with one thread, rank 0's writing time and share, and the per-frame costs
 # (`render --verbose`), and checks that every .glb is byte-identical to the one-process file.
-# Usage: scripts/mpi_report.sh [build/apparent] [render options, e.g. --compress draco]
+# With PEER=/path/to/another/apparent (e.g. a build of the commit before a change), every run is
+# made with both binaries in turn, rows marked "this" and "peer": a ratio measured side by side.
+# Usage: [PEER=other/apparent] scripts/mpi_report.sh [build/apparent] [render options, e.g. --compress draco]
 # (needs mpirun: scripts/setup.sh installs it)
 set -euo pipefail
 apparent=$(realpath "${1:-build/apparent}")
+peer=${PEER:+$(realpath "$PEER")}
 shift || true
 options="$*"
 work=$(mktemp -d)
@@ -48,26 +51,37 @@ run() {  # LABEL OUTDIR COMMAND...
     local line
     line=$(grep -E '^relativistic: loop ' "$out.log") || { cat "$out.log"; exit 1; }
     # "relativistic: loop L s; per frame: cut and encode C ms (CPU c ms; F frames cut here), write W ms
-    #  (CPU w ms; F frames, P% of the loop[ on rank 0])[; rank 0 waited T s for other ranks]"
+    #  (CPU w ms; F frames, P% of the loop[ on rank 0]); of the writing, the files' assembly A ms (CPU
+    #  a ms)[; rank 0 waited T s for other ranks]"
     field() { echo "$line" | sed -E "s/$1/\\1/"; }
-    local cut cut_cpu write write_cpu share
+    local cut cut_cpu write write_cpu share assembly="-"
     cut=$(field '.*cut and encode ([0-9.]+) ms.*')
     cut_cpu=$(field '.*cut and encode [0-9.]+ ms \(CPU ([0-9.]+) ms.*')
     write=$(field '.*, write ([0-9.]+) ms.*')
     write_cpu=$(field '.*, write [0-9.]+ ms \(CPU ([0-9.]+) ms.*')
     share=$(field '.*frames, ([0-9.]+)% of the loop.*')
+    if echo "$line" | grep -q "files' assembly"; then
+        assembly="$(field ".*files' assembly ([0-9.]+) ms.*") ($(field ".*files' assembly [0-9.]+ ms \\(CPU ([0-9.]+) ms.*"))"
+    fi
     cmp -s "$out/relativistic.glb" one1/relativistic.glb 2>/dev/null || [ "$out" = one1 ] || { echo "$label: .glb differs"; exit 1; }
-    printf '| %s | %.2f | %s (%s) | %s (%s) | %s |\n' "$label" "$(echo "$end - $start" | bc)" "$cut" "$cut_cpu" \
-        "$write" "$write_cpu" "$share" >> table.md
+    printf '| %s | %.2f | %s (%s) | %s (%s) | %s | %s |\n' "$label" "$(echo "$end - $start" | bc)" "$cut" "$cut_cpu" \
+        "$write" "$write_cpu" "$assembly" "$share" >> table.md
 }
 : > table.md
-run "1 process, 1 thread" one1 "$apparent" render --threads 1
-run "1 process, 2 threads" one2 "$apparent" render --threads 2
+# Each run with this binary, then (PEER set) with the peer, in turn.
+both() {  # LABEL OUTDIR COMMAND... (the binary as the word APPARENT)
+    local label=$1 out=$2
+    shift 2
+    run "$label${peer:+, this}" "$out" "${@/#APPARENT/$apparent}"
+    if [ -n "$peer" ]; then run "$label, peer" "$out-peer" "${@/#APPARENT/$peer}"; fi
+}
+both "1 process, 1 thread" one1 APPARENT render --threads 1
+both "1 process, 2 threads" one2 APPARENT render --threads 2
 for n in 1 2 4; do
-    run "mpirun -n $n, 1 thread each" "mpi$n" mpirun --oversubscribe -n "$n" "$apparent" render --threads 1
+    both "mpirun -n $n, 1 thread each" "mpi$n" mpirun --oversubscribe -n "$n" APPARENT render --threads 1
 done
-echo "| run | wall (s) | cut + encode per frame, ms (CPU) | write per frame on rank 0, ms (CPU) | writing share of rank 0's loop (%) |"
-echo "|---|---:|---:|---:|---:|"
+echo "| run | wall (s) | cut + encode per frame, ms (CPU) | write per frame on rank 0, ms (CPU) | of which the assembly at the end, ms (CPU) | writing share of rank 0's loop (%) |"
+echo "|---|---:|---:|---:|---:|---:|"
 cat table.md
 echo
 echo ".glb $(du -m one1/relativistic.glb | cut -f1) MiB, every one byte-identical to the one-process file. $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), $(date -u +%Y-%m-%dT%H:%M:%SZ)."

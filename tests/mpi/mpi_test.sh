@@ -1,6 +1,7 @@
 #!/bin/bash
 # `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
-# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt; PLY; OBJ;
+# (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt, its frames by
+# reference, diff -r also finding any scratch file left; PLY; OBJ;
 # raytrace's PNG files and video; figure's sheet and video), a
 # failure on any rank ends the job with the one-process code and one line from rank 0 and no
 # output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
@@ -28,10 +29,31 @@ for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
         out=$(mpi render "$scene" --out "$work/three" $options 2> "$work/stderr.txt") ||
             fail "mpirun: $scene $options: $out $(cat "$work/stderr.txt")"
         diff -r "$work/one" "$work/three" > /dev/null || fail "outputs differ: $scene $options"
+        # The .glb's frames went by reference (the ranks share the folder: no fallback warning).
+        ! grep -q "goes through rank 0 instead" "$work/stderr.txt" || fail "frames not by reference: $(cat "$work/stderr.txt")"
         case "$out" in *"3 processes shared the frames"*) ;; *) fail "summary without the process count: $out" ;; esac
         [ "$(echo "$out" | grep -c '^relativistic: ')" = 1 ] || fail "not one summary line (rank 0 alone): $out"
     done
 done
+# A folder rank 0 cannot see from the other ranks (ranks 1 and 2 in a mount namespace of their own
+# with a tmpfs over it): one warning, the .glb's frames travel whole, the same bytes.
+if unshare -m true 2> /dev/null; then
+    rm -rf "$work/one" "$work/apart"
+    mkdir -p "$work/apart"
+    common=(render data/scenes/flanges.json --frames 40:80 --format glb,ply)
+    "$apparent" "${common[@]}" --out "$work/one" --quiet || fail "one process: ${common[*]}"
+    printf '#!/bin/sh\nexec unshare -m sh -c '"'"'mount -t tmpfs none "$0" && exec "$@"'"'"' "$@"\n' > "$work/apart.sh"
+    chmod +x "$work/apart.sh"
+    timeout 300 mpirun --oversubscribe -n 1 "$apparent" "${common[@]}" --out "$work/apart" : \
+        -n 2 "$work/apart.sh" "$work/apart" "$apparent" "${common[@]}" --out "$work/apart" > /dev/null 2> "$work/stderr.txt" ||
+        fail "mpirun, folder not shared: $(cat "$work/stderr.txt")"
+    diff -r "$work/one" "$work/apart" > /dev/null || fail "outputs differ: folder not shared"
+    grep -q "is not visible on rank 0.*goes through rank 0 instead" "$work/stderr.txt" ||
+        fail "no warning for a folder not shared: $(cat "$work/stderr.txt")"
+else
+    echo "folder not shared: skipped (unshare -m not permitted here)"
+fi
+
 # raytrace splits its frames the same way: the PNG files and the video identical.
 "$apparent" raytrace data/scenes/flanges.json --out "$work/rt1" --frames 90:100 --size 160x90 --video "$work/rt1.mp4" \
     --quiet || fail "raytrace, one process"

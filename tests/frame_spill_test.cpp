@@ -1,0 +1,170 @@
+// Frames by reference (exporters/frame_spill.h): a .glb sequence whose frames go through
+// GlbSequenceWriter::encode with a frame spill installed, then addEncoded, is byte-identical to the
+// same frames added directly, for plain, meshopt and Draco frames, with index lists shared between
+// frames in whole, in part (one object of two: meshopt's partly shared stream) and not at all; the
+// descriptions that travel are a small fraction of the data (meshopt frames that may be morph
+// targets travel whole, and the file is the same); a description naming an unknown source is
+// refused with a message.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "exporters/atomic_file.h"
+#include "exporters/frame_spill.h"
+#include "exporters/gltf.h"
+
+using namespace apparent;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readBytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A wavy n x n grid; `flip` cuts each quad along the other diagonal (another index list).
+mesh4d::ApparentMesh grid(int n, double phase, bool flip, double x0) {
+    mesh4d::ApparentMesh m;
+    m.origin = {x0, 0.0, -5.0};
+    m.time_origin = -5.0;
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+            const double x = double(i) / n, y = double(j) / n;
+            m.positions.push_back({x, y, 0.1 * std::sin(6 * x + phase) * std::cos(5 * y)});
+            m.emission_times.push_back(-x);
+            m.doppler.push_back(1 + 0.1 * x);
+            m.proper_time.push_back(y);
+        }
+    auto at = [n](int i, int j) { return uint32_t(i * (n + 1) + j); };
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+            if (flip) {
+                m.triangles.push_back({a, b, d});
+                m.triangles.push_back({b, c, d});
+            } else {
+                m.triangles.push_back({a, b, c});
+                m.triangles.push_back({a, c, d});
+            }
+        }
+    return m;
+}
+
+// Six frames of two objects: object 0 keeps its index list (shared from frame 1 on), object 1
+// changes it every second frame and is hidden in frame 4.
+std::vector<ExportFrame> frames() {
+    std::vector<ExportFrame> out;
+    for (int k = 0; k < 6; ++k) {
+        ExportFrame f;
+        f.index = 10 + k;
+        f.t_c = 0.1 * k;
+        f.objects.push_back(grid(40, 0.3 * k, false, -1.5));
+        f.objects.push_back(k == 4 ? mesh4d::ApparentMesh() : grid(30, -0.2 * k, (k / 2) % 2 == 1, 0.5));
+        out.push_back(std::move(f));
+    }
+    return out;
+}
+
+SequenceInfo info() {
+    SequenceInfo s;
+    s.model = "relativistic";
+    s.tolerance = 1e-3;
+    s.fps = 10;
+    s.objects.resize(2);
+    s.objects[0].name = "left";
+    s.objects[1].name = "right";
+    return s;
+}
+
+struct Written {
+    std::string bytes;
+    size_t descriptions = 0;  // bytes of the encoded frames (by reference: what reaches the writer)
+};
+
+Written write(const fs::path& file, const GlbOptions& options, bool by_reference) {
+    Written w;
+    std::string error;
+    int spill = -1;
+    if (by_reference) {
+        spill = openAnonymousFile(file.parent_path().string(), &error);
+        EXPECT_GE(spill, 0) << error;
+        installFrameSpill(spill, 7);
+        addFrameSource(7, ::dup(spill));
+    }
+    GlbSequenceWriter writer(file.string(), info(), options);
+    for (const ExportFrame& f : frames()) {
+        if (!by_reference) {
+            EXPECT_TRUE(writer.add(f, &error)) << error;
+            continue;
+        }
+        const std::string description = writer.encode(f, *writer.prepare(f));
+        w.descriptions += description.size();
+        EXPECT_TRUE(writer.addEncoded(description, &error)) << error;
+    }
+    GlbStats stats;
+    EXPECT_TRUE(writer.finish(&stats, &error)) << error;
+    if (by_reference) {
+        installFrameSpill(-1, -1);  // the process's other tests encode frames whole
+        ::close(spill);
+    }
+    w.bytes = readBytes(file);
+    return w;
+}
+
+class FrameSpill : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("apparent_frame_spill_" + std::to_string(::getpid()));
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(FrameSpill, ByReferenceIsByteIdenticalForEveryCodec) {
+    for (const char* codec : {"plain", "meshopt", "draco"}) {
+        GlbOptions options;
+        options.doppler = options.proper_time = true;
+        options.meshopt = std::string(codec) == "meshopt";
+        options.draco = std::string(codec) == "draco";
+        const Written direct = write(dir_ / "direct.glb", options, false);
+        const Written by_reference = write(dir_ / "by_reference.glb", options, true);
+        ASSERT_GT(direct.bytes.size(), 100000u) << codec;
+        EXPECT_TRUE(direct.bytes == by_reference.bytes) << codec << ": the files differ";
+        // What travels to the writer: counts, bounds, hashes and spans (under 700 bytes per
+        // object whatever its size), not the frames' data (38 to 100 KiB per frame here).
+        EXPECT_LT(by_reference.descriptions, 8u * 1024u) << codec;
+    }
+    // Meshopt frames without attributes may be morph targets of the frame before (frame
+    // coherence): they travel whole, and the file is still the same.
+    GlbOptions options;
+    options.meshopt = true;
+    const Written direct = write(dir_ / "direct.glb", options, false);
+    const Written whole = write(dir_ / "whole.glb", options, true);
+    ASSERT_GT(direct.bytes.size(), 10000u);
+    EXPECT_TRUE(direct.bytes == whole.bytes) << "meshopt without attributes: the files differ";
+    EXPECT_GT(whole.descriptions, 8u * 1024u) << "meshopt without attributes: expected whole frames";
+}
+
+TEST_F(FrameSpill, ADescriptionOfAnUnknownSourceIsRefused) {
+    std::string error;
+    const int spill = openAnonymousFile(dir_.string(), &error);
+    ASSERT_GE(spill, 0) << error;
+    installFrameSpill(spill, 3);  // the writer knows no source 3
+    GlbSequenceWriter writer((dir_ / "refused.glb").string(), info(), GlbOptions());
+    const ExportFrame f = frames().front();
+    const std::string description = writer.encode(f, *writer.prepare(f));
+    installFrameSpill(-1, -1);
+    ::close(spill);
+    EXPECT_FALSE(writer.addEncoded(description, &error));
+    EXPECT_NE(error.find("refused.glb: frame data from another process is malformed (frame 10)"), std::string::npos)
+        << error;
+}
