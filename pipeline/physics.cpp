@@ -44,9 +44,11 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
         return Status::failure(field + "give angular_velocity or acceleration, not both (not modelled together)");
     if (cameraMotionOf(scene).moving())
         return Status::failure(field + what + " needs a camera at rest (camera.velocity is not [0, 0, 0])");
-    if (tolerance > 0)
-        return Status::failure(field + what + " is cut in vertex mode only: give --tolerance vertex (or the "
-                                       "scene's \"tolerance\": \"vertex\")");
+    // A tolerance is bounded for these motions (mesh4d/worldline_refine.h), but not the clip curve
+    // where the object begins or ends existing.
+    if (tolerance > 0 && (std::isfinite(s.exists_from) || std::isfinite(s.exists_to)))
+        return Status::failure(field + what + " that begins or ends existing (exists) is cut in vertex mode only: "
+                                       "give --tolerance vertex (or the scene's \"tolerance\": \"vertex\")");
     const mesh4d::Motion m = motionOf(s, model);
     // The turned angle |w| s stays finite and meaningful over every time a scene can hold.
     if (spin && !(mesh4d::norm(s.angular_velocity) <= 1e12))
