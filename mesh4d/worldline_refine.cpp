@@ -82,23 +82,41 @@ struct Refiner {
     bool piecePasses(const CornerCrossing c[3]) const {
         double d2 = 0;
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
-        const double K = secondDerivativeBound(m, view, shear, c);
-        if (K * d2 / 6 <= T) return true;
-        if (!std::isfinite(K)) return false;
-        int sub = 2;
-        while (sub < kMaxSubGrid && K * d2 / (6.0 * sub * sub) > 0.25 * T) sub *= 2;
-        const double rem = K * d2 / (6.0 * sub * sub);
-        if (!(rem < T)) return false;
+        if (secondDerivativeBound(m, view, shear, c) * d2 / 6 <= T) return true;
         const Vec3 F[3] = {image(c[0]), image(c[1]), image(c[2])};
-        for (int a = 0; a <= sub; ++a)
-            for (int b = 0; a + b <= sub; ++b) {
-                if (a + b == 0 || a == sub || b == sub) continue;  // the corners: no error
-                const double l1 = double(a) / sub, l2 = double(b) / sub, l0 = 1 - l1 - l2;
-                const CornerCrossing p = cut(c[0].q * l0 + c[1].q * l1 + c[2].q * l2);
-                const double eps = norm(image(p) - (F[0] * l0 + F[1] * l1 + F[2] * l2));
-                if (!(eps + rem <= T)) return false;
-            }
-        return true;
+        std::vector<CornerCrossing> g;
+        for (int sub = 2; sub <= kMaxSubGrid; sub *= 2) {
+            // The sub-grid's exact points and the largest measured |F - L| there.
+            g.assign(size_t(sub + 1) * (sub + 1), CornerCrossing{});
+            auto at = [&](int a, int b) -> CornerCrossing& { return g[size_t(b) * (sub + 1) + a]; };
+            double eps = 0;
+            for (int b = 0; b <= sub; ++b)
+                for (int a = 0; a + b <= sub; ++a) {
+                    if (a + b == 0) at(a, b) = c[0];
+                    else if (a == sub) at(a, b) = c[1];
+                    else if (b == sub) at(a, b) = c[2];
+                    else {
+                        const double l1 = double(a) / sub, l2 = double(b) / sub, l0 = 1 - l1 - l2;
+                        at(a, b) = cut(c[0].q * l0 + c[1].q * l1 + c[2].q * l2);
+                        eps = std::max(eps, norm(image(at(a, b)) - (F[0] * l0 + F[1] * l1 + F[2] * l2)));
+                    }
+                }
+            if (!(eps <= T)) return false;  // measured over: no finer sub-grid can pass it
+            // What lies between: each sub-piece's own bound K (its corners exact, its side d / sub).
+            const double scale = d2 / (6.0 * sub * sub);
+            double rem = 0;
+            for (int b = 0; b < sub && eps + rem <= T; ++b)
+                for (int a = 0; a + b < sub && eps + rem <= T; ++a) {
+                    const CornerCrossing up[3] = {at(a, b), at(a + 1, b), at(a, b + 1)};
+                    rem = std::max(rem, secondDerivativeBound(m, view, shear, up) * scale);
+                    if (a + b + 1 < sub) {
+                        const CornerCrossing down[3] = {at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)};
+                        rem = std::max(rem, secondDerivativeBound(m, view, shear, down) * scale);
+                    }
+                }
+            if (eps + rem <= T) return true;
+        }
+        return false;
     }
 
     // Triangle f at level n: true when every grid piece passes.

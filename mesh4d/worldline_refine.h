@@ -5,16 +5,18 @@
 // The scheme. Each mesh triangle gets a level n, a power of two (1 = the triangle itself): it is
 // cut into the n x n grid of its barycentric coordinates (n^2 pieces), every grid point the exact
 // crossing of its worldline (crossWorldline). A piece passes when
-//     eps + K (d / m)^2 / 6 <= T,
-// K the bound of worldline_bound.h on the map's second derivative over the piece, d its longest
-// rest side, eps the largest measured |F - L| at the (m + 1)(m + 2) / 2 points of the piece's own
-// m x m sub-grid (exact crossings against the piece's linear interpolant L). Sound: e = F - L has
-// the second derivative of F, so on each sub-piece e lies within K (d / m)^2 / 6 of its linear
-// interpolant there, whose largest value is at the sub-grid points (worldline_bound.h gives the
-// Taylor argument); so |F - L| <= eps + K (d / m)^2 / 6 on the whole piece. m is 1 when K d^2 / 6
-// <= T alone, else the least power of two with K (d / m)^2 / 6 <= T / 4 (at most 16; a piece
-// needing more, or with an infinite K, fails). The measured term is what makes the bound tight:
-// K takes the worst angles separately, eps does not.
+//     K d^2 / 6 <= T   (K the bound of worldline_bound.h on the map's second derivative over the
+//                       piece, d its longest rest side: no further cut), or, for the first m in
+//                       2, 4, 8, 16 where it holds,
+//     eps + max_k K_k (d / m)^2 / 6 <= T,
+// eps the largest measured |F - L| at the points of the piece's m x m sub-grid (exact crossings
+// against the piece's linear interpolant L), K_k the bound over sub-piece k from its own exact
+// corners. Sound: e = F - L has the second derivative of F, so on sub-piece k, e lies within
+// K_k (d / m)^2 / 6 of its linear interpolant there, whose largest value is at the sub-grid points
+// (worldline_bound.h gives the Taylor argument); so |F - L| <= eps + max_k K_k (d / m)^2 / 6 on the
+// whole piece. A piece with eps > T fails at once (that is a measured error). The measured term is
+// what makes the bound tight (K takes the worst angles separately; eps does not), and the sub-pieces'
+// own K (their Doppler term carried over a short distance only) what keeps K finite.
 // A triangle's level doubles until all its pieces pass, at most to SliceSettings::max_segments
 // pieces along an edge (then counted in limited_triangles) and while the output stays within
 // SliceSettings::max_triangles (else over_budget).
@@ -34,9 +36,8 @@
 // output), then the edge points (by edge, from the lower vertex), then each triangle's interior
 // and centroid points in the order its pieces first use them; triangles in input order, each
 // triangle's pieces row by row. Deterministic; no threads.
-// Cost: about (m + 1)(m + 2) / 2 exact crossings per tested piece (a safeguarded Newton search
-// each) plus one per output point; levels are tried from 1 up, so a triangle's tests cost about
-// 4/3 of those of its final level.
+// Cost: up to (m + 1)(m + 2) / 2 exact crossings per tested piece for each m tried (a safeguarded
+// Newton search each) plus one per output point; levels are tried from 1 up.
 #pragma once
 
 #include "extrude.h"
