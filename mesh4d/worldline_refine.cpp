@@ -34,6 +34,7 @@ struct Refiner {
     std::vector<int> level;        // per mesh triangle
     std::vector<int> edge_level;   // per mesh edge
     std::vector<uint8_t> limited;  // per mesh triangle: the level stopped at max_level
+    std::vector<std::vector<uint32_t>> edge_triangles;  // per mesh edge: the triangles around it
     bool over_budget = false;
 
     Refiner(const World4D& w, const ViewSurface& v, const SliceSettings& s)
@@ -84,17 +85,20 @@ struct Refiner {
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
         if (secondDerivativeBound(m, view, shear, c) * d2 / 6 <= T) return true;
         const Vec3 F[3] = {image(c[0]), image(c[1]), image(c[2])};
-        std::vector<CornerCrossing> g;
+        std::vector<CornerCrossing> g, coarse;
+        double eps = 0;  // measured at the points of every sub-grid so far (each holds the one before)
         for (int sub = 2; sub <= kMaxSubGrid; sub *= 2) {
-            // The sub-grid's exact points and the largest measured |F - L| there.
+            // The sub-grid's exact points (those of the sub-grid before taken over: the same
+            // barycentrics, exactly) and the largest measured |F - L| there.
+            coarse.swap(g);
             g.assign(size_t(sub + 1) * (sub + 1), CornerCrossing{});
             auto at = [&](int a, int b) -> CornerCrossing& { return g[size_t(b) * (sub + 1) + a]; };
-            double eps = 0;
             for (int b = 0; b <= sub; ++b)
                 for (int a = 0; a + b <= sub; ++a) {
                     if (a + b == 0) at(a, b) = c[0];
                     else if (a == sub) at(a, b) = c[1];
                     else if (b == sub) at(a, b) = c[2];
+                    else if (sub > 2 && a % 2 == 0 && b % 2 == 0) at(a, b) = coarse[size_t(b / 2) * (sub / 2 + 1) + a / 2];
                     else {
                         const double l1 = double(a) / sub, l2 = double(b) / sub, l0 = 1 - l1 - l2;
                         at(a, b) = cut(c[0].q * l0 + c[1].q * l1 + c[2].q * l2);
@@ -199,13 +203,17 @@ struct Refiner {
 
     // Pieces with finer points on their sides pass as fans; doubles the level of triangles where
     // one does not. True when some level changed.
-    bool checkFans(size_t* total) {
+    // Only triangles marked in `dirty` (cleared here) are checked; the neighbours of a triangle
+    // whose level grows are marked for the next pass.
+    bool checkFans(size_t* total, std::vector<uint8_t>* dirty) {
         bool changed = false;
         std::vector<PNode> poly;
         std::vector<std::array<uint32_t, 3>> tris;
         std::vector<CornerCrossing> cuts;
+        std::vector<uint32_t> grown;
         for (size_t f = 0; f < world.mesh.triangles.size(); ++f) {
-            if (degenerate(f)) continue;
+            if (degenerate(f) || !(*dirty)[f]) continue;
+            (*dirty)[f] = 0;
             const int n = level[f];
             bool finer = false;
             for (int c = 0; c < 3; ++c) finer |= edge_level[world.triangle_edges[f][c]] > n;
@@ -232,7 +240,11 @@ struct Refiner {
             if (ok) continue;
             if (!grow(f, total)) continue;
             changed = true;
+            grown.push_back(uint32_t(f));
         }
+        for (uint32_t f : grown)
+            for (int c = 0; c < 3; ++c)
+                for (uint32_t g : edge_triangles[world.triangle_edges[f][c]]) (*dirty)[g] = 1;
         return changed;
     }
 
@@ -283,8 +295,13 @@ struct Refiner {
                 if (!grow(f, &total)) break;
         }
         // Step: conforming edges; fans tested, levels raised where one fails, until stable.
+        edge_triangles.assign(world.edges.size(), {});
+        for (size_t f = 0; f < nt; ++f)
+            if (!degenerate(f))
+                for (int c = 0; c < 3; ++c) edge_triangles[world.triangle_edges[f][c]].push_back(uint32_t(f));
+        std::vector<uint8_t> dirty(nt, 1);
         do takeEdgeLevels();
-        while (checkFans(&total));
+        while (checkFans(&total, &dirty));
         return emit();
     }
 

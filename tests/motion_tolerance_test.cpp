@@ -252,3 +252,44 @@ TEST(MotionTolerance, CoarseToleranceKeepsVertexModeOutput) {
         EXPECT_EQ(out.positions[i].z, vertex.positions[i].z);
     }
 }
+
+// The shipped rolling wheel (data/scenes/rolling_wheel.json: wheel.obj, radius 1 ls, b = 0.9, w = -0.9,
+// camera at (0, 0, 5)) at T = 1e-2 of its size, at frames before, during and after it passes: the
+// figures of the README's motion section (err/T, output triangles).
+TEST(MotionTolerance, RollingWheelSceneWithinTheTolerance) {
+    mesh4d::RestMesh mesh;
+    FILE* f = std::fopen((std::string(APPARENT_SOURCE_DIR) + "/data/meshes/wheel.obj").c_str(), "r");
+    ASSERT_NE(f, nullptr);
+    char line[256];
+    while (std::fgets(line, sizeof line, f)) {
+        double x, y, z;
+        unsigned a, b, c;
+        if (std::sscanf(line, "v %lf %lf %lf", &x, &y, &z) == 3) mesh.positions.push_back({x, y, z});
+        if (std::sscanf(line, "f %u %u %u", &a, &b, &c) == 3) mesh.triangles.push_back({a - 1, b - 1, c - 1});
+    }
+    std::fclose(f);
+    ASSERT_EQ(mesh.triangles.size(), 792u);
+    Vec3 lo{1e9, 1e9, 1e9}, hi{-1e9, -1e9, -1e9};
+    for (const Vec3& p : mesh.positions)
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)},
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    const double size = mesh4d::norm(hi - lo);
+    mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, {-4.5, 0, 0}, {0.9, 0, 0});
+    m.angular_velocity = {0, 0, -0.9};
+    const Worldline exact = spinning(0.9, -0.9, {-4.5, 0, 0}, true);
+    const mesh4d::World4D world = mesh4d::extrude(mesh, m, -1e3, 1e3, false, false);
+    for (double t_c : {0.0, 5.0, 10.0, 15.0}) {
+        mesh4d::ViewSurface view;
+        view.t_c = t_c;
+        view.apex = {0, 0, 5};
+        mesh4d::SliceSettings settings;
+        settings.tolerance = 1e-2 * size;
+        const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view, settings);
+        const Sampled s = sample(mesh, out, exact, t_c, view.apex);
+        EXPECT_LE(s.output_to_exact, settings.tolerance + 1e-11) << "t_c " << t_c;
+        EXPECT_LE(s.exact_to_output, settings.tolerance + 1e-11) << "t_c " << t_c;
+        expectClosed(out);
+        std::printf("[ tolerance ] rolling_wheel.json t = %4.1f s, T = 1e-2 x size: err/T %.3f, 792 -> %zu triangles\n",
+                    t_c, std::max(s.output_to_exact, s.exact_to_output) / settings.tolerance, out.triangles.size());
+    }
+}
