@@ -27,7 +27,7 @@ FrameRates frameRates(const Motion& m, const CornerCrossing c[3], double s_lo, d
         double rim = 0, carried = 0;
         for (int i = 0; i < 3; ++i) {
             rim = std::max(rim, spinSpeed(m, c[i].q));
-            carried = std::max(carried, maxGalileanSpeed(m, c[i].q));
+            if (!lorentz) carried = std::max(carried, maxGalileanSpeed(m, c[i].q));
         }
         r.Ts = 1;
         r.Ys = lorentz ? rim : carried;

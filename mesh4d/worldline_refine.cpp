@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 #include <vector>
 
 #include "worldline.h"
@@ -35,6 +36,8 @@ struct Refiner {
     std::vector<int> edge_level;   // per mesh edge
     std::vector<uint8_t> limited;  // per mesh triangle: the level stopped at max_level
     std::vector<std::vector<uint32_t>> edge_triangles;  // per mesh edge: the triangles around it
+    std::unordered_map<uint64_t, CornerCrossing> cache;  // crossing()'s, for triangle cache_f
+    size_t cache_f = size_t(-1);
     bool over_budget = false;
 
     Refiner(const World4D& w, const ViewSurface& v, const SliceSettings& s)
@@ -79,8 +82,17 @@ struct Refiner {
         return (c.event.x - anchor.origin) - view.shear * (c.event.t - anchor.time_origin);
     }
 
+    // Where a piece lies in its mesh triangle's grid, so that its sub-grid points are that grid's
+    // points at a finer level (cached across levels, crossing()); none for a fan piece.
+    struct Placement {
+        size_t f;
+        int n;  // 0: not on the grid
+        int i, j;
+        bool down;
+    };
+
     // worldline_refine.h's test of one piece with exact corners.
-    bool piecePasses(const CornerCrossing c[3]) const {
+    bool piecePasses(const CornerCrossing c[3], const Placement& at_grid) {
         double d2 = 0;
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
         if (secondDerivativeBound(m, view, shear, c) * d2 / 6 <= T) return true;
@@ -101,7 +113,13 @@ struct Refiner {
                     else if (sub > 2 && a % 2 == 0 && b % 2 == 0) at(a, b) = coarse[size_t(b / 2) * (sub / 2 + 1) + a / 2];
                     else {
                         const double l1 = double(a) / sub, l2 = double(b) / sub, l0 = 1 - l1 - l2;
-                        at(a, b) = cut(c[0].q * l0 + c[1].q * l1 + c[2].q * l2);
+                        if (at_grid.n > 0) {
+                            const int I = at_grid.down ? (at_grid.i + 1) * sub - b : at_grid.i * sub + a;
+                            const int J = at_grid.down ? at_grid.j * sub + a + b : at_grid.j * sub + b;
+                            at(a, b) = crossing(at_grid.f, at_grid.n * sub, I, J);
+                        } else {
+                            at(a, b) = cut(c[0].q * l0 + c[1].q * l1 + c[2].q * l2);
+                        }
                         eps = std::max(eps, norm(image(at(a, b)) - (F[0] * l0 + F[1] * l1 + F[2] * l2)));
                     }
                 }
@@ -124,21 +142,37 @@ struct Refiner {
     }
 
     // Triangle f at level n: true when every grid piece passes.
-    bool gridPasses(size_t f, int n) const {
+    bool gridPasses(size_t f, int n) {
         std::vector<CornerCrossing> g(size_t(n + 1) * (n + 1));
         for (int j = 0; j <= n; ++j)
-            for (int i = 0; i + j <= n; ++i) g[size_t(j) * (n + 1) + i] = cut(nodePoint(f, n, i, j));
+            for (int i = 0; i + j <= n; ++i) g[size_t(j) * (n + 1) + i] = crossing(f, n, i, j);
         auto at = [&](int i, int j) -> const CornerCrossing& { return g[size_t(j) * (n + 1) + i]; };
         for (int j = 0; j < n; ++j)
             for (int i = 0; i + j < n; ++i) {
                 const CornerCrossing up[3] = {at(i, j), at(i + 1, j), at(i, j + 1)};
-                if (!piecePasses(up)) return false;
+                if (!piecePasses(up, {f, n, i, j, false})) return false;
                 if (i + j + 1 < n) {
                     const CornerCrossing down[3] = {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
-                    if (!piecePasses(down)) return false;
+                    if (!piecePasses(down, {f, n, i, j, true})) return false;
                 }
             }
         return true;
+    }
+
+    // The crossing of grid node (i, j) of triangle f at level n, cached for the triangle being
+    // leveled (cache_f) by its place at the finest level a test can reach.
+    CornerCrossing crossing(size_t f, int n, int i, int j) {
+        if (cache_f != f) {
+            cache.clear();
+            cache_f = f;
+        }
+        const uint64_t scale = uint64_t(max_level) * kMaxSubGrid / uint64_t(n);
+        const uint64_t key = (uint64_t(i) * scale) << 32 | (uint64_t(j) * scale);
+        const auto hit = cache.find(key);
+        if (hit != cache.end()) return hit->second;
+        const CornerCrossing c = cut(nodePoint(f, n, i, j));
+        cache.emplace(key, c);
+        return c;
     }
 
     // The polygon of the up piece (i, j) of triangle f at its level: its corners and, on the sides
@@ -231,7 +265,7 @@ struct Refiner {
                     if (with > 1) cuts.push_back(cut(centroidOf(f, i, j)));
                     for (const auto& t : tris) {
                         const CornerCrossing c3[3] = {cuts[t[0]], cuts[t[1]], cuts[t[2]]};
-                        if (!piecePasses(c3)) {
+                        if (!piecePasses(c3, {f, 0, 0, 0, false})) {
                             ok = false;
                             break;
                         }
