@@ -99,8 +99,8 @@ Status checkToleranceDial(const Scene& scene, const char* command) {
         const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
         if (spin || accel)
             return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +
-                                   ": `apparent " + command + "` sweeps the tolerance, which holds for uniform motion "
-                                   "only (spinning and accelerated objects are cut in vertex mode)");
+                                   ": `apparent " + command + "` sweeps the tolerance over uniform motion only (its "
+                                   "families and cost model are uniform motion's)");
     }
     return Status::success();
 }
