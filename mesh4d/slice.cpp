@@ -13,6 +13,7 @@
 #include "robust.h"
 #include "tessellate.h"
 #include "worldline.h"
+#include "worldline_refine.h"
 
 namespace mesh4d {
 
@@ -1531,9 +1532,14 @@ ApparentMesh sliceUnsheared(const World4D& world, const ViewSurface& view, const
     const bool at_rest = world.motion.beta == 0 && !view.sheared() && !(settings.displacement > 0);
     // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
     // are refined (FrameBuilder::restPlan).
-    // A motion that is not uniform (worldline.h) is cut in vertex mode only: exact points on the
-    // true worldlines (lightcone.h sends each cut to crossWorldline); callers refuse a tolerance.
+    // A motion that is not uniform (worldline.h) is otherwise cut in vertex mode: exact points on
+    // the true worldlines (lightcone.h sends each cut to crossWorldline).
     const bool uniform = isUniform(world.motion);
+    // A motion that is not uniform, with a tolerance: worldline_refine.h (no real cap; the callers
+    // refuse a tolerance for such an object that begins or ends existing, and a moving camera).
+    if (!uniform && settings.tolerance > 0 && !world.cap_a_real && !world.cap_b_real && !(settings.displacement >= 0) &&
+        !world.empty())
+        return refineWorldlines(world, view, settings);
     const bool rest_clip = uniform && view.kind == ViewKind::PastCone && at_rest && settings.tolerance > 0 &&
                            (world.cap_a_real || world.cap_b_real);
     if (view.kind == ViewKind::Hyperplane || at_rest || !uniform) settings.tolerance = 0;

@@ -140,7 +140,8 @@ struct SliceSettings {
 // Limit: an object at rest under a shear (or SliceSettings::displacement) is refined as a moving
 // one, so a real cap's clip curve wholly inside one triangle whose corners are all unseen (its
 // middle seen first) is not found: the search for those (restPlan) serves unsheared views.
-// A motion that is not uniform (worldline.h) is cut in vertex mode whatever the tolerance.
+// A motion that is not uniform (worldline.h) is refined by worldline_refine.h when a tolerance is
+// given and no real cap clips it (else cut in vertex mode).
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings = {});
 
 // A sphere that holds every apparent point of `world` in `view`: centred on the apparent position

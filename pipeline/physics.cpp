@@ -6,6 +6,7 @@
 #include "mesh4d/keyframes.h"
 #include "mesh4d/worldline.h"
 #include "pipeline/scene_fields.h"
+#include "pipeline/worlds.h"
 
 namespace apparent {
 
@@ -70,13 +71,20 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
     if (!spin && !accel) return Status::success();
     const std::string field = scene.path + ": " + s.field_path + (spin ? ".angular_velocity: " : ".acceleration: ");
     const std::string what = spin ? "a spinning object" : "an accelerated object";
+    // A tolerance is bounded for these motions (mesh4d/worldline_refine.h), but not the clip curve
+    // where the object begins or ends existing within the frames (a real cap of its world); checked
+    // last, once every vertex is known to have a worldline.
+    auto tolerance_ok = [&]() -> Status {
+        if (!(tolerance > 0) || (!std::isfinite(s.exists_from) && !std::isfinite(s.exists_to))) return Status::success();
+        const mesh4d::World4D w = buildWorld(object, model, scene, first_frame, last_frame);
+        if (!w.cap_a_real && !w.cap_b_real) return Status::success();
+        return Status::failure(field + what + " that begins or ends existing (exists) is cut in vertex mode only: "
+                                          "give --tolerance vertex (or the scene's \"tolerance\": \"vertex\")");
+    };
     if (spin && accel)
         return Status::failure(field + "give angular_velocity or acceleration, not both (not modelled together)");
     if (cameraMotionOf(scene).moving())
         return Status::failure(field + what + " needs a camera at rest (camera.velocity is not [0, 0, 0])");
-    if (tolerance > 0)
-        return Status::failure(field + what + " is cut in vertex mode only: give --tolerance vertex (or the "
-                                       "scene's \"tolerance\": \"vertex\")");
     const mesh4d::Motion m = motionOf(s, model);
     // The turned angle |w| s stays finite and meaningful over every time a scene can hold.
     if (spin && !(mesh4d::norm(s.angular_velocity) <= 1e12))
@@ -103,7 +111,7 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
                                        " in frame " + std::to_string(k) + ", beyond " + formatNumber(kMaxRapidity) +
                                        " (gamma 1e15, the limit of the gamma field)");
         }
-        return Status::success();
+        return tolerance_ok();
     }
     // The fastest vertex (a point inside a triangle is never faster: the speed is convex in q).
     double fastest = 0;
@@ -112,14 +120,14 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
                                                                                 : mesh4d::maxGalileanSpeed(m, q));
     if (!std::isfinite(fastest))
         return Status::failure(field + "the speed of a vertex is not finite");
-    if (model == Model::Instant) return Status::success();
+    if (model == Model::Instant) return tolerance_ok();
     if (!(fastest < 1))
         return Status::failure(field + "a vertex would move at " + formatNumber(fastest) +
                                (m.kinematics == mesh4d::Kinematics::Lorentz
                                     ? " (|w x q| in the centre frame)"
                                     : " (|velocity + w x q| in the lab, at the fastest angle)") +
                                ", which must be < 1 (the speed of light) for model " + modelName(model));
-    return Status::success();
+    return tolerance_ok();
 }
 
 Status checkToleranceDial(const Scene& scene, const char* command) {
@@ -131,8 +139,8 @@ Status checkToleranceDial(const Scene& scene, const char* command) {
         const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
         if (spin || accel)
             return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +
-                                   ": `apparent " + command + "` sweeps the tolerance, which holds for uniform motion "
-                                   "only (spinning and accelerated objects are cut in vertex mode)");
+                                   ": `apparent " + command + "` sweeps the tolerance over uniform motion only (its "
+                                   "families and cost model are uniform motion's)");
     }
     return Status::success();
 }

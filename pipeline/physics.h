@@ -35,7 +35,7 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
                          long long first_frame, long long last_frame);
 
 // For commands that sweep the tolerance (`apparent trade`): every object in uniform motion, else one
-// line naming the first spinning or accelerated object's field (those are cut in vertex mode only).
+// line naming the first spinning or accelerated object's field (the sweep's families are uniform motion's).
 Status checkToleranceDial(const Scene& scene, const char* command);
 
 // The camera's worldline (scene camera.position and camera.velocity).

@@ -345,8 +345,18 @@ TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
     apparent::Stage s5;
     std::string tol = scene(", \"angular_velocity\": [0, 0, 0.5]", "");
     tol.replace(tol.find("\"vertex\""), 8, "\"1e-3\"");
-    EXPECT_FALSE(apparent::loadQuietStage(write("tol.json", tol), &s5, &error));
-    EXPECT_NE(error.find("angular_velocity: a spinning object is cut in vertex mode only"), std::string::npos) << error;
+    EXPECT_TRUE(apparent::loadQuietStage(write("tol.json", tol), &s5, &error)) << error;  // worldline_refine.h
+    apparent::Stage s5b;
+    std::string tol_exists = scene(", \"angular_velocity\": [0, 0, 0.5], \"exists\": [-5, 100]", "");
+    tol_exists.replace(tol_exists.find("\"vertex\""), 8, "\"1e-3\"");
+    EXPECT_FALSE(apparent::loadQuietStage(write("tol_exists.json", tol_exists), &s5b, &error));
+    EXPECT_NE(error.find("angular_velocity: a spinning object that begins or ends existing (exists) is cut in vertex mode only"),
+              std::string::npos)
+        << error;
+    apparent::Stage s5c;  // an existence far outside the frames makes no cap: the tolerance holds
+    std::string tol_always = scene(", \"angular_velocity\": [0, 0, 0.5], \"exists\": [-1e30, 1e30]", "");
+    tol_always.replace(tol_always.find("\"vertex\""), 8, "\"1e-3\"");
+    EXPECT_TRUE(apparent::loadQuietStage(write("tol_always.json", tol_always), &s5c, &error)) << error;
     {
         apparent::Stage dial;
         ASSERT_TRUE(apparent::loadQuietStage(ok, &dial, &error)) << error;

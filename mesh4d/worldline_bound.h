@@ -1,0 +1,97 @@
+// A bound on the second derivative of the apparent-point map of a motion that is not uniform
+// (worldline.h: spin, rolling, Born-rigid acceleration), over one rest triangle: what the
+// tolerance mode of these motions (worldline_refine.h) bounds its chords by.
+//
+// The map. Rest point q's worldline is the event E(s, q) = (t(s, q), x(s, q)) at the object's
+// time s; at a fixed s it is affine in q for every motion of worldline.h (a spin turns the rest
+// mesh, an acceleration moves it Born-rigidly, a boost or the Galilean carry is affine), so
+// t_qq = 0 and x_qq = 0. The apparent point is F(q) = x(sigma(q), q), sigma(q) the root of
+//     g(s, q) = t_c - t(s, q) - rho(s, q) = 0,   rho = |x - C|   (past cone; on a hyperplane g = t_c - t).
+// Along a line of rest points q(l) = q0 + l u (derivatives in l written with dots, primes on sigma):
+//     sigma' = -(t_q u + n.x_q u) / Lambda,   Lambda = t_s + n.x_s   (n = (x - C) / rho; t_s on a hyperplane)
+//     x.     = x_s sigma' + x_q u
+//     Lambda sigma'' = -[(t_ss + n.x_ss) sigma'^2 + 2 (t_sq + n.x_sq)[u] sigma' + P / rho],  P = |x._perp|^2 <= |x.|^2
+//     x..    = x_s sigma'' + x_ss sigma'^2 + 2 x_sq[u] sigma'
+//     t..    = t_s sigma'' + t_ss sigma'^2 + 2 t_sq[u] sigma'
+// (differentiate g(sigma(q(l)), q(l)) = 0 twice; rho.. = n.x.. + P / rho). Lambda > 0 is the
+// Doppler denominator dt/ds (1 - n.V) of the point: it is what makes the map steep when a part
+// moves toward the camera, and it is the term a tight bound must not take at its worst case.
+//
+// The bound, term by term, over the triangle (q in it, s = sigma(q)):
+//   - rates of the worldline, as (time part, space part) magnitudes in the object's own frame (the
+//     centre frame of a spin, the start frame of an acceleration; the lab for the Galilean carry),
+//     per unit |u| where q enters (FrameRates, worldline_bound.cpp):
+//       spin:   (T, Y)_s = (1, w x Y), |w x Y| <= c = max_i |w x q_i| (the rim speed of the
+//               farthest corner from the axis: a distance to a line is convex), (T, Y)_ss =
+//               (0, w x (w x Y)) <= (0, |w| c), (T, Y)_q = (0, R u) <= (0, 1), (T, Y)_sq =
+//               (0, w x R u) <= (0, |w|)   (the curvature |w|^2 rho and the spread of the
+//               velocity across the triangle, |w| l, of the brief);
+//               Galilean carry: (1, w x Y + v) <= (1, max_i maxGalileanSpeed(q_i)), the rest as above;
+//       Born-rigid acceleration (xi = 1/|a| + q.k in [xi_lo, xi_hi] from the corners, s in a window
+//               [s_lo, s_hi], S = max(s_hi, 0), ch = cosh(|a| S), sh = sinh(|a| S)):
+//               (T, Y)_s = xi |a| (cosh, k sinh) <= xi_hi |a| (ch, sh), (T, Y)_ss = xi |a|^2 (sinh,
+//               k cosh) <= xi_hi |a|^2 (sh, ch) (the proper acceleration 1/xi), (T, Y)_q = ((k.u)
+//               sinh, u + k (k.u)(cosh - 1)) <= (sh, ch), (T, Y)_sq = (k.u)|a| (cosh, k sinh) <=
+//               |a| (ch, sh); before t0 (s <= 0) the uniform (1, 0), (0, 0), (0, 1), (0, 0); a window
+//               across s = 0 takes the larger of both (the map is C1 and piecewise C2 there, which is
+//               all the Taylor remainder below needs);
+//               Galilean carry (x = X0 + q + P(s), s the lab time since t0): (1, |P'|) with |P'| <=
+//               (b + th) / (1 + b th), th = tanh(|a| tau(S)) (velocity addition at its worst
+//               angle), (0, |P''|) <= (0, |a|) (a lab 3-acceleration is at most the proper one
+//               over gamma^2), (0, 1) for q, nothing mixed.
+//   - into the lab (Lorentz): a boost with speed b stretches a 4-vector (T, Y) to
+//     |t| <= g (T + b Y), |x| <= g (Y + b T), and the combination |t + n.x| <= g (1 + v.n)(T + Y) for a
+//     unit n (the Doppler factor of the boost is at most g (1 + b)); g = 1, b = 0 for the carry.
+//   - Lambda is not taken at its worst over the motion: it is computed exactly at the three
+//     corners (worldlineRate at each corner's crossing) and carried over the triangle by its
+//     Lipschitz bound L_Lambda = c_ss G + c_sq + |x_s| L_F / rho_min (a hyperplane: t_ss G + t_sq),
+//     G = c_q / Lambda_min bounding |sigma'|, L_F = |x_s| G + |x_q| bounding |x.|; likewise
+//     rho >= min_i rho_i - L_F d and sigma within G d of the corners' (the window of an
+//     acceleration's rates), d the longest side. These bounds depend on one another; a guess
+//     Lambda_min (first 0.9 times the corners' least) is accepted when min_i Lambda_i - L_Lambda d >
+//     Lambda_min and G d is inside the window, which makes them hold on the whole triangle (a point
+//     where one of them first failed would be reached from a corner along a segment on which all
+//     hold, a contradiction); else the guess moves toward min_i Lambda_i - 1.05 L_Lambda d, at least
+//     halving (at most 24 rounds: then no bound, INFINITY, and the caller splits).
+//   - the boost's Doppler factor for the cone's combination t + n.x is g (1 + v.n), not taken at its
+//     worst g (1 + b): v.n is guessed a hundredth of the way from the corners' largest to b and
+//     checked like Lambda (n turns by at most L_F d / rho_min over the triangle); so a part that
+//     moves toward the camera, where Lambda is small, gets the small factor g (1 - b) it has.
+//   - K = |x..| + |shear| |t..| <= |x_s| S2 + x_ss G^2 + 2 x_sq G + |shear| (t_s S2 + t_ss G^2 + 2 t_sq G),
+//     S2 = (c_ss G^2 + 2 c_sq G + L_F^2 / rho_min) / Lambda_min bounding |sigma''| (a hyperplane:
+//     (t_ss G^2 + 2 t_sq G) / Lambda_min), all per |u|^2. (shear: the finite model's moving camera,
+//     lightcone.h; the callers refuse it for these motions, so it is 0 in practice.)
+// The use: for the linear interpolant L of F on a triangle with exact corners, and any point
+// p = sum l_i q_i, Taylor's theorem with integral remainder from p to each corner gives
+// |F(p) - L(p)| <= (K / 2) sum_i l_i |q_i - p|^2 = (K / 2) sum_{i<j} l_i l_j |q_i - q_j|^2 <= K d^2 / 6.
+// For uniform motion (no curvature terms) K is the light delay's Hessian term of chord_error.h,
+// looser by the worst angles taken separately (G, L_F); worldline_refine.h therefore measures the
+// error at a sub-grid of exact points and uses K only for what lies between them.
+#pragma once
+
+#include "event.h"
+#include "lightcone.h"
+#include "worldline.h"
+
+namespace mesh4d {
+
+// A corner of a rest triangle with its exact crossing: the rest point, the crossing's lab event and
+// object time s, its distance rho to the camera (0 on a hyperplane) and its Lambda (above).
+struct CornerCrossing {
+    Vec3 q;
+    Event event;
+    double s = 0;
+    double rho = 0;
+    double lambda = 0;
+};
+
+// The exact crossing of q's worldline with `view` and its terms (crossWorldline, worldlineRate).
+// ok = false when the search failed (NaN or infinite input).
+CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Vec3& q, bool* ok);
+
+// K above for the rest triangle with these corners (INFINITY when no bound holds: a triangle that
+// may reach the camera, or too large for the guesses to close). `shear_speed`: |view.shear|.
+// Precondition: the motion is not uniform and every corner's worldline is timelike.
+double secondDerivativeBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]);
+
+}  // namespace mesh4d
