@@ -75,6 +75,11 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
     // where the object begins or ends existing within the frames (a real cap of its world); checked
     // last, once every vertex is known to have a worldline.
     auto tolerance_ok = [&]() -> Status {
+        // Nor the reflections of such an object (pipeline/mirror.h): their worlds may have real caps
+        // where the object's own has none, and would be cut in vertex mode.
+        if (tolerance > 0 && std::any_of(scene.objects.begin(), scene.objects.end(), [](const ObjectSpec& o) { return o.mirror; }))
+            return Status::failure(field + what + " seen in a mirror is cut in vertex mode only: give --tolerance vertex "
+                                              "(or the scene's \"tolerance\": \"vertex\")");
         if (!(tolerance > 0) || (!std::isfinite(s.exists_from) && !std::isfinite(s.exists_to))) return Status::success();
         const mesh4d::World4D w = buildWorld(object, model, scene, first_frame, last_frame);
         if (!w.cap_a_real && !w.cap_b_real) return Status::success();

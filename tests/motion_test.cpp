@@ -358,6 +358,16 @@ TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
     tol_always.replace(tol_always.find("\"vertex\""), 8, "\"1e-3\"");
     EXPECT_TRUE(apparent::loadQuietStage(write("tol_always.json", tol_always), &s5c, &error)) << error;
     {
+        apparent::Stage s5d;  // seen in a mirror: its reflections' worlds may be clipped, so refused
+        std::string tol_mirror = scene(", \"angular_velocity\": [0, 0, 0.5]}, {\"mesh\": \"" + std::string(APPARENT_SOURCE_DIR) +
+                                           "/data/meshes/backdrop.obj\", \"mirror\": true, \"position\": [0, 0, -3]", "");
+        tol_mirror.replace(tol_mirror.find("\"vertex\""), 8, "\"1e-3\"");
+        EXPECT_FALSE(apparent::loadQuietStage(write("tol_mirror.json", tol_mirror), &s5d, &error));
+        EXPECT_NE(error.find("tol_mirror.json: objects[0].angular_velocity: a spinning object seen in a mirror is cut in vertex mode only"),
+                  std::string::npos)
+            << error;
+    }
+    {
         apparent::Stage dial;
         ASSERT_TRUE(apparent::loadQuietStage(ok, &dial, &error)) << error;
         const apparent::Status t = apparent::checkToleranceDial(dial.scene, "trade");
