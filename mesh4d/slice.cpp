@@ -1,6 +1,7 @@
 #include "slice.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -615,9 +616,8 @@ struct FrameBuilder {
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
                 const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
-                const Vec3 s[3] = {k0.s, k1.s, k2.s};
-                const double xm[3] = {k0.xm, k1.xm, k2.xm};
-                const ChordError ce = pieceBound(c, s, xm);
+                const ChordError ce =
+                    chordErrorOfPoints(world.motion, bound_speed, c, k0, k1, k2, settings.tolerance);
                 if (ce.bound <= settings.tolerance) {
                     rt[id].state = kPassed;
                     continue;
@@ -625,7 +625,7 @@ struct FrameBuilder {
                 // (The form is worth making only for a piece that needs a level of kMinLevel or
                 // more: its bubbles alone say about how much.)
                 if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
-                    coarseForm(id, s, false)) {
+                    coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                     rt[id].state = kCoarse;
                     continue;
                 }
@@ -656,16 +656,20 @@ struct FrameBuilder {
         }
     };
     // The slot of the longest of the three edges e[c] (lengths known) of the triangle on v.
+    // (The ids are looked at only on a tie of lengths, as Rank orders them.)
     static int longestOf(const uint32_t v[3], const REdge* const e[3]) {
         int best = 0;
-        Rank r{e[0]->len, std::min(v[0], v[1]), std::max(v[0], v[1])};
+        double len = e[0]->len;
         for (int c = 1; c < 3; ++c) {
-            const uint32_t a = v[c], b = v[kSucc[c]];
-            const Rank rc{e[c]->len, std::min(a, b), std::max(a, b)};
-            if (r < rc) {
-                r = rc;
-                best = c;
+            const double lc = e[c]->len;
+            if (!(lc > len)) {  // (a NaN length is never the longest, as in Rank)
+                if (!(lc == len)) continue;
+                const Rank r{len, std::min(v[best], v[kSucc[best]]), std::max(v[best], v[kSucc[best]])};
+                const Rank rc{lc, std::min(v[c], v[kSucc[c]]), std::max(v[c], v[kSucc[c]])};
+                if (!(r < rc)) continue;
             }
+            len = lc;
+            best = c;
         }
         return best;
     }
