@@ -182,6 +182,9 @@ struct FrameBuilder {
         if (view.sheared()) return norm(world.motion.velocity - view.shear);
         return world.motion.beta;
     }
+    ChordError pointsBound(const double c[3], const VTerms& a, const VTerms& b, const VTerms& d) const {
+        return chordErrorOfPoints(world.motion, bound_speed, c, a, b, d, settings.tolerance);
+    }
     ChordError pieceBound(const double c[3], const Vec3 s[3], const double xm[3]) const {
         return chordErrorOfBubbles(world.motion, bound_speed, c, s, xm, settings.tolerance);
     }
@@ -604,20 +607,21 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
+            const uint8_t state = rt[id].state;
             if (r_caps) {
+                const uint32_t* v = rt[id].v;
                 const Side s0 = side[v[0]];
                 if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
             }
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
-            if (rt[id].state == kPassed || rt[id].state == kCoarse) continue;
-            if (rt[id].state == kUnknown) {
+            if (state == kPassed || state == kCoarse) continue;
+            if (state == kUnknown) {
+                const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
                 const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
-                const ChordError ce =
-                    chordErrorOfPoints(world.motion, bound_speed, c, k0, k1, k2, settings.tolerance);
+                const ChordError ce = pointsBound(c, k0, k1, k2);
                 if (ce.bound <= settings.tolerance) {
                     rt[id].state = kPassed;
                     continue;
