@@ -423,6 +423,11 @@ struct FrameBuilder {
     // inner edges that splits make. Every slot on an edge refers to the edge's record, so its
     // midpoint and length are made once and seen from every triangle around it.
     std::vector<REdge>& r_edges;
+    // The data of r_edges, r_terms and r_init while the splits run (set where they are sized): the
+    // hot loops index them without going through the vectors.
+    REdge* r_edge_data = nullptr;
+    VTerms* r_term_data = nullptr;
+    const uint8_t* r_init_data = nullptr;
 
     // Triangles (RTri): one array for all ids, left uninitialised (RTri is trivial): a large mesh
     // of which few triangles need refining touches only their pages (r_init says which base
@@ -453,7 +458,7 @@ struct FrameBuilder {
     }
 
     void ensureBase(uint32_t id) {
-        if (id >= r_nt || r_init[id]) return;
+        if (id >= r_nt || r_init_data[id]) return;
         r_init[id] = 1;
         RTri& t = rt[id];
         for (int c = 0; c < 3; ++c) {
@@ -469,7 +474,7 @@ struct FrameBuilder {
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
     uint32_t nextOf(uint32_t p) const {
         const uint32_t id = slotTri(p);
-        if (id < r_nt && !r_init[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
+        if (id < r_nt && !r_init_data[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
         return rt[id].next[slotSide(p)];
     }
     void setNext(uint32_t p, uint32_t to) {
@@ -482,6 +487,7 @@ struct FrameBuilder {
     uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b, double xm) {
         const uint32_t id = uint32_t(r_terms.size());
         r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
+        r_term_data = r_terms.data();
         r_rest.push_back(rest);
         // Without a real cap every point is inside and is given its output place in bulk
         // (refineFrame): side and vertex_out stay the mesh's.
@@ -501,10 +507,10 @@ struct FrameBuilder {
     // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
     // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
     const REdge& edgeOf(uint32_t id, int c) {
-        REdge& e = r_edges[rt[id].edge[c]];
+        REdge& e = r_edge_data[rt[id].edge[c]];
         if (e.len != e.len) {
             const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
-            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
+            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
             e.len = eb.length;
             e.c = eb.c;
             e.xm_mid = eb.xm_mid;
@@ -556,6 +562,7 @@ struct FrameBuilder {
         } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
         r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
+        r_edge_data = r_edges.data();
         reserveTris(members.size());
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
@@ -620,7 +627,7 @@ struct FrameBuilder {
                 const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
                 const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
-                const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
+                const VTerms &k0 = r_term_data[v[0]], &k1 = r_term_data[v[1]], &k2 = r_term_data[v[2]];
                 const ChordError ce = pointsBound(c, k0, k1, k2);
                 if (ce.bound <= settings.tolerance) {
                     rt[id].state = kPassed;
@@ -1080,6 +1087,9 @@ struct FrameBuilder {
             out.triangles.reserve(out.triangles.size() + expect);
             out.source_triangles.reserve(out.source_triangles.size() + expect);
             r_init.assign(r_nt, 0);
+            r_init_data = r_init.data();
+            r_edge_data = r_edges.data();
+            r_term_data = r_terms.data();
             r_limited.assign(r_nt, 0);
             r_leaves = r_nt;
             std::vector<uint32_t>& stack = scratch.stack;
