@@ -111,6 +111,7 @@ struct RefineScratch {
     // local triangles and its local-to-global point map.
     std::vector<PieceForm> forms;
     std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
+    std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
     std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
@@ -120,7 +121,8 @@ struct RefineScratch {
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
                init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
-               (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity()) *
+               (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity() +
+                coarse.capacity()) *
                    sizeof(uint32_t) +
                local.capacity() * sizeof(std::array<uint32_t, 3>);
     }
@@ -638,6 +640,7 @@ struct FrameBuilder {
                 if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
                     coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                     rt[id].state = kCoarse;
+                    scratch.coarse.push_back(id);
                     continue;
                 }
                 rt[id].state = kFailed;
@@ -1008,6 +1011,7 @@ struct FrameBuilder {
         r_templates = !caps;
         scratch.forms.clear();
         scratch.form_of.clear();
+        scratch.coarse.clear();
         if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
         // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
@@ -1107,19 +1111,19 @@ struct FrameBuilder {
                 auto share = [&](uint32_t id) {
                     if (rt[id].state == kCoarse) templated += std::pow(double(formLevel(scratch.forms[scratch.form_of[id]], cap)), 2);
                 };
-                for (uint32_t f = 0; f < r_nt; ++f)
-                    if (r_init[f]) share(f);
-                for (uint32_t id = r_nt; id < uint32_t(r_tri_size); ++id) share(id);
+                // The records still coarse, in id order (as a pass over all records would meet
+                // them), from the list of those marked: no pass over every record.
+                std::vector<uint32_t>& coarse = scratch.coarse;
+                std::sort(coarse.begin(), coarse.end());
+                coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
+                for (uint32_t id : coarse) share(id);
                 if (templated < kTemplateShare * double(r_leaves)) {
                     r_templates = false;
-                    auto resume = [&](uint32_t id) {
-                        if (rt[id].state != kCoarse) return;
+                    for (uint32_t id : coarse) {
+                        if (rt[id].state != kCoarse) continue;
                         rt[id].state = kUnknown;
                         stack.push_back(id);
-                    };
-                    for (uint32_t f = 0; f < r_nt; ++f)
-                        if (r_init[f]) resume(f);
-                    for (uint32_t id = r_nt; id < uint32_t(r_tri_size); ++id) resume(id);
+                    }
                     drain(stack);
                     scratch.forms.clear();
                 }
