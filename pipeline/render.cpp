@@ -122,10 +122,12 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
         return kExitOutputError;
     }
 
-    // Step (MPI, .glb): the ranks write their frames' data themselves when rank 0 sees their files.
+    // Step (MPI): the ranks write their frames' data (the .glb's) and files (PLY, OBJ) themselves
+    // when rank 0 sees their files.
     const bool glb = std::find(settings.formats.begin(), settings.formats.end(), "glb") != settings.formats.end();
-    if (distributed && glb && !shareFrameSpills(settings.out_dir, &error) && !settings.quiet)
-        err << "warning: " << error << "; the .glb's frame data goes through rank 0 instead (slower)\n";
+    if (distributed && !shareFrameSpills(settings.out_dir, &error) && !settings.quiet)
+        err << "warning: " << error << "; the " << (glb ? ".glb's frame data" : "frames' files")
+            << " goes through rank 0 instead (slower)\n";
 
     // Step: per model, the frame loop into one sink per format; the budget spans the whole run.
     OutputBudget budget(settings.max_output_bytes);
