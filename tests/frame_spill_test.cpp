@@ -4,7 +4,9 @@
 // frames in whole, in part (one object of two: meshopt's partly shared stream) and not at all; the
 // descriptions that travel are a small fraction of the data (meshopt frames that may be morph
 // targets travel whole, and the file is the same); a description naming an unknown source is
-// refused with a message.
+// refused with a message. PLY frames written by the rank that cut them (exporters/frame_files.h)
+// are renamed into place byte-identical to frames added directly, a replaced or planted temporary
+// is refused, and what was not taken is removed.
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
