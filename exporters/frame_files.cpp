@@ -147,7 +147,13 @@ void FrameFileSink::beforeSending(long long index, EncodedOutput* frame) {
 }
 
 void FrameFileSink::expectEncoded(long long index) {
-    if (frameSpillInstalled() && !expected_.count(index)) expected_[index] = registerTemporary(temporaryPath(index));
+    if (!frameSpillInstalled() || expected_.count(index)) return;
+    // At most kRegisteredMost names of other ranks' frames at once per sink: the interrupt
+    // cleanup's other slots stay for this process's own temporaries (the .glb's among them).
+    constexpr size_t kRegisteredMost = 16;
+    size_t registered = 0;
+    for (const auto& e : expected_) registered += e.second >= 0 ? 1 : 0;
+    expected_[index] = registered < kRegisteredMost ? registerTemporary(temporaryPath(index)) : -1;
 }
 
 void FrameFileSink::dropEncoded(long long first, long long last_excl) {

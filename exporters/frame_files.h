@@ -13,8 +13,9 @@
 // one; a rank writes one frame at a time) and of each one received and not yet renamed, and
 // removes every such name of the sequence when the run fails (dropEncoded). A rank killed by
 // SIGKILL while rank 0 lives leaves its frame under way to rank 0's cleanup when mpirun ends rank 0
-// with SIGTERM; with more than about 60 ranks the 64 slots of that cleanup run out (a name not
-// registered may then stay, as AtomicOutput's temporary does after SIGKILL: never a final file).
+// with SIGTERM. Rank 0 registers at most 16 such names per sink at once (the cleanup has 64 slots,
+// shared with its own temporaries): from about 14 ranks on, a killed rank's frame under way may
+// stay, as AtomicOutput's temporary does after SIGKILL (a hidden .tmp- name, never a final file).
 // Without shared spills the bytes travel to rank 0, which commits them (addEncoded).
 #pragma once
 
