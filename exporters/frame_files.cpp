@@ -101,7 +101,8 @@ uint64_t getU64(const std::string& in, size_t at) {
 }
 
 bool isWrittenFrame(const std::string& bytes) {
-    return bytes.size() >= sizeof kWrittenMarker + 16 && std::memcmp(bytes.data(), kWrittenMarker, sizeof kWrittenMarker) == 0;
+    return bytes.size() >= sizeof kWrittenMarker + 16 &&
+           std::memcmp(bytes.data(), kWrittenMarker, sizeof kWrittenMarker) == 0;
 }
 
 }  // namespace
@@ -131,8 +132,8 @@ void FrameFileSink::beforeSending(long long index, EncodedOutput* frame) {
         size_t done = 0;
         std::string w;
         if (!writeAll(fd, frame->bytes.data(), frame->bytes.size(), &w, &done))
-            why = final_path + ": cannot write (" + std::to_string(done) + " of " + std::to_string(frame->bytes.size()) +
-                  " bytes written): " + w;
+            why = final_path + ": cannot write (" + std::to_string(done) + " of " +
+                  std::to_string(frame->bytes.size()) + " bytes written): " + w;
         else if (::fsync(fd) != 0 || ::fstat(fd, &st) != 0)
             why = final_path + ": cannot write: " + std::strerror(errno);
         if (::close(fd) != 0 && why.empty()) why = final_path + ": cannot write: " + std::strerror(errno);

@@ -112,14 +112,15 @@ public:
 };
 
 // Frames by reference (exporters/frame_spill.h), set up once per run before the frame loops: every
-// rank creates its frame spill in `dir` (".apparent-frames-TOKEN.RANK", TOKEN random (frameRunToken()), broadcast by
-// rank 0), rank 0 opens every rank's file by name and then unlinks every name, so that nothing is
-// left behind from here on whatever ends the job. True on every rank when every spill is in place:
+// rank creates its frame spill in `dir` (".apparent-frames-TOKEN.RANK", TOKEN random, broadcast by
+// rank 0, then frameRunToken()), rank 0 opens every rank's file by name and then unlinks every
+// name, so that nothing is left behind from here on whatever ends the job. True on every rank when every spill is in place:
 // a rank's .glb frames then travel as descriptions, their data written by the rank that cut them
 // and, when rank 0 assembles the file, copied into it by that rank (placeOnRanks, installed here
-// as rank 0's frame placer); its PLY and OBJ files are written by the rank, renamed by rank 0. False on every rank, the reason in `why` on rank
-// 0, when a rank cannot create its file or rank 0 cannot see it (the folder is not on a file system
-// every rank shares): the frames then travel whole, as to a writer without spills. Collective.
+// as rank 0's frame placer); its PLY and OBJ files are written by the rank, renamed by rank 0.
+// False on every rank, the reason in `why` on rank 0, when a rank cannot create its file or rank 0
+// cannot see it (the folder is not on a file system every rank shares): the frames then travel
+// whole, as to a writer without spills. Collective.
 bool shareFrameSpills(const std::string& dir, std::string* why);
 
 // The group of this process (single until setFrameGroup installs another).

@@ -145,6 +145,9 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     const bool sender = settings.distributed && group.rank() > 0;
     const bool receiver = settings.distributed && group.rank() == 0 && group.size() > 1;
     const FrameSplit split = settings.split;
+    // Every other rank may make its first frame as soon as it has its worlds (FrameSink::expectEncoded).
+    for (long long k = first + 1; receiver && k < std::min(last_excl, first + group.size()); ++k)
+        for (FrameSink* sink : sinks) sink->expectEncoded(k);
     // Step: the static 4D worlds and the mirrors' reflections, once per model.
     const std::vector<mesh4d::World4D> worlds = take && stage.mirrors.empty()
                                                     ? takeWorlds(take, model, scene, first, last_excl - 1)
@@ -356,7 +359,8 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     auto inOrder = [&](WorkPtr w) {
         if (sender) {
             if (stop || (stop = group.stopRequested())) return;
-            for (size_t s = 0; s < w->encoded->sinks.size(); ++s) sinks[s]->beforeSending(w->frame.index, &w->encoded->sinks[s]);
+            for (size_t s = 0; s < w->encoded->sinks.size(); ++s)
+                sinks[s]->beforeSending(w->frame.index, &w->encoded->sinks[s]);
             const std::string header = frameHeader(*w->encoded);
             group.sendParts(frameParts(*w->encoded, header));
             return;
@@ -411,9 +415,6 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         result->group_code = code;
         return false;
     };
-    // Every other rank may make its first frame at once.
-    for (long long k = first + 1; receiver && k < std::min(last_excl, first + group.size()); ++k)
-        for (FrameSink* sink : sinks) sink->expectEncoded(k);
     run();
     if (stop) return fail(failed_code ? failed_code : result->over_budget ? kExitBadInput : kExitOutputError);
 
