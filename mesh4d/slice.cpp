@@ -956,6 +956,9 @@ struct FrameBuilder {
             }
             if (form_of[id] == kUnset) return;
             const uint32_t n = formLevel(scratch.forms[form_of[id]], cap);
+            // A form asking for more than max_segments segments gets that many: the tolerance is
+            // not met there, counted as the depth limit is.
+            if (n == cap && formLevel(scratch.forms[form_of[id]], kNoCap) > cap) r_limited[t.src] = 1;
             estimate += double(n) * double(n);
             for (int c = 0; c < 3; ++c) count[t.edge[c]] = std::max(count[t.edge[c]], n - 1);
         };

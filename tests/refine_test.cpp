@@ -694,6 +694,22 @@ TEST(Refine, PieceFormBoundsEveryTriangleInside) {
     EXPECT_GT(checked, 500);
 }
 
+// A refinement that needs more than max_segments segments stops there and says so: the box at
+// its closest, T = 1e-5 x size, max_segments = 4 (at most 4 segments along an input edge, far
+// fewer than the tolerance asks for): limited_triangles counts the input triangles that stopped.
+TEST(Refine, RefinementLimitIsCounted) {
+    const TradeScene sc = boxNear();
+    const World4D w = extrude(sc.mesh, sc.motion, -100, 100, false, false);
+    SliceSettings s;
+    s.tolerance = 1e-5 * sc.size;
+    s.max_segments = 4;
+    const ApparentMesh out = sliceWorld(w, sc.view, s);
+    EXPECT_GT(out.limited_triangles, 0u);
+    EXPECT_LE(out.limited_triangles, sc.mesh.triangles.size());
+    s.max_segments = 4096;
+    EXPECT_EQ(sliceWorld(w, sc.view, s).limited_triangles, 0u);
+}
+
 // The whole-piece form dominates the delay's Hessian everywhere on the piece, near the camera
 // too: random pieces 1.2 to 6 sizes from the camera (where the Taylor form's third-order term is
 // as large as the Hessian), random points of each piece and random steps u in its plane, the
