@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "keyframes.h"
+
 namespace mesh4d {
 
 namespace {
@@ -19,9 +21,37 @@ struct FrameRates {
 
 bool accelerated(const Motion& m) { return norm(m.acceleration) > 0; }
 
+// A keyframed path's segments whose s-range meets [s_lo, s_hi]: first and last index.
+struct SegmentSpan {
+    size_t first, last;
+};
+SegmentSpan segmentsIn(const KeyedMotion& k, double s_lo, double s_hi) {
+    return {keyedSegment(k, s_lo), keyedSegment(k, s_hi)};
+}
+
+// Segment j of a keyframed path, as a carry in its own frame (the header): Y = P + u s + R(s) Q q.
+// rho: the corners' largest distance from the turn axis after the key's turn (a distance to a line
+// is convex, so no point of the triangle is farther).
+FrameRates segmentRates(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
+    const size_t key = j == 0 ? 0 : j - 1;
+    const double w = k.rate[j];
+    double rho = 0;
+    if (w > 0)
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = rotate(k.turns[key], c[i].q);
+            rho = std::max(rho, norm(p - k.axis[j] * dot(k.axis[j], p)));
+        }
+    return {1, norm(k.velocity[j]) + w * rho, 0, w * w * rho, 0, 1, 0, w};
+}
+
 FrameRates frameRates(const Motion& m, const CornerCrossing c[3], double s_lo, double s_hi) {
     FrameRates r;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
+    if (m.keyed) {
+        const SegmentSpan span = segmentsIn(*m.keyed, s_lo, s_hi);
+        for (size_t j = span.first; j <= span.last; ++j) r.takeMax(segmentRates(*m.keyed, j, c));
+        return r;
+    }
     if (!accelerated(m)) {  // spin
         const double wn = norm(m.angular_velocity);
         double rim = 0, carried = 0;
@@ -86,7 +116,80 @@ CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Ve
     return c;
 }
 
-double secondDerivativeBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
+namespace {
+
+// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as boost.h.
+Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
+
+// Lambda of segment j's rates at corner c's exact event (the header: its own segment's is c.lambda).
+double segmentLambda(const Motion& m, const ViewSurface& view, const CornerCrossing& c, size_t j) {
+    const KeyedLocal l = keyedSegmentLocal(*m.keyed, j, c.s, c.q);
+    double dt = 1;
+    Vec3 dx = l.dy;
+    if (m.kinematics == Kinematics::Lorentz) {
+        dt = m.gamma * (1 + dot(m.velocity, l.dy));
+        dx = l.dy + stretch(m.velocity, m.gamma, l.dy) + m.velocity * m.gamma;
+    }
+    if (view.kind != ViewKind::PastCone) return dt;
+    return dt + (c.rho > 0 ? dot(c.event.x - view.apex, dx) / c.rho : -norm(dx));
+}
+
+// The least Lambda of every segment meeting [s_lo, s_hi] at the three corners.
+double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossing c[3], double s_lo, double s_hi) {
+    const SegmentSpan span = segmentsIn(*m.keyed, s_lo, s_hi);
+    double out = INFINITY;
+    for (size_t j = span.first; j <= span.last; ++j)
+        for (int i = 0; i < 3; ++i) out = std::min(out, segmentLambda(m, view, c[i], j));
+    return out;
+}
+
+// The jump of dY/ds at key i over the triangle, in the own frame: |du + dw x Q_i q| with du, dw the
+// changes of the centre's velocity and of the angular velocity (rate times axis) from segment i to
+// i + 1; affine in q under a norm, so its largest value is at a corner.
+double keyJump(const KeyedMotion& k, size_t i, const CornerCrossing c[3]) {
+    const Vec3 du = k.velocity[i + 1] - k.velocity[i];
+    const Vec3 dw = k.axis[i + 1] * k.rate[i + 1] - k.axis[i] * k.rate[i];
+    double out = 0;
+    for (int j = 0; j < 3; ++j) out = std::max(out, norm(du + cross(dw, rotate(k.turns[i], c[j].q))));
+    return out;
+}
+
+// Whether the curve sigma = s_i may meet the triangle (header): the sign of
+// g(s_i, q) = t_c - t - |x - C| (t_c - t on a hyperplane) at the corners' events at s_i. t and x are
+// affine in q at a fixed s, so g is concave (affine on a hyperplane): corners all inside the cone
+// (g > 0) keep the whole triangle inside; corners all outside keep it outside when one corner's
+// tangent plane, g_a - (t_b - t_a) - n_a.(x_b - x_a) at the corners b, lies below 0 (a concave
+// function lies below its tangent planes; affine: the corners decide). Near 0 counts as crossing.
+bool keyMayCross(const Motion& m, const ViewSurface& view, size_t i, const CornerCrossing c[3]) {
+    const bool cone = view.kind == ViewKind::PastCone;
+    const double s = m.keyed->s[i];
+    Event e[3];
+    double g[3], scale = 1;
+    for (int k = 0; k < 3; ++k) {
+        e[k] = worldlineEvent(m, s, c[k].q);
+        g[k] = view.t_c - e[k].t - (cone ? norm(e[k].x - view.apex) : 0.0);
+        scale = std::max(scale, std::fabs(view.t_c - e[k].t));
+    }
+    const double tiny = 1e-12 * scale;
+    if (g[0] > tiny && g[1] > tiny && g[2] > tiny) return false;
+    if (!(g[0] < -tiny && g[1] < -tiny && g[2] < -tiny)) return true;
+    if (!cone) return false;
+    for (int a = 0; a < 3; ++a) {
+        const Vec3 d = e[a].x - view.apex;
+        const double r = norm(d);
+        if (!(r > 0)) continue;
+        bool below = true;
+        for (int b = 0; b < 3 && below; ++b)
+            below = g[a] - (e[b].t - e[a].t) - dot(d, e[b].x - e[a].x) / r < -tiny;
+        if (below) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
+    const PieceBound none;
     const bool cone = view.kind == ViewKind::PastCone;
     double d2 = 0;
     for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
@@ -98,8 +201,8 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
         s_lo = std::min(s_lo, c[i].s);
         s_hi = std::max(s_hi, c[i].s);
     }
-    if (!(lam_c > 0) || (cone && !(rho_c > 0))) return INFINITY;
-    const bool windowed = accelerated(m);
+    if (!(lam_c > 0) || (cone && !(rho_c > 0))) return none;
+    const bool windowed = accelerated(m) || m.keyed;
     // v.n at the corners (the Doppler factor of the boost, header): the guess nu starts a hundredth
     // of the way from their largest to b.
     const double b = m.kinematics == Kinematics::Lorentz ? m.beta : 0.0;
@@ -107,10 +210,16 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
     if (cone)
         for (int i = 0; i < 3; ++i) nu_c = std::max(nu_c, dot(m.velocity, c[i].event.x - view.apex) / c[i].rho);
     double nu = std::min(b, nu_c + 0.01 * (b - nu_c));
-    double lam_min = 0.9 * lam_c;
     double spread = std::max(s_hi - s_lo, 1e-300);  // the window's margin about the corners' s
+    if (m.keyed) lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+    if (!(lam_c > 0)) return none;
+    double lam_min = 0.9 * lam_c;
     for (int iter = 0; iter < 24; ++iter) {
         const FrameRates f = frameRates(m, c, s_lo - spread, s_hi + spread);
+        if (m.keyed) {  // every segment the window meets, at every corner (header)
+            lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+            if (!(lam_c > 0)) return none;
+        }
         const LabPair s1 = toLab(m, nu, f.Ts, f.Ys), ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq),
                       sq = toLab(m, nu, f.Tsq, f.Ysq);
         const double cq = cone ? q1.c : q1.t;
@@ -120,7 +229,7 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
         bool nu_holds = true;
         if (cone) {
             const double r = rho_c - LF * d;
-            if (!(r > 0)) return INFINITY;  // the triangle may reach the camera (a smaller one may not)
+            if (!(r > 0)) return none;  // the triangle may reach the camera (a smaller one may not)
             rho_min = r * (1 - 1e-9);
             L_lambda = ss.c * G + sq.c + s1.x * LF / rho_min;
             // n turns by at most L_F d / rho_min over the triangle.
@@ -137,7 +246,26 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
             const double xdd = s1.x * S2 + ss.x * G * G + 2 * sq.x * G;
             const double tdd = s1.t * S2 + ss.t * G * G + 2 * sq.t * G;
             const double K = xdd + shear_speed * tdd;
-            return K == K ? K : INFINITY;
+            PieceBound out;
+            out.K = K == K ? K : INFINITY;
+            if (m.keyed) {
+                // The kinks (header): at each key in the window, the jump of the apparent point's
+                // gradient is (c_q . u) times x_s+/Lambda+ - x_s-/Lambda-, which is at most
+                // (|dx| + |x_s| |dc| / Lambda_min) / Lambda_min with (dt, dx) the boosted jump of
+                // dY/ds and dc its cone combination dt + n.dx (dt on a hyperplane).
+                const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
+                double kinks = 0;
+                for (size_t i = span.first; i < span.last; ++i) {
+                    if (!keyMayCross(m, view, i, c)) continue;
+                    const LabPair jump = toLab(m, nu, 0, keyJump(*m.keyed, i, c));
+                    const double dc = cone ? jump.c : jump.t;
+                    const double jx = G * (jump.x + s1.x * dc / lam_min) / lam_min;
+                    const double jt = G * (jump.t + s1.t * dc / lam_min) / lam_min;
+                    kinks += (cone ? 2 : 1) * (jx + shear_speed * jt);
+                }
+                out.kinks = kinks == kinks ? kinks : INFINITY;
+            }
+            return out;
         }
         if (!lam_holds) {  // toward the fixed point lam_min = lam_c - L_lambda(lam_min) d
             const double next = lam_c - 1.05 * L_lambda * d;
@@ -146,7 +274,7 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
         if (!window_holds) spread = 2 * G * d;
         if (!(lam_min > 0) || !std::isfinite(spread)) break;
     }
-    return INFINITY;
+    return none;
 }
 
 }  // namespace mesh4d

@@ -216,7 +216,8 @@ TEST(Keyframes, ClockOfAMovingTurningPointIsTheIntegral) {
 
 // Faster than light anywhere is refused with the time and the speed: the centre's path (every
 // model), and a vertex carried by the turn (the box's corner at rho = 0.707 turning at 3 rad/s).
-// A keyframed object needs vertex mode; its velocity comes from the path.
+// A tolerance for a keyframed object that begins existing within the frames is refused (its clip
+// curve is not bounded); its velocity comes from the path.
 TEST(Keyframes, RefusalsNameFileFieldTimeAndSpeed) {
     std::string error;
     {
@@ -246,9 +247,12 @@ TEST(Keyframes, RefusalsNameFileFieldTimeAndSpeed) {
         KeyedGltf g;
         g.channels.push_back(translationKeys({0, 1}, {{0, 0, -8}, {0.5, 0, -8}}));
         g.scene_extras["tolerance"] = "1e-3";
+        g.object_extras = {{"t0", 0}, {"exists", {-8.0, nullptr}}};
         apparent::Stage st;
         EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "tol"), &st, &error));
-        EXPECT_NE(error.find("tol.gltf: animations[0].channels[0]: a keyframed object is cut in vertex mode only"), std::string::npos)
+        EXPECT_NE(error.find("tol.gltf: animations[0].channels[0]: a keyframed object that begins or ends existing (exists) "
+                             "is cut in vertex mode only"),
+                  std::string::npos)
             << error;
     }
     {
