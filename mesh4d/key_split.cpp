@@ -11,6 +11,10 @@ namespace mesh4d {
 
 namespace {
 
+// The kink term a triangle may keep (in units of T): the grids' measured test that follows
+// divides it by its sub-grid m <= 16 (worldline_refine.h), so 8 T leaves at most T / 2 there.
+constexpr double kKinkShare = 8;
+
 uint64_t edgeKey(uint32_t a, uint32_t b) {
     if (a > b) std::swap(a, b);
     return uint64_t(a) << 32 | b;
@@ -126,7 +130,7 @@ struct Splitter {
         const PieceBound b = pieceBound(m, view, shear, c);
         double d2 = 0;
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
-        if (b.K < INFINITY) return b.kinks * std::sqrt(d2 / 3) > 0.5 * T;
+        if (b.K < INFINITY) return b.kinks * std::sqrt(d2 / 3) > kKinkShare * T;
         const double lo = std::min({c[0].s, c[1].s, c[2].s}), hi = std::max({c[0].s, c[1].s, c[2].s});
         return keyedSegment(*m.keyed, lo) != keyedSegment(*m.keyed, hi);
     }

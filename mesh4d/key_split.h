@@ -10,9 +10,13 @@
 // O(1/T) triangles per unit length of it.
 //
 // The scheme. A triangle is split when its kink term (pieceBound: kinks d / sqrt(3), from its
-// corners' exact crossings) exceeds T / 2, or when its bound does not close (K infinite) while its
-// corners' emission times straddle a key; so what is left for worldline_refine.h's test is at most
-// T / 2 of kinks. A split is Rivara's longest-edge bisection (LEPP): follow the longest-edge
+// corners' exact crossings) exceeds 8 T, or when its bound does not close (K infinite) while its
+// corners' emission times straddle a key. worldline_refine.h's test then measures the error at a
+// sub-grid of up to 16 x 16 exact points and bounds only the sub-pieces, whose kink terms are at
+// most 8 T / 16 = T / 2; where that does not pass it refines the (now small) triangle as a whole.
+// (8 T by measurement over the keyed cases of tests/motion_tolerance_test.cpp, T / 2 to 32 T
+// tried: T / 2, whose straddling pieces must be about 16 times narrower, made up to 10 times more
+// triangles; 32 T, which leaves wider triangles to the grids, up to 3.6 times more.) A split is Rivara's longest-edge bisection (LEPP): follow the longest-edge
 // neighbours from the triangle until an edge that is the longest of every triangle around it (or
 // lies on the boundary), bisect that edge at its midpoint in every triangle around it, repeat
 // until the triangle itself is split. Every bisected edge is split in all its triangles at one

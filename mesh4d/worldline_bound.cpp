@@ -143,17 +143,6 @@ double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossin
     return out;
 }
 
-// The jump of dY/ds at key i over the triangle, in the own frame: |du + dw x Q_i q| with du, dw the
-// changes of the centre's velocity and of the angular velocity (rate times axis) from segment i to
-// i + 1; affine in q under a norm, so its largest value is at a corner.
-double keyJump(const KeyedMotion& k, size_t i, const CornerCrossing c[3]) {
-    const Vec3 du = k.velocity[i + 1] - k.velocity[i];
-    const Vec3 dw = k.axis[i + 1] * k.rate[i + 1] - k.axis[i] * k.rate[i];
-    double out = 0;
-    for (int j = 0; j < 3; ++j) out = std::max(out, norm(du + cross(dw, rotate(k.turns[i], c[j].q))));
-    return out;
-}
-
 // Whether the curve sigma = s_i may meet the triangle (header): the sign of
 // g(s_i, q) = t_c - t - |x - C| (t_c - t on a hyperplane) at the corners' events at s_i. t and x are
 // affine in q at a fixed s, so g is concave (affine on a hyperplane): corners all inside the cone
@@ -184,6 +173,62 @@ bool keyMayCross(const Motion& m, const ViewSurface& view, size_t i, const Corne
         if (below) return false;
     }
     return true;
+}
+
+// The kink's size per unit length at key i over the triangle (header): j(q) = |c(q)| D(q) at q's
+// event at s_i, exact at the corners, carried over the triangle by its Lipschitz bound. INFINITY
+// when the carried bounds do not close (the triangle may reach the camera or a Lambda 0).
+double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const CornerCrossing c[3], double d) {
+    const KeyedMotion& k = *m.keyed;
+    const bool cone = view.kind == ViewKind::PastCone, lorentz = m.kinematics == Kinematics::Lorentz;
+    const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
+    const Vec3 V = lorentz ? m.velocity : Vec3{0, 0, 0};
+    const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
+    auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
+    auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
+    double rho_min = INFINITY, j_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0, lam_min = INFINITY;
+    for (int q = 0; q < 3; ++q) {
+        const Event e = worldlineEvent(m, s, c[q].q);
+        Vec3 n{0, 0, 0};
+        if (cone) {
+            const Vec3 r = e.x - view.apex;
+            const double rho = norm(r);
+            if (!(rho > 0)) return INFINITY;
+            rho_min = std::min(rho_min, rho);
+            n = r / rho;
+        }
+        const Vec3 dya = keyedSegmentLocal(k, i, s, c[q].q).dy, dyb = keyedSegmentLocal(k, i + 1, s, c[q].q).dy;
+        const double ta = labT(dya), tb = labT(dyb);
+        const Vec3 xa = labX(dya), xb = labX(dyb);
+        const double la = ta + dot(n, xa), lb = tb + dot(n, xb);
+        if (!(la > 0) || !(lb > 0)) return INFINITY;
+        const double D = norm(xb / lb - xa / la) + shear_speed * std::fabs(tb / lb - ta / la);
+        // c = t_q + x_q^T n, up to the key's turn Q_i (a rotation): g V + n + g^2/(g + 1) (V.n) V
+        // (Lorentz; its n-part is n itself for the carry), g V on a hyperplane (0 for the carry).
+        const Vec3 cv = cone ? V * g + n + V * (g * g / (g + 1) * dot(V, n)) : V * g;
+        j_min = std::min(j_min, norm(cv) * D);
+        D_max = std::max(D_max, D);
+        c_max = std::max(c_max, norm(cv));
+        x_max = std::max({x_max, norm(xa), norm(xb)});
+        t_max = std::max({t_max, ta, tb});
+        lam_min = std::min({lam_min, la, lb});
+    }
+    // Over the triangle: |x_q| <= g, so |x - C| >= rho_min - g d and n turns at most g / rho_lo per
+    // unit length; c's n-part at most g times that; (t_s, x_s) move at most (g b w, g w) (the turn's
+    // spread, boosted); Lambda = t_s + n.x_s then at most L_lam; D's two quotients x_s / Lambda at
+    // most g w / lam_lo + X L_lam / lam_lo^2 each (t_s / Lambda likewise).
+    const double rho_lo = cone ? rho_min - g * d : INFINITY;
+    if (!(rho_lo > 0)) return INFINITY;
+    const double dn = cone ? g / rho_lo : 0.0;
+    const double X = x_max + g * w * d, Tm = t_max + g * b * w * d;
+    const double L_lam = g * b * w + g * w + X * dn;
+    const double lam_lo = lam_min - L_lam * d;
+    if (!(lam_lo > 0)) return INFINITY;
+    const double L_D = 2 * (g * w / lam_lo + X * L_lam / (lam_lo * lam_lo)) +
+                       shear_speed * 2 * (g * b * w / lam_lo + Tm * L_lam / (lam_lo * lam_lo));
+    const double L_c = g * dn;
+    const double j = j_min + (L_c * (D_max + L_D * d) + (c_max + L_c * d) * L_D) * d;
+    return j == j ? j : INFINITY;
 }
 
 }  // namespace
@@ -249,19 +294,13 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
             PieceBound out;
             out.K = K == K ? K : INFINITY;
             if (m.keyed) {
-                // The kinks (header): at each key in the window, the jump of the apparent point's
-                // gradient is (c_q . u) times x_s+/Lambda+ - x_s-/Lambda-, which is at most
-                // (|dx| + |x_s| |dc| / Lambda_min) / Lambda_min with (dt, dx) the boosted jump of
-                // dY/ds and dc its cone combination dt + n.dx (dt on a hyperplane).
+                // The kinks (header): m_i j_i for each key in the window whose curve may meet the
+                // triangle.
                 const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
                 double kinks = 0;
                 for (size_t i = span.first; i < span.last; ++i) {
                     if (!keyMayCross(m, view, i, c)) continue;
-                    const LabPair jump = toLab(m, nu, 0, keyJump(*m.keyed, i, c));
-                    const double dc = cone ? jump.c : jump.t;
-                    const double jx = G * (jump.x + s1.x * dc / lam_min) / lam_min;
-                    const double jt = G * (jump.t + s1.t * dc / lam_min) / lam_min;
-                    kinks += (cone ? 2 : 1) * (jx + shear_speed * jt);
+                    kinks += (cone ? 2 : 1) * keyKink(m, view, shear_speed, i, c, d);
                 }
                 out.kinks = kinks == kinks ? kinks : INFINITY;
             }

@@ -90,18 +90,27 @@
 // (the pose at s_i), so with c_q = t_q + n.x_q (t_q on a hyperplane) and sigma'_pm = -c_q u / Lambda_pm,
 //     [grad F] u = -(c_q u) (x_s+ / Lambda+ - x_s- / Lambda-),
 //     x_s+ Lambda- - x_s- Lambda+ = dx Lambda- - x_s- (dt + n.dx)   ((dt, dx) = the jump of (t_s, x_s)),
-// so |[grad F] u| <= j_i |u|, j_i = G (|dx| + |x_s| |dc| / Lambda_min) / Lambda_min (dc = dt + n.dx,
-// dt on a hyperplane; the finite model's shear adds |shear| G (|dt| + |t_s| |dc| / Lambda_min) /
-// Lambda_min). (dt, dx) is the boost of (0, dY), dY = du + dw x Q_i q the jump of dY/ds at the key
-// (keyJump: its corners' largest), bounded as "into the lab" above: |dt| <= g b |dY|, |dx| <= g |dY|,
-// |dc| <= g (1 + nu) |dY|. Along the line from p to a corner q_l, f(1) - f(0) - f'(0) is the
-// integral remainder of the C2 parts plus, for each crossing c of a Gamma_i, the kink [f'] times
+// so |[grad F] u| <= j(q) |u|, j(q) = |c(q)| D(q), D = |x_s+ / Lambda+ - x_s- / Lambda-| (plus the finite
+// model's shear times the same for t_s), all at q's event at s_i, which is affine in q whether or
+// not q lies on Gamma_i (keyKink): c = Q_i^T (g V + n + g^2/(g + 1)(V.n) V) (Lorentz; n for the
+// carry; g V, or 0, on a hyperplane) and (t_s, x_s)+- the two segments' rates there, boosted.
+// j is computed exactly at the three corners and carried over the triangle by its Lipschitz bound:
+// |x_q| <= g, so rho >= rho_min - g d and n turns at most g / rho per unit length; c's n-part moves
+// at most g times that; (t_s, x_s) at most (g b w, g w) (w the faster turn rate); so Lambda at most
+// L = g b w + g w + X g / rho (X the largest |x_s|, carried likewise), each quotient x_s / Lambda at
+// most g w / Lambda_lo + X L / Lambda_lo^2 (Lambda_lo = the corners' least minus L d); then
+// j <= min_k j(q_k) + (L_c D_max + c_max L_D) d. A key's curve counts only where it may meet the
+// triangle (keyMayCross): g(s_i, q) is concave in q (affine on a hyperplane), so corners inside
+// the cone keep the triangle inside, and corners outside keep it outside when a corner's tangent
+// plane is negative at all three.
+// Along the line from p to a corner q_l, f(1) - f(0) - f'(0) is the integral remainder of the C2
+// parts plus, for each crossing c of a Gamma_i, the kink [f'] times
 // the rest of the way, |q_l - c|; at fixed s_i, t and x are affine in q, so on a line
 // t_c - t = |x - C| squares to a quadratic: a line meets Gamma_i at most m_i = 2 times (once on a
 // hyperplane, t_c - t linear; a line lying in Gamma_i kinks only at its ends). With
 // sum_l l_l |q_l - p| <= sqrt(sum_l l_l |q_l - p|^2) <= d / sqrt(3):
 //     |F(p) - L(p)| <= K d^2 / 6 + (sum_i m_i j_i) d / sqrt(3),
-// the sum over the keys whose s_i lie in the window. The kink term is linear in d: a piece that
+// the sum over the keys in the window whose curve may meet the triangle. The kink term is linear in d: a piece that
 // straddles a key passes once it is about T / (m j) wide, so refinement concentrates where the
 // emission time crosses a key, and a sampled CUBICSPLINE path (many keys, each with a small jump)
 // pays for the sum of its small jumps, about its velocity change over the window, not for the count.
