@@ -247,6 +247,7 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
         s_hi = std::max(s_hi, c[i].s);
     }
     if (!(lam_c > 0) || (cone && !(rho_c > 0))) return none;
+    if (m.keyed && !(std::isfinite(s_lo) && std::isfinite(s_hi))) return none;  // no window of segments
     const bool windowed = accelerated(m) || m.keyed;
     // v.n at the corners (the Doppler factor of the boost, header): the guess nu starts a hundredth
     // of the way from their largest to b.

@@ -10,7 +10,7 @@ committed. The box (../meshes/box.obj) follows the path:
 
 The fastest vertex: 0.8c plus the turn's rim speed (pi/20 rad/s x 0.71 ls = 0.11c) stays below 1.
 The node's extras hold t0 = 0 (an object field, which makes the node an object) and the scene's
-extras set the vertex tolerance (keyframed objects are cut in vertex mode)."""
+extras set the vertex tolerance (the fastest; `--tolerance` overrides it)."""
 import base64
 import json
 import math
