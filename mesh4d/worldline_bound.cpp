@@ -32,15 +32,18 @@ SegmentSpan segmentsIn(const KeyedMotion& k, double s_lo, double s_hi) {
 // Segment j of a keyframed path, as a carry in its own frame (the header): Y = P + u s + R(s) Q q.
 // rho: the corners' largest distance from the turn axis after the key's turn (a distance to a line
 // is convex, so no point of the triangle is farther).
-FrameRates segmentRates(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
+double turnRho(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
     const size_t key = j == 0 ? 0 : j - 1;
-    const double w = k.rate[j];
     double rho = 0;
-    if (w > 0)
+    if (k.rate[j] > 0)
         for (int i = 0; i < 3; ++i) {
             const Vec3 p = rotate(k.turns[key], c[i].q);
             rho = std::max(rho, norm(p - k.axis[j] * dot(k.axis[j], p)));
         }
+    return rho;
+}
+FrameRates segmentRates(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
+    const double w = k.rate[j], rho = turnRho(k, j, c);
     return {1, norm(k.velocity[j]) + w * rho, 0, w * w * rho, 0, 1, 0, w};
 }
 
@@ -140,6 +143,26 @@ double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossin
     double out = INFINITY;
     for (size_t j = span.first; j <= span.last; ++j)
         for (int i = 0; i < 3; ++i) out = std::min(out, segmentLambda(m, view, c[i], j));
+    return out;
+}
+
+// The lab rate (t_s, x_s) of a keyframed path over the segments meeting [s_lo, s_hi] (header): per
+// segment the boost of (1, u) exactly plus the turn's part (0, w x R Q q) by its magnitude w rho,
+// so a segment at rest in the lab has |x_s| = 0 but for its turn.
+LabPair keyedFirstRates(const Motion& m, double nu, const CornerCrossing c[3], double s_lo, double s_hi) {
+    const KeyedMotion& k = *m.keyed;
+    const bool lorentz = m.kinematics == Kinematics::Lorentz;
+    const SegmentSpan span = segmentsIn(k, s_lo, s_hi);
+    LabPair out{0, 0, 0};
+    for (size_t j = span.first; j <= span.last; ++j) {
+        const Vec3& u = k.velocity[j];
+        const double tt = lorentz ? m.gamma * (1 + dot(m.velocity, u)) : 1.0;
+        const double xt = norm(lorentz ? u + stretch(m.velocity, m.gamma, u) + m.velocity * m.gamma : u);
+        const LabPair turn = toLab(m, nu, 0, k.rate[j] * turnRho(k, j, c));
+        out.t = std::max(out.t, tt + turn.t);
+        out.x = std::max(out.x, xt + turn.x);
+        out.c = std::max(out.c, tt + xt + turn.c);
+    }
     return out;
 }
 
@@ -266,7 +289,7 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
             lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
             if (!(lam_c > 0)) return none;
         }
-        const LabPair s1 = toLab(m, nu, f.Ts, f.Ys), ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq),
+        const LabPair s1 = m.keyed ? keyedFirstRates(m, nu, c, s_lo - spread, s_hi + spread) : toLab(m, nu, f.Ts, f.Ys), ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq),
                       sq = toLab(m, nu, f.Tsq, f.Ysq);
         const double cq = cone ? q1.c : q1.t;
         const double G = cq / lam_min;  // |sigma'| per |u|
