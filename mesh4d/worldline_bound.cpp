@@ -289,8 +289,8 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
             lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
             if (!(lam_c > 0)) return none;
         }
-        const LabPair s1 = m.keyed ? keyedFirstRates(m, nu, c, s_lo - spread, s_hi + spread) : toLab(m, nu, f.Ts, f.Ys), ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq),
-                      sq = toLab(m, nu, f.Tsq, f.Ysq);
+        const LabPair s1 = m.keyed ? keyedFirstRates(m, nu, c, s_lo - spread, s_hi + spread) : toLab(m, nu, f.Ts, f.Ys);
+        const LabPair ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq), sq = toLab(m, nu, f.Tsq, f.Ysq);
         const double cq = cone ? q1.c : q1.t;
         const double G = cq / lam_min;  // |sigma'| per |u|
         const double LF = s1.x * G + q1.x;

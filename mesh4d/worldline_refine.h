@@ -30,6 +30,10 @@
 // more exact point). Each fan triangle is tested as a piece (above); when one fails, its mesh
 // triangle's level doubles and the edge levels are taken again, until nothing changes (levels only
 // grow, so this ends).
+// A keyframed path's rest mesh is first split along the curves where the emission time crosses a
+// key (key_split.h); the grids run on the split mesh, and its output triangles name the input
+// triangle they lie in (source_triangles; refined_triangles and limited_triangles count input
+// triangles).
 // Preconditions (slice.cpp's hook): not isUniform(world.motion), tolerance > 0, no real cap (an
 // object that begins or ends existing is refused a tolerance by the callers, pipeline/physics.cpp:
 // the cap's clip curve is not bounded here), world not empty.
