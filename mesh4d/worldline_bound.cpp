@@ -149,7 +149,8 @@ double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossin
 // The lab rate (t_s, x_s) of a keyframed path over the segments meeting [s_lo, s_hi] (header): per
 // segment the boost of (1, u) exactly plus the turn's part (0, w x R Q q) by its magnitude w rho,
 // so a segment at rest in the lab has |x_s| = 0 but for its turn.
-LabPair keyedFirstRates(const Motion& m, double nu, const CornerCrossing c[3], double s_lo, double s_hi) {
+LabPair keyedFirstRates(const CornerCrossing c[3], const Motion& m, double s_lo, double s_hi) {
+    const double nu = m.kinematics == Kinematics::Lorentz ? m.beta : 0.0;  // the c part at its worst
     const KeyedMotion& k = *m.keyed;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
     const SegmentSpan span = segmentsIn(k, s_lo, s_hi);
@@ -283,13 +284,29 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
     if (m.keyed) lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
     if (!(lam_c > 0)) return none;
     double lam_min = 0.9 * lam_c;
+    // A keyframed path's rates depend on the window only through the segments it meets: taken
+    // again when those change.
+    SegmentSpan held{1, 0};
+    FrameRates keyed_f;
+    LabPair keyed_s1{0, 0, 0};
     for (int iter = 0; iter < 24; ++iter) {
-        const FrameRates f = frameRates(m, c, s_lo - spread, s_hi + spread);
+        FrameRates f;
+        LabPair s1;
         if (m.keyed) {  // every segment the window meets, at every corner (header)
-            lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+            const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
+            if (span.first != held.first || span.last != held.last) {
+                keyed_f = frameRates(m, c, s_lo - spread, s_hi + spread);
+                lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+                keyed_s1 = keyedFirstRates(c, m, s_lo - spread, s_hi + spread);  // its .c is not used
+                held = span;
+            }
             if (!(lam_c > 0)) return none;
+            f = keyed_f;
+            s1 = keyed_s1;
+        } else {
+            f = frameRates(m, c, s_lo - spread, s_hi + spread);
+            s1 = toLab(m, nu, f.Ts, f.Ys);
         }
-        const LabPair s1 = m.keyed ? keyedFirstRates(m, nu, c, s_lo - spread, s_hi + spread) : toLab(m, nu, f.Ts, f.Ys);
         const LabPair ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq), sq = toLab(m, nu, f.Tsq, f.Ysq);
         const double cq = cone ? q1.c : q1.t;
         const double G = cq / lam_min;  // |sigma'| per |u|
