@@ -210,6 +210,11 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             const double len = norm(n);
             const double facing = nd > 0 ? -1.0 : 1.0;
             w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
+            // Event index 2 i + cap: rest vertex i at tau_a (cap 0) or tau_b (cap 1).
+            for (size_t c = 0; c < 4; ++c) {
+                w.rest_point = w.rest_point + hit->bary[c] * world.mesh.positions[t[c] / 2];
+                w.own_time += hit->bary[c] * (t[c] % 2 ? world.tau_b : world.tau_a);
+            }
             best = w;
         }
     };

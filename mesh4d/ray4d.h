@@ -94,6 +94,8 @@ struct WorldHit {
     Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant, turned
                             // towards the side the ray arrives from in 4D (N . D < 0, D = dR/ds): the
                             // outward normal wherever a closed surface is seen from outside
+    Vec3 rest_point;        // the rest point of the hit: its tetrahedron's barycentric mix of rest vertices
+    double own_time = 0;    // the object's time s there: the same mix of the world's tau_a and tau_b
 };
 
 // The nearest hit of `ray` with any tetrahedron of `trace`, s in (0, s_max). Empty for a miss.

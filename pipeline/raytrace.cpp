@@ -143,20 +143,9 @@ Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, lon
     return Status::success();
 }
 
-// What the raytracer needs of motions beyond uniform: slabs within the limits, and plain shading
-// (its Doppler factor is the uniform one; `render --shade doppler` has the worldline's).
-Status checkTracedMotions(const Stage& stage, const char* command, bool shade_doppler) {
-    for (const PreparedObject& o : stage.objects) {
-        if (shade_doppler && o.spec.keys)
-            return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +
-                                   stage.scene.path + ": " + o.spec.keys_field +
-                                   " (a keyframed path) is not (use `apparent render --shade doppler`, or plain shading)");
-        const bool spin = mesh4d::norm(o.spec.angular_velocity) != 0, accel = mesh4d::norm(o.spec.acceleration) != 0;
-        if (shade_doppler && (spin || accel))
-            return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +
-                                   stage.scene.path + ": " + o.spec.field_path + (spin ? ".angular_velocity" : ".acceleration") +
-                                   " is not (use `apparent render --shade doppler`, or plain shading)");
-    }
+// What the raytracer needs of motions beyond uniform: slabs within the limits (their Doppler
+// factors are the worldlines', shadeWith).
+Status checkTracedMotions(const Stage& stage) {
     return checkTraceSlabs(stage, stage.models, stage.first, stage.last_excl - 1);
 }
 
@@ -214,6 +203,7 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
         if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
             s_max = h->s;
             best.object = int32_t(owner_[i]);
+            best.world = uint32_t(i);
             best.hit = *h;
         }
     }
@@ -244,7 +234,17 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
     const double lambert = light.ambient + (1 - light.ambient) * diffuse;
     std::array<double, 3> c{colors_[size_t(h.object)][0], colors_[size_t(h.object)][1], colors_[size_t(h.object)][2]};
     if (shade_doppler_) {
-        const double d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
+        double d = 1;
+        if (mesh4d::isUniform(motion)) {
+            d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
+        } else {
+            // The hit's own time kept inside its slab's open interval on the upper side, so that a
+            // hit at the slab's closing key takes this slab's segment (keyframes.h's segment lookup
+            // gives a key to the segment it starts); the camera is at rest for these motions.
+            const mesh4d::World4D& slab = worlds_[h.world];
+            const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));
+            d = mesh4d::worldlineDoppler(motion, kind, receiver, s, h.hit.rest_point, emitted_at);
+        }
         c = mesh4d::dopplerColour(c, d);
     }
     return {c[0] * lambert, c[1] * lambert, c[2] * lambert};
@@ -332,7 +332,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
-        if (Status s = checkTracedMotions(stage, "raytrace", settings.shade_doppler); !s.ok) {
+        if (Status s = checkTracedMotions(stage); !s.ok) {
             error = s.message;
             code = kExitBadInput;
         }
@@ -597,7 +597,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
-        if (Status s = checkTracedMotions(stage, "figure", settings.shade_doppler); !s.ok) {
+        if (Status s = checkTracedMotions(stage); !s.ok) {
             error = s.message;
             code = kExitBadInput;
         }

@@ -8,7 +8,13 @@
 // first shifted by the hit's Doppler factor (mesh4d/light_factors.h dopplerFactor from the hit
 // event to the camera, or to the mirror point for a reflection, which is at rest in the camera's
 // frame) and scaled by the searchlight factor, as `render --shade doppler` bakes it
-// (mesh4d/doppler_colour.h): pixel = Lambert * dopplerColour(base, D).
+// (mesh4d/doppler_colour.h): pixel = Lambert * dopplerColour(base, D). For a spinning, accelerated
+// or keyframed object D is the worldline's at the hit (worldline.h worldlineDoppler: the rest point
+// and own time of the hit, ray4d.h WorldHit). A keyframed path's velocity jumps at a key; a hit
+// exactly at a key takes the velocity of the time slab whose tetrahedron it hit (the slabs end at
+// the keys, extrude.h), the segment that slab draws, so that the colour, the geometry and the normal
+// come from one piece of the history. Slabs sharing a key's cap are tried in time order and a later
+// one must be strictly nearer, so a tie goes to the earlier slab: the segment that ends at the key.
 #pragma once
 
 #include <array>
@@ -64,6 +70,7 @@ public:
 private:
     struct Hit {
         int32_t object = -1;
+        uint32_t world = 0;  // the world (time slab) hit
         mesh4d::WorldHit hit;
     };
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
@@ -71,7 +78,8 @@ private:
     // velocity (light_factors.h dopplerFactor: nonzero only for finite with a moving camera).
     std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
                                 const mesh4d::Vec3& receiver_velocity = {0, 0, 0}) const;
-    // The same with the source's `motion` and emission point given for D (in that motion's frame).
+    // The same with the source's `motion` and emission point given for D (in that motion's frame);
+    // a motion that is not uniform has D from the worldline of the hit's rest point.
     std::array<double, 3> shadeWith(const Hit& h, const mesh4d::Motion& motion, const mesh4d::Vec3& emitted_at,
                                     mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
                                     const mesh4d::Vec3& receiver_velocity) const;
