@@ -198,14 +198,20 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
     Hit best;
     double s_max = INFINITY;
-    for (size_t i = 0; i < traces_.size(); ++i) {
-        if (skip_mirrors && mirror_of_object_[owner_[i]] >= 0) continue;
-        if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
-            s_max = h->s;
-            best.object = int32_t(owner_[i]);
-            best.world = uint32_t(i);
-            best.hit = *h;
-        }
+    // Objects in scene order; an object's time slabs latest first: the ray runs back in time, so
+    // the first slab it hits is the nearest hit of that object, and the earlier slabs then fail
+    // their root box at once instead of being searched for farther hits.
+    for (size_t begin = 0, end = 0; begin < traces_.size(); begin = end) {
+        end = begin + 1;
+        while (end < traces_.size() && owner_[end] == owner_[begin]) ++end;
+        if (skip_mirrors && mirror_of_object_[owner_[begin]] >= 0) continue;
+        for (size_t i = end; i-- > begin;)
+            if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
+                s_max = h->s;
+                best.object = int32_t(owner_[i]);
+                best.world = uint32_t(i);
+                best.hit = *h;
+            }
     }
     return best;
 }
@@ -238,9 +244,9 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
         if (mesh4d::isUniform(motion)) {
             d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
         } else {
-            // The hit's own time kept inside its slab's open interval on the upper side, so that a
-            // hit at the slab's closing key takes this slab's segment (keyframes.h's segment lookup
-            // gives a key to the segment it starts); the camera is at rest for these motions.
+            // The hit's own time kept inside its slab, short of its closing key, so that the segment
+            // is this slab's (keyframes.h gives a key to the segment it starts); the camera is at
+            // rest for these motions.
             const mesh4d::World4D& slab = worlds_[h.world];
             const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));
             d = mesh4d::worldlineDoppler(motion, kind, receiver, s, h.hit.rest_point, emitted_at);

@@ -13,8 +13,9 @@
 // and own time of the hit, ray4d.h WorldHit). A keyframed path's velocity jumps at a key; a hit
 // exactly at a key takes the velocity of the time slab whose tetrahedron it hit (the slabs end at
 // the keys, extrude.h), the segment that slab draws, so that the colour, the geometry and the normal
-// come from one piece of the history. Slabs sharing a key's cap are tried in time order and a later
-// one must be strictly nearer, so a tie goes to the earlier slab: the segment that ends at the key.
+// come from one piece of the history. An object's slabs are tried latest first and an earlier one
+// must be strictly nearer, so a ray through a key's cap takes the later slab: the segment that
+// starts at the key (as keyframes.h places a key in the segment it starts).
 #pragma once
 
 #include <array>
