@@ -192,24 +192,46 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
             owner_.push_back(uint32_t(i));
         }
     }
-    for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w, hierarchy));
+    // An object of several time slabs is traced through one hierarchy over all of them (ray4d.h
+    // prepareSlabsTrace); without the hierarchy (the benchmarks' peer) each slab is scanned alone.
+    for (size_t begin = 0, end = 0; begin < worlds_.size(); begin = end) {
+        end = begin + 1;
+        while (end < worlds_.size() && owner_[end] == owner_[begin]) ++end;
+        if (end - begin > 1 && hierarchy) {
+            std::vector<const mesh4d::World4D*> slabs;
+            for (size_t i = begin; i < end; ++i) slabs.push_back(&worlds_[i]);
+            traces_.push_back(mesh4d::prepareSlabsTrace(slabs));
+            // The trace leaves out empty slabs: map its slab numbers back to worlds.
+            std::vector<uint32_t> world_of_slab;
+            for (size_t i = begin; i < end; ++i)
+                if (!worlds_[i].empty()) world_of_slab.push_back(uint32_t(i));
+            trace_worlds_.push_back(std::move(world_of_slab));
+            trace_owner_.push_back(owner_[begin]);
+            continue;
+        }
+        for (size_t i = begin; i < end; ++i) {
+            traces_.push_back(mesh4d::prepareTrace(worlds_[i], hierarchy));
+            trace_worlds_.push_back({uint32_t(i)});
+            trace_owner_.push_back(owner_[i]);
+        }
+    }
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
     Hit best;
     double s_max = INFINITY;
-    // Objects in scene order; an object's time slabs latest first: the ray runs back in time, so
-    // the first slab it hits is the nearest hit of that object, and the earlier slabs then fail
-    // their root box at once instead of being searched for farther hits.
+    // Objects in scene order; an object's traces (its time slabs, when scanned one by one) latest
+    // first: the ray runs back in time, so the first slab it hits holds that object's nearest hit,
+    // and the earlier slabs then fail their root box at once.
     for (size_t begin = 0, end = 0; begin < traces_.size(); begin = end) {
         end = begin + 1;
-        while (end < traces_.size() && owner_[end] == owner_[begin]) ++end;
-        if (skip_mirrors && mirror_of_object_[owner_[begin]] >= 0) continue;
+        while (end < traces_.size() && trace_owner_[end] == trace_owner_[begin]) ++end;
+        if (skip_mirrors && mirror_of_object_[trace_owner_[begin]] >= 0) continue;
         for (size_t i = end; i-- > begin;)
             if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
                 s_max = h->s;
-                best.object = int32_t(owner_[i]);
-                best.world = uint32_t(i);
+                best.object = int32_t(trace_owner_[i]);
+                best.world = trace_worlds_[i][h->slab];
                 best.hit = *h;
             }
     }

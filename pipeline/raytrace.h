@@ -13,9 +13,8 @@
 // and own time of the hit, ray4d.h WorldHit). A keyframed path's velocity jumps at a key; a hit
 // exactly at a key takes the velocity of the time slab whose tetrahedron it hit (the slabs end at
 // the keys, extrude.h), the segment that slab draws, so that the colour, the geometry and the normal
-// come from one piece of the history. An object's slabs are tried latest first and an earlier one
-// must be strictly nearer, so a ray through a key's cap takes the later slab: the segment that
-// starts at the key (as keyframes.h places a key in the segment it starts).
+// come from one piece of the history (the hit's own time is kept inside that slab; a ray exactly
+// through a key's cap, shared by two slabs, takes the one the hierarchy meets first, deterministic).
 #pragma once
 
 #include <array>
@@ -97,7 +96,9 @@ private:
     std::vector<mesh4d::Motion> lab_motions_;   // each object's lab motion (reflections' Doppler)
     std::vector<mesh4d::World4D> worlds_;       // per object, or per time slab of a motion that is not uniform
     std::vector<uint32_t> owner_;               // the object of each world
-    std::vector<mesh4d::TraceWorld> traces_;    // per world
+    std::vector<mesh4d::TraceWorld> traces_;    // per world, or one over all slabs of an object
+    std::vector<uint32_t> trace_owner_;         // the object of each trace
+    std::vector<std::vector<uint32_t>> trace_worlds_;  // per trace, the world of each of its slabs
     bool shade_doppler_ = false;
 };
 

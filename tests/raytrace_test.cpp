@@ -28,6 +28,7 @@
 #include "pipeline/raytrace.h"
 #include "pipeline/worlds.h"
 #include "keyed_gltf.h"
+#include "test_meshes.h"
 #include "quiet_stage.h"
 
 using namespace apparent;
@@ -1000,4 +1001,47 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsItsSegmentsVelocitys) {
     EXPECT_GT(checked, 200);
     EXPECT_GT(smallest_d, 1.2);  // far from the mean velocity's D = 1
     EXPECT_LE(worst, 0.03);
+}
+
+// One hierarchy over the time slabs of a history (ray4d.h prepareSlabsTrace, splitting along time
+// too) finds the hit the slabs' own linear scans find, nearest over all: the same ray parameter,
+// slab and triangle, for rays across a rolling cylinder (b = 0.6, w R = b) cut into 60 slabs.
+TEST(Ray4D, SlabsHierarchyFindsWhatEachSlabsScanFinds) {
+    const mesh4d::RestMesh mesh = testmesh::cylinder(1, 0.3, 24);
+    mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0});
+    m.angular_velocity = {0, 0, -0.6};
+    std::vector<double> samples;
+    for (int k = 0; k <= 60; ++k) samples.push_back(-12 + 0.2 * k);
+    const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(mesh, m, samples, false, false);
+    std::vector<const mesh4d::World4D*> pointers;
+    std::vector<mesh4d::TraceWorld> scans;
+    for (const auto& w : slabs) {
+        pointers.push_back(&w);
+        scans.push_back(mesh4d::prepareTrace(w, false));
+    }
+    const mesh4d::TraceWorld joint = mesh4d::prepareSlabsTrace(pointers);
+    ASSERT_EQ(joint.slabs.size(), slabs.size());
+    int hits = 0;
+    for (int iy = -20; iy <= 20; ++iy)
+        for (int ix = -40; ix <= 40; ++ix) {
+            mesh4d::Ray4D ray;
+            ray.origin = {6, {0, 0, 6}};
+            const Vec3 d{0.02 * ix, 0.02 * iy, -1};
+            ray.direction = d / mesh4d::norm(d);
+            std::optional<mesh4d::WorldHit> expected;
+            uint32_t expected_slab = 0;
+            for (size_t k = 0; k < scans.size(); ++k)
+                if (const auto h = mesh4d::intersectWorld(scans[k], ray, expected ? expected->s : INFINITY)) {
+                    expected = h;
+                    expected_slab = uint32_t(k);
+                }
+            const auto got = mesh4d::intersectWorld(joint, ray, INFINITY);
+            ASSERT_EQ(got.has_value(), expected.has_value()) << ix << " " << iy;
+            if (!got) continue;
+            ++hits;
+            EXPECT_EQ(got->s, expected->s);
+            EXPECT_EQ(got->slab, expected_slab);
+            EXPECT_EQ(got->triangle, expected->triangle);
+        }
+    EXPECT_GT(hits, 150);
 }
