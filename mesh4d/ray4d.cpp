@@ -206,12 +206,27 @@ TraceWorld prepareSlabsTrace(const std::vector<const World4D*>& slabs) {
     return trace;
 }
 
-std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max) {
-    if (!trace.world || trace.prisms.empty()) return std::nullopt;
+namespace {
+
+// intersectWorld for one world (kSlabs false) or for the slabs of a history (true).
+template <bool kSlabs>
+std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray, double s_max) {
     const Vec4 d = rayDirection(ray);
     const Vec4 o = toVec4(ray.origin);
     std::optional<WorldHit> best;
     double best_s = s_max;
+    // The best hit's tetrahedron, for its rest point and own time (filled in once, at the end).
+    const World4D* best_world = trace.world;
+    std::array<uint32_t, 4> best_tet;
+    std::array<double, 4> best_bary;
+    auto finish = [&]() {
+        if (!best) return;
+        // Event index 2 i + cap: rest vertex i at tau_a (cap 0) or tau_b (cap 1).
+        for (size_t c = 0; c < 4; ++c) {
+            best->rest_point = best->rest_point + best_bary[c] * best_world->mesh.positions[best_tet[c] / 2];
+            best->own_time += best_bary[c] * (best_tet[c] % 2 ? best_world->tau_b : best_world->tau_a);
+        }
+    };
     auto testPrism = [&](size_t f) {
         const TraceWorld::Prism& p = trace.prisms[f];
         // Step: cheap rejection: where the ray meets the prism's 3-flat must be ahead, nearer than
@@ -227,12 +242,12 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
         if (!p.box.contains(at, slack)) return;
         // Step: the prism's world (its slab) and triangle there.
         uint32_t slab = 0, triangle = uint32_t(f);
-        if (!trace.slabs.empty()) {
+        if constexpr (kSlabs) {
             slab = uint32_t(std::upper_bound(trace.slab_first.begin(), trace.slab_first.end(), uint32_t(f)) -
                             trace.slab_first.begin()) - 1;
             triangle = uint32_t(f) - trace.slab_first[slab];
         }
-        const World4D& world = trace.slabs.empty() ? *trace.world : *trace.slabs[slab];
+        const World4D& world = kSlabs ? *trace.slabs[slab] : *trace.world;
         // Step: the prism's three tetrahedra by the 4D barycentric method; the nearest hit wins.
         for (size_t j = 0; j < 3; ++j) {
             const auto t = world.tet(3 * size_t(triangle) + j);
@@ -252,16 +267,15 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             const double len = norm(n);
             const double facing = nd > 0 ? -1.0 : 1.0;
             w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
-            // Event index 2 i + cap: rest vertex i at tau_a (cap 0) or tau_b (cap 1).
-            for (size_t c = 0; c < 4; ++c) {
-                w.rest_point = w.rest_point + hit->bary[c] * world.mesh.positions[t[c] / 2];
-                w.own_time += hit->bary[c] * (t[c] % 2 ? world.tau_b : world.tau_a);
-            }
             best = w;
+            best_world = &world;
+            best_tet = t;
+            best_bary = hit->bary;
         }
     };
     if (trace.nodes.empty()) {
         for (size_t f = 0; f < trace.prisms.size(); ++f) testPrism(f);
+        finish();
         return best;
     }
     // Step: walk the hierarchy in co-moving coordinates, skipping nodes the ray meets only beyond
@@ -288,7 +302,15 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             for (uint32_t i = node.begin; i < node.end; ++i) testPrism(trace.order[i]);
         }
     }
+    finish();
     return best;
+}
+
+}  // namespace
+
+std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max) {
+    if (!trace.world || trace.prisms.empty()) return std::nullopt;
+    return trace.slabs.empty() ? intersectTrace<false>(trace, ray, s_max) : intersectTrace<true>(trace, ray, s_max);
 }
 
 }  // namespace mesh4d

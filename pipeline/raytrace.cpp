@@ -215,6 +215,9 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
             trace_owner_.push_back(owner_[i]);
         }
     }
+    trace_group_end_.resize(traces_.size());
+    for (size_t i = traces_.size(); i-- > 0;)
+        trace_group_end_[i] = i + 1 < traces_.size() && trace_owner_[i + 1] == trace_owner_[i] ? trace_group_end_[i + 1] : i + 1;
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
@@ -224,8 +227,7 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     // first: the ray runs back in time, so the first slab it hits holds that object's nearest hit,
     // and the earlier slabs then fail their root box at once.
     for (size_t begin = 0, end = 0; begin < traces_.size(); begin = end) {
-        end = begin + 1;
-        while (end < traces_.size() && trace_owner_[end] == trace_owner_[begin]) ++end;
+        end = trace_group_end_[begin];
         if (skip_mirrors && mirror_of_object_[trace_owner_[begin]] >= 0) continue;
         for (size_t i = end; i-- > begin;)
             if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {

@@ -98,6 +98,7 @@ private:
     std::vector<uint32_t> owner_;               // the object of each world
     std::vector<mesh4d::TraceWorld> traces_;    // per world, or one over all slabs of an object
     std::vector<uint32_t> trace_owner_;         // the object of each trace
+    std::vector<size_t> trace_group_end_;       // per trace, one past the last trace of its object
     std::vector<std::vector<uint32_t>> trace_worlds_;  // per trace, the world of each of its slabs
     bool shade_doppler_ = false;
 };
