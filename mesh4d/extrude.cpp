@@ -184,46 +184,64 @@ World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_
     return extrudeMesh(mesh, &mesh, motion, tau_a, tau_b, cap_a_real, cap_b_real);
 }
 
-// A keyframed path (keyframes.h) between two keys: straight in its own frame plus a turn at the
-// segment's rate, so the spin's bound with the fastest rate of the segments over [tau_a, tau_b]
-// (every |q| bounding its distance from any axis); without a turn the worldlines are straight
-// between keys, where slabSamples puts a sample.
-double keyedSlabSpacing(const RestMesh& mesh, const KeyedMotion& k, double tau_a, double tau_b, double chord) {
-    double w = 0;
-    for (size_t j = 1; j < k.s.size(); ++j)
-        if (k.s[j] > tau_a && k.s[j - 1] < tau_b) w = std::max(w, k.rate[j]);
-    if (!(w > 0)) return INFINITY;
-    double rho = 0, edge = 0;
-    for (const Vec3& q : mesh.positions) rho = std::max(rho, norm(q));
+namespace {
+
+// The largest |axis x e| over the rest mesh's edges e: how fast an edge turns off its own line per
+// unit turn rate about `axis` (unit); edges along the axis do not turn.
+double largestTurningEdge(const RestMesh& mesh, const Vec3& axis) {
+    double edge = 0;
     for (const auto& t : mesh.triangles)
-        for (int c = 0; c < 3; ++c) edge = std::max(edge, norm(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]));
-    const double M = w * w * rho, K = w * edge;
+        for (int c = 0; c < 3; ++c)
+            edge = std::max(edge, norm(cross(axis, mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]])));
+    return edge;
+}
+
+// The largest ds with K ds / 2 + M ds^2 / 8 <= chord (extrude.h), the positive root without
+// cancellation; infinity when neither term grows.
+double stepWithin(double K, double M, double chord) {
     const double root = K + std::sqrt(K * K + 2 * M * chord);
     if (!(root > 0)) return INFINITY;
-    return 2 * chord / root;
+    return 4 * chord / root;
+}
+
+}  // namespace
+
+// A keyframed path (keyframes.h) between two keys: straight in its own frame plus a turn at the
+// segment's rate about the segment's axis, so the spin's bound with the segments over
+// [tau_a, tau_b]: K the largest rate |axis x e|, M the largest rate^2 |q| (every |q| bounding its
+// distance from any axis); without a turn the worldlines are straight between keys, where
+// slabSamples puts a sample.
+double keyedSlabSpacing(const RestMesh& mesh, const KeyedMotion& k, double tau_a, double tau_b, double chord) {
+    double rho = 0;
+    for (const Vec3& q : mesh.positions) rho = std::max(rho, norm(q));
+    double K = 0, M = 0;
+    for (size_t j = 1; j < k.s.size(); ++j)
+        if (k.s[j] > tau_a && k.s[j - 1] < tau_b && k.rate[j] > 0) {
+            K = std::max(K, k.rate[j] * largestTurningEdge(mesh, k.axis[j]));
+            M = std::max(M, k.rate[j] * k.rate[j] * rho);
+        }
+    if (!(M > 0)) return INFINITY;
+    return stepWithin(K, M, chord);
 }
 
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord) {
     if (isUniform(motion)) return INFINITY;
     if (motion.keyed) return keyedSlabSpacing(mesh, *motion.keyed, tau_a, tau_b, chord);
-    // M: the largest second derivative of a vertex's own-frame worldline over the span; K: the
-    // largest difference of the first derivatives of two points of one triangle (extrude.h).
+    // M: the largest second derivative of a vertex's own-frame worldline over the span (spin:
+    // |w|^2 rho, rho the vertex's distance from the axis); K: the largest difference of the first
+    // derivatives of two points of one triangle (extrude.h).
     const double w = norm(motion.angular_velocity);
     const double a = norm(motion.acceleration);
     const double s_max = std::max(std::fabs(tau_a), std::fabs(tau_b));
     const double ch = a > 0 ? std::cosh(a * s_max) : 1.0;
-    double M = 0, edge = 0;
+    double M = 0;
     for (const Vec3& q : mesh.positions)
         M = std::max(M, a > 0 ? std::sqrt(2.0) * a * a * horizonDistance(motion, q) * ch : w * spinSpeed(motion, q));
-    for (const auto& t : mesh.triangles)
-        for (int c = 0; c < 3; ++c) edge = std::max(edge, norm(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]));
     // An acceleration's E_i' - E_q' = |a| (xi_i - xi_q) (cosh, k sinh) is parallel to E_q': along
-    // the history, not off it, so it adds no distance to the history (K = 0).
-    const double K = a > 0 ? 0.0 : w * edge;
-    // M ds^2 / 2 + K ds = chord, the positive root without cancellation.
-    const double root = K + std::sqrt(K * K + 2 * M * chord);
-    if (!(root > 0)) return INFINITY;
-    return 2 * chord / root;
+    // the history, not off it, so it adds no distance to the history (K = 0). A spin's is
+    // w x R (q_i - q), at most |w x e| over the triangle's edges e.
+    const double K = a > 0 || !(w > 0) ? 0.0 : w * largestTurningEdge(mesh, motion.angular_velocity / w);
+    return stepWithin(K, M, chord);
 }
 
 std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord,

@@ -105,22 +105,28 @@ World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_
 // between two samples, whose cap events lie on the true worldlines. slabSpacing is the largest step
 // ds for which every point of every slab's tetrahedra lies within `chord` (Euclidean, in the
 // object's own frame: the centre frame of a spin, the start frame of an acceleration) of the true
-// event of its rest point, or of the history near it (a shift along the history is no error). The argument: a point of a tetrahedron is sum l_i E_i(s_i) over its
-// vertices' events, s_i within one slab; the rest point q = sum l_i q_i has the event
-// E_q(s) = sum l_i E_i(s) at every s (events are affine in q at fixed s), so at s = sum l_i s_i the
-// difference is sum l_i [E_i'(s) - E_q'(s)] (s_i - s) plus Taylor remainders, at most
-//     K ds + M ds^2 / 2,
-// K bounding the part of |E_i' - E_q'| off the history over a triangle (spin: |w| L, L the longest
-// rest edge; acceleration: 0, since E_i' - E_q' = |a| (xi_i - xi_q)(cosh, k sinh) is parallel to
-// E_q', a shift along the history) and M bounding |E''| (spin: |w|^2 rho_max; acceleration:
-// sqrt(2) |a|^2 xi_max cosh(|a| s_max); s_max the largest |s| of the span). The first-order term is
-// the twist of a prism whose vertices move differently, which the tetrahedra cannot follow; the
-// second is the chord of each worldline. A boost or the Galilean carry stretches these distances by
-// at most gamma (1 + b) in the lab (callers divide the lab chord by it). Uniform motion needs one
-// slab: slabSpacing returns infinity. A keyframed path (keyframes.h) is straight between keys in
-// its own frame plus a turn: the spin's bound with the fastest turn rate of the segments in the
-// interval (rho_max bounded by max |q|), infinity without a turn; slabSamples puts a sample at
-// every key, where the worldlines bend.
+// event of its rest point, or of the history near it (a shift along the history is no error).
+// The argument: a point of a tetrahedron is sum l_i E_i(s_i) over its vertices' events, each s_i
+// one of the slab's two samples, p the weight on the later one; the rest point q = sum l_i q_i has
+// the event E_q(s) = sum l_i E_i(s) at every s (events are affine in q at fixed s), so at
+// s = sum l_i s_i the difference is sum l_i [E_i'(s) - E_q'(s)] (s_i - s) plus Taylor remainders.
+// With sum l_i |s_i - s| = 2 p (1 - p) ds and sum l_i (s_i - s)^2 = p (1 - p) ds^2 it is at most
+//     p (1 - p) (2 K ds + M ds^2 / 2)  <=  K ds / 2 + M ds^2 / 8,
+// K bounding the part of |E_i' - E_q'| off the history over a triangle (spin: E_i' - E_q' =
+// w x R (q_i - q), at most the largest |w x e| over the rest edges e, edges along the axis not
+// turning; acceleration: 0, since E_i' - E_q' = |a| (xi_i - xi_q)(cosh, k sinh) is parallel to
+// E_q', a shift along the history) and M bounding |E''| (spin: |w|^2 rho, rho a vertex's distance
+// from the axis, so M ds^2 / 8 is the sagitta rho w^2 ds^2 / 8 of each vertex's chord; acceleration:
+// sqrt(2) |a|^2 xi_max cosh(|a| s_max); s_max the largest |s| of the span). The first term is the
+// twist of a prism whose vertices move differently: its lateral quads are not flat, the
+// tetrahedra fold them along a diagonal, and a long edge turning at |w| (a wheel's spoke, 1.8 ls
+// at 0.9 rad/s) bends its faces by up to |w x e| ds / 2 off the history, more than the chords do;
+// dropping it would leave that error unbounded. A boost or the Galilean carry stretches these
+// distances by at most gamma (1 + b) in the lab (callers divide the lab chord by it). Uniform
+// motion needs one slab: slabSpacing returns infinity. A keyframed path (keyframes.h) is straight
+// between keys in its own frame plus a turn: the spin's bound with each segment's turn rate and
+// axis over the interval (rho bounded by max |q|), infinity without a turn; slabSamples puts a
+// sample at every key, where the worldlines bend.
 // ds over the interval [tau_a, tau_b] of s (s_max = max(|tau_a|, |tau_b|)).
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord);
 

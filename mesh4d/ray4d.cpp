@@ -92,18 +92,20 @@ void buildNode(TraceWorld* trace, const std::vector<EventBox>& boxes, uint32_t i
         const EventBox& b = boxes[trace->order[i]];
         box.add({b.t_lo, b.lo});
         box.add({b.t_hi, b.hi});
-        centres.addPoint(b.center());
+        centres.add({0.5 * (b.t_lo + b.t_hi), b.center()});
     }
     trace->nodes[index].box = box;
     trace->nodes[index].begin = begin;
     trace->nodes[index].end = end;
     if (end - begin <= kLeafPrisms) return;
     // Step: split at the median centre along the widest axis of the centres.
+    // Time slabs traced as one (split_time): time is a fourth axis, in seconds = light-seconds.
     const Vec3 ext = centres.hi - centres.lo;
-    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    if (trace->split_time && centres.t_hi - centres.t_lo > std::max(ext.x, std::max(ext.y, ext.z))) axis = 3;
     auto key = [&](uint32_t p) {
         const Vec3 c = boxes[p].center();
-        return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
+        return axis == 3 ? 0.5 * (boxes[p].t_lo + boxes[p].t_hi) : (axis == 0 ? c.x : (axis == 1 ? c.y : c.z));
     };
     const uint32_t mid = begin + (end - begin) / 2;
     std::nth_element(trace->order.begin() + begin, trace->order.begin() + mid, trace->order.begin() + end,
@@ -137,48 +139,94 @@ bool slab(const EventBox& box, double slack, const Vec4& o, const Vec4& D, doubl
 
 }  // namespace
 
-TraceWorld prepareTrace(const World4D& world, bool hierarchy) {
-    TraceWorld trace;
-    trace.world = &world;
-    if (world.empty()) return trace;
-    trace.prisms.resize(world.mesh.triangles.size());
+namespace {
+
+// The prisms of `world` appended to trace->prisms, and their co-moving boxes to *boxes.
+void addPrisms(TraceWorld* trace, const World4D& world, std::vector<EventBox>* boxes) {
     for (size_t f = 0; f < world.mesh.triangles.size(); ++f) {
-        TraceWorld::Prism& p = trace.prisms[f];
+        TraceWorld::Prism p;
         // Step: the 3-flat, from the first tetrahedron of the prism (all three share it: the prism
         // is the affine image of triangle x interval).
         const auto t = world.tet(3 * f);
         const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
         p.normal = flatNormal(v);
         p.offset = dot4(p.normal, toVec4(v[0]));
-        // Step: bounds of the prism's six events.
-        for (uint32_t vi : world.mesh.triangles[f])
-            for (uint32_t cap = 0; cap < 2; ++cap) p.box.add(world.events[2 * vi + cap]);
-    }
-    if (!hierarchy) return trace;
-    // Step: the co-moving boxes, then the hierarchy over them.
-    trace.velocity = world.motion.velocity;
-    std::vector<EventBox> boxes(trace.prisms.size());
-    for (size_t f = 0; f < world.mesh.triangles.size(); ++f)
+        // Step: bounds of the prism's six events, in the lab and co-moving.
+        EventBox co;
         for (uint32_t vi : world.mesh.triangles[f])
             for (uint32_t cap = 0; cap < 2; ++cap) {
                 const Event& e = world.events[2 * vi + cap];
-                boxes[f].add({e.t, comoving(e, trace.velocity)});
+                p.box.add(e);
+                co.add({e.t, comoving(e, trace->velocity)});
             }
-    trace.order.resize(trace.prisms.size());
-    for (uint32_t f = 0; f < trace.order.size(); ++f) trace.order[f] = f;
-    trace.nodes.reserve(2 * trace.prisms.size() / kLeafPrisms + 2);
-    trace.nodes.resize(1);
-    buildNode(&trace, boxes, 0, 0, uint32_t(trace.order.size()));
+        trace->prisms.push_back(p);
+        if (boxes) boxes->push_back(co);
+    }
+}
+
+// The hierarchy over trace->prisms from their co-moving boxes.
+void buildHierarchy(TraceWorld* trace, const std::vector<EventBox>& boxes) {
+    trace->order.resize(trace->prisms.size());
+    for (uint32_t f = 0; f < trace->order.size(); ++f) trace->order[f] = f;
+    trace->nodes.reserve(2 * trace->prisms.size() / kLeafPrisms + 2);
+    trace->nodes.resize(1);
+    buildNode(trace, boxes, 0, 0, uint32_t(trace->order.size()));
+}
+
+}  // namespace
+
+TraceWorld prepareTrace(const World4D& world, bool hierarchy) {
+    TraceWorld trace;
+    trace.world = &world;
+    if (world.empty()) return trace;
+    trace.prisms.reserve(world.mesh.triangles.size());
+    trace.velocity = hierarchy ? world.motion.velocity : Vec3{0, 0, 0};
+    std::vector<EventBox> boxes;
+    addPrisms(&trace, world, hierarchy ? &boxes : nullptr);
+    if (!hierarchy) return trace;
+    buildHierarchy(&trace, boxes);
     return trace;
 }
 
-std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max) {
-    if (!trace.world || trace.prisms.empty()) return std::nullopt;
-    const World4D& world = *trace.world;
+TraceWorld prepareSlabsTrace(const std::vector<const World4D*>& slabs) {
+    TraceWorld trace;
+    if (slabs.empty()) return trace;
+    trace.world = slabs.front();
+    trace.velocity = slabs.front()->motion.velocity;
+    trace.split_time = true;
+    std::vector<EventBox> boxes;
+    for (const World4D* w : slabs) {
+        if (w->empty()) continue;
+        trace.slabs.push_back(w);
+        trace.slab_first.push_back(uint32_t(trace.prisms.size()));
+        addPrisms(&trace, *w, &boxes);
+    }
+    if (trace.prisms.empty()) return trace;
+    buildHierarchy(&trace, boxes);
+    return trace;
+}
+
+namespace {
+
+// intersectWorld for one world (kSlabs false) or for the slabs of a history (true).
+template <bool kSlabs>
+std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray, double s_max) {
     const Vec4 d = rayDirection(ray);
     const Vec4 o = toVec4(ray.origin);
     std::optional<WorldHit> best;
     double best_s = s_max;
+    // The best hit's tetrahedron, for its rest point and own time (filled in once, at the end).
+    const World4D* best_world = trace.world;
+    std::array<uint32_t, 4> best_tet;
+    std::array<double, 4> best_bary;
+    auto finish = [&]() {
+        if (!best) return;
+        // Event index 2 i + cap: rest vertex i at tau_a (cap 0) or tau_b (cap 1).
+        for (size_t c = 0; c < 4; ++c) {
+            best->rest_point = best->rest_point + best_bary[c] * best_world->mesh.positions[best_tet[c] / 2];
+            best->own_time += best_bary[c] * (best_tet[c] % 2 ? best_world->tau_b : best_world->tau_a);
+        }
+    };
     auto testPrism = [&](size_t f) {
         const TraceWorld::Prism& p = trace.prisms[f];
         // Step: cheap rejection: where the ray meets the prism's 3-flat must be ahead, nearer than
@@ -192,9 +240,17 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
         const Event at = ray.at(s_flat);
         const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
         if (!p.box.contains(at, slack)) return;
+        // Step: the prism's world (its slab) and triangle there.
+        uint32_t slab = 0, triangle = uint32_t(f);
+        if constexpr (kSlabs) {
+            slab = uint32_t(std::upper_bound(trace.slab_first.begin(), trace.slab_first.end(), uint32_t(f)) -
+                            trace.slab_first.begin()) - 1;
+            triangle = uint32_t(f) - trace.slab_first[slab];
+        }
+        const World4D& world = kSlabs ? *trace.slabs[slab] : *trace.world;
         // Step: the prism's three tetrahedra by the 4D barycentric method; the nearest hit wins.
         for (size_t j = 0; j < 3; ++j) {
-            const auto t = world.tet(3 * f + j);
+            const auto t = world.tet(3 * size_t(triangle) + j);
             const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
             const std::optional<TetHit> hit = intersectTet(ray, v, best_s);
             if (!hit) continue;
@@ -202,7 +258,8 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             WorldHit w;
             w.s = hit->s;
             w.event = ray.at(hit->s);
-            w.triangle = uint32_t(f);
+            w.triangle = triangle;
+            w.slab = slab;
             // The side the ray arrives from is a 4D question: it meets the 3-flat coming from
             // where N . (R(s) - V) has the sign of -N . D. The spatial test n . d alone flips the
             // normal across a moving face wherever aberration makes d graze it (issue 20).
@@ -211,10 +268,14 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             const double facing = nd > 0 ? -1.0 : 1.0;
             w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
             best = w;
+            best_world = &world;
+            best_tet = t;
+            best_bary = hit->bary;
         }
     };
     if (trace.nodes.empty()) {
         for (size_t f = 0; f < trace.prisms.size(); ++f) testPrism(f);
+        finish();
         return best;
     }
     // Step: walk the hierarchy in co-moving coordinates, skipping nodes the ray meets only beyond
@@ -241,7 +302,15 @@ std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray
             for (uint32_t i = node.begin; i < node.end; ++i) testPrism(trace.order[i]);
         }
     }
+    finish();
     return best;
+}
+
+}  // namespace
+
+std::optional<WorldHit> intersectWorld(const TraceWorld& trace, const Ray4D& ray, double s_max) {
+    if (!trace.world || trace.prisms.empty()) return std::nullopt;
+    return trace.slabs.empty() ? intersectTrace<false>(trace, ray, s_max) : intersectTrace<true>(trace, ray, s_max);
 }
 
 }  // namespace mesh4d

@@ -80,6 +80,13 @@ struct TraceWorld {
     Vec3 velocity;                       // v of the co-moving coordinates
     std::vector<Node> nodes;             // nodes[0] is the root; empty: every prism is tested (linear scan)
     std::vector<uint32_t> order;         // prism indices grouped by leaf
+    // The time slabs of one history traced as one (prepareSlabsTrace): their prisms in one
+    // hierarchy, which then splits along time as well as space (a ray through a spinning wheel
+    // passes thousands of slabs' boxes; one hierarchy meets only the prisms near its 4D path).
+    // Empty for one world (`world`).
+    std::vector<const World4D*> slabs;
+    std::vector<uint32_t> slab_first;    // per slab its first prism: prism p of slab k is its triangle p - slab_first[k]
+    bool split_time = false;             // the hierarchy may split along t (only with slabs)
 };
 constexpr uint32_t kLeafPrisms = 4;
 
@@ -87,13 +94,21 @@ constexpr uint32_t kLeafPrisms = 4;
 // linear scan, kept as the benchmarks' and tests' peer). `world` must outlive the result.
 TraceWorld prepareTrace(const World4D& world, bool hierarchy = true);
 
+// The same over the slabs of one history (extrude.h extrudeSlabs; one motion): one hierarchy over
+// all their prisms, splitting along the widest of t and the co-moving axes. Empty slabs are left out.
+// The slabs must outlive the result.
+TraceWorld prepareSlabsTrace(const std::vector<const World4D*>& slabs);
+
 struct WorldHit {
     double s = 0;           // ray parameter of the hit
     Event event;            // the hit event: emission time and lab position
-    uint32_t triangle = 0;  // input triangle (prism) hit
+    uint32_t triangle = 0;  // input triangle (prism) hit, in its slab's mesh
+    uint32_t slab = 0;      // the slab hit (TraceWorld::slabs; 0 for one world)
     Vec3 lab_normal;        // unit lab-frame normal of that triangle at the hit's lab instant, turned
                             // towards the side the ray arrives from in 4D (N . D < 0, D = dR/ds): the
                             // outward normal wherever a closed surface is seen from outside
+    Vec3 rest_point;        // the rest point of the hit: its tetrahedron's barycentric mix of rest vertices
+    double own_time = 0;    // the object's time s there: the same mix of the world's tau_a and tau_b
 };
 
 // The nearest hit of `ray` with any tetrahedron of `trace`, s in (0, s_max). Empty for a miss.

@@ -40,11 +40,58 @@ uint8_t toSrgb8(double linear) {
     return uint8_t(std::lround(s * 255));
 }
 
+// Time slabs for a motion that is not uniform (mesh4d/extrude.h): each vertex's sampled worldline
+// within kSlabChordRelative of the object's bounding-box diagonal of its true one in the lab (the
+// own-frame chord divided by the boost's or carry's largest stretch, gamma (1 + b)); at most
+// kMaxSlabs slabs and kMaxSlabPrisms prisms over all slabs of one object.
+constexpr double kSlabChordRelative = 1e-3;
+constexpr size_t kMaxSlabs = 4096;
+constexpr size_t kMaxSlabPrisms = 20000000;
+
+// The slabs' chord in the object's own frame (above) for `mesh` moving with `motion`.
+double slabChord(const mesh4d::RestMesh& mesh, const mesh4d::Motion& motion) {
+    mesh4d::EventBox box;
+    for (const Vec3& p : mesh.positions) box.addPoint(p);
+    const double g = 1 / std::sqrt(motion.one_minus_beta2);
+    return kSlabChordRelative * box.diagonal() / (g * (1 + motion.beta));
+}
+
+// A spinning object's world over only the times its frames can see (worlds.h spinSpanSeen), from
+// the camera and from each mirror image of it (the camera is at rest: spin needs it), cut to the
+// object's existence. The padded span of buildWorld (light-crossing time over 1 - b) would be
+// 58.5 s of the rolling wheel's time for frames 100:102, where this one is 2.1 s.
+mesh4d::World4D spinTraceWorld(const PreparedObject& object, Model model, const Scene& scene,
+                               const std::vector<MirrorPlane>& mirrors, long long first, long long last) {
+    const mesh4d::MotionInCameraFrame in_cut = cutMotionOf(object.spec, model, scene);
+    mesh4d::RestMesh rotated;
+    const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_cut, &rotated);
+    const double offset = slabChord(rest, in_cut.motion);
+    mesh4d::ProperTimeSpan span = spinSpanSeen(rest, in_cut.motion, viewForFrame(scene, model, first),
+                                               viewForFrame(scene, model, last), offset);
+    for (const MirrorPlane& m : mirrors) {
+        Scene image = scene;
+        image.camera.position = reflectPoint(m, scene.camera.position);
+        const mesh4d::ProperTimeSpan seen = spinSpanSeen(rest, in_cut.motion, viewForFrame(image, model, first),
+                                                         viewForFrame(image, model, last), offset);
+        span = {std::min(span.lo, seen.lo), std::max(span.hi, seen.hi)};
+    }
+    const ObjectSpec& s = object.spec;
+    const bool cap_a_real = s.exists_from > span.lo, cap_b_real = s.exists_to < span.hi;
+    const double tau_a = cap_a_real ? s.exists_from : span.lo, tau_b = cap_b_real ? s.exists_to : span.hi;
+    if (!(tau_a < tau_b)) {
+        mesh4d::World4D empty;
+        empty.motion = in_cut.motion;
+        return empty;
+    }
+    return mesh4d::extrude(rest, in_cut.motion, tau_a, tau_b, cap_a_real, cap_b_real);
+}
+
 // The world of `object` extruded over the union of the spans seen from the camera and from each
 // mirror image of the camera, so that reflected rays, which reach further into the past, stay
 // inside the history. Existence caps stay real where they clip either span.
 mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scene& scene,
                            const std::vector<MirrorPlane>& mirrors, long long first, long long last) {
+    if (mesh4d::norm(object.spec.angular_velocity) != 0) return spinTraceWorld(object, model, scene, mirrors, first, last);
     mesh4d::World4D direct = buildWorld(object, model, scene, first, last);
     if (mirrors.empty()) return direct;
     double tau_a = direct.empty() ? INFINITY : direct.tau_a, tau_b = direct.empty() ? -INFINITY : direct.tau_b;
@@ -70,22 +117,10 @@ mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scen
     return mesh4d::extrude(rest, direct.motion, tau_a, tau_b, real_a, real_b);
 }
 
-// Time slabs for a motion that is not uniform (mesh4d/extrude.h): each vertex's sampled worldline
-// within kSlabChordRelative of the object's bounding-box diagonal of its true one in the lab (the
-// own-frame chord divided by the boost's or carry's largest stretch, gamma (1 + b)); at most
-// kMaxSlabs slabs and kMaxSlabPrisms prisms over all slabs of one object.
-constexpr double kSlabChordRelative = 1e-3;
-constexpr size_t kMaxSlabs = 4096;
-constexpr size_t kMaxSlabPrisms = 20000000;
-
 // The sample times of w's slabs: {tau_a, tau_b} for uniform motion, empty beyond kMaxSlabs.
 std::vector<double> slabTimes(const mesh4d::World4D& w) {
     if (mesh4d::isUniform(w.motion) || w.empty()) return {w.tau_a, w.tau_b};
-    mesh4d::EventBox box;
-    for (const Vec3& p : w.mesh.positions) box.addPoint(p);
-    const double g = 1 / std::sqrt(w.motion.one_minus_beta2);
-    const double chord = kSlabChordRelative * box.diagonal() / (g * (1 + w.motion.beta));
-    return mesh4d::slabSamples(w.mesh, w.motion, w.tau_a, w.tau_b, chord, kMaxSlabs);
+    return mesh4d::slabSamples(w.mesh, w.motion, w.tau_a, w.tau_b, slabChord(w.mesh, w.motion), kMaxSlabs);
 }
 
 // One line when an object would need more slabs than the limits allow.
@@ -108,20 +143,9 @@ Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, lon
     return Status::success();
 }
 
-// What the raytracer needs of motions beyond uniform: slabs within the limits, and plain shading
-// (its Doppler factor is the uniform one; `render --shade doppler` has the worldline's).
-Status checkTracedMotions(const Stage& stage, const char* command, bool shade_doppler) {
-    for (const PreparedObject& o : stage.objects) {
-        if (shade_doppler && o.spec.keys)
-            return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +
-                                   stage.scene.path + ": " + o.spec.keys_field +
-                                   " (a keyframed path) is not (use `apparent render --shade doppler`, or plain shading)");
-        const bool spin = mesh4d::norm(o.spec.angular_velocity) != 0, accel = mesh4d::norm(o.spec.acceleration) != 0;
-        if (shade_doppler && (spin || accel))
-            return Status::failure(std::string("--shade doppler: `apparent ") + command + "` shades uniform motion only; " +
-                                   stage.scene.path + ": " + o.spec.field_path + (spin ? ".angular_velocity" : ".acceleration") +
-                                   " is not (use `apparent render --shade doppler`, or plain shading)");
-    }
+// What the raytracer needs of motions beyond uniform: slabs within the limits (their Doppler
+// factors are the worldlines', shadeWith).
+Status checkTracedMotions(const Stage& stage) {
     return checkTraceSlabs(stage, stage.models, stage.first, stage.last_excl - 1);
 }
 
@@ -168,19 +192,50 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
             owner_.push_back(uint32_t(i));
         }
     }
-    for (const auto& w : worlds_) traces_.push_back(mesh4d::prepareTrace(w, hierarchy));
+    // An object of several time slabs is traced through one hierarchy over all of them (ray4d.h
+    // prepareSlabsTrace); without the hierarchy (the benchmarks' peer) each slab is scanned alone.
+    for (size_t begin = 0, end = 0; begin < worlds_.size(); begin = end) {
+        end = begin + 1;
+        while (end < worlds_.size() && owner_[end] == owner_[begin]) ++end;
+        if (end - begin > 1 && hierarchy) {
+            std::vector<const mesh4d::World4D*> slabs;
+            for (size_t i = begin; i < end; ++i) slabs.push_back(&worlds_[i]);
+            traces_.push_back(mesh4d::prepareSlabsTrace(slabs));
+            // The trace leaves out empty slabs: map its slab numbers back to worlds.
+            std::vector<uint32_t> world_of_slab;
+            for (size_t i = begin; i < end; ++i)
+                if (!worlds_[i].empty()) world_of_slab.push_back(uint32_t(i));
+            trace_worlds_.push_back(std::move(world_of_slab));
+            trace_owner_.push_back(owner_[begin]);
+            continue;
+        }
+        for (size_t i = begin; i < end; ++i) {
+            traces_.push_back(mesh4d::prepareTrace(worlds_[i], hierarchy));
+            trace_worlds_.push_back({uint32_t(i)});
+            trace_owner_.push_back(owner_[i]);
+        }
+    }
+    trace_group_end_.resize(traces_.size());
+    for (size_t i = traces_.size(); i-- > 0;)
+        trace_group_end_[i] = i + 1 < traces_.size() && trace_owner_[i + 1] == trace_owner_[i] ? trace_group_end_[i + 1] : i + 1;
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
     Hit best;
     double s_max = INFINITY;
-    for (size_t i = 0; i < traces_.size(); ++i) {
-        if (skip_mirrors && mirror_of_object_[owner_[i]] >= 0) continue;
-        if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
-            s_max = h->s;
-            best.object = int32_t(owner_[i]);
-            best.hit = *h;
-        }
+    // Objects in scene order; an object's traces (its time slabs, when scanned one by one) latest
+    // first: the ray runs back in time, so the first slab it hits holds that object's nearest hit,
+    // and the earlier slabs then fail their root box at once.
+    for (size_t begin = 0, end = 0; begin < traces_.size(); begin = end) {
+        end = trace_group_end_[begin];
+        if (skip_mirrors && mirror_of_object_[trace_owner_[begin]] >= 0) continue;
+        for (size_t i = end; i-- > begin;)
+            if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
+                s_max = h->s;
+                best.object = int32_t(trace_owner_[i]);
+                best.world = trace_worlds_[i][h->slab];
+                best.hit = *h;
+            }
     }
     return best;
 }
@@ -209,7 +264,17 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
     const double lambert = light.ambient + (1 - light.ambient) * diffuse;
     std::array<double, 3> c{colors_[size_t(h.object)][0], colors_[size_t(h.object)][1], colors_[size_t(h.object)][2]};
     if (shade_doppler_) {
-        const double d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
+        double d = 1;
+        if (mesh4d::isUniform(motion)) {
+            d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
+        } else {
+            // The hit's own time kept inside its slab, short of its closing key, so that the segment
+            // is this slab's (keyframes.h gives a key to the segment it starts); the camera is at
+            // rest for these motions.
+            const mesh4d::World4D& slab = worlds_[h.world];
+            const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));
+            d = mesh4d::worldlineDoppler(motion, kind, receiver, s, h.hit.rest_point, emitted_at);
+        }
         c = mesh4d::dopplerColour(c, d);
     }
     return {c[0] * lambert, c[1] * lambert, c[2] * lambert};
@@ -297,7 +362,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
-        if (Status s = checkTracedMotions(stage, "raytrace", settings.shade_doppler); !s.ok) {
+        if (Status s = checkTracedMotions(stage); !s.ok) {
             error = s.message;
             code = kExitBadInput;
         }
@@ -385,6 +450,9 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
             if (settings.write_png) log << ", " << dir << "/";
             if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
             if (receiver) log << ", " << group.size() << " processes shared the frames";
+            const size_t slabs = size_t(std::count_if(tracer.worlds().begin(), tracer.worlds().end(),
+                                                      [](const mesh4d::World4D& w) { return !mesh4d::isUniform(w.motion); }));
+            if (slabs > 0) log << ", " << slabs << " time slabs";
             log << "\n";
         }
     }
@@ -559,7 +627,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
-        if (Status s = checkTracedMotions(stage, "figure", settings.shade_doppler); !s.ok) {
+        if (Status s = checkTracedMotions(stage); !s.ok) {
             error = s.message;
             code = kExitBadInput;
         }

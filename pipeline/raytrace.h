@@ -8,7 +8,13 @@
 // first shifted by the hit's Doppler factor (mesh4d/light_factors.h dopplerFactor from the hit
 // event to the camera, or to the mirror point for a reflection, which is at rest in the camera's
 // frame) and scaled by the searchlight factor, as `render --shade doppler` bakes it
-// (mesh4d/doppler_colour.h): pixel = Lambert * dopplerColour(base, D).
+// (mesh4d/doppler_colour.h): pixel = Lambert * dopplerColour(base, D). For a spinning, accelerated
+// or keyframed object D is the worldline's at the hit (worldline.h worldlineDoppler: the rest point
+// and own time of the hit, ray4d.h WorldHit). A keyframed path's velocity jumps at a key; a hit
+// exactly at a key takes the velocity of the time slab whose tetrahedron it hit (the slabs end at
+// the keys, extrude.h), the segment that slab draws, so that the colour, the geometry and the normal
+// come from one piece of the history (the hit's own time is kept inside that slab; a ray exactly
+// through a key's cap, shared by two slabs, takes the one the hierarchy meets first, deterministic).
 #pragma once
 
 #include <array>
@@ -64,6 +70,7 @@ public:
 private:
     struct Hit {
         int32_t object = -1;
+        uint32_t world = 0;  // the world (time slab) hit
         mesh4d::WorldHit hit;
     };
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
@@ -71,7 +78,8 @@ private:
     // velocity (light_factors.h dopplerFactor: nonzero only for finite with a moving camera).
     std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
                                 const mesh4d::Vec3& receiver_velocity = {0, 0, 0}) const;
-    // The same with the source's `motion` and emission point given for D (in that motion's frame).
+    // The same with the source's `motion` and emission point given for D (in that motion's frame);
+    // a motion that is not uniform has D from the worldline of the hit's rest point.
     std::array<double, 3> shadeWith(const Hit& h, const mesh4d::Motion& motion, const mesh4d::Vec3& emitted_at,
                                     mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
                                     const mesh4d::Vec3& receiver_velocity) const;
@@ -88,7 +96,10 @@ private:
     std::vector<mesh4d::Motion> lab_motions_;   // each object's lab motion (reflections' Doppler)
     std::vector<mesh4d::World4D> worlds_;       // per object, or per time slab of a motion that is not uniform
     std::vector<uint32_t> owner_;               // the object of each world
-    std::vector<mesh4d::TraceWorld> traces_;    // per world
+    std::vector<mesh4d::TraceWorld> traces_;    // per world, or one over all slabs of an object
+    std::vector<uint32_t> trace_owner_;         // the object of each trace
+    std::vector<size_t> trace_group_end_;       // per trace, one past the last trace of its object
+    std::vector<std::vector<uint32_t>> trace_worlds_;  // per trace, the world of each of its slabs
     bool shade_doppler_ = false;
 };
 

@@ -7,6 +7,7 @@
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
 #include "mesh4d/keyframes.h"
+#include "mesh4d/worldline.h"
 
 namespace apparent {
 
@@ -85,6 +86,33 @@ mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scen
 mesh4d::World4D extrudeSeen(const ObjectSpec& s, const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
                             const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last) {
     return extrudeSeenFrom(s, rest, nullptr, motion, first, last);
+}
+
+mesh4d::ProperTimeSpan spinSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
+                                    const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last, double offset) {
+    const bool lorentz = motion.kinematics == mesh4d::Kinematics::Lorentz;
+    const bool cone = first.kind == mesh4d::ViewKind::PastCone;
+    double r = 0, u = 0;
+    for (const Vec3& q : rest.positions) {
+        r = std::max(r, mesh4d::norm(q));
+        u = std::max(u, lorentz ? mesh4d::spinSpeed(motion, q) : mesh4d::maxGalileanSpeed(motion, q));
+    }
+    const Vec3 origin{0, 0, 0};
+    auto originCrossing = [&](mesh4d::ViewSurface view, double apex_shift) {
+        view.t_c += apex_shift;
+        return mesh4d::crossWorldline(view, motion, origin).s;
+    };
+    mesh4d::ProperTimeSpan span;
+    if (lorentz) {
+        const double reach = cone ? r : motion.beta * r;
+        span = {originCrossing(first, 0) - reach, originCrossing(last, 0) + reach};
+    } else if (cone) {
+        span = {originCrossing(first, -r), originCrossing(last, r)};
+    } else {
+        span = {originCrossing(first, 0), originCrossing(last, 0)};
+    }
+    const double widen = 2 * offset / std::max(1e-12, 1 - u) + 1e-9 * std::max(std::fabs(span.lo), std::fabs(span.hi));
+    return {span.lo - widen, span.hi + widen};
 }
 
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,

@@ -26,6 +26,24 @@ mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scen
 mesh4d::World4D extrudeSeen(const ObjectSpec& spec, const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
                             const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last);
 
+// The object's times s at which views `first` .. `last` (a frame range's first and last: the
+// lab's past cones or instants, the camera at rest) can meet any point of a spinning body
+// (Motion::angular_velocity, no acceleration or keys), tight and sound without a search over the
+// surface: every point of the body stays within r = max |q| of its origin, in the centre frame
+// (Lorentz) and in the lab at each lab instant (Galilean carry). s_o(view) is the origin's
+// crossing (worldline.h), increasing with the camera time.
+//   Lorentz, past cone: the cone is a cone in the centre frame too, apex (T_c, Y_c); a point at
+//     |Y| <= r emits at T_c - s = |Y - Y_c| within |Y_c| -+ r, so s in s_o -+ r (s_o = T_c - |Y_c|).
+//   Lorentz, instant t = t_c (contracted): s = (t_c - t0)/g - v.Y, so s in s_o -+ b r.
+//   Galilean, past cone (finite): t_c - t = |x(t) - C| is within |origin(t) - C| -+ r, so t lies
+//     between the origin's crossings of the cones with apex times t_c - r and t_c + r.
+//   Galilean, instant: s = t_c - t0 for every point.
+// Widened on both sides by 2 `offset` / (1 - u), u the fastest vertex's speed in the frame of s:
+// a traced surface within `offset` of the true history (extrude.h slabSpacing's chord) crosses a
+// view at most offset / (1 - u) earlier or later; and by 1e-9 |s| for rounding.
+mesh4d::ProperTimeSpan spinSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
+                                    const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last, double offset);
+
 // buildWorld for every object, in scene order.
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
                                          long long first_frame, long long last_frame);
