@@ -536,9 +536,9 @@ TEST(Cli, GlbIsIdenticalForAnyThreadCountOnALargeMesh) {
 }
 
 // An absurdly fine tolerance is refused up front (below 1e-6 of the object's size, issue 15); one
-// just above that floor is refined without a crash. (It stopped at the refinement limit with a
-// warning until the whole-piece form passed pieces as they are, issue 13: now 4e-6 is met within
-// 256 segments here; the limit's count is tested by Refine.RefinementLimitIsCounted.)
+// just above that floor, on a tetrahedron passing 1.6 ls from the camera at 0.99c, stops at the
+// refinement limit with a warning, not a crash. (The tetra of scene_tetra.json at 4e-6 is met within
+// 256 segments since the whole-piece form passes pieces as they are, issue 13.)
 TEST(Cli, AbsurdToleranceHitsTheLimitWithAWarning) {
     TempDir dir;
     CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(),
@@ -548,4 +548,9 @@ TEST(Cli, AbsurdToleranceHitsTheLimitWithAWarning) {
     r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(), "--frames", "0:1",
                      "--tolerance", "4e-6"});
     EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("reached the refinement limit"), std::string::npos) << r.err;
+    r = apparentRun({"render", source("data/fixtures/scene_tetra_near.json"), "--out", dir.str(), "--frames", "0:1",
+                     "--tolerance", "3.5e-6"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("reached the refinement limit of 256 segments"), std::string::npos) << r.err;
 }
