@@ -133,8 +133,9 @@ struct MeshoptFrame {
     FileSpan remote_encoded, remote_normals, remote_indices;
     // By reference, for frame coherence (SequenceModel::morphTarget): whether the frame's records
     // may open a run, and the frame as a morph target of the previous frame, made where it was
-    // cut, in the two forms the previous frame's normals take: [0] when that frame opened its run
-    // (its normals as its file decodes them), [1] when it was a target itself (its int8 normals).
+    // cut, in the two forms the previous frame's normals take as a reader decodes them: [0] the
+    // octahedral view's output (that frame opened its run, its normals in a view of their own),
+    // [1] the int8 normals (it opened its run with its normals in the records, or was a target).
     // Without them (`targets` false) the frame cannot continue a run.
     struct RemoteTarget {
         bool fits = false;  // every difference holds in the target's record
@@ -1149,6 +1150,7 @@ struct SequenceModel {
         }
         run.mesh = mesh;
         run.step = step;
+        run.normals_inline = mf.normals_inline;
         run.count = mf.count;
         run.limit = limit;
         run.targets = 0;
@@ -1177,7 +1179,7 @@ struct SequenceModel {
                 *error = "internal: frame " + std::to_string(f.index) + " by reference without its morph target";
                 return false;
             }
-            const MeshoptFrame::RemoteTarget& t = mf.remote_target[run.targets == 0 ? 0 : 1];
+            const MeshoptFrame::RemoteTarget& t = mf.remote_target[run.targets == 0 && !run.normals_inline ? 0 : 1];
             if (!t.fits) return false;
             size_t v = 0;
             for (const size_t o : objects) {
@@ -1406,6 +1408,7 @@ struct SequenceModel {
         int mesh = -1;
         double step = 0;
         size_t count = 0, targets = 0, limit = 0;
+        bool normals_inline = false;  // the run's first frame's normals were in its records
         std::vector<size_t> objects;
         std::vector<unsigned char> records;  // the last frame's records (int16 x, y, z, 0 | float32 time)
         std::vector<unsigned char> normals;  // the last frame's normals as decoded (int8 x, y, z, w)
@@ -1602,7 +1605,7 @@ double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
 
 }  // namespace
 
-std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
+std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f, bool streams) const {
     // Step: a frame's buffers from the process's pool (they keep their capacity: a sequence does
     // not allocate again frame after frame, nor a lone frame after the first); the shared pointer
     // gives them back when released.
@@ -1701,7 +1704,17 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         if (impl_->options.draco)
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty()) encodeDraco(d->data[o], impl_->options, &d->data[o].draco);
-        if (impl_->options.meshopt) {
+        if (impl_->options.meshopt && !streams) {
+            // Records only (the frame before a frame encoded by reference): no streams.
+            MeshoptFrame& mf = d->meshopt;
+            mf.stride = MeshoptLayout(impl_->options).stride;
+            mf.first.assign(f.objects.size(), 0);
+            mf.count = 0;
+            for (size_t o = 0; o < f.objects.size(); ++o) {
+                mf.first[o] = mf.count;
+                mf.count += d->data[o].packed.size() / mf.stride;
+            }
+        } else if (impl_->options.meshopt) {
             // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
             // worker thread).
             const size_t stride = MeshoptLayout(impl_->options).stride;
@@ -2049,10 +2062,10 @@ bool getText(FrameBytesIn* in, std::string* text) {
 // A frame by reference: its arrays written to this process's frame spill in the order the file
 // takes them (plainPrimitive's views; meshopt's streams), the frame's description with their spans.
 // With meshopt records that may be morph targets (no --attributes, no --shade doppler), also the
-// frame as a morph target of the previous frame (`pf`, `pd`: prepared here too), in both forms
-// rank 0 may take (MeshoptFrame::RemoteTarget), and whether its records may open a run.
-std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const GlbFrameData& d, const ExportFrame* pf,
-                                                 const GlbFrameData* pd) const {
+// frame as a morph target of the previous frame (`pf`: its records prepared here too), in both
+// forms rank 0 may take (MeshoptFrame::RemoteTarget), and whether its records may open a run.
+std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const GlbFrameData& d,
+                                                 const ExportFrame* pf) const {
     const bool meshopt = impl_->options.meshopt;
     const size_t record = MeshoptLayout(impl_->options).stride;
     // Step (frame coherence): the run facts and the targets (one encoding when both forms agree).
@@ -2068,6 +2081,10 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         };
         const std::vector<const PrimitiveData*> shown = shownOf(f, d);
         may_run = runReference(shown, d.meshopt.count, d.meshopt.normals_inline, true, nullptr, nullptr);
+        // The frame before, its records alone (no streams: which form its normals took is in its
+        // own description, for rank 0 to pick the target's form).
+        const std::shared_ptr<GlbFrameData> before_data = pf ? prepare(*pf, false) : nullptr;
+        const GlbFrameData* pd = before_data.get();
         if (pf && pd) {
             targets = 1;
             const std::vector<const PrimitiveData*> before = shownOf(*pf, *pd);
@@ -2080,16 +2097,10 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
                              d.data[o].indices == pd->data[o].indices;
             std::vector<unsigned char> rec[2];
             for (int form = 0; same_lists && form < 2; ++form) {
-                if (form == 1 && pd->meshopt.normals_inline) {  // a run start's normals are the int8 ones
-                    target[1] = target[0];
-                    rec[1] = rec[0];
-                    break;
-                }
                 std::vector<unsigned char> records, normals;
                 std::vector<size_t> first;
                 MeshoptFrame::RemoteTarget& t = target[form];
-                t.fits = runReference(before, pd->meshopt.count, pd->meshopt.normals_inline, form == 0, &records,
-                                      &normals) &&
+                t.fits = runReference(before, pd->meshopt.count, false, form == 0, &records, &normals) &&
                          morphRecords(shown, records, normals, pd->meshopt.count, &rec[form], &first, t.lo, t.hi);
                 if (!t.fits) continue;
                 if (form == 1 && target[0].fits && rec[1] == rec[0])
@@ -2285,9 +2296,8 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
     return add(f, d, error);
 }
 
-std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d, const ExportFrame* previous,
-                                      const GlbFrameData* previous_prepared) const {
-    if (frameSpillInstalled()) return encodeByReference(f, d, previous, previous_prepared);
+std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d, const ExportFrame* previous) const {
+    if (frameSpillInstalled()) return encodeByReference(f, d, previous);
     std::string bytes;
     FrameBytesOut out(&bytes);
     out.put(kFrameBytesMagic);
@@ -2403,11 +2413,11 @@ bool GlbSink::encodesAfterPrevious() const {
 }
 
 EncodedOutput GlbSink::encode(const ExportFrame& frame, const PreparedFrame* prepared) const {
-    return encodeAfter(frame, prepared, nullptr, nullptr);
+    return encodeAfter(frame, prepared, nullptr);
 }
 
-EncodedOutput GlbSink::encodeAfter(const ExportFrame& frame, const PreparedFrame* prepared, const ExportFrame* previous,
-                                   const PreparedFrame* previous_prepared) const {
+EncodedOutput GlbSink::encodeAfter(const ExportFrame& frame, const PreparedFrame* prepared,
+                                   const ExportFrame* previous) const {
     EncodedOutput e;
     if (!options_.draco && !options_.meshopt)
         for (const auto& o : frame.objects) e.least += 24 * (long long)o.positions.size();  // as pending()
@@ -2417,8 +2427,7 @@ EncodedOutput GlbSink::encodeAfter(const ExportFrame& frame, const PreparedFrame
         own = writer_->prepare(frame);
         prepared = own.get();
     }
-    e.bytes = writer_->encode(frame, static_cast<const GlbFrameData&>(*prepared), previous,
-                              static_cast<const GlbFrameData*>(previous_prepared));
+    e.bytes = writer_->encode(frame, static_cast<const GlbFrameData&>(*prepared), previous);
     return e;
 }
 

@@ -245,22 +245,19 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             for (const auto& o : frame.objects) e->limited_triangles += o.limited_triangles;
             e->over_budget = w->over_budget;
             // A sink that encodes frame k against frame k - 1 (FrameSink::encodesAfterPrevious)
-            // gets it cut and prepared here again: the frame before belongs to another part.
+            // gets it cut here again: the frame before belongs to another part.
             ExportFrame before;
-            std::vector<std::shared_ptr<const PreparedFrame>> before_prepared(sinks.size());
-            bool have_before = false;
-            for (size_t s = 0; !w->over_budget && k > first && s < sinks.size(); ++s) {
-                if (!sinks[s]->encodesAfterPrevious()) continue;
-                if (!have_before) {
-                    before.index = k - 1;
-                    cutOne(k - 1, &before);
-                    have_before = true;
-                }
-                if (!overBudget(before, settings.max_frame_triangles)) before_prepared[s] = sinks[s]->prepare(before);
+            bool wanted = false;
+            for (size_t s = 0; !w->over_budget && k > first && s < sinks.size(); ++s)
+                wanted = wanted || sinks[s]->encodesAfterPrevious();
+            if (wanted) {
+                before.index = k - 1;
+                cutOne(k - 1, &before);
             }
+            const bool have_before = wanted && !overBudget(before, settings.max_frame_triangles);
             for (size_t s = 0; !w->over_budget && s < sinks.size(); ++s)
-                e->sinks.push_back(before_prepared[s]
-                                       ? sinks[s]->encodeAfter(frame, w->prepared[s].get(), &before, before_prepared[s].get())
+                e->sinks.push_back(have_before && sinks[s]->encodesAfterPrevious()
+                                       ? sinks[s]->encodeAfter(frame, w->prepared[s].get(), &before)
                                        : sinks[s]->encode(frame, w->prepared[s].get()));
             w->prepared.clear();
             frame.objects.clear();

@@ -113,12 +113,8 @@ Written write(const fs::path& file, const GlbOptions& options, bool by_reference
             EXPECT_TRUE(writer.add(f, &error)) << error;
             continue;
         }
-        // The frame before prepared again (by another writer: a rank's own).
-        GlbSequenceWriter other((file.string() + ".unused"), sequence_info, options);
         const bool previous = with_previous && k > 0;
-        const auto before = previous ? other.prepare(sequence[k - 1]) : nullptr;
-        const std::string description =
-            writer.encode(f, *writer.prepare(f), previous ? &sequence[k - 1] : nullptr, before.get());
+        const std::string description = writer.encode(f, *writer.prepare(f), previous ? &sequence[k - 1] : nullptr);
         w.descriptions += description.size();
         EXPECT_TRUE(writer.addEncoded(description, &error)) << error;
     }
