@@ -2297,7 +2297,12 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
 }
 
 std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d, const ExportFrame* previous) const {
-    if (frameSpillInstalled()) return encodeByReference(f, d, previous);
+    // Frames by reference, but meshopt frames that may be morph targets (records, no --attributes
+    // or --shade doppler) only when morphTargetsByReference(): else they travel whole, since
+    // frame coherence takes their records' differences from the previous frame's on rank 0.
+    const bool morph_capable = impl_->options.meshopt && MeshoptLayout(impl_->options).stride == 12;
+    if (frameSpillInstalled() && (!morph_capable || morphTargetsByReference()))
+        return encodeByReference(f, d, previous);
     std::string bytes;
     FrameBytesOut out(&bytes);
     out.put(kFrameBytesMagic);
@@ -2409,7 +2414,8 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
 }
 
 bool GlbSink::encodesAfterPrevious() const {
-    return options_.meshopt && MeshoptLayout(options_).stride == 12 && frameSpillInstalled();
+    return options_.meshopt && MeshoptLayout(options_).stride == 12 && frameSpillInstalled() &&
+           morphTargetsByReference();
 }
 
 EncodedOutput GlbSink::encode(const ExportFrame& frame, const PreparedFrame* prepared) const {
