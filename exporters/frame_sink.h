@@ -81,6 +81,15 @@ public:
     // The frame as the writing process's addEncoded() needs it (const, any thread). The default
     // encodes nothing: a sink that cannot take frames from another process (addEncoded fails).
     virtual EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const;
+    // Whether the encoding of frame k needs frame k - 1 (the .glb's morph targets by reference):
+    // the loop then cuts frame k - 1 again where it cuts frame k (k > the sequence's first frame;
+    // not when frame k - 1 is over the triangle budget) and calls encodeAfter() with it instead of
+    // encode(). The default: no; encodeAfter() is then encode().
+    virtual bool encodesAfterPrevious() const { return false; }
+    virtual EncodedOutput encodeAfter(const ExportFrame& frame, const PreparedFrame* prepared,
+                                      const ExportFrame* /*previous*/) const {
+        return encode(frame, prepared);
+    }
     // pending() and add() of a frame that arrives encoded: frame `index`, in order.
     virtual PendingOutput pendingEncoded(long long index, const EncodedOutput& frame);
     virtual bool addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,

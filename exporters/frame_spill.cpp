@@ -44,6 +44,17 @@ void installFrameSpill(int fd, int source) {
 bool frameSpillInstalled() { return spill().fd >= 0; }
 
 namespace {
+bool& morphByReference() {
+    static bool on = true;
+    return on;
+}
+}  // namespace
+
+void setMorphTargetsByReference(bool on) { morphByReference() = on; }
+
+bool morphTargetsByReference() { return morphByReference(); }
+
+namespace {
 std::string& runToken() {
     static std::string token;
     return token;

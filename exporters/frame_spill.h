@@ -36,6 +36,13 @@ struct FileSpan {
 // writer as source `source`.
 void installFrameSpill(int fd, int source);
 bool frameSpillInstalled();
+// Whether meshopt frames that may be morph targets also travel by reference (default true): then
+// each process cuts the frame before each of its frames again and encodes both forms
+// (GlbSink::encodesAfterPrevious), about 2.5 times a process's work per frame for rank 0's 0.1 times;
+// false: such frames travel whole to rank 0 (docs/PERFORMANCE.md, "Meshopt morph targets by
+// reference"). pipeline/distribute.cpp sets it from the number of processes.
+void setMorphTargetsByReference(bool on);
+bool morphTargetsByReference();
 // The run's random token (the same on every process, pipeline/distribute.h): names of files the
 // processes make for one another in the output folder carry it (exporters/frame_files.h).
 void setFrameRunToken(const std::string& token);

@@ -131,6 +131,19 @@ struct MeshoptFrame {
     // and the index stream of every shown object (none shared), made there.
     bool remote = false;
     FileSpan remote_encoded, remote_normals, remote_indices;
+    // By reference, for frame coherence (SequenceModel::morphTarget): whether the frame's records
+    // may open a run, and the frame as a morph target of the previous frame, made where it was
+    // cut, in the two forms the previous frame's normals take as a reader decodes them: [0] the
+    // octahedral view's output (that frame opened its run, its normals in a view of their own),
+    // [1] the int8 normals (it opened its run with its normals in the records, or was a target).
+    // Without them (`targets` false) the frame cannot continue a run.
+    struct RemoteTarget {
+        bool fits = false;  // every difference holds in the target's record
+        int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // POSITION's bounds (steps)
+        FileSpan encoded;   // the target's view
+    };
+    bool remote_run = false, targets = false;
+    RemoteTarget remote_target[2];
 };
 constexpr size_t kMeshoptViewJsonBytes = 200;
 
@@ -819,6 +832,92 @@ bool appendOrdered(const PrimitiveData& d, std::vector<unsigned int>* all, std::
     return readSpan(d.remote.ordered, all->data() + at, error);
 }
 
+// Frame coherence (gltf.h), the one home of its record arithmetic, used where the file is written
+// and, by reference, where the frame was cut. A frame's records and normals as a run's reference
+// for the next frame: its shown objects' packed records in order, and their normals as a reader
+// decodes them (`decoded_normals`: the octahedral view's int8 output, or the record's when the
+// normals are inline; else the int8 normals, as a target's record holds them). False when they
+// do not make `count` whole vertices.
+// Without `records` and `normals`: only whether they would make them.
+bool runReference(const std::vector<const PrimitiveData*>& shown, size_t count, bool normals_inline,
+                  bool decoded_normals, std::vector<unsigned char>* records, std::vector<unsigned char>* normals) {
+    size_t record_bytes = 0, normal_bytes = 0;
+    for (const PrimitiveData* d : shown) {
+        const std::vector<unsigned char>& n = decoded_normals && !normals_inline ? d->packed_normals : d->packed_snorm;
+        record_bytes += d->packed.size();
+        normal_bytes += n.size();
+    }
+    if (record_bytes != count * 12 || normal_bytes != count * 4) return false;
+    if (!records) return true;
+    records->clear();
+    normals->clear();
+    for (const PrimitiveData* d : shown) {
+        records->insert(records->end(), d->packed.begin(), d->packed.end());
+        const std::vector<unsigned char>& n = decoded_normals && !normals_inline ? d->packed_normals : d->packed_snorm;
+        normals->insert(normals->end(), n.begin(), n.end());
+    }
+    if (decoded_normals && !normals_inline) meshopt_decodeFilterOct(normals->data(), count, kMeshoptNormalStride);
+    return true;
+}
+
+// The shown objects' records (in order) as differences from the reference `records` and
+// `normals` (runReference) of `count` vertices: one kMorphStride record per vertex in `rec`,
+// each object's first vertex in `first`, POSITION's bounds in `lo` and `hi` (steps). False when
+// a difference does not fit the record (int16 steps, an emission time difference exact in
+// float32, int8 normal steps) or the vertex counts differ.
+bool morphRecords(const std::vector<const PrimitiveData*>& shown, const std::vector<unsigned char>& records,
+                  const std::vector<unsigned char>& normals, size_t count, std::vector<unsigned char>* rec,
+                  std::vector<size_t>* first, int lo[3], int hi[3]) {
+    for (const PrimitiveData* d : shown)
+        if (d->packed.size() != d->packed_snorm.size() * 3) return false;
+    if (records.size() != count * 12 || normals.size() != count * 4) return false;
+    rec->assign(count * kMorphStride, 0);
+    first->clear();
+    for (int c = 0; c < 3; ++c) {
+        lo[c] = INT32_MAX;
+        hi[c] = INT32_MIN;
+    }
+    size_t v = 0;
+    for (const PrimitiveData* d : shown) {
+        first->push_back(v);
+        for (size_t i = 0; i < d->packed.size() / 12; ++i, ++v) {
+            if (v >= count) return false;
+            int16_t now[4], before[4], dq[4] = {0, 0, 0, 0};
+            std::memcpy(now, &d->packed[12 * i], 8);
+            std::memcpy(before, &records[12 * v], 8);
+            int8_t dn[4] = {0, 0, 0, 0};
+            for (int c = 0; c < 3; ++c) {
+                const int dd = int(now[c]) - int(before[c]);
+                if (dd < -32767 || dd > 32767) return false;
+                dq[c] = int16_t(dd);
+                lo[c] = std::min(lo[c], dd);
+                hi[c] = std::max(hi[c], dd);
+                const int dnc = int(int8_t(d->packed_snorm[4 * i + size_t(c)])) - int(int8_t(normals[4 * v + size_t(c)]));
+                if (dnc < -127 || dnc > 127) return false;
+                dn[c] = int8_t(dnc);
+            }
+            float t_now, t_before;
+            std::memcpy(&t_now, &d->packed[12 * i + 8], 4);
+            std::memcpy(&t_before, &records[12 * v + 8], 4);
+            const double dt = double(t_now) - double(t_before);
+            const float dt32 = float(dt);
+            if (double(dt32) != dt) return false;
+            unsigned char* r = &(*rec)[kMorphStride * v];
+            std::memcpy(r, dq, 8);
+            std::memcpy(r + 8, &dt32, 4);
+            std::memcpy(r + 12, dn, 4);
+        }
+    }
+    return v == count;
+}
+
+// A target's records as its view's bytes (EXT_meshopt_compression ATTRIBUTES).
+std::vector<unsigned char> encodeMorphRecords(const std::vector<unsigned char>& rec, size_t count) {
+    std::vector<unsigned char> encoded(meshopt_encodeVertexBufferBound(count, kMorphStride));
+    encoded.resize(meshopt_encodeVertexBuffer(encoded.data(), encoded.size(), rec.data(), count, kMorphStride));
+    return encoded;
+}
+
 // The glTF model of a sequence, built frame by frame: JSON-side objects in `model`, binary data
 // streamed to the sink. Two run side by side with Draco: the real one and a plain one that only
 // counts, for the size without Draco.
@@ -903,10 +1002,17 @@ struct SequenceModel {
                 shared[o] = prev.accessor;
         }
         // Step (meshopt): a frame that continues the open run becomes a morph target of its mesh.
-        if (compression == Compression::meshopt && meshopt && morphTarget(f, data, scale, *meshopt, shared, groups)) {
-            morph_nodes.push_back({b.model.nodes.size(), run.targets, runs.size() - 1});
-            node.mesh = run.mesh;
-            return endFrame(f, &node, origin, scale);
+        if (compression == Compression::meshopt && meshopt) {
+            std::string target_error;
+            if (morphTarget(f, data, scale, *meshopt, shared, groups, &target_error)) {
+                morph_nodes.push_back({b.model.nodes.size(), run.targets, runs.size() - 1});
+                node.mesh = run.mesh;
+                return endFrame(f, &node, origin, scale);
+            }
+            if (!target_error.empty()) {
+                *error = target_error;
+                return false;
+            }
         }
         // Step (meshopt): the frame's vertex and normal views, and one index view for the objects
         // that do not share, uint16 unless one of them has more than 65535 vertices.
@@ -1034,20 +1140,17 @@ struct SequenceModel {
         const size_t limit = std::min(kMorphTargetsMost, kMorphVertexTargets / mf.count);
         if (limit == 0) return;
         run.objects = shownObjects(f);
-        run.records.clear();
-        run.normals.clear();
-        for (const size_t o : run.objects) {
-            const PrimitiveData& d = data[o];
-            run.records.insert(run.records.end(), d.packed.begin(), d.packed.end());
-            if (mf.normals_inline)
-                run.normals.insert(run.normals.end(), d.packed_snorm.begin(), d.packed_snorm.end());
-            else
-                run.normals.insert(run.normals.end(), d.packed_normals.begin(), d.packed_normals.end());
+        if (mf.remote) {
+            // By reference the records stay where the frame was cut, which made the next frame's target.
+            if (!mf.remote_run) return;
+        } else {
+            std::vector<const PrimitiveData*> shown;
+            for (const size_t o : run.objects) shown.push_back(&data[o]);
+            if (!runReference(shown, mf.count, mf.normals_inline, true, &run.records, &run.normals)) return;
         }
-        if (run.records.size() != mf.count * 12 || run.normals.size() != mf.count * 4) return;
-        if (!mf.normals_inline) meshopt_decodeFilterOct(run.normals.data(), mf.count, kMeshoptNormalStride);
         run.mesh = mesh;
         run.step = step;
+        run.normals_inline = mf.normals_inline;
         run.count = mf.count;
         run.limit = limit;
         run.targets = 0;
@@ -1060,57 +1163,44 @@ struct SequenceModel {
     // the target's record (int16 steps, an emission time difference exact in float32, int8
     // normal steps). Returns false, having changed nothing, otherwise.
     bool morphTarget(const ExportFrame& f, const std::vector<PrimitiveData>& data, double step, const MeshoptFrame& mf,
-                     const std::vector<int>& shared, const std::vector<int>& groups) {
+                     const std::vector<int>& shared, const std::vector<int>& groups, std::string* error) {
         if (run.mesh < 0 || step != run.step || mf.count != run.count || run.targets >= run.limit) return false;
         if (groups.size() != 1 || groups[0] >= 0) return false;
         const std::vector<size_t> objects = shownObjects(f);
         if (objects != run.objects) return false;
         for (const size_t o : objects)
-            if (shared[o] < 0 || data[o].packed.size() != data[o].packed_snorm.size() * 3) return false;
-        std::vector<unsigned char>& rec = morph_records;
-        rec.assign(run.count * kMorphStride, 0);
+            if (shared[o] < 0) return false;
         std::vector<size_t> first;
-        int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-        size_t v = 0;
-        for (const size_t o : objects) {
-            const PrimitiveData& d = data[o];
-            first.push_back(v);
-            for (size_t i = 0; i < d.packed.size() / 12; ++i, ++v) {
-                if (v >= run.count) return false;
-                int16_t now[4], before[4], dq[4] = {0, 0, 0, 0};
-                std::memcpy(now, &d.packed[12 * i], 8);
-                std::memcpy(before, &run.records[12 * v], 8);
-                int8_t dn[4] = {0, 0, 0, 0};
-                for (int c = 0; c < 3; ++c) {
-                    const int dd = int(now[c]) - int(before[c]);
-                    if (dd < -32767 || dd > 32767) return false;
-                    dq[c] = int16_t(dd);
-                    lo[c] = std::min(lo[c], dd);
-                    hi[c] = std::max(hi[c], dd);
-                    const int dnc = int(int8_t(d.packed_snorm[4 * i + size_t(c)])) - int(int8_t(run.normals[4 * v + size_t(c)]));
-                    if (dnc < -127 || dnc > 127) return false;
-                    dn[c] = int8_t(dnc);
-                }
-                float t_now, t_before;
-                std::memcpy(&t_now, &d.packed[12 * i + 8], 4);
-                std::memcpy(&t_before, &run.records[12 * v + 8], 4);
-                const double dt = double(t_now) - double(t_before);
-                const float dt32 = float(dt);
-                if (double(dt32) != dt) return false;
-                unsigned char* r = &rec[kMorphStride * v];
-                std::memcpy(r, dq, 8);
-                std::memcpy(r + 8, &dt32, 4);
-                std::memcpy(r + 12, dn, 4);
+        int lo[3], hi[3];
+        int view = -1;
+        if (mf.remote) {
+            // Made where the frame was cut, against the previous frame's records (runReference).
+            if (!mf.targets) {
+                *error = "internal: frame " + std::to_string(f.index) + " by reference without its morph target";
+                return false;
             }
+            const MeshoptFrame::RemoteTarget& t = mf.remote_target[run.targets == 0 && !run.normals_inline ? 0 : 1];
+            if (!t.fits) return false;
+            size_t v = 0;
+            for (const size_t o : objects) {
+                first.push_back(v);
+                v += data[o].packedVertices(12);
+            }
+            if (v != run.count) return false;
+            std::copy(t.lo, t.lo + 3, lo);
+            std::copy(t.hi, t.hi + 3, hi);
+            view = b.addMeshoptView(t.encoded, run.count, kMorphStride, false);
+        } else {
+            std::vector<const PrimitiveData*> shown;
+            for (const size_t o : objects) shown.push_back(&data[o]);
+            std::vector<unsigned char>& rec = morph_records;
+            if (!morphRecords(shown, run.records, run.normals, run.count, &rec, &first, lo, hi)) return false;
+            view = b.addMeshoptView(encodeMorphRecords(rec, run.count), run.count, kMorphStride, false);
         }
-        if (v != run.count) return false;
-        // The target's view, and per primitive its three accessors.
-        std::vector<unsigned char> encoded(meshopt_encodeVertexBufferBound(run.count, kMorphStride));
-        encoded.resize(meshopt_encodeVertexBuffer(encoded.data(), encoded.size(), rec.data(), run.count, kMorphStride));
-        const int view = b.addMeshoptView(encoded, run.count, kMorphStride, false);
+        // Per primitive the target's three accessors.
         tinygltf::Mesh& mesh = b.model.meshes[size_t(run.mesh)];
         for (size_t j = 0; j < objects.size(); ++j) {
-            const size_t nv = data[objects[j]].packed.size() / 12;
+            const size_t nv = data[objects[j]].packedVertices(12);
             auto attribute = [&](size_t offset, int component, int type, bool normalized, std::vector<double> min_v,
                                  std::vector<double> max_v) {
                 const int a = b.addAccessor(view, component, type, nv, std::move(min_v), std::move(max_v));
@@ -1128,8 +1218,9 @@ struct SequenceModel {
             mesh.primitives[j].targets.push_back(target);
         }
         // The frame is now the run's reference for the next one.
-        v = 0;
+        size_t v = 0;
         for (const size_t o : objects) {
+            if (mf.remote) break;
             const PrimitiveData& d = data[o];
             std::memcpy(&run.records[12 * v], d.packed.data(), d.packed.size());
             std::memcpy(&run.normals[4 * v], d.packed_snorm.data(), d.packed_snorm.size());
@@ -1317,6 +1408,7 @@ struct SequenceModel {
         int mesh = -1;
         double step = 0;
         size_t count = 0, targets = 0, limit = 0;
+        bool normals_inline = false;  // the run's first frame's normals were in its records
         std::vector<size_t> objects;
         std::vector<unsigned char> records;  // the last frame's records (int16 x, y, z, 0 | float32 time)
         std::vector<unsigned char> normals;  // the last frame's normals as decoded (int8 x, y, z, w)
@@ -1513,7 +1605,7 @@ double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
 
 }  // namespace
 
-std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) const {
+std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f, bool streams) const {
     // Step: a frame's buffers from the process's pool (they keep their capacity: a sequence does
     // not allocate again frame after frame, nor a lone frame after the first); the shared pointer
     // gives them back when released.
@@ -1612,7 +1704,17 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         if (impl_->options.draco)
             for (size_t o = 0; o < f.objects.size(); ++o)
                 if (!f.objects[o].triangles.empty()) encodeDraco(d->data[o], impl_->options, &d->data[o].draco);
-        if (impl_->options.meshopt) {
+        if (impl_->options.meshopt && !streams) {
+            // Records only (the frame before a frame encoded by reference): no streams.
+            MeshoptFrame& mf = d->meshopt;
+            mf.stride = MeshoptLayout(impl_->options).stride;
+            mf.first.assign(f.objects.size(), 0);
+            mf.count = 0;
+            for (size_t o = 0; o < f.objects.size(); ++o) {
+                mf.first[o] = mf.count;
+                mf.count += d->data[o].packed.size() / mf.stride;
+            }
+        } else if (impl_->options.meshopt) {
             // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
             // worker thread).
             const size_t stride = MeshoptLayout(impl_->options).stride;
@@ -1959,9 +2061,54 @@ bool getText(FrameBytesIn* in, std::string* text) {
 
 // A frame by reference: its arrays written to this process's frame spill in the order the file
 // takes them (plainPrimitive's views; meshopt's streams), the frame's description with their spans.
-std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const GlbFrameData& d) const {
+// With meshopt records that may be morph targets (no --attributes, no --shade doppler), also the
+// frame as a morph target of the previous frame (`pf`: its records prepared here too), in both
+// forms rank 0 may take (MeshoptFrame::RemoteTarget), and whether its records may open a run.
+std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const GlbFrameData& d,
+                                                 const ExportFrame* pf) const {
     const bool meshopt = impl_->options.meshopt;
     const size_t record = MeshoptLayout(impl_->options).stride;
+    // Step (frame coherence): the run facts and the targets (one encoding when both forms agree).
+    uint8_t may_run = 0, targets = 0;
+    MeshoptFrame::RemoteTarget target[2];
+    std::vector<unsigned char> target_encoded[2];
+    if (meshopt && record == 12 && d.meshopt.count > 0) {
+        auto shownOf = [](const ExportFrame& frame, const GlbFrameData& data) {
+            std::vector<const PrimitiveData*> shown;
+            for (size_t o = 0; o < frame.objects.size() && o < data.data.size(); ++o)
+                if (!frame.objects[o].triangles.empty()) shown.push_back(&data.data[o]);
+            return shown;
+        };
+        const std::vector<const PrimitiveData*> shown = shownOf(f, d);
+        may_run = runReference(shown, d.meshopt.count, d.meshopt.normals_inline, true, nullptr, nullptr);
+        // The frame before, its records alone (no streams: which form its normals took is in its
+        // own description, for rank 0 to pick the target's form).
+        const std::shared_ptr<GlbFrameData> before_data = pf ? prepare(*pf, false) : nullptr;
+        const GlbFrameData* pd = before_data.get();
+        if (pf && pd) {
+            targets = 1;
+            const std::vector<const PrimitiveData*> before = shownOf(*pf, *pd);
+            // A target keeps every object's index list (the writer's sharing): else none fits.
+            bool same_lists = before.size() == shown.size();
+            same_lists = same_lists && f.objects.size() == pf->objects.size() && d.data.size() == f.objects.size() &&
+                         pd->data.size() == f.objects.size();
+            for (size_t o = 0; same_lists && o < f.objects.size(); ++o)
+                same_lists = f.objects[o].triangles.empty() == pf->objects[o].triangles.empty() &&
+                             d.data[o].indices == pd->data[o].indices;
+            std::vector<unsigned char> rec[2];
+            for (int form = 0; same_lists && form < 2; ++form) {
+                std::vector<unsigned char> records, normals;
+                std::vector<size_t> first;
+                MeshoptFrame::RemoteTarget& t = target[form];
+                t.fits = runReference(before, pd->meshopt.count, false, form == 0, &records, &normals) &&
+                         morphRecords(shown, records, normals, pd->meshopt.count, &rec[form], &first, t.lo, t.hi);
+                if (!t.fits) continue;
+                if (form == 1 && target[0].fits && rec[1] == rec[0])
+                    continue;  // the same bytes: one encoding (its span copied below)
+                target_encoded[form] = encodeMorphRecords(rec[form], pd->meshopt.count);
+            }
+        }
+    }
     size_t shown = 0;
     for (const auto& o : f.objects) shown += o.triangles.empty() ? 0 : 1;
     // Step (meshopt): the index stream of every shown object, as add() makes it when none shares.
@@ -1992,9 +2139,13 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         static const std::vector<uint32_t> none;
         piece(meshopt && shown > 1 && p.ordered ? *p.ordered : none);  // a partly shared stream is made from them
     }
+    piece(target_encoded[0]);
+    piece(target_encoded[1]);
     std::vector<FileSpan> spans;
     std::string spill_error;
     if (!spillFrameData(pieces, &spans, &spill_error)) spans.assign(pieces.size(), FileSpan());
+    target[0].encoded = spans[pieces.size() - 2];
+    target[1].encoded = target_encoded[1].empty() ? target[0].encoded : spans[pieces.size() - 1];
     // Step: the description.
     std::string bytes;
     FrameBytesOut out(&bytes);
@@ -2037,6 +2188,14 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         for (int32_t id : dc.ids) out.put(id);
         out.put(dc.quantization_error);
         putText(&out, dc.error);
+    }
+    out.put(may_run);
+    out.put(targets);
+    for (const MeshoptFrame::RemoteTarget& t : target) {
+        out.put(uint8_t(t.fits));
+        for (int c = 0; c < 3; ++c) out.put(t.lo[c]);
+        for (int c = 0; c < 3; ++c) out.put(t.hi[c]);
+        putSpan(&out, t.encoded);
     }
     return bytes;
 }
@@ -2111,7 +2270,20 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
                 impl_->use(*s);
             }
     }
-    for (const FileSpan* s : {&mf.remote_encoded, &mf.remote_normals, &mf.remote_indices})
+    uint8_t may_run = 0, targets = 0;
+    ok = ok && in.get(&may_run) && in.get(&targets);
+    mf.remote_run = may_run != 0;
+    mf.targets = targets != 0;
+    for (MeshoptFrame::RemoteTarget& t : mf.remote_target) {
+        uint8_t fits = 0;
+        ok = ok && in.get(&fits);
+        t.fits = fits != 0;
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&t.lo[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in.get(&t.hi[c]);
+        ok = ok && getSpan(&in, &t.encoded) && (!t.fits || t.encoded.length > 0);
+    }
+    for (const FileSpan* s : {&mf.remote_encoded, &mf.remote_normals, &mf.remote_indices, &mf.remote_target[0].encoded,
+                              &mf.remote_target[1].encoded})
         if (ok && s->length > 0) {
             ok = frameSource(s->source) >= 0;
             impl_->use(*s);
@@ -2124,13 +2296,13 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
     return add(f, d, error);
 }
 
-std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d) const {
-    // Frames by reference, but for meshopt frames that may be morph targets (records without
-    // --attributes or --shade doppler): frame coherence (SequenceModel::morphTarget) takes the
-    // differences of their records from the previous frame's, so rank 0 needs the records; they
-    // travel whole.
+std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& d, const ExportFrame* previous) const {
+    // Frames by reference, but meshopt frames that may be morph targets (records, no --attributes
+    // or --shade doppler) only when morphTargetsByReference(): else they travel whole, since
+    // frame coherence takes their records' differences from the previous frame's on rank 0.
     const bool morph_capable = impl_->options.meshopt && MeshoptLayout(impl_->options).stride == 12;
-    if (frameSpillInstalled() && !morph_capable) return encodeByReference(f, d);
+    if (frameSpillInstalled() && (!morph_capable || morphTargetsByReference()))
+        return encodeByReference(f, d, previous);
     std::string bytes;
     FrameBytesOut out(&bytes);
     out.put(kFrameBytesMagic);
@@ -2241,7 +2413,17 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
     return add(f, d, error);
 }
 
+bool GlbSink::encodesAfterPrevious() const {
+    return options_.meshopt && MeshoptLayout(options_).stride == 12 && frameSpillInstalled() &&
+           morphTargetsByReference();
+}
+
 EncodedOutput GlbSink::encode(const ExportFrame& frame, const PreparedFrame* prepared) const {
+    return encodeAfter(frame, prepared, nullptr);
+}
+
+EncodedOutput GlbSink::encodeAfter(const ExportFrame& frame, const PreparedFrame* prepared,
+                                   const ExportFrame* previous) const {
     EncodedOutput e;
     if (!options_.draco && !options_.meshopt)
         for (const auto& o : frame.objects) e.least += 24 * (long long)o.positions.size();  // as pending()
@@ -2251,7 +2433,7 @@ EncodedOutput GlbSink::encode(const ExportFrame& frame, const PreparedFrame* pre
         own = writer_->prepare(frame);
         prepared = own.get();
     }
-    e.bytes = writer_->encode(frame, static_cast<const GlbFrameData&>(*prepared));
+    e.bytes = writer_->encode(frame, static_cast<const GlbFrameData&>(*prepared), previous);
     return e;
 }
 

@@ -132,7 +132,9 @@ public:
     // The same in two steps: prepare() (crease split, normals, float32 conversion: the costly
     // part) may run on any thread and for several frames at once; add() then takes the frames in
     // order. The file is the same either way.
-    std::shared_ptr<GlbFrameData> prepare(const ExportFrame& frame) const;  // shared: GlbFrameData is opaque here
+    // shared: GlbFrameData is opaque here. Without `streams`, meshopt's records alone (encode()'s
+    // previous frame), not a frame for add().
+    std::shared_ptr<GlbFrameData> prepare(const ExportFrame& frame, bool streams = true) const;
     bool add(const ExportFrame& frame, const GlbFrameData& prepared, std::string* error);
     // Frames across processes (pipeline/distribute.h): a prepared frame as bytes (its number,
     // camera time, which objects show, and the prepared data: float32 attributes, index lists, the
@@ -148,14 +150,20 @@ public:
     // copy_file_range. The writing process then handles no frame data except, with meshopt, a
     // frame whose objects share their index lists only in part: their lists are read back and
     // their stream encoded there. Either form gives the same file.
-    std::string encode(const ExportFrame& frame, const GlbFrameData& prepared) const;
+    // Meshopt records that may be morph targets (frame coherence: no --attributes, no --shade
+    // doppler) by reference need the previous frame (`previous`: its records are prepared here):
+    // the frame is also encoded as its morph target, in both forms the writer may pick (after a
+    // run's first frame, after a target), and the writer decides the runs from the descriptions
+    // as in one process. Without it the frame cannot continue a run (the writer refuses it when
+    // one is open).
+    std::string encode(const ExportFrame& frame, const GlbFrameData& prepared, const ExportFrame* previous = nullptr) const;
     bool addEncoded(const std::string& bytes, std::string* error);
     // Writes the file; a .glb cannot exceed 4 GiB (refused with a message). With `check`, the
     // file's whole size (JSON chunk included) is checked with it before anything is written.
     bool finish(GlbStats* stats, std::string* error, const FrameSink::OutputCheck& check = nullptr);
 
 private:
-    std::string encodeByReference(const ExportFrame& frame, const GlbFrameData& prepared) const;
+    std::string encodeByReference(const ExportFrame& frame, const GlbFrameData& prepared, const ExportFrame* previous) const;
     bool addByReference(const std::string& bytes, std::string* error);
     struct Impl;
     std::unique_ptr<Impl> impl_;
@@ -182,6 +190,10 @@ public:
     // Frames across processes: GlbSequenceWriter::encode and addEncoded.
     bool beginEncoding(const SequenceInfo& info, std::string* error) override { return begin(info, error); }
     EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const override;
+    // Meshopt frames by reference that may be morph targets (GlbSequenceWriter::encode).
+    bool encodesAfterPrevious() const override;
+    EncodedOutput encodeAfter(const ExportFrame& frame, const PreparedFrame* prepared,
+                              const ExportFrame* previous) const override;
     PendingOutput pendingEncoded(long long index, const EncodedOutput& frame) override;
     bool addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
                     std::string* error) override;

@@ -16,6 +16,8 @@ namespace apparent {
 namespace {
 
 constexpr uint32_t kFrameMagic = 0x31524641;  // "AFR1": apparent frame, version 1
+// From how many processes meshopt frames that may be morph targets travel by reference.
+constexpr int kMorphTargetsByReferenceFrom = 10;
 
 void putU64(std::string* out, uint64_t v) {
     for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));  // little-endian
@@ -139,6 +141,10 @@ bool shareFrameSpills(const std::string& dir, std::string* why) {
         return false;
     }
     installFrameSpill(fd, group.rank());
+    // Meshopt morph targets by reference cost every process about 2.5 times its work per frame (it
+    // cuts the frame before again and encodes two forms) and save rank 0 about 4 ms of a frame's 16:
+    // measured faster than whole frames only from about 10 processes (docs/PERFORMANCE.md).
+    setMorphTargetsByReference(group.size() >= kMorphTargetsByReferenceFrom);
     setFrameRunToken(token);
     if (group.rank() == 0)
         setFramePlacer([](const std::string& path, const std::vector<Placement>& placements, std::string* e) {

@@ -206,6 +206,26 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         ++result->frames_cut;
         return w;
     };
+    // Frame k cut: every world with the frame's view surface (refined to the tolerance).
+    auto cutOne = [&](long long k, ExportFrame* frame) {
+        frame->t_c = frameTime(scene.frames, k);
+        const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
+        // Objects in parallel too (a short range of frames of a many-object scene), each into its
+        // own slot: the result does not depend on the scheduling.
+        frame->objects.resize(worlds.size());
+        tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
+            const mesh4d::World4D& world = worlds[o];
+            // --cull-view: an object wholly outside the camera's view is left empty.
+            if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(world, view))) return;
+            mesh4d::SliceSettings own = slice_settings;
+            own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
+            frame->objects[o] = mesh4d::sliceWorld(world, view, own);
+            mesh4d::addLightFactors(world, view, &frame->objects[o]);
+        });
+        // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
+        reflections.append(view, slice_settings, &frame->objects, &stage.tolerances);
+        APPARENT_CHECK(frame->objects.size(), ==, info.objects.size());
+    };
     // In parallel: cut every world with the frame's view surface, then each sink's conversion.
     auto cutFrame = [&](WorkPtr w) -> WorkPtr {
         if (stop) return w;
@@ -213,23 +233,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         const double cpu_start = threadCpuSeconds();
         ExportFrame& frame = w->frame;
         const long long k = frame.index;
-        frame.t_c = frameTime(scene.frames, k);
-        const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-        // Objects in parallel too (a short range of frames of a many-object scene), each into its
-        // own slot: the result does not depend on the scheduling.
-        frame.objects.resize(worlds.size());
-        tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
-            const mesh4d::World4D& world = worlds[o];
-            // --cull-view: an object wholly outside the camera's view is left empty.
-            if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(world, view))) return;
-            mesh4d::SliceSettings own = slice_settings;
-            own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
-            frame.objects[o] = mesh4d::sliceWorld(world, view, own);
-            mesh4d::addLightFactors(world, view, &frame.objects[o]);
-        });
-        // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-        reflections.append(view, slice_settings, &frame.objects, &stage.tolerances);
-        APPARENT_CHECK(frame.objects.size(), ==, info.objects.size());
+        cutOne(k, &frame);
         w->over_budget = overBudget(frame, settings.max_frame_triangles);
         if (!w->over_budget)
             for (const FrameSink* sink : sinks) w->prepared.push_back(sink->prepare(frame));
@@ -240,8 +244,21 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             e->triangles = frame.triangleCount();
             for (const auto& o : frame.objects) e->limited_triangles += o.limited_triangles;
             e->over_budget = w->over_budget;
+            // A sink that encodes frame k against frame k - 1 (FrameSink::encodesAfterPrevious)
+            // gets it cut here again: the frame before belongs to another part.
+            ExportFrame before;
+            bool wanted = false;
+            for (size_t s = 0; !w->over_budget && k > first && s < sinks.size(); ++s)
+                wanted = wanted || sinks[s]->encodesAfterPrevious();
+            if (wanted) {
+                before.index = k - 1;
+                cutOne(k - 1, &before);
+            }
+            const bool have_before = wanted && !overBudget(before, settings.max_frame_triangles);
             for (size_t s = 0; !w->over_budget && s < sinks.size(); ++s)
-                e->sinks.push_back(sinks[s]->encode(frame, w->prepared[s].get()));
+                e->sinks.push_back(have_before && sinks[s]->encodesAfterPrevious()
+                                       ? sinks[s]->encodeAfter(frame, w->prepared[s].get(), &before)
+                                       : sinks[s]->encode(frame, w->prepared[s].get()));
             w->prepared.clear();
             frame.objects.clear();
             frame.objects.shrink_to_fit();
