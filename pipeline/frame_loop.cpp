@@ -340,6 +340,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         for (; !stop && remote_next < until; ++remote_next) {
             const int from = FrameSplit{0, group.size()}.partOf(remote_next, first);
             if (from == 0) continue;
+            // The rank may make its next frame once this one's send is matched (FrameSink::
+            // expectEncoded): registered before the receive, so that no file of it can exist unregistered.
+            if (remote_next + group.size() < last_excl)
+                for (FrameSink* sink : sinks) sink->expectEncoded(remote_next + group.size());
             std::vector<std::string> parts;
             auto w = std::make_shared<Work>();
             w->encoded = std::make_unique<EncodedFrame>();
@@ -364,9 +368,6 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
                 stop = true;
                 return;
             }
-            // The rank may now make its next frame (FrameSink::expectEncoded).
-            if (remote_next + group.size() < last_excl)
-                for (FrameSink* sink : sinks) sink->expectEncoded(remote_next + group.size());
             w->frame.index = remote_next;
             w->over_budget = w->encoded->over_budget;
             deliver(std::move(w));
