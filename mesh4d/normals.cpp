@@ -53,11 +53,15 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     w->area.resize(nf);
     w->length.resize(nf);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
+        const Vec3* const pos = mesh.positions.data();
+        Vec3* const area = w->area.data();
+        double* const length = w->length.data();
         for (size_t f = r.begin(); f < r.end(); ++f) {
-            const auto& t = mesh.triangles[f];
-            const Vec3 a = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
-            w->area[f] = a;
-            w->length[f] = std::sqrt(dot(a, a));
+            const auto& t = tri[f];
+            const Vec3 a = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
+            area[f] = a;
+            length[f] = std::sqrt(dot(a, a));
         }
     });
     const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
@@ -102,18 +106,26 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     // triangle inequality); otherwise every pair is tested. The direction is the sum of the area
     // vectors (what the vertex's normal is made of), so the test reads each face's area vector and
     // length once: dot(a_f, s) >= cos_half |a_f| |s|.
-    const double cos_half = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
+    const double cos_half_ = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
     w->uniform.assign(nv, 0);
     w->vertex_normal.resize(nv);
     // Raw pointers: the stores to `uniform` (bytes, which may alias anything) would otherwise
     // reload every vector's data pointer in the inner loops.
-    const Vec3* const area_p = area.data();
-    const double* const length_p = length.data();
-    const uint32_t* const start_p = start.data();
-    const uint32_t* const faces_p = faces.data();
-    unsigned char* const uniform_p = w->uniform.data();
-    Vec3* const vertex_normal_p = w->vertex_normal.data();
+    const Vec3* const area_p_ = area.data();
+    const double* const length_p_ = length.data();
+    const uint32_t* const start_p_ = start.data();
+    const uint32_t* const faces_p_ = faces.data();
+    unsigned char* const uniform_p_ = w->uniform.data();
+    Vec3* const vertex_normal_p_ = w->vertex_normal.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        // Local copies: the captures are references, reloaded through the closure after every store.
+        const Vec3* const area_p = area_p_;
+        const double* const length_p = length_p_;
+        const uint32_t* const start_p = start_p_;
+        const uint32_t* const faces_p = faces_p_;
+        unsigned char* const uniform_p = uniform_p_;
+        Vec3* const vertex_normal_p = vertex_normal_p_;
+        const double cos_half = cos_half_;
         for (size_t v = r.begin(); v < r.end(); ++v) {
             const uint32_t first = start_p[v], end = start_p[v + 1];
             if (first == end) continue;
