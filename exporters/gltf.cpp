@@ -723,17 +723,29 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     const double worst = tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, nv, 16384), 0.0,
         [&](const tbb::blocked_range<size_t>& r, double w) {
+            // Local pointers: through the by-reference captures every array would be reloaded
+            // after each store.
+            const uint32_t* const source = map->source.data();
+            const mesh4d::Vec3* const pos = m.positions.data();
+            const mesh4d::Vec3* const nrm = map->normals.data();
+            float* const out_pos = d->positions.data();
+            float* const out_nrm = d->normals.data();
+            float* const out_emission = d->emission.data();
+            double* const out_exact = step > 0 ? exact.data() : nullptr;
+            const double s0 = shift[0], s1 = shift[1], s2 = shift[2];
             for (size_t k = r.begin(); k < r.end(); ++k) {
-                const uint32_t v = map->source[k];
+                const uint32_t v = source[k];
+                const double rel[3] = {s0 + pos[v].x, s1 + pos[v].y, s2 + pos[v].z};
                 for (int c = 0; c < 3; ++c) {
-                    const double rel = shift[c] + m.positions[v][c];
-                    const float fv = float(rel);
-                    d->positions[3 * k + c] = fv;
-                    w = std::max(w, std::fabs(double(fv) - rel));
-                    d->normals[3 * k + c] = float(map->normals[k][c]);
-                    if (step > 0) exact[3 * k + c] = rel;
+                    const float fv = float(rel[c]);
+                    out_pos[3 * k + c] = fv;
+                    w = std::max(w, std::fabs(double(fv) - rel[c]));
+                    if (out_exact) out_exact[3 * k + c] = rel[c];
                 }
-                d->emission[k] = float(m.absoluteTime(v));
+                out_nrm[3 * k] = float(nrm[k].x);
+                out_nrm[3 * k + 1] = float(nrm[k].y);
+                out_nrm[3 * k + 2] = float(nrm[k].z);
+                out_emission[k] = float(m.absoluteTime(v));
                 if (doppler) d->doppler[k] = float(m.doppler[v]);
                 if (proper_time) d->proper_time[k] = float(m.proper_time[v]);
                 if (shade) {
