@@ -1941,6 +1941,17 @@ private:
 constexpr uint32_t kFrameBytesMagic = 0x31464741;  // "AGF1": apparent glb frame, version 1
 constexpr uint32_t kFrameRefMagic = 0x31524741;    // "AGR1": the same by reference (frame_spill.h)
 
+// What both forms of a frame (whole, by reference) say first after their own start: which
+// objects show, and the frame's origin, step and bounds.
+void putFrameHead(FrameBytesOut* out, const ExportFrame& f, const GlbFrameData& d) {
+    out->put(uint64_t(f.objects.size()));
+    for (const auto& o : f.objects) out->put(uint8_t(o.triangles.empty() ? 0 : 1));
+    for (int c = 0; c < 3; ++c) out->put(d.origin[c]);
+    out->put(d.step);
+    out->put(uint8_t(d.clamped));
+    for (double v : {d.far, d.max_extent, d.max_float_error, d.max_quantization_error}) out->put(v);
+}
+
 void putSpan(FrameBytesOut* out, const FileSpan& s) {
     out->put(s.source);
     out->put(s.offset);
@@ -2003,12 +2014,7 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
     out.put(int64_t(f.index));
     out.put(f.t_c);
     putText(&out, spill_error);
-    out.put(uint64_t(f.objects.size()));
-    for (const auto& o : f.objects) out.put(uint8_t(o.triangles.empty() ? 0 : 1));
-    for (int c = 0; c < 3; ++c) out.put(d.origin[c]);
-    out.put(d.step);
-    out.put(uint8_t(d.clamped));
-    for (double v : {d.far, d.max_extent, d.max_float_error, d.max_quantization_error}) out.put(v);
+    putFrameHead(&out, f, d);
     out.put(uint64_t(d.meshopt.count));
     out.put(uint64_t(d.meshopt.stride));
     out.put(uint8_t(d.meshopt.normals_inline));
@@ -2142,12 +2148,7 @@ std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& 
     out.put(kFrameBytesMagic);
     out.put(int64_t(f.index));
     out.put(f.t_c);
-    out.put(uint64_t(f.objects.size()));
-    for (const auto& o : f.objects) out.put(uint8_t(o.triangles.empty() ? 0 : 1));
-    for (int c = 0; c < 3; ++c) out.put(d.origin[c]);
-    out.put(d.step);
-    out.put(uint8_t(d.clamped));
-    for (double v : {d.far, d.max_extent, d.max_float_error, d.max_quantization_error}) out.put(v);
+    putFrameHead(&out, f, d);
     out.putVector(d.meshopt.encoded);
     out.putVector(d.meshopt.encoded_normals);
     out.put(uint64_t(d.meshopt.count));

@@ -215,8 +215,10 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
 // instead of the measured bubbles, and the corners' shape offsets and |x|_M.
 // `speed` is the factor on the delay's error: the object's speed b for its own image, |w| for a
 // displaced one (displacedChordError).
-inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],
-                                      const double xm[3], double tolerance = INFINITY) {
+// chordErrorOfPoints takes the corners' terms in place (the refinement keeps them per point: no
+// copy per piece); chordErrorOfBubbles is it, bit for bit, from arrays.
+inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3], const PointTerms& p0,
+                                     const PointTerms& p1, const PointTerms& p2, double tolerance = INFINITY) {
     ChordError r;
     if (speed == 0) return r;
     const double Q = bubbleMax(c[0], c[1], c[2]);
@@ -227,14 +229,15 @@ inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const doubl
         return r;
     }
     // The shape offsets' centroid, the M-radius r_M and the least |x_i|_M.
+    const PointTerms* p[3] = {&p0, &p1, &p2};
     double xm_min = INFINITY;
-    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, xm[i]);
-    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
+    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, p[i]->xm);
+    const Vec3 centre = (p0.s + p1.s + p2.s) / 3.0;
     // The largest |s_i - centre|_M: one square root of the largest square (sqrt is monotonic and
     // correctly rounded, so this is the largest of the three roots, bit for bit).
     double q = 0;
     for (int i = 0; i < 3; ++i) {
-        const Vec3 u = s[i] - centre;
+        const Vec3 u = p[i]->s - centre;
         const double uv = dot(u, m.velocity);
         q = std::max(q, uv * uv + m.one_minus_beta2 * norm2(u));
     }
@@ -244,6 +247,11 @@ inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const doubl
     r.bound = speed * (Q + R);
     if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
     return r;
+}
+inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],
+                                      const double xm[3], double tolerance = INFINITY) {
+    return chordErrorOfPoints(m, speed, c, PointTerms{s[0], xm[0]}, PointTerms{s[1], xm[1]}, PointTerms{s[2], xm[2]},
+                              tolerance);
 }
 inline ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const Vec3 s[3], const double xm[3],
                                       double tolerance = INFINITY) {

@@ -1,6 +1,7 @@
 #include "slice.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -111,6 +112,7 @@ struct RefineScratch {
     // local triangles and its local-to-global point map.
     std::vector<PieceForm> forms;
     std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
+    std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
     std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
@@ -120,7 +122,8 @@ struct RefineScratch {
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
                init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
-               (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity()) *
+               (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity() +
+                coarse.capacity()) *
                    sizeof(uint32_t) +
                local.capacity() * sizeof(std::array<uint32_t, 3>);
     }
@@ -181,6 +184,9 @@ struct FrameBuilder {
         if (settings.displacement >= 0) return settings.displacement;
         if (view.sheared()) return norm(world.motion.velocity - view.shear);
         return world.motion.beta;
+    }
+    ChordError pointsBound(const double c[3], const VTerms& a, const VTerms& b, const VTerms& d) const {
+        return chordErrorOfPoints(world.motion, bound_speed, c, a, b, d, settings.tolerance);
     }
     ChordError pieceBound(const double c[3], const Vec3 s[3], const double xm[3]) const {
         return chordErrorOfBubbles(world.motion, bound_speed, c, s, xm, settings.tolerance);
@@ -420,6 +426,11 @@ struct FrameBuilder {
     // inner edges that splits make. Every slot on an edge refers to the edge's record, so its
     // midpoint and length are made once and seen from every triangle around it.
     std::vector<REdge>& r_edges;
+    // The data of r_edges, r_terms and r_init while the splits run (set where they are sized): the
+    // hot loops index them without going through the vectors.
+    REdge* r_edge_data = nullptr;
+    VTerms* r_term_data = nullptr;
+    const uint8_t* r_init_data = nullptr;
 
     // Triangles (RTri): one array for all ids, left uninitialised (RTri is trivial): a large mesh
     // of which few triangles need refining touches only their pages (r_init says which base
@@ -450,7 +461,7 @@ struct FrameBuilder {
     }
 
     void ensureBase(uint32_t id) {
-        if (id >= r_nt || r_init[id]) return;
+        if (id >= r_nt || r_init_data[id]) return;
         r_init[id] = 1;
         RTri& t = rt[id];
         for (int c = 0; c < 3; ++c) {
@@ -466,7 +477,7 @@ struct FrameBuilder {
     // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
     uint32_t nextOf(uint32_t p) const {
         const uint32_t id = slotTri(p);
-        if (id < r_nt && !r_init[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
+        if (id < r_nt && !r_init_data[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
         return rt[id].next[slotSide(p)];
     }
     void setNext(uint32_t p, uint32_t to) {
@@ -479,6 +490,7 @@ struct FrameBuilder {
     uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b, double xm) {
         const uint32_t id = uint32_t(r_terms.size());
         r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
+        r_term_data = r_terms.data();
         r_rest.push_back(rest);
         // Without a real cap every point is inside and is given its output place in bulk
         // (refineFrame): side and vertex_out stay the mesh's.
@@ -498,10 +510,10 @@ struct FrameBuilder {
     // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
     // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
     const REdge& edgeOf(uint32_t id, int c) {
-        REdge& e = r_edges[rt[id].edge[c]];
+        REdge& e = r_edge_data[rt[id].edge[c]];
         if (e.len != e.len) {
             const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
-            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[std::min(a, b)], r_terms[std::max(a, b)]);
+            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
             e.len = eb.length;
             e.c = eb.c;
             e.xm_mid = eb.xm_mid;
@@ -553,6 +565,7 @@ struct FrameBuilder {
         } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
         r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
+        r_edge_data = r_edges.data();
         reserveTris(members.size());
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
@@ -604,21 +617,21 @@ struct FrameBuilder {
         while (!stack.empty()) {
             const uint32_t id = stack.back();
             stack.pop_back();
-            const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
+            const uint8_t state = rt[id].state;
             if (r_caps) {
+                const uint32_t* v = rt[id].v;
                 const Side s0 = side[v[0]];
                 if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
             }
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
-            if (rt[id].state == kPassed || rt[id].state == kCoarse) continue;
-            if (rt[id].state == kUnknown) {
+            if (state == kPassed || state == kCoarse) continue;
+            if (state == kUnknown) {
+                const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
                 const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
-                const VTerms &k0 = r_terms[v[0]], &k1 = r_terms[v[1]], &k2 = r_terms[v[2]];
-                const Vec3 s[3] = {k0.s, k1.s, k2.s};
-                const double xm[3] = {k0.xm, k1.xm, k2.xm};
-                const ChordError ce = pieceBound(c, s, xm);
+                const VTerms &k0 = r_term_data[v[0]], &k1 = r_term_data[v[1]], &k2 = r_term_data[v[2]];
+                const ChordError ce = pointsBound(c, k0, k1, k2);
                 if (ce.bound <= settings.tolerance) {
                     rt[id].state = kPassed;
                     continue;
@@ -626,8 +639,9 @@ struct FrameBuilder {
                 // (The form is worth making only for a piece that needs a level of kMinLevel or
                 // more: its bubbles alone say about how much.)
                 if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
-                    coarseForm(id, s, false)) {
+                    coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                     rt[id].state = kCoarse;
+                    scratch.coarse.push_back(id);
                     continue;
                 }
                 rt[id].state = kFailed;
@@ -657,16 +671,20 @@ struct FrameBuilder {
         }
     };
     // The slot of the longest of the three edges e[c] (lengths known) of the triangle on v.
+    // (The ids are looked at only on a tie of lengths, as Rank orders them.)
     static int longestOf(const uint32_t v[3], const REdge* const e[3]) {
         int best = 0;
-        Rank r{e[0]->len, std::min(v[0], v[1]), std::max(v[0], v[1])};
+        double len = e[0]->len;
         for (int c = 1; c < 3; ++c) {
-            const uint32_t a = v[c], b = v[kSucc[c]];
-            const Rank rc{e[c]->len, std::min(a, b), std::max(a, b)};
-            if (r < rc) {
-                r = rc;
-                best = c;
+            const double lc = e[c]->len;
+            if (!(lc > len)) {  // (a NaN length is never the longest, as in Rank)
+                if (!(lc == len)) continue;
+                const Rank r{len, std::min(v[best], v[kSucc[best]]), std::max(v[best], v[kSucc[best]])};
+                const Rank rc{lc, std::min(v[c], v[kSucc[c]]), std::max(v[c], v[kSucc[c]])};
+                if (!(r < rc)) continue;
             }
+            len = lc;
+            best = c;
         }
         return best;
     }
@@ -994,6 +1012,7 @@ struct FrameBuilder {
         r_templates = !caps;
         scratch.forms.clear();
         scratch.form_of.clear();
+        scratch.coarse.clear();
         if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
         // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
@@ -1073,6 +1092,9 @@ struct FrameBuilder {
             out.triangles.reserve(out.triangles.size() + expect);
             out.source_triangles.reserve(out.source_triangles.size() + expect);
             r_init.assign(r_nt, 0);
+            r_init_data = r_init.data();
+            r_edge_data = r_edges.data();
+            r_term_data = r_terms.data();
             r_limited.assign(r_nt, 0);
             r_leaves = r_nt;
             std::vector<uint32_t>& stack = scratch.stack;
@@ -1090,19 +1112,19 @@ struct FrameBuilder {
                 auto share = [&](uint32_t id) {
                     if (rt[id].state == kCoarse) templated += std::pow(double(formLevel(scratch.forms[scratch.form_of[id]], cap)), 2);
                 };
-                for (uint32_t f = 0; f < r_nt; ++f)
-                    if (r_init[f]) share(f);
-                for (uint32_t id = r_nt; id < uint32_t(r_tri_size); ++id) share(id);
+                // The records still coarse, in id order (as a pass over all records would meet
+                // them), from the list of those marked: no pass over every record.
+                std::vector<uint32_t>& coarse = scratch.coarse;
+                std::sort(coarse.begin(), coarse.end());
+                coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
+                for (uint32_t id : coarse) share(id);
                 if (templated < kTemplateShare * double(r_leaves)) {
                     r_templates = false;
-                    auto resume = [&](uint32_t id) {
-                        if (rt[id].state != kCoarse) return;
+                    for (uint32_t id : coarse) {
+                        if (rt[id].state != kCoarse) continue;
                         rt[id].state = kUnknown;
                         stack.push_back(id);
-                    };
-                    for (uint32_t f = 0; f < r_nt; ++f)
-                        if (r_init[f]) resume(f);
-                    for (uint32_t id = r_nt; id < uint32_t(r_tri_size); ++id) resume(id);
+                    }
                     drain(stack);
                     scratch.forms.clear();
                 }

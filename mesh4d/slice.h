@@ -55,8 +55,8 @@
 // appended; a templated piece gives its template's triangles in its place).
 // Cost: per output triangle of the bisection about two edge bounds, one and a fifth triangle
 // bounds, half a split (its point's square root and the slot bookkeeping) and the output; about
-// 1250 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per
-// output triangle"). A templated piece costs one form and its grid: a few tens of instructions
+// 1170 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per
+// output triangle"), of which the two bounds' arithmetic is about 500. A templated piece costs one form and its grid: a few tens of instructions
 // per output triangle besides its share of the batched cut.
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that

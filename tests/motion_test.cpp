@@ -12,6 +12,7 @@
 #include "mesh4d/light_factors.h"
 #include "mesh4d/ray4d.h"
 #include "mesh4d/slice.h"
+#include "test_meshes.h"
 #include "mesh4d/worldline.h"
 #include "quiet_stage.h"
 #include "pipeline/physics.h"
@@ -24,29 +25,9 @@ using mesh4d::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using testmesh::cylinder;
 
-// A closed cylinder of radius r about z, z in [-h, h], n segments: rings at -h and h, two hub
-// vertices. Vertex 0 is at angle 0 on the ring z = -h ... the ring z = h starts at n.
-mesh4d::RestMesh cylinder(double r, double h, int n) {
-    mesh4d::RestMesh m;
-    for (double z : {-h, h})
-        for (int k = 0; k < n; ++k) {
-            const double a = 2 * kPi * k / n;
-            m.positions.push_back({r * std::cos(a), r * std::sin(a), z});
-        }
-    const uint32_t hub_lo = uint32_t(m.positions.size());
-    m.positions.push_back({0, 0, -h});
-    m.positions.push_back({0, 0, h});
-    for (uint32_t k = 0; k < uint32_t(n); ++k) {
-        const uint32_t j = (k + 1) % n;
-        m.triangles.push_back({k, j + n, k + n});
-        m.triangles.push_back({k, j, j + n});
-        m.triangles.push_back({hub_lo, j, k});
-        m.triangles.push_back({hub_lo + 1, k + n, j + n});
-    }
-    return m;
-}
+constexpr double kPi = 3.14159265358979323846;
 
 mesh4d::ViewSurface cone(double t_c, const Vec3& apex) {
     mesh4d::ViewSurface v;

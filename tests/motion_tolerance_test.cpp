@@ -13,34 +13,14 @@
 
 #include "mesh4d/extrude.h"
 #include "mesh4d/slice.h"
+#include "test_meshes.h"
 
 using mesh4d::Event;
 using mesh4d::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-// A closed cylinder of radius r about z, z in [-h, h], n segments, with hubs (as motion_test.cpp's).
-mesh4d::RestMesh cylinder(double r, double h, int n) {
-    mesh4d::RestMesh m;
-    for (double z : {-h, h})
-        for (int k = 0; k < n; ++k) {
-            const double a = 2 * kPi * k / n;
-            m.positions.push_back({r * std::cos(a), r * std::sin(a), z});
-        }
-    const uint32_t hub = uint32_t(m.positions.size());
-    m.positions.push_back({0, 0, -h});
-    m.positions.push_back({0, 0, h});
-    for (uint32_t k = 0; k < uint32_t(n); ++k) {
-        const uint32_t j = (k + 1) % n;
-        m.triangles.push_back({k, j + n, k + n});
-        m.triangles.push_back({k, j, j + n});
-        m.triangles.push_back({hub, j, k});
-        m.triangles.push_back({hub + 1, k + n, j + n});
-    }
-    return m;
-}
+using testmesh::cylinder;
 
 // A closed box of half-size a (12 triangles, outward).
 mesh4d::RestMesh box(double a) {

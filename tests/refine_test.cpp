@@ -723,3 +723,52 @@ TEST(Refine, TemplatedPiecesStayWatertightAndWithinTolerance) {
         EXPECT_EQ(again.positions.size(), local.positions.size());
     }
 }
+
+// The bisection's output near the camera, byte for byte: the box passing 2 ls from the camera
+// and the 320-face sphere passing 4 ls away at 0.9c, seen at closest approach and cut at
+// T = 1e-4 x size (benchmarks/refine_bench.cpp's scenes; no template is taken there). The
+// FNV-1a of every output array and counter was computed by `refine_bench --count 0 4` and
+// `--count 1 4` on main at 8498c8d; the speed-ups of the bisection since (issue 13, slice.cpp)
+// keep these bytes. A change meant to alter the output pins them again and says why.
+TEST(Refine, NearCameraBisectionBytesPinned) {
+    auto fnv = [](const ApparentMesh& m) {
+        uint64_t h = 1469598103934665603ull;
+        auto mix = [&](const void* p, size_t n) {
+            const unsigned char* b = static_cast<const unsigned char*>(p);
+            for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+        };
+        mix(m.positions.data(), m.positions.size() * sizeof(Vec3));
+        mix(m.emission_times.data(), m.emission_times.size() * sizeof(double));
+        mix(m.rest_points.data(), m.rest_points.size() * sizeof(Vec3));
+        mix(m.triangles.data(), m.triangles.size() * sizeof(m.triangles[0]));
+        mix(m.source_triangles.data(), m.source_triangles.size() * sizeof(uint32_t));
+        const size_t counters[4] = {m.refined_triangles, m.limited_triangles, m.clipped_triangles, size_t(m.over_budget)};
+        mix(counters, sizeof(counters));
+        return h;
+    };
+    RestMesh box;
+    for (int i = 0; i < 8; ++i) box.positions.push_back({i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5});
+    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads) {
+        box.triangles.push_back({q[0], q[1], q[2]});
+        box.triangles.push_back({q[0], q[2], q[3]});
+    }
+    struct Case {
+        RestMesh mesh;
+        double distance, size;
+        size_t triangles;
+        uint64_t hash;
+    };
+    const Case cases[] = {{box, 2.0, std::sqrt(3.0), 7152, 0x397194ba27445839ull},
+                          {testmesh::icosphere(2, 1.0), 4.0, 2.0, 5702, 0x2215a7c5bcfd9d5aull}};
+    for (const Case& c : cases) {
+        const World4D w = extrude(c.mesh, makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -c.distance}, {0.9, 0, 0}), -100,
+                                  100, false, false);
+        SliceSettings s;
+        s.max_segments = 4096;
+        s.tolerance = 1e-4 * c.size;
+        const ApparentMesh m = sliceWorld(w, {ViewKind::PastCone, c.distance, {0, 0, 0}}, s);
+        EXPECT_EQ(m.triangles.size(), c.triangles) << "distance " << c.distance;
+        EXPECT_EQ(fnv(m), c.hash) << "distance " << c.distance << ": the refined output's bytes changed";
+    }
+}

@@ -1,4 +1,4 @@
-// Small meshes built in code for the tests: an icosphere, a torus, a thin rod.
+// Small meshes built in code for the tests: an icosphere, a torus, a cylinder, a thin rod.
 #pragma once
 
 #include <cmath>
@@ -59,6 +59,30 @@ inline RestMesh torus(int nu, int nv, double R, double r) {
             m.triangles.push_back({id(i, j), id(i, j + 1), id(i + 1, j)});
             m.triangles.push_back({id(i + 1, j), id(i, j + 1), id(i + 1, j + 1)});
         }
+    return m;
+}
+
+// A closed cylinder of radius r about z, z in [-h, h], n segments: rings at -h and h, two hub
+// vertices. Vertex 0 is at angle 0 on the ring z = -h ... the ring z = h starts at n; the hubs
+// are vertices 2n (z = -h) and 2n + 1 (z = h).
+inline RestMesh cylinder(double r, double h, int n) {
+    const double pi = 3.14159265358979323846;
+    RestMesh m;
+    for (double z : {-h, h})
+        for (int k = 0; k < n; ++k) {
+            const double a = 2 * pi * k / n;
+            m.positions.push_back({r * std::cos(a), r * std::sin(a), z});
+        }
+    const uint32_t hub_lo = uint32_t(m.positions.size());
+    m.positions.push_back({0, 0, -h});
+    m.positions.push_back({0, 0, h});
+    for (uint32_t k = 0; k < uint32_t(n); ++k) {
+        const uint32_t j = (k + 1) % n;
+        m.triangles.push_back({k, j + n, k + n});
+        m.triangles.push_back({k, j, j + n});
+        m.triangles.push_back({hub_lo, j, k});
+        m.triangles.push_back({hub_lo + 1, k + n, j + n});
+    }
     return m;
 }
 
