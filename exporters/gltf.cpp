@@ -62,6 +62,10 @@ struct PrimitiveData {
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
     std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
+    // POSITION's bounds (of the float32 values, in vertex order), found by prepare()'s conversion;
+    // `bounded` false (frames decoded from bytes): plainPrimitive() finds them from `positions`.
+    bool bounded = false;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     std::vector<unsigned char> packed, packed_normals, packed_snorm;
     std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
@@ -77,6 +81,11 @@ struct PrimitiveData {
         double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // POSITION's bounds (of the float32 values)
         uint64_t index_hash[2] = {0, 0};              // indexHash(indices)
     } remote;
+    // Empties the float32 arrays and the index list (an object the frame does not show).
+    void clearArrays() {
+        for (auto* v : {&positions, &normals, &emission, &doppler, &proper_time, &colors}) v->clear();
+        indices.clear();
+    }
     size_t vertexCount() const { return remote.on ? size_t(remote.vertices) : emission.size(); }
     size_t indexCount() const { return remote.on ? size_t(remote.index_count) : indices.size(); }
     size_t packedVertices(size_t stride) const { return remote.on ? size_t(remote.packed_vertices) : packed.size() / stride; }
@@ -500,6 +509,9 @@ public:
         if (d.remote.on) {
             lo.assign(d.remote.lo, d.remote.lo + 3);
             hi.assign(d.remote.hi, d.remote.hi + 3);
+        } else if (d.bounded) {
+            lo.assign(d.lo, d.lo + 3);
+            hi.assign(d.hi, d.hi + 3);
         } else {
             bounds(d.positions, &lo, &hi);
         }
@@ -720,9 +732,16 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     exact.resize(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
     const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
-    const double worst = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, nv, 16384), 0.0,
-        [&](const tbb::blocked_range<size_t>& r, double w) {
+    // The largest rounding and the float32 positions' bounds. std::min and std::max keep the
+    // first of equal values (a signed zero) and the join takes the left part first, so the
+    // bounds are GlbBuilder::bounds()'s in vertex order, bit for bit, whatever the split.
+    struct Reduced {
+        double worst = 0;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    };
+    const Reduced reduced = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), Reduced{},
+        [&](const tbb::blocked_range<size_t>& r, Reduced red) {
             // Local pointers: through the by-reference captures every array would be reloaded
             // after each store.
             const uint32_t* const source = map->source.data();
@@ -733,6 +752,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
             float* const out_emission = d->emission.data();
             double* const out_exact = step > 0 ? exact.data() : nullptr;
             const double s0 = shift[0], s1 = shift[1], s2 = shift[2];
+            double w = red.worst;
+            double lo[3] = {red.lo[0], red.lo[1], red.lo[2]}, hi[3] = {red.hi[0], red.hi[1], red.hi[2]};
             for (size_t k = r.begin(); k < r.end(); ++k) {
                 const uint32_t v = source[k];
                 const double rel[3] = {s0 + pos[v].x, s1 + pos[v].y, s2 + pos[v].z};
@@ -740,6 +761,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                     const float fv = float(rel[c]);
                     out_pos[3 * k + c] = fv;
                     w = std::max(w, std::fabs(double(fv) - rel[c]));
+                    lo[c] = std::min(lo[c], double(fv));
+                    hi[c] = std::max(hi[c], double(fv));
                     if (out_exact) out_exact[3 * k + c] = rel[c];
                 }
                 out_nrm[3 * k] = float(nrm[k].x);
@@ -753,10 +776,27 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                     for (int j = 0; j < 3; ++j) d->colors[3 * k + size_t(j)] = float(c[size_t(j)]);
                 }
             }
-            return w;
+            red.worst = w;
+            for (int c = 0; c < 3; ++c) {
+                red.lo[c] = lo[c];
+                red.hi[c] = hi[c];
+            }
+            return red;
         },
-        [](double x, double y) { return std::max(x, y); });
-    *max_err = std::max(*max_err, worst);
+        [](Reduced a, const Reduced& b) {
+            a.worst = std::max(a.worst, b.worst);
+            for (int c = 0; c < 3; ++c) {
+                a.lo[c] = std::min(a.lo[c], b.lo[c]);
+                a.hi[c] = std::max(a.hi[c], b.hi[c]);
+            }
+            return a;
+        });
+    *max_err = std::max(*max_err, reduced.worst);
+    d->bounded = true;
+    for (int c = 0; c < 3; ++c) {
+        d->lo[c] = reduced.lo[c];
+        d->hi[c] = reduced.hi[c];
+    }
     d->indices.resize(3 * map->triangles.size());
     if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
     if (step > 0)
@@ -1409,8 +1449,9 @@ struct GlbFrameData : PreparedFrame, std::enable_shared_from_this<GlbFrameData> 
         meshopt.remote = false;
         data.resize(objects);
         for (PrimitiveData& p : data) {
-            for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
-            p.indices.clear();
+            // The float32 arrays and the index list keep their size: prepare() empties those of
+            // the objects not shown, toPrimitive() sizes the others (no zero fill unless they grow).
+            p.bounded = false;
             p.ordered.reset();
             p.draco.bytes.clear();
             p.draco.error.clear();
@@ -1545,6 +1586,8 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f) c
         if (pool->free.size() < poolFrames()) pool->free.push_back(std::move(owned));
     });
     d->reset(f.objects.size());
+    for (size_t o = 0; o < f.objects.size(); ++o)
+        if (f.objects[o].triangles.empty()) d->data[o].clearArrays();  // not shown: no data
     std::unique_ptr<PrepareScratch> scratch;
     {
         std::lock_guard<std::mutex> lock(pool->mutex);
