@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "exporters/atomic_file.h"
@@ -798,7 +799,9 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
         d->hi[c] = reduced.hi[c];
     }
     d->indices.resize(3 * map->triangles.size());
-    if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, map->triangles.size(), 65536), [&](const tbb::blocked_range<size_t>& r) {
+        std::memcpy(d->indices.data() + 3 * r.begin(), map->triangles.data() + r.begin(), r.size() * sizeof(map->triangles[0]));
+    });
     if (step > 0)
         *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), order,
                                                       &scratch->normals));

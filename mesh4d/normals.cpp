@@ -5,6 +5,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "angles.h"
 
@@ -50,22 +51,26 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     // Step: face area vectors and their lengths (parallel); faces around each vertex (CSR layout).
     // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s hypot (the
     // output normals below still use norm()); unit() gives it where needed, the same bits each time.
+    // The same pass compares the triangles with the last call's (adjacency reuse), when the counts match.
     w->area.resize(nf);
     w->length.resize(nf);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
-        const Vec3* const pos = mesh.positions.data();
-        Vec3* const area = w->area.data();
-        double* const length = w->length.data();
-        for (size_t f = r.begin(); f < r.end(); ++f) {
-            const auto& t = tri[f];
-            const Vec3 a = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
-            area[f] = a;
-            length[f] = std::sqrt(dot(a, a));
-        }
-    });
-    const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
-                      (nf == 0 || std::memcmp(w->triangles.data(), mesh.triangles.data(), nf * sizeof(mesh.triangles[0])) == 0);
+    const bool may_be_same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1;
+    const bool same = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nf, kGrain), may_be_same,
+        [&](const tbb::blocked_range<size_t>& r, bool equal) {
+            const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
+            const Vec3* const pos = mesh.positions.data();
+            Vec3* const area = w->area.data();
+            double* const length = w->length.data();
+            for (size_t f = r.begin(); f < r.end(); ++f) {
+                const auto& t = tri[f];
+                const Vec3 a = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
+                area[f] = a;
+                length[f] = std::sqrt(dot(a, a));
+            }
+            return equal && std::memcmp(w->triangles.data() + r.begin(), tri + r.begin(), r.size() * sizeof(tri[0])) == 0;
+        },
+        [](bool a, bool b) { return a && b; });
     if (!same) {
         w->unsplit = false;
         w->vertices = nv;
@@ -161,12 +166,12 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         for (size_t v = r.begin(); v < r.end(); v += 2) {
             const size_t b = std::min(v + 1, r.end() - 1);  // an odd end repeats its last vertex
             const Vec3 s0 = vertex_normal_p[v], s1 = vertex_normal_p[b];
-            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, length;
-            unitPair(x, y, z, &ux, &uy, &uz, &length);
+            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
+            unitPair(x, y, z, &ux, &uy, &uz, &len);
             for (int k = 0; k < 2; ++k) {
                 const size_t i = k == 0 ? v : b;
                 if (!uniform_p[i]) continue;
-                if (!(length[k] > 0)) uniform_p[i] = 0;
+                if (!(len[k] > 0)) uniform_p[i] = 0;
                 else vertex_normal_p[i] = {ux[k], uy[k], uz[k]};
             }
         }
