@@ -1036,7 +1036,7 @@ struct SequenceModel {
                 } else {
                     prim = b.plainPrimitive(data[o], shared[o]);
                 }
-                if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o]);
+                if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o], borrow_indices);
                 shown[o] = true;
                 prim.material = o < info.objects.size() ? int(o) : -1;
                 mesh.primitives.push_back(prim);
@@ -1334,32 +1334,47 @@ struct SequenceModel {
     enum class Compression { none, draco, meshopt } compression = Compression::none;
     // Per object, its index list in the previous frame and the accessor holding it (-1: none).
     // Frames by reference compare the lists' hashes (indexHash), frames of this process the lists.
+    // An object's index list in the last frame. Copied, or only pointed to while its frame is
+    // held in place (borrow_indices: the writer's first frame, BinSink::pinned), so that a lone
+    // frame never copies it; keepPrevious() copies it before that frame is let go.
     struct Previous {
         int accessor = -1;
         size_t vertices = 0;
         std::vector<uint32_t> indices;
+        const std::vector<uint32_t>* borrowed = nullptr;  // instead of `indices`
         bool remote = false;
         uint64_t count = 0, hash[2] = {0, 0};
         bool same(const PrimitiveData& d) const {
             if (vertices != d.vertexCount() || remote != d.remote.on) return false;
-            if (!remote) return indices == d.indices;
+            if (!remote) return (borrowed ? *borrowed : indices) == d.indices;
             return count == d.remote.index_count && hash[0] == d.remote.index_hash[0] && hash[1] == d.remote.index_hash[1];
         }
-        void take(int accessor_, const PrimitiveData& d) {
+        void take(int accessor_, const PrimitiveData& d, bool borrow) {
             accessor = accessor_;
             vertices = d.vertexCount();
             remote = d.remote.on;
+            borrowed = nullptr;
             if (remote) {
                 indices.clear();
                 count = d.remote.index_count;
                 hash[0] = d.remote.index_hash[0];
                 hash[1] = d.remote.index_hash[1];
+            } else if (borrow) {
+                borrowed = &d.indices;
             } else {
                 indices = d.indices;
             }
         }
+        void keep() {
+            if (borrowed) indices = *borrowed;
+            borrowed = nullptr;
+        }
     };
     std::vector<Previous> previous;
+    bool borrow_indices = false;  // the frame being added is held in place until keepPrevious()
+    void keepPrevious() {
+        for (Previous& p : previous) p.keep();
+    }
     struct Reflection {
         size_t frame;        // frame node 1 + frame is the parent
         std::string mirror;  // the mirror's name
@@ -1734,11 +1749,15 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     // Step: the first frame is held (its own buffers kept, BinSink), a second one sends it to the
     // spill file.
     if (m.model.frames > 0) {
+        m.model.keepPrevious();  // the held frame's index lists copied before it is let go
+        if (m.plain) m.plain->keepPrevious();
         m.sink.spill();
     } else if (m.sink.holding) {
         m.sink.pinned = prepared.weak_from_this().lock();  // none (addEncoded's frame): copied instead
         if (m.sink.pinned) m.sink.borrowable = prepared.buffers();
     }
+    m.model.borrow_indices = m.sink.pinned != nullptr;
+    if (m.plain) m.plain->borrow_indices = m.model.borrow_indices;
     // Step: into the model (binary data to the spill file), and into the counted plain twin.
     if (!m.model.addFrame(f, data, origin, prepared.step > 0 ? prepared.step : 1.0, &prepared.meshopt, &m.stats,
                           error)) {
