@@ -1834,6 +1834,10 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
         // The BIN chunk copied from the spill file after the head (copy_file_range: the kernel
         // copies between the two files' pages; pread and write where it cannot).
         static const char zeros[4] = {0, 0, 0, 0};
+        // The file's blocks reserved in one call first: page by page, ext4's delayed allocation
+        // cost the lone 1M-triangle frame's write more than copying its bytes. Only a hint: where
+        // it fails (a file system without it, no space), the writes below say what is wrong.
+        (void)::fallocate(fd, 0, 0, off_t(total));
         // A lone frame: from where it is held, written once (no spill file).
         ok = writeAll(fd, head.data(), head.size(), &werr) &&
              (m.sink.holding ? m.sink.writeHeld(fd, &werr) : copyRange(m.sink.fd, 0, bin, fd, &werr)) &&
