@@ -165,6 +165,10 @@ bool AtomicOutput::commitBytes(const std::string& bytes, std::string* error) {
     return commit(error);
 }
 
+int registerTemporary(const std::string& path) { return registerTemp(path); }
+
+void unregisterTemporary(int slot) { unregisterTemp(slot); }
+
 int openAnonymousFile(const std::string& dir, std::string* error) {
     const std::string folder = dir.empty() ? "." : dir;
     int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_EXCL | O_CLOEXEC, 0600);

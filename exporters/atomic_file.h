@@ -57,6 +57,13 @@ bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* wr
 // behind whatever ends the process, SIGKILL and the OOM killer included. -1 with a message on failure.
 int openAnonymousFile(const std::string& dir, std::string* error);
 
+// Names the interrupt cleanup below removes besides AtomicOutput's own temporaries: temporary
+// files another process writes for this one to rename (frames across processes,
+// exporters/frame_files.h). Returns the slot for unregisterTemporary, or -1 when the 64 slots are
+// all taken (the name is then not removed on an interrupt; never a truncated final file either way).
+int registerTemporary(const std::string& path);
+void unregisterTemporary(int slot);
+
 // Installs handlers for SIGINT, SIGTERM and SIGHUP (SIGINT and SIGHUP only when not ignored) that
 // remove every temporary file of a live AtomicOutput, print one line and exit with 128 + the
 // signal number (130, 143, 129). Files already renamed into place are complete and stay. SIGXFSZ is ignored, so a

@@ -1,10 +1,17 @@
 #include "exporters/frame_files.h"
 
 #include "exporters/atomic_file.h"
+#include "exporters/frame_spill.h"
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <system_error>
 #include <utility>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace apparent {
 
@@ -77,9 +84,121 @@ PendingOutput FrameFileSink::pendingEncoded(long long index, const EncodedOutput
     return {frame.least, path(index)};
 }
 
+namespace {
+
+// A frame file written by the rank that cut the frame, as it travels: the marker (a NUL first: no
+// PLY or OBJ file starts so), the file's size and inode, then the write's error (empty: written).
+constexpr char kWrittenMarker[8] = {'\0', 'A', 'F', 'F', 'I', 'L', 'E', '1'};
+
+void putU64(std::string* out, uint64_t v) {
+    for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));
+}
+
+uint64_t getU64(const std::string& in, size_t at) {
+    uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) v |= uint64_t(uint8_t(in[at + size_t(i)])) << (8 * i);
+    return v;
+}
+
+bool isWrittenFrame(const std::string& bytes) {
+    return bytes.size() >= sizeof kWrittenMarker + 16 &&
+           std::memcmp(bytes.data(), kWrittenMarker, sizeof kWrittenMarker) == 0;
+}
+
+}  // namespace
+
+std::string FrameFileSink::temporaryPath(long long k) const {
+    return (std::filesystem::path(dir_) / ("." + frameName(k) + ".tmp-" + frameRunToken() + "." + extension_)).string();
+}
+
+bool FrameFileSink::beginEncoding(const SequenceInfo& info, std::string* error) {
+    // The rank writes into DIR, possibly before rank 0's begin() made it.
+    return !frameSpillInstalled() || begin(info, error);
+}
+
+void FrameFileSink::beforeSending(long long index, EncodedOutput* frame) {
+    if (!frameSpillInstalled()) return;
+    const std::string temp = temporaryPath(index), final_path = path(index);
+    // Step: the previous frame is with rank 0 (sent), which registered its name: this one instead.
+    unregisterTemporary(sent_slot_);
+    sent_slot_ = registerTemporary(temp);
+    // Step: the file, created exclusively, written, synced and closed, as AtomicOutput does.
+    std::string why;
+    struct stat st {};
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        why = final_path + ": cannot create " + temp + ": " + std::strerror(errno);
+    } else {
+        size_t done = 0;
+        std::string w;
+        if (!writeAll(fd, frame->bytes.data(), frame->bytes.size(), &w, &done))
+            why = final_path + ": cannot write (" + std::to_string(done) + " of " +
+                  std::to_string(frame->bytes.size()) + " bytes written): " + w;
+        else if (::fsync(fd) != 0 || ::fstat(fd, &st) != 0)
+            why = final_path + ": cannot write: " + std::strerror(errno);
+        if (::close(fd) != 0 && why.empty()) why = final_path + ": cannot write: " + std::strerror(errno);
+        if (!why.empty()) ::unlink(temp.c_str());
+    }
+    // Step: its description replaces the bytes.
+    std::string d(kWrittenMarker, sizeof kWrittenMarker);
+    putU64(&d, why.empty() ? uint64_t(st.st_size) : 0);
+    putU64(&d, why.empty() ? uint64_t(st.st_ino) : 0);
+    d += why;
+    frame->bytes = std::move(d);
+}
+
+void FrameFileSink::expectEncoded(long long index) {
+    if (!frameSpillInstalled() || expected_.count(index)) return;
+    // At most kRegisteredMost names of other ranks' frames at once per sink: the interrupt
+    // cleanup's other slots stay for this process's own temporaries (the .glb's among them).
+    constexpr size_t kRegisteredMost = 16;
+    size_t registered = 0;
+    for (const auto& e : expected_) registered += e.second >= 0 ? 1 : 0;
+    expected_[index] = registered < kRegisteredMost ? registerTemporary(temporaryPath(index)) : -1;
+}
+
+void FrameFileSink::dropEncoded(long long first, long long last_excl) {
+    if (!frameSpillInstalled() || frameRunToken().empty()) return;
+    for (long long k = first; k < last_excl; ++k) ::unlink(temporaryPath(k).c_str());
+    for (const auto& e : expected_) unregisterTemporary(e.second);
+    expected_.clear();
+}
+
+FrameFileSink::~FrameFileSink() {
+    unregisterTemporary(sent_slot_);
+    for (const auto& e : expected_) unregisterTemporary(e.second);
+}
+
 bool FrameFileSink::addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
                                std::string* error) {
     const std::string p = path(index);
+    if (isWrittenFrame(frame.bytes)) {
+        // Written by its rank: renamed into place when it is still the file the rank wrote.
+        const size_t at = sizeof kWrittenMarker;
+        const uint64_t size = getU64(frame.bytes, at), ino = getU64(frame.bytes, at + 8);
+        if (frame.bytes.size() > at + 16) {
+            *error = frame.bytes.substr(at + 16);  // the rank's message, as one process gives it
+            return false;
+        }
+        const std::string temp = temporaryPath(index);
+        struct stat st {};
+        if (::lstat(temp.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || uint64_t(st.st_size) != size ||
+            uint64_t(st.st_ino) != ino) {
+            *error = p + ": the temporary file " + temp + " was replaced while writing (not renamed into place)";
+            return false;
+        }
+        if (std::rename(temp.c_str(), p.c_str()) != 0) {
+            *error = p + ": cannot rename from " + temp + ": " + std::strerror(errno);
+            return false;
+        }
+        const auto e = expected_.find(index);
+        if (e != expected_.end()) {
+            unregisterTemporary(e->second);
+            expected_.erase(e);
+        }
+        completed->push_back(p);
+        return true;
+    }
     AtomicOutput out(p);
     if (!out.commitBytes(frame.bytes, error)) return false;
     completed->push_back(p);

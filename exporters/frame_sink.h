@@ -85,6 +85,16 @@ public:
     virtual PendingOutput pendingEncoded(long long index, const EncodedOutput& frame);
     virtual bool addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
                             std::string* error);
+    // Files a process writes for the writing process (FrameFileSink under MPI). On the process that
+    // cut frame `index`, in frame order just before the frame is sent: the sink may write it where
+    // the writing process finds it, leaving a description in `frame` (the default: nothing).
+    virtual void beforeSending(long long /*index*/, EncodedOutput* /*frame*/) {}
+    // On the writing process: another process may write for frame `index` from now on (called
+    // once per such frame, before it arrives; the default: nothing).
+    virtual void expectEncoded(long long /*index*/) {}
+    // On the writing process when the loop ends without finishing, after every other process
+    // stopped sending: whatever they wrote for frames [first, last_excl) and was not taken goes.
+    virtual void dropEncoded(long long /*first*/, long long /*last_excl*/) {}
 };
 
 // The least size of a frame in any of the formats: 12 bytes per vertex and 12 per triangle

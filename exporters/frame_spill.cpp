@@ -43,6 +43,17 @@ void installFrameSpill(int fd, int source) {
 
 bool frameSpillInstalled() { return spill().fd >= 0; }
 
+namespace {
+std::string& runToken() {
+    static std::string token;
+    return token;
+}
+}  // namespace
+
+void setFrameRunToken(const std::string& token) { runToken() = token; }
+
+const std::string& frameRunToken() { return runToken(); }
+
 bool spillFrameData(const std::vector<iovec>& pieces, std::vector<FileSpan>* spans, std::string* error) {
     Spill& s = spill();
     uint64_t total = 0;

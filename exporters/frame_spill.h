@@ -36,6 +36,10 @@ struct FileSpan {
 // writer as source `source`.
 void installFrameSpill(int fd, int source);
 bool frameSpillInstalled();
+// The run's random token (the same on every process, pipeline/distribute.h): names of files the
+// processes make for one another in the output folder carry it (exporters/frame_files.h).
+void setFrameRunToken(const std::string& token);
+const std::string& frameRunToken();
 // Writes the pieces one after another at a fresh range of the spill and returns one span per
 // piece (contiguous); false with errno's message when the write fails.
 bool spillFrameData(const std::vector<iovec>& pieces, std::vector<FileSpan>* spans, std::string* error);

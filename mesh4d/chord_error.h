@@ -262,27 +262,50 @@ inline ChordError chordErrorOfBubbles(const Motion& m, const double c[3], const 
 // ---- The whole-piece bound: one quadratic form for every triangle inside a piece ----
 // The refinement fills each piece it stops bisecting with a template (tessellate.h) of many
 // triangles; this bounds them all at once, from the piece's own terms.
-// On the piece, for any direction u, with c the centroid (x_c = E + the shape offsets' mean) and
-// x any point of the piece,
-//     u^T H(x) u <= u^T H(x_c) u + K |u|_M^2,   K = (2 / sqrt 3) r_M / ((1 - b^2) m^2):
-// u^T (H(x) - H(x_c)) u is the integral of D^3 delta [u, u, x - x_c] along the segment, and a
-// symmetric trilinear form's norm is its largest value on one unit vector (Banach), here
-// (2 / sqrt 3) / ((1 - b^2) |x|_M^2) in the metric M (the norm's third derivative, as above);
-// |x - x_c|_M <= r_M (the largest M-distance from the centroid to a corner) and
-// |x|_M >= m = |x_c|_M - r_M on the piece. So H(x) <= A = H(x_c) + K M everywhere on the piece
-// (as quadratic forms). For a triangle S with corners x_i inside the piece and p in S,
+// What a form must do. If A >= H(x) (the delay's Hessian, as quadratic forms) at every point x of
+// the piece, then for a triangle S with corners x_i inside the piece and p in S,
 //     L delta(p) - delta(p) = sum_i l_i integral_0^1 (1 - t) (x_i - p)^T H (x_i - p) dt
 //                          <= (1/2) sum_i l_i |x_i - p|_A^2 = sum_{i<j} l_i l_j c_ij,
 // c_ij = |x_i - x_j|_A^2 / 2 (the first-order terms cancel: sum_i l_i (x_i - p) = 0), and delta is
 // convex, so 0 <= L delta - delta <= bubbleMax(c01, c12, c20) on S:
-//     |F - L| <= speed bubbleMax(c(S's edges)),   c(e) = e^T A e / 2 = e^T H(x_c) e / 2 + K |e|_M^2 / 2.
+//     |F - L| <= speed bubbleMax(c(S's edges)),   c(e) = e^T A e / 2.
 // A is one form for the whole piece: a triangle of the piece scaled by 1/n has the bound of the
-// piece over n^2. The price is K, relative to H(x_c) about r_M / |x|: `centre` holds the
-// coefficients without it, so the caller can tell how much the piece's size costs (pieces small
-// against their distance from the camera get the template; larger ones are bisected first).
+// piece over n^2. Two forms A qualify; pieceForm takes, per piece, the one whose bubbleMax on the
+// piece's sides is the smaller (both bound H, so either is sound).
+// In the coordinates where |.|_M is Euclidean (y = M^(1/2) x, rho = |y_c| = |x_c|_M at the
+// centroid, y^ = y / |y|), H(y) = P_y / ((1 - b^2) |y|), P_y the projection across y^ (above).
+// (1) The direct form. Split a step u = alpha y_c^ + u_perp (along and across the centroid's
+// direction). P_y u = alpha P_y y_c^ + P_y u_perp, |P_y y_c^| = sin theta (theta: the angle between
+// y^ and y_c^) and |P_y u_perp| <= |u_perp|, so for any mu > 0 (Young)
+//     |P_y u|^2 <= (|alpha| sin theta + |u_perp|)^2 <= (1 + mu) |u_perp|^2 + (1 + 1/mu) sin^2 theta alpha^2.
+// On the piece y = y_c + d with d in the triangle of the corners' offsets d_i: |y| >= y_c^.y =
+// rho + y_c^.d >= m = rho - max_i (-y_c^.d_i) (linear in d: least at a corner), and
+// sin theta = |d_perp| / |y| <= min(1, p / m), p = max_i |d_i,perp| (|d_perp| is convex in d). So
+//     A1 = ((1 + mu) P_c + (1 + 1/mu) sin^2 y_c^ y_c^T) / ((1 - b^2) m),   P_c the projection across y_c^,
+// with no derivative of the delay at all: its slack over H(y_c) = P_c / ((1 - b^2) rho) is the
+// piece's reach towards the camera, rho / m - 1, and mu across the direction of sight (the Hessian
+// really is larger by rho / |y| at the piece's near corner: a uniform grid pays the worst spot), and
+// along it only the second-order term sin^2 (the Hessian has no part along y_c^ at the centroid).
+// mu is chosen per piece among the four values that balance the two terms on each side and on
+// their sums (mu = sqrt(b / a), a the across-part of the side, b its along-part times sin^2,
+// clamped to [1e-6, 1e6]), the one with the least bubbleMax. With a segment of the piece on the
+// line of sight through the camera's side (m <= 0) A1 is unbounded.
+// (2) The Taylor form (the earlier one, kept for pieces where it is tighter): for any u,
+//     u^T H(x) u <= u^T H(x_c) u + K |u|_M^2,   K = (2 / sqrt 3) r_M / ((1 - b^2) m_r^2):
+// u^T (H(x) - H(x_c)) u is the integral of D^3 delta [u, u, x - x_c] along the segment, and a
+// symmetric trilinear form's norm is its largest value on one unit vector (Banach), here
+// (2 / sqrt 3) / ((1 - b^2) |x|_M^2) in the metric M (the norm's third derivative, as above);
+// |x - x_c|_M <= r_M (the largest M-distance from the centroid to a corner) and
+// |x|_M >= m_r = |x_c|_M - r_M on the piece. So A2 = H(x_c) + K M.
+// The price of either over H(x_c) is about the piece's size over its distance (A2: r_M / |x| on
+// every side, the sides along the line of sight included, where H(x_c) is nearly zero; A1: the
+// reach towards the camera across it, second order along it): `centre` holds the coefficients of
+// H(x_c) alone, so the caller can tell how much the piece's size costs (pieces small against
+// their distance from the camera get the template; larger ones are bisected first).
+// Rounding: as the edge bounds', a few ulps of terms of the size of the bound.
 struct PieceForm {
     double c[3] = {INFINITY, INFINITY, INFINITY};  // c(e) of side e (s[e] -> s[e + 1]) with A
-    double centre[3] = {0, 0, 0};                  // the same with H(x_c) alone (K = 0)
+    double centre[3] = {0, 0, 0};                  // the same with H(x_c) alone
     bool finite = false;                           // false when the piece may reach the camera (m <= 0)
 };
 inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
@@ -293,23 +316,61 @@ inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
     const double xv = dot(x, m.velocity);
     const double xm2 = xv * xv + k * norm2(x);
     const double xm = std::sqrt(xm2);
-    double q = 0;  // r_M^2
+    double q = 0;       // r_M^2
+    double reach = 0;   // max_i (-y_c^.d_i): the piece's reach towards the camera
+    double perp2 = 0;   // p^2 = max_i |d_i,perp|^2
     for (int i = 0; i < 3; ++i) {
         const Vec3 u = s[i] - centre;
         const double uv = dot(u, m.velocity);
-        q = std::max(q, uv * uv + k * norm2(u));
+        const double d2 = uv * uv + k * norm2(u);
+        const double along = (uv * xv + k * dot(u, x)) / xm;  // y_c^.d_i
+        q = std::max(q, d2);
+        reach = std::max(reach, -along);
+        perp2 = std::max(perp2, d2 - along * along);
     }
-    const double rM = std::sqrt(q);
-    const double mlow = xm - rM;
-    if (!(mlow > 0)) return r;
-    const double K = 2 / 1.7320508075688772 * rM / (k * mlow * mlow);
+    // The sides' parts across and along y_c^ (|e_perp|^2, alpha^2), and H(x_c)'s coefficients.
+    double across[3], along2[3];
     for (int e = 0; e < 3; ++e) {
         const Vec3 u = s[(e + 1) % 3] - s[e];
         const double uv = dot(u, m.velocity);
         const double l2 = uv * uv + k * norm2(u);
         const double uMx = uv * xv + k * dot(u, x);
         r.centre[e] = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
-        r.c[e] = r.centre[e] + 0.5 * K * l2;
+        along2[e] = uMx * uMx / xm2;
+        across[e] = std::max(0.0, l2 - along2[e]);
+    }
+    double best = INFINITY;
+    // (1) The direct form.
+    const double m1 = xm - reach;
+    if (m1 > 0) {
+        const double sin2 = std::min(1.0, std::max(0.0, perp2) / (m1 * m1));
+        const double inv = 0.5 / (k * m1);
+        double a[4] = {across[0], across[1], across[2], across[0] + across[1] + across[2]};
+        double b[4] = {sin2 * along2[0], sin2 * along2[1], sin2 * along2[2], 0};
+        b[3] = b[0] + b[1] + b[2];
+        for (int j = 0; j < 4; ++j) {
+            double mu = 1e-6;
+            if (b[3] > 0) mu = a[j] > 0 ? std::min(1e6, std::max(1e-6, std::sqrt(b[j] / a[j]))) : 1e6;
+            const double fa = 1 + mu, fb = b[3] > 0 ? 1 + 1 / mu : 0;
+            double c[3];
+            for (int e = 0; e < 3; ++e) c[e] = inv * (fa * across[e] + fb * sin2 * along2[e]);
+            const double v = bubbleMax(c[0], c[1], c[2]);
+            if (v < best) {
+                best = v;
+                for (int e = 0; e < 3; ++e) r.c[e] = c[e];
+            }
+            if (b[3] == 0) break;
+        }
+    }
+    // (2) The Taylor form.
+    const double rM = std::sqrt(q);
+    const double mlow = xm - rM;
+    if (mlow > 0) {
+        const double K = 2 / 1.7320508075688772 * rM / (k * mlow * mlow);
+        double c[3];
+        for (int e = 0; e < 3; ++e) c[e] = r.centre[e] + 0.5 * K * (across[e] + along2[e]);
+        if (bubbleMax(c[0], c[1], c[2]) < best)
+            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
     }
     r.finite = r.c[0] == r.c[0] && r.c[1] == r.c[1] && r.c[2] == r.c[2] && r.c[0] < INFINITY &&
                r.c[1] < INFINITY && r.c[2] < INFINITY;

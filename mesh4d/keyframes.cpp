@@ -159,9 +159,15 @@ std::shared_ptr<const KeyedMotion> makeKeyedMotion(const KeyPath& path, bool lor
     return k;
 }
 
+size_t keyedSegment(const KeyedMotion& k, double s) { return locate(k, s).segment; }
+
 KeyedLocal keyedLocal(const KeyedMotion& k, double s, const Vec3& q) {
+    return keyedSegmentLocal(k, locate(k, s).segment, s, q);
+}
+
+KeyedLocal keyedSegmentLocal(const KeyedMotion& k, size_t j, double s, const Vec3& q) {
     KeyedLocal l;
-    const Where at = locate(k, s);
+    const Where at{j, j == 0 ? 0 : j - 1};
     const double ds = s - k.s[at.key];
     const Vec3 p = rotate(k.turns[at.key], q);
     const double rate = k.rate[at.segment];

@@ -105,6 +105,17 @@ struct KeyedLocal {
 };
 KeyedLocal keyedLocal(const KeyedMotion& k, double s, const Vec3& q);
 
+// The segment holding s (the index into the vectors sized n + 1 above; a key's own time belongs to
+// the segment that starts there).
+size_t keyedSegment(const KeyedMotion& k, double s);
+
+// keyedLocal with segment j's motion extended to every s: the straight line at velocity[j] and the
+// turn at rate[j] about axis[j], from the pose at the segment's first key (key 0 for j = 0). So
+// keyedLocal(k, s, q) is keyedSegmentLocal(k, keyedSegment(k, s), s, q), and at key i both
+// segments i and i + 1 give the same y (the pose at key i) but different dy: the kink that the
+// tolerance bound across a key (worldline_bound.h) takes apart.
+KeyedLocal keyedSegmentLocal(const KeyedMotion& k, size_t j, double s, const Vec3& q);
+
 // q's own clock at s: the integral of d tau above from 0 to s, closed form per segment. O(keys).
 double keyedProperTime(const KeyedMotion& k, double s, const Vec3& q);
 

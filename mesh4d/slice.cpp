@@ -636,6 +636,12 @@ struct FrameBuilder {
                     rt[id].state = kPassed;
                     continue;
                 }
+                // The bubbles pass but the third-order term does not: the whole-piece form (tighter
+                // near the camera, chord_error.h pieceForm) may pass the piece as it is.
+                if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
+                    rt[id].state = kPassed;
+                    continue;
+                }
                 // (The form is worth making only for a piece that needs a level of kMinLevel or
                 // more: its bubbles alone say about how much.)
                 if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
@@ -656,7 +662,21 @@ struct FrameBuilder {
                 stack.clear();
                 return;
             }
-            if (!splitLongestPath(id, stack)) stack.push_back(id);  // a coarser neighbour went first
+            const int split = splitLongestPath(id, stack);
+            if (split == kSplitBlocked) {
+                // The split would halve a piece a template fills: this piece is filled by its own
+                // template instead (any level its form asks for), so the template stays whole.
+                const uint32_t* v = rt[id].v;
+                const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
+                if (coarseForm(id, s, true)) {
+                    rt[id].state = kCoarse;
+                    scratch.coarse.push_back(id);
+                    continue;
+                }
+                if (splitLongestPath(id, stack, false) == kSplitOther) stack.push_back(id);
+            } else if (split == kSplitOther) {
+                stack.push_back(id);  // a coarser neighbour went first
+            }
         }
     }
 
@@ -705,7 +725,10 @@ struct FrameBuilder {
     // bends along it) without slivers.
     // True when the edge halved is id's own (along the path lengths grow strictly, so no edge
     // after the first is id's).
-    bool splitLongestPath(uint32_t id, std::vector<uint32_t>& stack) {
+    // With `guard` (templates on), a split that would halve a piece marked kCoarse whose level
+    // is kKeptLevel or more is not made: kSplitBlocked (the caller templates id instead).
+    static constexpr int kSplitOther = 0, kSplitOwn = 1, kSplitBlocked = 2;
+    int splitLongestPath(uint32_t id, std::vector<uint32_t>& stack, bool guard = true) {
         uint32_t t = id;
         for (;;) {
             const int c = longestSlot(t);
@@ -717,8 +740,17 @@ struct FrameBuilder {
                     break;
                 }
             if (other == kUnset) {
+                if (guard && r_templates) {
+                    uint32_t p = start;
+                    do {
+                        const uint32_t u = slotTri(p);
+                        if (rt[u].state == kCoarse && formLevel(scratch.forms[scratch.form_of[u]], kNoCap) >= kKeptLevel)
+                            return kSplitBlocked;
+                        p = nextOf(p);
+                    } while (p != start);
+                }
                 splitEdge(t, c, stack);
-                return t == id;
+                return t == id ? kSplitOwn : kSplitOther;
             }
             t = other;
         }
@@ -734,7 +766,15 @@ struct FrameBuilder {
     // shape), and A is nearly the form at its centroid (within kCoarseSlack) or the n^2
     // triangles of the template are fewer than the two halves are expected to need (each half
     // asks for half the centroid's need, its excess of A over the centroid's form shrunk by
-    // sqrt 2, its level rounded up by kRounding on average).
+    // sqrt 2, its level rounded up by kRounding on average). With the form of chord_error.h
+    // (second-order slack along the line of sight) this holds near the camera too.
+    // A split that would halve a piece marked kCoarse at a level of kKeptLevel or more (the
+    // longest-edge path of a neighbour reaching it) is not made: the neighbour is filled by its
+    // own template instead (splitLongestPath's guard), so a large template, once chosen, stays
+    // whole (near the camera the bisection would otherwise cut every template its neighbours
+    // reach). Smaller ones are halved as before (their halves judged again): guarding them too
+    // templated the box's closest frame at T = 1e-3 x size into more triangles than uniform
+    // subdivision's (the neighbours' forced templates round their levels up).
     // The grid triangles of a piece at level n (the piece scaled by 1/n) are within T
     // (chord_error.h PieceForm). Each edge record gets the largest level of the pieces around
     // it, and both sides cut it into that many equal segments: no T-junctions, and the counts
@@ -746,15 +786,28 @@ struct FrameBuilder {
     // nothing) keeps level 1: its sides' extra points are fanned and, the delay being convex,
     // every triangle inside it is within its own bound.
     // The template makes no record per output triangle; where it is not used (a level below
-    // kMinLevel, or a form far from the centroid's: large pieces near the camera) the bisection
-    // goes on to pieces that pass, which adapts more finely (docs/ACCURACY.md: the constants are
-    // the ones that keep every trade ratio of the bisection alone).
+    // kMinLevel, or more triangles than the halves') the bisection goes on to pieces that
+    // pass, which adapts more finely (docs/ACCURACY.md: the constants keep every trade ratio
+    // within the targets).
     static constexpr double kMinLevel = 2;
     static constexpr double kShapeShare = 0.3;
     static constexpr double kEquilateral = 2.598076211353316;  // 3 sqrt(3) / 2: area / bubbleMax of an equilateral triangle
     static constexpr double kCoarseSlack = 1.1;
     static constexpr double kRounding = 0.3;
     static constexpr double kTemplateShare = 0.5;  // least share of the leaves the templates' triangles must make (refineFrame)
+    static constexpr uint32_t kKeptLevel = 8;      // least level of a template the guard keeps whole
+    static constexpr uint32_t kNoCap = 1u << 20;   // formLevel without the max_segments cap
+
+    // True when the whole-piece form of the piece with corners' shape offsets a, b, c (chord_error.h
+    // pieceForm: A >= the delay's Hessian on the whole piece) bounds the piece itself within the
+    // tolerance: speed bubbleMax(A's sides) <= T. A sound bound of the piece as chordErrorOfPoints'
+    // is; tighter than its third-order term near the camera (the form's slack there is second
+    // order along the line of sight), so a piece it passes needs no further split.
+    bool passesByForm(const Vec3& a, const Vec3& b, const Vec3& c) const {
+        const Vec3 s[3] = {a, b, c};
+        const PieceForm pf = pieceForm(world.motion, r_now, s);
+        return pf.finite && bound_speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]) <= settings.tolerance;
+    }
 
     // The form of piece id (its corners' shape offsets s) when it is finite and (unless `force`:
     // the depth limit stopped the piece) the piece is better filled by a template (above); kept
@@ -903,6 +956,9 @@ struct FrameBuilder {
             }
             if (form_of[id] == kUnset) return;
             const uint32_t n = formLevel(scratch.forms[form_of[id]], cap);
+            // A form asking for more than max_segments segments gets that many: the tolerance is
+            // not met there, counted as the depth limit is.
+            if (n == cap && formLevel(scratch.forms[form_of[id]], kNoCap) > cap) r_limited[t.src] = 1;
             estimate += double(n) * double(n);
             for (int c = 0; c < 3; ++c) count[t.edge[c]] = std::max(count[t.edge[c]], n - 1);
         };
@@ -1054,8 +1110,10 @@ struct FrameBuilder {
                 sc[k] = r_terms[v].s;
                 xc[k] = r_terms[v].xm;
             }
-            const double bound = pieceBound(c, sc, xc).bound;
-            if (bound > settings.tolerance) {
+            const ChordError ce = pieceBound(c, sc, xc);
+            const double bound = ce.bound;
+            if (bound > settings.tolerance &&
+                !(ce.quadratic <= settings.tolerance && passesByForm(sc[0], sc[1], sc[2]))) {
                 failing.push_back(f);
                 // About bound / T pieces once halved down to T (the error falls about as the area).
                 expected_pieces += std::min(bound / settings.tolerance, 1e6);

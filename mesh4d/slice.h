@@ -23,7 +23,9 @@
 //     c of its midpoint bubble from the Hessian of the delay at the edge's middle, with a
 //     fourth-order remainder (edgeBubble: one square root for that middle, no cut), and per
 //     triangle the largest value of the quadratic form those c give plus a third-order term
-//     (chordErrorOfBubbles). The bound is on the whole triangle, so the measured error of a
+//     (chordErrorOfBubbles). A triangle whose bubbles pass but whose third-order term does
+//     not is passed by its whole-piece form (chord_error.h pieceForm, tighter near the camera)
+//     when that is within T. The bound is on the whole triangle, so the measured error of a
 //     refined mesh is 0.5 to 1 times T (docs/ACCURACY.md);
 //   - a triangle that fails is halved by longest-edge bisection (Rivara) in the map's own metric
 //     (edge lengths from the same Hessian: chord_error.h EdgeBubble::length), so pieces are short
@@ -43,8 +45,10 @@
 //     bisected further but filled by a template (tessellate.h): the regular grid of level n
 //     (each triangle within T by the form), stitched along its sides to the equal segments its
 //     neighbours share (each edge cut into the largest level of the pieces around it; every
-//     stitched triangle checked against the form). When such pieces would make less than half
-//     of the output, they are bisected like the rest (slice.cpp, "Templates").
+//     stitched triangle checked against the form). A template of level 8 or more is kept whole:
+//     a neighbour whose split would halve it is filled by its own template instead. When such
+//     pieces would make less than half of the output, they are bisected like the rest
+//     (slice.cpp, "Templates").
 // |F - L| bounds both one-sided distances between the output and the exact surface, so the
 // two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
 // no triangle needs refining, identical to vertex mode's. Output order: the visible input
@@ -55,9 +59,11 @@
 // appended; a templated piece gives its template's triangles in its place).
 // Cost: per output triangle of the bisection about two edge bounds, one and a fifth triangle
 // bounds, half a split (its point's square root and the slot bookkeeping) and the output; about
-// 1170 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost per
-// output triangle"), of which the two bounds' arithmetic is about 500. A templated piece costs one form and its grid: a few tens of instructions
-// per output triangle besides its share of the batched cut.
+// 1200 to 1600 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost
+// per output triangle", "Templates"), of which the two bounds' arithmetic is about 500. A
+// templated piece costs one form and its grid: a few tens of instructions per output triangle
+// besides its share of the batched cut (200 to 300 per output triangle where templates make most
+// of the output, 700 to 800 on the box 2 ls from the camera at T = 1e-4, 1e-5 x size).
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
 // grew them past 256 MiB.

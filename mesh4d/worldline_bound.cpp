@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "keyframes.h"
+
 namespace mesh4d {
 
 namespace {
@@ -19,9 +21,40 @@ struct FrameRates {
 
 bool accelerated(const Motion& m) { return norm(m.acceleration) > 0; }
 
+// A keyframed path's segments whose s-range meets [s_lo, s_hi]: first and last index.
+struct SegmentSpan {
+    size_t first, last;
+};
+SegmentSpan segmentsIn(const KeyedMotion& k, double s_lo, double s_hi) {
+    return {keyedSegment(k, s_lo), keyedSegment(k, s_hi)};
+}
+
+// Segment j of a keyframed path, as a carry in its own frame (the header): Y = P + u s + R(s) Q q.
+// rho: the corners' largest distance from the turn axis after the key's turn (a distance to a line
+// is convex, so no point of the triangle is farther).
+double turnRho(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
+    const size_t key = j == 0 ? 0 : j - 1;
+    double rho = 0;
+    if (k.rate[j] > 0)
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = rotate(k.turns[key], c[i].q);
+            rho = std::max(rho, norm(p - k.axis[j] * dot(k.axis[j], p)));
+        }
+    return rho;
+}
+FrameRates segmentRates(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
+    const double w = k.rate[j], rho = turnRho(k, j, c);
+    return {1, norm(k.velocity[j]) + w * rho, 0, w * w * rho, 0, 1, 0, w};
+}
+
 FrameRates frameRates(const Motion& m, const CornerCrossing c[3], double s_lo, double s_hi) {
     FrameRates r;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
+    if (m.keyed) {
+        const SegmentSpan span = segmentsIn(*m.keyed, s_lo, s_hi);
+        for (size_t j = span.first; j <= span.last; ++j) r.takeMax(segmentRates(*m.keyed, j, c));
+        return r;
+    }
     if (!accelerated(m)) {  // spin
         const double wn = norm(m.angular_velocity);
         double rim = 0, carried = 0;
@@ -86,7 +119,146 @@ CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Ve
     return c;
 }
 
-double secondDerivativeBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
+namespace {
+
+// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as boost.h.
+Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
+
+// Lambda of segment j's rates at corner c's exact event (the header: its own segment's is c.lambda).
+double segmentLambda(const Motion& m, const ViewSurface& view, const CornerCrossing& c, size_t j) {
+    const KeyedLocal l = keyedSegmentLocal(*m.keyed, j, c.s, c.q);
+    double dt = 1;
+    Vec3 dx = l.dy;
+    if (m.kinematics == Kinematics::Lorentz) {
+        dt = m.gamma * (1 + dot(m.velocity, l.dy));
+        dx = l.dy + stretch(m.velocity, m.gamma, l.dy) + m.velocity * m.gamma;
+    }
+    if (view.kind != ViewKind::PastCone) return dt;
+    return dt + (c.rho > 0 ? dot(c.event.x - view.apex, dx) / c.rho : -norm(dx));
+}
+
+// The least Lambda of every segment meeting [s_lo, s_hi] at the three corners.
+double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossing c[3], double s_lo, double s_hi) {
+    const SegmentSpan span = segmentsIn(*m.keyed, s_lo, s_hi);
+    double out = INFINITY;
+    for (size_t j = span.first; j <= span.last; ++j)
+        for (int i = 0; i < 3; ++i) out = std::min(out, segmentLambda(m, view, c[i], j));
+    return out;
+}
+
+// The lab rate (t_s, x_s) of a keyframed path over the segments meeting [s_lo, s_hi] (header): per
+// segment the boost of (1, u) exactly plus the turn's part (0, w x R Q q) by its magnitude w rho,
+// so a segment at rest in the lab has |x_s| = 0 but for its turn.
+LabPair keyedFirstRates(const CornerCrossing c[3], const Motion& m, double s_lo, double s_hi) {
+    const double nu = m.kinematics == Kinematics::Lorentz ? m.beta : 0.0;  // the c part at its worst
+    const KeyedMotion& k = *m.keyed;
+    const bool lorentz = m.kinematics == Kinematics::Lorentz;
+    const SegmentSpan span = segmentsIn(k, s_lo, s_hi);
+    LabPair out{0, 0, 0};
+    for (size_t j = span.first; j <= span.last; ++j) {
+        const Vec3& u = k.velocity[j];
+        const double tt = lorentz ? m.gamma * (1 + dot(m.velocity, u)) : 1.0;
+        const double xt = norm(lorentz ? u + stretch(m.velocity, m.gamma, u) + m.velocity * m.gamma : u);
+        const LabPair turn = toLab(m, nu, 0, k.rate[j] * turnRho(k, j, c));
+        out.t = std::max(out.t, tt + turn.t);
+        out.x = std::max(out.x, xt + turn.x);
+        out.c = std::max(out.c, tt + xt + turn.c);
+    }
+    return out;
+}
+
+// Whether the curve sigma = s_i may meet the triangle (header): the sign of
+// g(s_i, q) = t_c - t - |x - C| (t_c - t on a hyperplane) at the corners' events at s_i. t and x are
+// affine in q at a fixed s, so g is concave (affine on a hyperplane): corners all inside the cone
+// (g > 0) keep the whole triangle inside; corners all outside keep it outside when one corner's
+// tangent plane, g_a - (t_b - t_a) - n_a.(x_b - x_a) at the corners b, lies below 0 (a concave
+// function lies below its tangent planes; affine: the corners decide). Near 0 counts as crossing.
+bool keyMayCross(const Motion& m, const ViewSurface& view, size_t i, const CornerCrossing c[3]) {
+    const bool cone = view.kind == ViewKind::PastCone;
+    const double s = m.keyed->s[i];
+    Event e[3];
+    double g[3], scale = 1;
+    for (int k = 0; k < 3; ++k) {
+        e[k] = worldlineEvent(m, s, c[k].q);
+        g[k] = view.t_c - e[k].t - (cone ? norm(e[k].x - view.apex) : 0.0);
+        scale = std::max(scale, std::fabs(view.t_c - e[k].t));
+    }
+    const double tiny = 1e-12 * scale;
+    if (g[0] > tiny && g[1] > tiny && g[2] > tiny) return false;
+    if (!(g[0] < -tiny && g[1] < -tiny && g[2] < -tiny)) return true;
+    if (!cone) return false;
+    for (int a = 0; a < 3; ++a) {
+        const Vec3 d = e[a].x - view.apex;
+        const double r = norm(d);
+        if (!(r > 0)) continue;
+        bool below = true;
+        for (int b = 0; b < 3 && below; ++b)
+            below = g[a] - (e[b].t - e[a].t) - dot(d, e[b].x - e[a].x) / r < -tiny;
+        if (below) return false;
+    }
+    return true;
+}
+
+// The kink's size per unit length at key i over the triangle (header): j(q) = |c(q)| D(q) at q's
+// event at s_i, exact at the corners, carried over the triangle by its Lipschitz bound. INFINITY
+// when the carried bounds do not close (the triangle may reach the camera or a Lambda 0).
+double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const CornerCrossing c[3], double d) {
+    const KeyedMotion& k = *m.keyed;
+    const bool cone = view.kind == ViewKind::PastCone, lorentz = m.kinematics == Kinematics::Lorentz;
+    const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
+    const Vec3 V = lorentz ? m.velocity : Vec3{0, 0, 0};
+    const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
+    auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
+    auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
+    double rho_min = INFINITY, j_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0, lam_min = INFINITY;
+    for (int q = 0; q < 3; ++q) {
+        const Event e = worldlineEvent(m, s, c[q].q);
+        Vec3 n{0, 0, 0};
+        if (cone) {
+            const Vec3 r = e.x - view.apex;
+            const double rho = norm(r);
+            if (!(rho > 0)) return INFINITY;
+            rho_min = std::min(rho_min, rho);
+            n = r / rho;
+        }
+        const Vec3 dya = keyedSegmentLocal(k, i, s, c[q].q).dy, dyb = keyedSegmentLocal(k, i + 1, s, c[q].q).dy;
+        const double ta = labT(dya), tb = labT(dyb);
+        const Vec3 xa = labX(dya), xb = labX(dyb);
+        const double la = ta + dot(n, xa), lb = tb + dot(n, xb);
+        if (!(la > 0) || !(lb > 0)) return INFINITY;
+        const double D = norm(xb / lb - xa / la) + shear_speed * std::fabs(tb / lb - ta / la);
+        // c = t_q + x_q^T n, up to the key's turn Q_i (a rotation): g V + n + g^2/(g + 1) (V.n) V
+        // (Lorentz; its n-part is n itself for the carry), g V on a hyperplane (0 for the carry).
+        const Vec3 cv = cone ? V * g + n + V * (g * g / (g + 1) * dot(V, n)) : V * g;
+        j_min = std::min(j_min, norm(cv) * D);
+        D_max = std::max(D_max, D);
+        c_max = std::max(c_max, norm(cv));
+        x_max = std::max({x_max, norm(xa), norm(xb)});
+        t_max = std::max({t_max, ta, tb});
+        lam_min = std::min({lam_min, la, lb});
+    }
+    // Over the triangle: |x_q| <= g, so |x - C| >= rho_min - g d and n turns at most g / rho_lo per
+    // unit length; c's n-part at most g times that; (t_s, x_s) move at most (g b w, g w) (the turn's
+    // spread, boosted); Lambda = t_s + n.x_s then at most L_lam; D's two quotients x_s / Lambda at
+    // most g w / lam_lo + X L_lam / lam_lo^2 each (t_s / Lambda likewise).
+    const double rho_lo = cone ? rho_min - g * d : INFINITY;
+    if (!(rho_lo > 0)) return INFINITY;
+    const double dn = cone ? g / rho_lo : 0.0;
+    const double X = x_max + g * w * d, Tm = t_max + g * b * w * d;
+    const double L_lam = g * b * w + g * w + X * dn;
+    const double lam_lo = lam_min - L_lam * d;
+    if (!(lam_lo > 0)) return INFINITY;
+    const double L_D = 2 * (g * w / lam_lo + X * L_lam / (lam_lo * lam_lo)) +
+                       shear_speed * 2 * (g * b * w / lam_lo + Tm * L_lam / (lam_lo * lam_lo));
+    const double L_c = g * dn;
+    const double j = j_min + (L_c * (D_max + L_D * d) + (c_max + L_c * d) * L_D) * d;
+    return j == j ? j : INFINITY;
+}
+
+}  // namespace
+
+PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
+    const PieceBound none;
     const bool cone = view.kind == ViewKind::PastCone;
     double d2 = 0;
     for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
@@ -98,8 +270,9 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
         s_lo = std::min(s_lo, c[i].s);
         s_hi = std::max(s_hi, c[i].s);
     }
-    if (!(lam_c > 0) || (cone && !(rho_c > 0))) return INFINITY;
-    const bool windowed = accelerated(m);
+    if (!(lam_c > 0) || (cone && !(rho_c > 0))) return none;
+    if (m.keyed && !(std::isfinite(s_lo) && std::isfinite(s_hi))) return none;  // no window of segments
+    const bool windowed = accelerated(m) || m.keyed;
     // v.n at the corners (the Doppler factor of the boost, header): the guess nu starts a hundredth
     // of the way from their largest to b.
     const double b = m.kinematics == Kinematics::Lorentz ? m.beta : 0.0;
@@ -107,12 +280,34 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
     if (cone)
         for (int i = 0; i < 3; ++i) nu_c = std::max(nu_c, dot(m.velocity, c[i].event.x - view.apex) / c[i].rho);
     double nu = std::min(b, nu_c + 0.01 * (b - nu_c));
-    double lam_min = 0.9 * lam_c;
     double spread = std::max(s_hi - s_lo, 1e-300);  // the window's margin about the corners' s
+    if (m.keyed) lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+    if (!(lam_c > 0)) return none;
+    double lam_min = 0.9 * lam_c;
+    // A keyframed path's rates depend on the window only through the segments it meets: taken
+    // again when those change.
+    SegmentSpan held{1, 0};
+    FrameRates keyed_f;
+    LabPair keyed_s1{0, 0, 0};
     for (int iter = 0; iter < 24; ++iter) {
-        const FrameRates f = frameRates(m, c, s_lo - spread, s_hi + spread);
-        const LabPair s1 = toLab(m, nu, f.Ts, f.Ys), ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq),
-                      sq = toLab(m, nu, f.Tsq, f.Ysq);
+        FrameRates f;
+        LabPair s1;
+        if (m.keyed) {  // every segment the window meets, at every corner (header)
+            const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
+            if (span.first != held.first || span.last != held.last) {
+                keyed_f = frameRates(m, c, s_lo - spread, s_hi + spread);
+                lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+                keyed_s1 = keyedFirstRates(c, m, s_lo - spread, s_hi + spread);  // its .c is not used
+                held = span;
+            }
+            if (!(lam_c > 0)) return none;
+            f = keyed_f;
+            s1 = keyed_s1;
+        } else {
+            f = frameRates(m, c, s_lo - spread, s_hi + spread);
+            s1 = toLab(m, nu, f.Ts, f.Ys);
+        }
+        const LabPair ss = toLab(m, nu, f.Tss, f.Yss), q1 = toLab(m, nu, f.Tq, f.Yq), sq = toLab(m, nu, f.Tsq, f.Ysq);
         const double cq = cone ? q1.c : q1.t;
         const double G = cq / lam_min;  // |sigma'| per |u|
         const double LF = s1.x * G + q1.x;
@@ -120,7 +315,7 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
         bool nu_holds = true;
         if (cone) {
             const double r = rho_c - LF * d;
-            if (!(r > 0)) return INFINITY;  // the triangle may reach the camera (a smaller one may not)
+            if (!(r > 0)) return none;  // the triangle may reach the camera (a smaller one may not)
             rho_min = r * (1 - 1e-9);
             L_lambda = ss.c * G + sq.c + s1.x * LF / rho_min;
             // n turns by at most L_F d / rho_min over the triangle.
@@ -137,7 +332,20 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
             const double xdd = s1.x * S2 + ss.x * G * G + 2 * sq.x * G;
             const double tdd = s1.t * S2 + ss.t * G * G + 2 * sq.t * G;
             const double K = xdd + shear_speed * tdd;
-            return K == K ? K : INFINITY;
+            PieceBound out;
+            out.K = K == K ? K : INFINITY;
+            if (m.keyed) {
+                // The kinks (header): m_i j_i for each key in the window whose curve may meet the
+                // triangle.
+                const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
+                double kinks = 0;
+                for (size_t i = span.first; i < span.last; ++i) {
+                    if (!keyMayCross(m, view, i, c)) continue;
+                    kinks += (cone ? 2 : 1) * keyKink(m, view, shear_speed, i, c, d);
+                }
+                out.kinks = kinks == kinks ? kinks : INFINITY;
+            }
+            return out;
         }
         if (!lam_holds) {  // toward the fixed point lam_min = lam_c - L_lambda(lam_min) d
             const double next = lam_c - 1.05 * L_lambda * d;
@@ -146,7 +354,7 @@ double secondDerivativeBound(const Motion& m, const ViewSurface& view, double sh
         if (!window_holds) spread = 2 * G * d;
         if (!(lam_min > 0) || !std::isfinite(spread)) break;
     }
-    return INFINITY;
+    return none;
 }
 
 }  // namespace mesh4d

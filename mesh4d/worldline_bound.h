@@ -1,5 +1,6 @@
 // A bound on the second derivative of the apparent-point map of a motion that is not uniform
-// (worldline.h: spin, rolling, Born-rigid acceleration), over one rest triangle: what the
+// (worldline.h: spin, rolling, Born-rigid acceleration, keyframed paths with the kinks where the
+// emission time crosses a key, below), over one rest triangle: what the
 // tolerance mode of these motions (worldline_refine.h) bounds its chords by.
 //
 // The map. Rest point q's worldline is the event E(s, q) = (t(s, q), x(s, q)) at the object's
@@ -64,6 +65,55 @@
 // The use: for the linear interpolant L of F on a triangle with exact corners, and any point
 // p = sum l_i q_i, Taylor's theorem with integral remainder from p to each corner gives
 // |F(p) - L(p)| <= (K / 2) sum_i l_i |q_i - p|^2 = (K / 2) sum_{i<j} l_i l_j |q_i - q_j|^2 <= K d^2 / 6.
+//
+// Keyframed paths (keyframes.h). Within one key segment the path is, in its own frame (F_V for
+// relativistic and contracted, the lab for finite and instant), Y(s) = P_k + u (s - s_k) + R(s) Q_k q:
+// a straight carry at the segment's velocity u plus a turn at the constant rate w about a fixed axis
+// (slerp). At a fixed s that is affine in q, and its rates are those of the Galilean carry of a spin
+// above, taken in the path's own frame: (T, Y)_s = (1, u + w x R Q q) <= (1, |u| + w rho),
+// (T, Y)_ss <= (0, w^2 rho), (T, Y)_q <= (0, 1), (T, Y)_sq <= (0, w), rho the corners' largest
+// distance from the axis after Q_k (convex, so the triangle's). Relativistic and contracted then
+// boost that frame's events to the lab with V about (t0, X0): the same boost as the spin's, so
+// "into the lab" above applies unchanged (g, b those of V); finite and instant carry in the lab
+// (g = 1, b = 0). So a piece whose emission times all lie in one segment has the bound above with
+// that segment's rates. The window of s ([s_lo - spread, s_hi + spread], checked like an
+// acceleration's: sigma within G d of the corners') may meet several segments; every rate is then
+// the largest over them, and Lambda is bounded per segment: Lambda_j(q), the cone's combination of
+// segment j's rates (its motion extended past its keys, keyframes.h keyedSegmentLocal) at q's
+// exact event, is computed at the corners for every segment j in the window and is Lipschitz with
+// the L_Lambda above (its derivative along a line is (t_ss + n.x_ss)_j sigma' + (t_sq + n.x_sq)_j u
+// + x_s,j . n', each term bounded as there), so the bootstrap above bounds every Lambda_j, hence
+// the true Lambda (the active segment's) below by Lambda_min. Between kinks along any line F is C2
+// with that K.
+// Across a key time s_i the map is continuous (the worldlines are), but its gradient jumps on the
+// curve Gamma_i = {q : sigma(q) = s_i} = {q : g(s_i, q) = 0}. There x_q and t_q agree on both sides
+// (the pose at s_i), so with c_q = t_q + n.x_q (t_q on a hyperplane) and sigma'_pm = -c_q u / Lambda_pm,
+//     [grad F] u = -(c_q u) (x_s+ / Lambda+ - x_s- / Lambda-),
+//     x_s+ Lambda- - x_s- Lambda+ = dx Lambda- - x_s- (dt + n.dx)   ((dt, dx) = the jump of (t_s, x_s)),
+// so |[grad F] u| <= j(q) |u|, j(q) = |c(q)| D(q), D = |x_s+ / Lambda+ - x_s- / Lambda-| (plus the finite
+// model's shear times the same for t_s), all at q's event at s_i, which is affine in q whether or
+// not q lies on Gamma_i (keyKink): c = Q_i^T (g V + n + g^2/(g + 1)(V.n) V) (Lorentz; n for the
+// carry; g V, or 0, on a hyperplane) and (t_s, x_s)+- the two segments' rates there, boosted.
+// j is computed exactly at the three corners and carried over the triangle by its Lipschitz bound:
+// |x_q| <= g, so rho >= rho_min - g d and n turns at most g / rho per unit length; c's n-part moves
+// at most g times that; (t_s, x_s) at most (g b w, g w) (w the faster turn rate); so Lambda at most
+// L = g b w + g w + X g / rho (X the largest |x_s|, carried likewise), each quotient x_s / Lambda at
+// most g w / Lambda_lo + X L / Lambda_lo^2 (Lambda_lo = the corners' least minus L d); then
+// j <= min_k j(q_k) + (L_c D_max + c_max L_D) d. A key's curve counts only where it may meet the
+// triangle (keyMayCross): g(s_i, q) is concave in q (affine on a hyperplane), so corners inside
+// the cone keep the triangle inside, and corners outside keep it outside when a corner's tangent
+// plane is negative at all three.
+// Along the line from p to a corner q_l, f(1) - f(0) - f'(0) is the integral remainder of the C2
+// parts plus, for each crossing c of a Gamma_i, the kink [f'] times
+// the rest of the way, |q_l - c|; at fixed s_i, t and x are affine in q, so on a line
+// t_c - t = |x - C| squares to a quadratic: a line meets Gamma_i at most m_i = 2 times (once on a
+// hyperplane, t_c - t linear; a line lying in Gamma_i kinks only at its ends). With
+// sum_l l_l |q_l - p| <= sqrt(sum_l l_l |q_l - p|^2) <= d / sqrt(3):
+//     |F(p) - L(p)| <= K d^2 / 6 + (sum_i m_i j_i) d / sqrt(3),
+// the sum over the keys in the window whose curve may meet the triangle. The kink term is linear in d: a piece that
+// straddles a key passes once it is about T / (m j) wide, so refinement concentrates where the
+// emission time crosses a key, and a sampled CUBICSPLINE path (many keys, each with a small jump)
+// pays for the sum of its small jumps, about its velocity change over the window, not for the count.
 // For uniform motion (no curvature terms) K is the light delay's Hessian term of chord_error.h,
 // looser by the worst angles taken separately (G, L_F); worldline_refine.h therefore measures the
 // error at a sub-grid of exact points and uses K only for what lies between them.
@@ -89,9 +139,17 @@ struct CornerCrossing {
 // ok = false when the search failed (NaN or infinite input).
 CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Vec3& q, bool* ok);
 
-// K above for the rest triangle with these corners (INFINITY when no bound holds: a triangle that
-// may reach the camera, or too large for the guesses to close). `shear_speed`: |view.shear|.
+// The bound of one rest triangle: K above (per |u|^2) and, for a keyframed path, the sum over the
+// keys its emission times may cross of m_i j_i (per unit length; 0 for the other motions), so that
+// |F - L| <= K d^2 / 6 + kinks d / sqrt(3) on the triangle, d its longest side.
+struct PieceBound {
+    double K = INFINITY;
+    double kinks = 0;
+};
+
+// The bound for the rest triangle with these corners (K = INFINITY when none holds: a triangle
+// that may reach the camera, or too large for the guesses to close). `shear_speed`: |view.shear|.
 // Precondition: the motion is not uniform and every corner's worldline is timelike.
-double secondDerivativeBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]);
+PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]);
 
 }  // namespace mesh4d

@@ -5,6 +5,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "key_split.h"
 #include "worldline.h"
 #include "worldline_bound.h"
 
@@ -95,7 +96,8 @@ struct Refiner {
     bool piecePasses(const CornerCrossing c[3], const Placement& at_grid) {
         double d2 = 0;
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
-        if (secondDerivativeBound(m, view, shear, c) * d2 / 6 <= T) return true;
+        const PieceBound whole = pieceBound(m, view, shear, c);
+        if (whole.K * d2 / 6 + whole.kinks * std::sqrt(d2 / 3) <= T) return true;
         const Vec3 F[3] = {image(c[0]), image(c[1]), image(c[2])};
         std::vector<CornerCrossing> g, coarse;
         double eps = 0;  // measured at the points of every sub-grid so far (each holds the one before)
@@ -125,15 +127,19 @@ struct Refiner {
                 }
             if (!(eps <= T)) return false;  // measured over: no finer sub-grid can pass it
             // What lies between: each sub-piece's own bound K (its corners exact, its side d / sub).
-            const double scale = d2 / (6.0 * sub * sub);
+            const double scale = d2 / (6.0 * sub * sub), width = std::sqrt(d2 / 3) / sub;
             double rem = 0;
+            auto bound = [&](const CornerCrossing piece[3]) {
+                const PieceBound pb = pieceBound(m, view, shear, piece);
+                return pb.K * scale + pb.kinks * width;
+            };
             for (int b = 0; b < sub && eps + rem <= T; ++b)
                 for (int a = 0; a + b < sub && eps + rem <= T; ++a) {
                     const CornerCrossing up[3] = {at(a, b), at(a + 1, b), at(a, b + 1)};
-                    rem = std::max(rem, secondDerivativeBound(m, view, shear, up) * scale);
+                    rem = std::max(rem, bound(up));
                     if (a + b + 1 < sub) {
                         const CornerCrossing down[3] = {at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)};
-                        rem = std::max(rem, secondDerivativeBound(m, view, shear, down) * scale);
+                        rem = std::max(rem, bound(down));
                     }
                 }
             if (eps + rem <= T) return true;
@@ -437,8 +443,23 @@ struct Refiner {
 }  // namespace
 
 ApparentMesh refineWorldlines(const World4D& world, const ViewSurface& view, const SliceSettings& settings) {
-    Refiner r(world, view, settings);
-    return r.run();
+    if (!world.motion.keyed) {
+        Refiner r(world, view, settings);
+        return r.run();
+    }
+    // A keyframed path: split along the keys' curves first (key_split.h), then the grids on the
+    // split mesh; its triangles report the input triangle they lie in.
+    KeySplit split = splitAlongKeys(world, view, settings);
+    const World4D fine = extrude(std::move(split.mesh), world.motion, world.tau_a, world.tau_b, false, false);
+    Refiner r(fine, view, settings);
+    ApparentMesh out = r.run();
+    std::vector<uint32_t> count(world.mesh.triangles.size(), 0);
+    for (uint32_t& f : out.source_triangles) ++count[f = split.source[f]];
+    for (size_t f = 0; f < fine.mesh.triangles.size(); ++f) split.limited[split.source[f]] |= r.limited[f];
+    out.refined_triangles = size_t(std::count_if(count.begin(), count.end(), [](uint32_t c) { return c > 1; }));
+    out.limited_triangles = size_t(std::count(split.limited.begin(), split.limited.end(), uint8_t(1)));
+    out.over_budget = out.over_budget || split.over_budget;
+    return out;
 }
 
 }  // namespace mesh4d

@@ -1,20 +1,22 @@
 // Tolerance mode for motions that are not uniform (worldline.h: spinning, rolling, Born-rigid
-// accelerated bodies): the cut of slice.h refined until the straight output lies within T of the
-// exact apparent surface, both ways.
+// accelerated bodies, keyframed paths): the cut of slice.h refined until the straight output lies
+// within T of the exact apparent surface, both ways.
 //
 // The scheme. Each mesh triangle gets a level n, a power of two (1 = the triangle itself): it is
 // cut into the n x n grid of its barycentric coordinates (n^2 pieces), every grid point the exact
 // crossing of its worldline (crossWorldline). A piece passes when
-//     K d^2 / 6 <= T   (K the bound of worldline_bound.h on the map's second derivative over the
-//                       piece, d its longest rest side: no further cut), or, for the first m in
+//     B(d) = K d^2 / 6 + J d / sqrt(3) <= T   (K and J the bounds of worldline_bound.h pieceBound
+//                       over the piece: the map's second derivative, and the kinks where a keyframed
+//                       path's emission time crosses a key, J = 0 for the other motions; d the
+//                       piece's longest rest side: no further cut), or, for the first m in
 //                       2, 4, 8, 16 where it holds,
-//     eps + max_k K_k (d / m)^2 / 6 <= T,
+//     eps + max_k B_k(d / m) <= T,
 // eps the largest measured |F - L| at the points of the piece's m x m sub-grid (exact crossings
-// against the piece's linear interpolant L), K_k the bound over sub-piece k from its own exact
-// corners. Sound: e = F - L has the second derivative of F, so on sub-piece k, e lies within
-// K_k (d / m)^2 / 6 of its linear interpolant there, whose largest value is at the sub-grid points
-// (worldline_bound.h gives the Taylor argument); so |F - L| <= eps + max_k K_k (d / m)^2 / 6 on the
-// whole piece. A piece with eps > T fails at once (that is a measured error). The measured term is
+// against the piece's linear interpolant L), B_k the bound over sub-piece k from its own exact
+// corners. Sound: e = F - L has the second derivative and the kinks of F, so on sub-piece k, e lies
+// within B_k(d / m) of its linear interpolant there, whose largest value is at the sub-grid points
+// (worldline_bound.h gives the Taylor argument, kinks included); so |F - L| <= eps + max_k B_k(d / m)
+// on the whole piece. A piece with eps > T fails at once (that is a measured error). The measured term is
 // what makes the bound tight (K takes the worst angles separately; eps does not), and the sub-pieces'
 // own K (their Doppler term carried over a short distance only) what keeps K finite.
 // A triangle's level doubles until all its pieces pass, at most to SliceSettings::max_segments
@@ -28,6 +30,10 @@
 // more exact point). Each fan triangle is tested as a piece (above); when one fails, its mesh
 // triangle's level doubles and the edge levels are taken again, until nothing changes (levels only
 // grow, so this ends).
+// A keyframed path's rest mesh is first split along the curves where the emission time crosses a
+// key (key_split.h); the grids run on the split mesh, and its output triangles name the input
+// triangle they lie in (source_triangles; refined_triangles and limited_triangles count input
+// triangles).
 // Preconditions (slice.cpp's hook): not isUniform(world.motion), tolerance > 0, no real cap (an
 // object that begins or ends existing is refused a tolerance by the callers, pipeline/physics.cpp:
 // the cap's clip curve is not bounded here), world not empty.

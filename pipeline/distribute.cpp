@@ -139,6 +139,7 @@ bool shareFrameSpills(const std::string& dir, std::string* why) {
         return false;
     }
     installFrameSpill(fd, group.rank());
+    setFrameRunToken(token);
     if (group.rank() == 0)
         setFramePlacer([](const std::string& path, const std::vector<Placement>& placements, std::string* e) {
             return frameGroup().placeOnRanks(path, placements, e);

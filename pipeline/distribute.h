@@ -21,7 +21,9 @@
 // sends END(code) to every rank and then drains each rank's messages up to its DONE (which
 // unblocks a rank stuck in a send). Each part of a frame is received straight into the string
 // that keeps it (a sink's bytes are moved, never copied, into the EncodedFrame).
-// Frames by reference (shareFrameSpills below, the .glb only): a FRAME then holds the frame's
+// PLY and OBJ frames with shareFrameSpills: the rank writes the frame's file under a temporary name
+// just before sending it, the FRAME holds its size (exporters/frame_files.h), rank 0 renames it.
+// Frames by reference (shareFrameSpills below, the .glb): a FRAME then holds the frame's
 // description, its data being in the sending rank's frame spill; when rank 0 assembles the .glb it
 // sends each rank concerned PLACE (the temporary file's name and where each of the rank's ranges
 // goes), which the rank, between its DONE and END, answers with PLACED (its status) after copying
@@ -111,13 +113,14 @@ public:
 
 // Frames by reference (exporters/frame_spill.h), set up once per run before the frame loops: every
 // rank creates its frame spill in `dir` (".apparent-frames-TOKEN.RANK", TOKEN random, broadcast by
-// rank 0), rank 0 opens every rank's file by name and then unlinks every name, so that nothing is
-// left behind from here on whatever ends the job. True on every rank when every spill is in place:
+// rank 0, then frameRunToken()), rank 0 opens every rank's file by name and then unlinks every
+// name, so that nothing is left behind from here on whatever ends the job. True on every rank when every spill is in place:
 // a rank's .glb frames then travel as descriptions, their data written by the rank that cut them
 // and, when rank 0 assembles the file, copied into it by that rank (placeOnRanks, installed here
-// as rank 0's frame placer). False on every rank, the reason in `why` on rank
-// 0, when a rank cannot create its file or rank 0 cannot see it (the folder is not on a file system
-// every rank shares): the frames then travel whole, as to a writer without spills. Collective.
+// as rank 0's frame placer); its PLY and OBJ files are written by the rank, renamed by rank 0.
+// False on every rank, the reason in `why` on rank 0, when a rank cannot create its file or rank 0
+// cannot see it (the folder is not on a file system every rank shares): the frames then travel
+// whole, as to a writer without spills. Collective.
 bool shareFrameSpills(const std::string& dir, std::string* why);
 
 // The group of this process (single until setFrameGroup installs another).

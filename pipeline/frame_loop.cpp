@@ -145,6 +145,9 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     const bool sender = settings.distributed && group.rank() > 0;
     const bool receiver = settings.distributed && group.rank() == 0 && group.size() > 1;
     const FrameSplit split = settings.split;
+    // Every other rank may make its first frame as soon as it has its worlds (FrameSink::expectEncoded).
+    for (long long k = first + 1; receiver && k < std::min(last_excl, first + group.size()); ++k)
+        for (FrameSink* sink : sinks) sink->expectEncoded(k);
     // Step: the static 4D worlds and the mirrors' reflections, once per model.
     const std::vector<mesh4d::World4D> worlds = take && stage.mirrors.empty()
                                                     ? takeWorlds(take, model, scene, first, last_excl - 1)
@@ -154,7 +157,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     reflections.describe(&info);
     for (FrameSink* sink : sinks)
         if (!(sender ? sink->beginEncoding(info, error) : sink->begin(info, error))) {
-            if (receiver) group.endFrames(kExitOutputError);
+            if (receiver) {
+                group.endFrames(kExitOutputError);
+                for (FrameSink* other : sinks) other->dropEncoded(first, last_excl);
+            }
             return false;
         }
 
@@ -341,6 +347,9 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
                 stop = true;
                 return;
             }
+            // The rank may now make its next frame (FrameSink::expectEncoded).
+            if (remote_next + group.size() < last_excl)
+                for (FrameSink* sink : sinks) sink->expectEncoded(remote_next + group.size());
             w->frame.index = remote_next;
             w->over_budget = w->encoded->over_budget;
             deliver(std::move(w));
@@ -350,6 +359,8 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     auto inOrder = [&](WorkPtr w) {
         if (sender) {
             if (stop || (stop = group.stopRequested())) return;
+            for (size_t s = 0; s < w->encoded->sinks.size(); ++s)
+                sinks[s]->beforeSending(w->frame.index, &w->encoded->sinks[s]);
             const std::string header = frameHeader(*w->encoded);
             group.sendParts(frameParts(*w->encoded, header));
             return;
@@ -397,7 +408,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     }
     // Rank 0 with MPI: tell the other ranks how this loop ended (after the sinks are done).
     auto fail = [&](int code) {
-        if (receiver) group.endFrames(code);
+        if (receiver) {
+            group.endFrames(code);
+            for (FrameSink* sink : sinks) sink->dropEncoded(first, last_excl);
+        }
         result->group_code = code;
         return false;
     };

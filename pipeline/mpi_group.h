@@ -8,7 +8,8 @@
 //   duplicate of MPI_COMM_WORLD, frames over 1 GiB in several messages). The .glb's frame data
 //   stays with the rank that made it when rank 0 can open every rank's frame spill in the output
 //   folder (shareFrameSpills): rank 0 takes the frames' descriptions and each rank copies its own
-//   data into the file at the end.
+//   data into the file at the end; PLY and OBJ files are written by their ranks and renamed into
+//   place by rank 0 (exporters/frame_files.h).
 // - `raytrace`: the same split; rank r traces its frames and sends each picture to rank 0, which
 //   writes the PNG files and the video in frame order.
 // - `figure`: the same split over its pictures (the sheet's panels, row by row; or the video's

@@ -37,18 +37,38 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     return m;
 }
 
+// A tolerance is bounded for the motions beyond uniform (mesh4d/worldline_refine.h), but not the
+// clip curve where the object begins or ends existing within the frames (a real cap of its world),
+// nor the reflections of such an object (pipeline/mirror.h: their worlds may have real caps where
+// the object's own has none, and would be cut in vertex mode). `field` names the object's field,
+// `what` the object ("a spinning object"). Call once every vertex is known to have a worldline.
+static Status checkMotionTolerance(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
+                                   long long first_frame, long long last_frame, const std::string& field,
+                                   const std::string& what) {
+    const ObjectSpec& s = object.spec;
+    if (tolerance > 0 && std::any_of(scene.objects.begin(), scene.objects.end(), [](const ObjectSpec& o) { return o.mirror; }))
+        return Status::failure(field + what + " seen in a mirror is cut in vertex mode only: give --tolerance vertex "
+                                          "(or the scene's \"tolerance\": \"vertex\")");
+    if (!(tolerance > 0) || (!std::isfinite(s.exists_from) && !std::isfinite(s.exists_to))) return Status::success();
+    const mesh4d::World4D w = buildWorld(object, model, scene, first_frame, last_frame);
+    if (!w.cap_a_real && !w.cap_b_real) return Status::success();
+    return Status::failure(field + what + " that begins or ends existing (exists) is cut in vertex mode only: "
+                                      "give --tolerance vertex (or the scene's \"tolerance\": \"vertex\")");
+}
+
 // A keyframed path's needs (physics.h).
-static Status checkKeyedMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance) {
+static Status checkKeyedMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
+                               long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
     const std::string field = scene.path + ": " + s.keys_field + ": ";
     if (mesh4d::norm(s.angular_velocity) != 0 || mesh4d::norm(s.acceleration) != 0)
         return Status::failure(field + "a keyframed path with angular_velocity or acceleration is not modelled (give one)");
     if (cameraMotionOf(scene).moving())
         return Status::failure(field + "a keyframed object needs a camera at rest (camera.velocity is not [0, 0, 0])");
-    if (tolerance > 0)
-        return Status::failure(field + "a keyframed object is cut in vertex mode only: give --tolerance vertex (or the "
-                                       "scene's \"tolerance\": \"vertex\")");
-    if (model == Model::Instant) return Status::success();
+    auto tolerance_ok = [&]() {
+        return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, "a keyframed object");
+    };
+    if (model == Model::Instant) return tolerance_ok();
     // Every vertex slower than light over every segment (keyframes.h maxKeyedSpeed: the centre's
     // speed and the turn's rim speed together, closed form).
     const mesh4d::Motion m = motionOf(s, model);
@@ -60,31 +80,20 @@ static Status checkKeyedMotion(const PreparedObject& object, Model model, const 
                                    " at lab time " + formatNumber(v.lab_time) + " s, which must be < 1 (the speed of light) for model " +
                                    modelName(model));
     }
-    return Status::success();
+    return tolerance_ok();
 }
 
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
-    if (s.keys) return checkKeyedMotion(object, model, scene, tolerance);
+    if (s.keys) return checkKeyedMotion(object, model, scene, tolerance, first_frame, last_frame);
     const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
     if (!spin && !accel) return Status::success();
     const std::string field = scene.path + ": " + s.field_path + (spin ? ".angular_velocity: " : ".acceleration: ");
     const std::string what = spin ? "a spinning object" : "an accelerated object";
-    // A tolerance is bounded for these motions (mesh4d/worldline_refine.h), but not the clip curve
-    // where the object begins or ends existing within the frames (a real cap of its world); checked
-    // last, once every vertex is known to have a worldline.
-    auto tolerance_ok = [&]() -> Status {
-        // Nor the reflections of such an object (pipeline/mirror.h): their worlds may have real caps
-        // where the object's own has none, and would be cut in vertex mode.
-        if (tolerance > 0 && std::any_of(scene.objects.begin(), scene.objects.end(), [](const ObjectSpec& o) { return o.mirror; }))
-            return Status::failure(field + what + " seen in a mirror is cut in vertex mode only: give --tolerance vertex "
-                                              "(or the scene's \"tolerance\": \"vertex\")");
-        if (!(tolerance > 0) || (!std::isfinite(s.exists_from) && !std::isfinite(s.exists_to))) return Status::success();
-        const mesh4d::World4D w = buildWorld(object, model, scene, first_frame, last_frame);
-        if (!w.cap_a_real && !w.cap_b_real) return Status::success();
-        return Status::failure(field + what + " that begins or ends existing (exists) is cut in vertex mode only: "
-                                          "give --tolerance vertex (or the scene's \"tolerance\": \"vertex\")");
+    // The tolerance (checkMotionTolerance) last, once every vertex is known to have a worldline.
+    auto tolerance_ok = [&]() {
+        return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, what);
     };
     if (spin && accel)
         return Status::failure(field + "give angular_velocity or acceleration, not both (not modelled together)");
@@ -139,8 +148,8 @@ Status checkToleranceDial(const Scene& scene, const char* command) {
     for (const ObjectSpec& s : scene.objects) {
         if (s.keys)
             return Status::failure(scene.path + ": " + s.keys_field + ": `apparent " + command +
-                                   "` sweeps the tolerance, which holds for uniform motion only (keyframed objects are "
-                                   "cut in vertex mode)");
+                                   "` sweeps the tolerance over uniform motion only (its families and cost model are "
+                                   "uniform motion's)");
         const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
         if (spin || accel)
             return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +

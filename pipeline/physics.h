@@ -22,14 +22,15 @@ mesh4d::Kinematics kinematicsOf(Model model);
 mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
 
 // What an object's motion beyond uniform (angular_velocity or acceleration, mesh4d/worldline.h)
-// needs, one line naming file, field and problem when refused: not both; a camera at rest; vertex
-// mode (tolerance 0). Spin: |w| <= 1e12 rad/s, every vertex slower than light, |w x q| < 1 in the centre frame
+// needs, one line naming file, field and problem when refused: not both; a camera at rest; a
+// tolerance (mesh4d/worldline_refine.h) only for an object that exists throughout the frames (no
+// real cap) and in a scene without a mirror, else vertex mode (tolerance 0). Spin: |w| <= 1e12 rad/s, every vertex slower than light, |w x q| < 1 in the centre frame
 // (relativistic, contracted), |velocity + w x q| < 1 in the lab at every angle (finite); instant
 // has no limit. Acceleration: |a| in [1e-12, 1e12], every vertex ahead of the Born-rigid horizon
 // (q.a/|a| > -1/|a|), and the origin's rapidity at frames first_frame and last_frame within
 // kMaxRapidity (gamma 1e15, as the gamma field). A keyframed path (ObjectSpec::keys): no spin or
-// acceleration with it, a camera at rest, vertex mode, and every vertex slower than light over
-// every segment (not checked for instant), refused with the vertex, its speed and the lab time.
+// acceleration with it, a camera at rest, the tolerance as above, and every vertex slower than light
+// over every segment (not checked for instant), refused with the vertex, its speed and the lab time.
 constexpr double kMaxRapidity = 35.2;
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame);

@@ -122,10 +122,23 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
         return kExitOutputError;
     }
 
-    // Step (MPI, .glb): the ranks write their frames' data themselves when rank 0 sees their files.
+    // DIR/<model> folders of per-frame files that did not exist (seen before the ranks start: they
+    // make them too, exporters/frame_files.h)
+    std::vector<std::string> created;
+    for (Model model : stage.models) {
+        const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
+        if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
+    }
+    if (settings.sharded) {
+        const std::string shards = (std::filesystem::path(settings.out_dir) / "shards").string();
+        if (!std::filesystem::exists(shards, ec)) created.push_back(shards);
+    }
+    // Step (MPI): the ranks write their frames' data (the .glb's) and files (PLY, OBJ) themselves
+    // when rank 0 sees their files.
     const bool glb = std::find(settings.formats.begin(), settings.formats.end(), "glb") != settings.formats.end();
-    if (distributed && glb && !shareFrameSpills(settings.out_dir, &error) && !settings.quiet)
-        err << "warning: " << error << "; the .glb's frame data goes through rank 0 instead (slower)\n";
+    if (distributed && !shareFrameSpills(settings.out_dir, &error) && !settings.quiet)
+        err << "warning: " << error << "; the " << (glb ? ".glb's frame data" : "frames' files")
+            << " goes through rank 0 instead (slower)\n";
 
     // Step: per model, the frame loop into one sink per format; the budget spans the whole run.
     OutputBudget budget(settings.max_output_bytes);
@@ -139,15 +152,6 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
     loop.distributed = distributed;
     if (distributed) loop.split = FrameSplit{group.rank(), group.size()};
     if (settings.sharded) loop.split = settings.shard;
-    std::vector<std::string> created;  // DIR/<model> folders of per-frame files that did not exist
-    for (Model model : stage.models) {
-        const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
-        if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
-    }
-    if (settings.sharded) {
-        const std::string shards = (std::filesystem::path(settings.out_dir) / "shards").string();
-        if (!std::filesystem::exists(shards, ec)) created.push_back(shards);
-    }
     for (Model model : stage.models) {
         const std::string name = modelName(model);
         const std::string base = (std::filesystem::path(settings.out_dir) / name).string();

@@ -4,7 +4,9 @@
 // frames in whole, in part (one object of two: meshopt's partly shared stream) and not at all; the
 // descriptions that travel are a small fraction of the data (meshopt frames that may be morph
 // targets travel whole, and the file is the same); a description naming an unknown source is
-// refused with a message.
+// refused with a message. PLY frames written by the rank that cut them (exporters/frame_files.h)
+// are renamed into place byte-identical to frames added directly, a replaced or planted temporary
+// is refused, and what was not taken is removed.
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -17,6 +19,7 @@
 #include "exporters/atomic_file.h"
 #include "exporters/frame_spill.h"
 #include "exporters/gltf.h"
+#include "exporters/ply.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -167,4 +170,84 @@ TEST_F(FrameSpill, ADescriptionOfAnUnknownSourceIsRefused) {
     EXPECT_FALSE(writer.addEncoded(description, &error));
     EXPECT_NE(error.find("refused.glb: frame data from another process is malformed (frame 10)"), std::string::npos)
         << error;
+}
+
+// PLY frames written by the rank that cut them (exporters/frame_files.h): the rank writes the file
+// under the run's temporary name just before sending, a few bytes travel, and the writer renames
+// it into place: the same files, byte for byte, as frames added directly, and nothing else left.
+// A temporary replaced after the rank wrote it is refused; a name planted where the rank would
+// write is never written through (the rank's message reaches the writer); dropEncoded() removes
+// what was not taken.
+TEST_F(FrameSpill, FrameFilesWrittenByTheirRankAreRenamedInPlace) {
+    std::string error;
+    const SequenceInfo seq = info();
+    const fs::path direct = dir_ / "direct", ranks = dir_ / "ranks";
+    {
+        auto sink = plySink(direct.string());
+        ASSERT_TRUE(sink->begin(seq, &error)) << error;
+        for (const ExportFrame& f : frames()) {
+            std::vector<std::string> completed;
+            ASSERT_TRUE(sink->add(f, sink->prepare(f).get(), &completed, &error)) << error;
+        }
+    }
+    const int spill = openAnonymousFile(dir_.string(), &error);
+    ASSERT_GE(spill, 0) << error;
+    installFrameSpill(spill, 1);
+    setFrameRunToken("0123456789abcdef");
+    auto sink = plySink(ranks.string());
+    ASSERT_TRUE(sink->beginEncoding(seq, &error)) << error;  // the rank makes the folder it writes into
+    size_t travelled = 0;
+    for (const ExportFrame& f : frames()) {
+        EncodedOutput e = sink->encode(f, sink->prepare(f).get());
+        sink->expectEncoded(f.index);
+        sink->beforeSending(f.index, &e);
+        travelled += e.bytes.size();
+        std::vector<std::string> completed;
+        ASSERT_TRUE(sink->addEncoded(f.index, e, &completed, &error)) << error;
+        ASSERT_EQ(completed.size(), 1u);
+        EXPECT_EQ(fs::path(completed[0]).filename().string(), "frame_000" + std::to_string(f.index) + ".ply");
+    }
+    EXPECT_LT(travelled, 6u * 64u);  // 24 bytes per frame, not the frames' 40 to 80 KiB
+    size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(direct)) {
+        ++files;
+        EXPECT_TRUE(readBytes(entry.path()) == readBytes(ranks / entry.path().filename())) << entry.path();
+    }
+    EXPECT_EQ(files, 6u);
+    EXPECT_EQ(size_t(std::distance(fs::directory_iterator(ranks), fs::directory_iterator())), 6u) << "a temporary left";
+
+    // A temporary replaced between the rank's write and the rename: refused, nothing renamed.
+    ExportFrame f = frames().front();
+    f.index = 20;
+    EncodedOutput e = sink->encode(f, sink->prepare(f).get());
+    sink->expectEncoded(20);
+    sink->beforeSending(20, &e);
+    const fs::path temp = ranks / ".frame_00020.tmp-0123456789abcdef.ply";
+    ASSERT_TRUE(fs::exists(temp));
+    fs::remove(temp);
+    std::ofstream(temp) << "not the frame";
+    std::vector<std::string> completed;
+    EXPECT_FALSE(sink->addEncoded(20, e, &completed, &error));
+    EXPECT_EQ(error, (ranks / "frame_00020.ply").string() + ": the temporary file " + temp.string() +
+                         " was replaced while writing (not renamed into place)");
+    EXPECT_FALSE(fs::exists(ranks / "frame_00020.ply"));
+    // A name planted where the rank writes frame 21: not written through; the rank's line arrives.
+    const fs::path planted = ranks / ".frame_00021.tmp-0123456789abcdef.ply";
+    std::ofstream(planted) << "planted";
+    f.index = 21;
+    e = sink->encode(f, sink->prepare(f).get());
+    sink->beforeSending(21, &e);
+    EXPECT_EQ(readBytes(planted), "planted");
+    EXPECT_FALSE(sink->addEncoded(21, e, &completed, &error));
+    EXPECT_EQ(error.rfind((ranks / "frame_00021.ply").string() + ": cannot create " + planted.string() + ": ", 0), 0u)
+        << error;
+    // The run failed: what the ranks left for frames it did not take goes.
+    sink->dropEncoded(10, 30);
+    EXPECT_FALSE(fs::exists(temp));
+    EXPECT_FALSE(fs::exists(planted));
+    EXPECT_EQ(size_t(std::distance(fs::directory_iterator(ranks), fs::directory_iterator())), 6u);
+    sink.reset();
+    installFrameSpill(-1, -1);
+    setFrameRunToken("");
+    ::close(spill);
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <cstdio>
 #include <string>
@@ -216,7 +217,8 @@ TEST(Keyframes, ClockOfAMovingTurningPointIsTheIntegral) {
 
 // Faster than light anywhere is refused with the time and the speed: the centre's path (every
 // model), and a vertex carried by the turn (the box's corner at rho = 0.707 turning at 3 rad/s).
-// A keyframed object needs vertex mode; its velocity comes from the path.
+// A tolerance for a keyframed object that begins existing within the frames is refused (its clip
+// curve is not bounded); its velocity comes from the path.
 TEST(Keyframes, RefusalsNameFileFieldTimeAndSpeed) {
     std::string error;
     {
@@ -246,9 +248,12 @@ TEST(Keyframes, RefusalsNameFileFieldTimeAndSpeed) {
         KeyedGltf g;
         g.channels.push_back(translationKeys({0, 1}, {{0, 0, -8}, {0.5, 0, -8}}));
         g.scene_extras["tolerance"] = "1e-3";
+        g.object_extras = {{"t0", 0}, {"exists", {-8.0, nullptr}}};
         apparent::Stage st;
         EXPECT_FALSE(apparent::loadQuietStage(g.write(dir(), "tol"), &st, &error));
-        EXPECT_NE(error.find("tol.gltf: animations[0].channels[0]: a keyframed object is cut in vertex mode only"), std::string::npos)
+        EXPECT_NE(error.find("tol.gltf: animations[0].channels[0]: a keyframed object that begins or ends existing (exists) "
+                             "is cut in vertex mode only"),
+                  std::string::npos)
             << error;
     }
     {
@@ -379,6 +384,38 @@ TEST(Keyframes, ShippedSceneRenders) {
         for (size_t i = 0; i < 8; ++i)
             EXPECT_LE(mesh4d::norm(c.positions[k][i] - c.positions[k - 1][i]), 0.92 * std::fabs(c.times[k][i] - c.times[k - 1][i]) + 1e-12);
     }
+}
+
+// A tolerance for a keyframed object is taken (mesh4d/worldline_refine.h, key_split.h): the scene's
+// "1e-2x" loads, and the frames where the emission times cross the corner key at t = 1 s are refined
+// (more triangles than the box's 12, each on one of them), the box's output closed in every frame.
+TEST(Keyframes, ToleranceModeRefinesAcrossTheCorner) {
+    KeyedGltf g;
+    g.channels.push_back(translationKeys({0, 1, 2}, {{-0.5, 0, -8}, {0, 0, -8}, {0, 0.4, -8}}));
+    g.scene_extras["tolerance"] = "1e-2x";
+    g.scene_extras["frames"] = {{"start", 8}, {"end", 10}, {"fps", 10}};
+    apparent::Stage st;
+    std::string error;
+    ASSERT_TRUE(apparent::loadQuietStage(g.write(dir(), "keyed_tol"), &st, &error)) << error;
+    ASSERT_GT(st.tolerances[0], 0.0);
+    const mesh4d::World4D world = apparent::buildWorld(st.objects[0], Model::Relativistic, st.scene, st.first, st.last_excl - 1);
+    size_t refined = 0;
+    for (long long k = st.first; k < st.last_excl; ++k) {
+        mesh4d::SliceSettings settings;
+        settings.tolerance = st.tolerances[0];
+        const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, apparent::viewForFrame(st.scene, Model::Relativistic, k), settings);
+        refined += out.triangles.size() > 12 ? 1 : 0;
+        std::map<std::pair<uint32_t, uint32_t>, int> directed;
+        for (const auto& t : out.triangles)
+            for (int c = 0; c < 3; ++c) ++directed[{t[c], t[(c + 1) % 3]}];
+        for (const auto& [e, count] : directed) {
+            EXPECT_EQ(count, 1) << "frame " << k;
+            EXPECT_EQ(directed.count({e.second, e.first}), 1u) << "frame " << k;
+        }
+        for (uint32_t f : out.source_triangles) EXPECT_LT(f, 12u);
+        EXPECT_EQ(out.limited_triangles, 0u) << "frame " << k;
+    }
+    EXPECT_GT(refined, 0u);
 }
 
 // Keys under a turned parent are composed with the parent's transform as static values are: a

@@ -5,6 +5,7 @@
 // bisection), sharing nothing with the code under test.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -12,7 +13,9 @@
 #include <vector>
 
 #include "mesh4d/extrude.h"
+#include "mesh4d/keyframes.h"
 #include "mesh4d/slice.h"
+#include "mesh4d/worldline.h"
 #include "test_meshes.h"
 
 using mesh4d::Event;
@@ -282,5 +285,253 @@ TEST(MotionTolerance, RollingWheelSceneWithinTheTolerance) {
         expectClosed(out);
         std::printf("[ tolerance ] rolling_wheel.json t = %4.1f s, T = 1e-2 x size: err/T %.3f, 792 -> %zu triangles\n",
                     t_c, std::max(s.output_to_exact, s.exact_to_output) / settings.tolerance, out.triangles.size());
+    }
+}
+
+// ---- Keyframed paths (mesh4d/keyframes.h, the bound across keys in worldline_bound.h) ----
+
+namespace {
+
+// A keyframed path written out here: keys at lab times t_k with centres X_k and turns by angle a_k
+// about one fixed unit axis (so the turn between keys is the linear interpolation of the angle; the
+// code slerps quaternions). The object's t0 is 0 and its origin X_0 (the first key is at t = 0).
+struct TestPath {
+    std::vector<double> t;
+    std::vector<Vec3> X;
+    std::vector<double> angle;
+    Vec3 axis{0, 1, 0};
+};
+
+Vec3 turnAbout(const Vec3& k, double a, const Vec3& q) {
+    const Vec3 kxq{k.y * q.z - k.z * q.y, k.z * q.x - k.x * q.z, k.x * q.y - k.y * q.x};
+    const double kq = k.x * q.x + k.y * q.y + k.z * q.z;
+    return q * std::cos(a) + kxq * std::sin(a) + k * (kq * (1 - std::cos(a)));
+}
+
+// The boost into the frame moving at v, as a 4 x 4 matrix on (t, x, y, z).
+std::array<std::array<double, 4>, 4> boostMatrix(const Vec3& v) {
+    const double b2 = v.x * v.x + v.y * v.y + v.z * v.z, g = 1 / std::sqrt(1 - b2);
+    const double u[3] = {v.x, v.y, v.z};
+    std::array<std::array<double, 4>, 4> B{};
+    B[0][0] = g;
+    for (int i = 0; i < 3; ++i) {
+        B[0][i + 1] = B[i + 1][0] = -g * u[i];
+        for (int j = 0; j < 3; ++j) B[i + 1][j + 1] = (i == j ? 1.0 : 0.0) + (b2 > 0 ? (g - 1) * u[i] * u[j] / b2 : 0.0);
+    }
+    return B;
+}
+Event apply(const std::array<std::array<double, 4>, 4>& B, double t, const Vec3& x) {
+    const double in[4] = {t, x.x, x.y, x.z};
+    double o[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) o[i] += B[i][j] * in[j];
+    return {o[0], {o[1], o[2], o[3]}};
+}
+
+// The centre and angle at parameter u of keys (u_k, C_k, a_k), linear between, resting at the end
+// values outside ("rest" velocity `outside` per unit u: 0 in the lab, -V in the path's frame).
+void interpolate(const std::vector<double>& u, const std::vector<Vec3>& C, const std::vector<double>& a, double x,
+                 const Vec3& outside, Vec3* c, double* angle) {
+    const size_t n = u.size();
+    if (x <= u[0]) {
+        *c = C[0] + outside * (x - u[0]);
+        *angle = a[0];
+        return;
+    }
+    if (x >= u[n - 1]) {
+        *c = C[n - 1] + outside * (x - u[n - 1]);
+        *angle = a[n - 1];
+        return;
+    }
+    size_t j = 1;
+    while (u[j] < x) ++j;
+    const double f = (x - u[j - 1]) / (u[j] - u[j - 1]);
+    *c = C[j - 1] + (C[j] - C[j - 1]) * f;
+    *angle = a[j - 1] + (a[j] - a[j - 1]) * f;
+}
+
+// The true worldlines of the keyframes.h model, written independently: relativistic and contracted
+// carry the body in the frame of the mean velocity V (keys boosted there by a matrix), then back to
+// the lab; finite carries it in the lab. Parameter: that frame's time (lab time for finite).
+Worldline keyedPath(const TestPath& p, bool lorentz) {
+    const size_t n = p.t.size();
+    const Vec3 V = (p.X[n - 1] - p.X[0]) / (p.t[n - 1] - p.t[0]);
+    if (!lorentz)
+        return [=](double s, const Vec3& q) {
+            Vec3 c;
+            double a = 0;
+            interpolate(p.t, p.X, p.angle, s, {0, 0, 0}, &c, &a);
+            return Event{s, c + turnAbout(p.axis, a, q)};
+        };
+    const auto into = boostMatrix(V), back = boostMatrix(V * -1.0);
+    std::vector<double> s;
+    std::vector<Vec3> P;
+    for (size_t k = 0; k < n; ++k) {
+        const Event e = apply(into, p.t[k] - p.t[0], p.X[k] - p.X[0]);
+        s.push_back(e.t);
+        P.push_back(e.x);
+    }
+    return [=](double sv, const Vec3& q) {
+        Vec3 c;
+        double a = 0;
+        interpolate(s, P, p.angle, sv, V * -1.0, &c, &a);
+        const Event lab = apply(back, sv, c + turnAbout(p.axis, a, q));
+        return Event{p.t[0] + lab.t, p.X[0] + lab.x};
+    };
+}
+
+// The same path as the code takes it (mesh4d::KeyPath, quaternions).
+mesh4d::Motion keyedMotion(const TestPath& p, bool lorentz) {
+    mesh4d::KeyPath path;
+    path.times = p.t;
+    path.positions = p.X;
+    for (double a : p.angle)
+        path.turns.push_back({std::cos(a / 2), p.axis.x * std::sin(a / 2), p.axis.y * std::sin(a / 2), p.axis.z * std::sin(a / 2)});
+    const Vec3 V = mesh4d::meanVelocity(path);
+    mesh4d::Motion m = mesh4d::makeMotion(lorentz ? mesh4d::Kinematics::Lorentz : mesh4d::Kinematics::Galilean, p.t[0], p.X[0], V);
+    m.keyed = mesh4d::makeKeyedMotion(path, lorentz, p.t[0], p.X[0], V);
+    return m;
+}
+
+struct KeyedCase {
+    const char* name;
+    TestPath path;
+    bool lorentz;
+    bool hyperplane;
+    std::vector<double> t_c;  // frames where the emission times cross a key over the body
+};
+
+std::vector<KeyedCase> keyedCases() {
+    // keyed.gltf's path without its turn: 0.8c along +x, a corner at t = 5 s, 0.6c along +y.
+    const TestPath corner{{0, 5, 10}, {{-4, -1, -6}, {0, -1, -6}, {0, 2, -6}}, {0, 0, 0}};
+    // 0.5c along +x; the turn about y runs forward at 0.5 rad/s, then back at 0.375 rad/s from t = 4 s.
+    const TestPath turn{{0, 4, 8}, {{-2, 0, -5}, {0, 0, -5}, {2, 0, -5}}, {0, 2.0, 0.5}};
+    return {{"corner, relativistic", corner, true, false, {11.0, 16.0}},
+            {"corner, finite", corner, false, false, {11.0, 16.0}},
+            {"corner, contracted", corner, true, true, {5.0}},
+            {"turn key, relativistic", turn, true, false, {9.0}},
+            {"turn key, finite", turn, false, false, {9.0}}};
+}
+
+// The output's point of rest point q on input triangle f (rest-frame barycentrics in the output
+// triangle of that source that holds q); false when none holds it.
+bool outputAt(const mesh4d::ApparentMesh& out, const std::map<uint32_t, std::vector<size_t>>& by_source, uint32_t f,
+              const Vec3& q, Vec3* p) {
+    const auto it = by_source.find(f);
+    if (it == by_source.end()) return false;
+    for (size_t t : it->second) {
+        const auto& o = out.triangles[t];
+        const Vec3 a = out.rest_points[o[0]], e1 = out.rest_points[o[1]] - a, e2 = out.rest_points[o[2]] - a;
+        const Vec3 d = q - a;
+        const double d11 = mesh4d::dot(e1, e1), d12 = mesh4d::dot(e1, e2), d22 = mesh4d::dot(e2, e2);
+        const double det = d11 * d22 - d12 * d12;
+        const double u = (d22 * mesh4d::dot(d, e1) - d12 * mesh4d::dot(d, e2)) / det;
+        const double v = (d11 * mesh4d::dot(d, e2) - d12 * mesh4d::dot(d, e1)) / det;
+        if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
+        *p = out.absolutePosition(o[0]) * (1 - u - v) + out.absolutePosition(o[1]) * u + out.absolutePosition(o[2]) * v;
+        return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+// The independent worldlines above agree with the code's (keyframes.h, worldline.h) event for event:
+// the test's exact surface is the model's.
+TEST(MotionTolerance, KeyedTestWorldlinesAreTheModels) {
+    for (const KeyedCase& c : keyedCases()) {
+        const mesh4d::Motion m = keyedMotion(c.path, c.lorentz);
+        const Worldline exact = keyedPath(c.path, c.lorentz);
+        for (double s : {-3.0, 0.5, 2.0, 4.5, 7.0, 9.5, 14.0})
+            for (const Vec3& q : {Vec3{0.5, 0.5, 0.5}, Vec3{-0.5, 0.2, 0.5}}) {
+                const Event a = mesh4d::worldlineEvent(m, s, q), b = exact(s, q);
+                EXPECT_NEAR(a.t, b.t, 1e-12) << c.name << " s " << s;
+                EXPECT_LT(mesh4d::norm(a.x - b.x), 1e-12) << c.name << " s " << s;
+            }
+    }
+}
+
+// A path that turns a corner and one whose turn changes at a key, relativistic, finite and
+// contracted, at frames where the emission times cross a key over the box: two-sided error <= T at
+// T = 1e-2 and 1e-3 of the box's size, sampled both ways against the exact surface of the true
+// keyframed worldlines; the output of the closed box stays closed. Prints err / T, vertex mode's
+// error and the triangles.
+TEST(MotionTolerance, KeyedPathsWithinTheTolerance) {
+    const mesh4d::RestMesh mesh = box(0.5);
+    const double size = std::sqrt(3.0);
+    for (const KeyedCase& c : keyedCases()) {
+        const mesh4d::Motion m = keyedMotion(c.path, c.lorentz);
+        const Worldline exact = keyedPath(c.path, c.lorentz);
+        const mesh4d::World4D world = mesh4d::extrude(mesh, m, -1e3, 1e3, false, false);
+        plane = c.hyperplane;
+        for (double t_c : c.t_c) {
+            mesh4d::ViewSurface view;
+            view.kind = c.hyperplane ? mesh4d::ViewKind::Hyperplane : mesh4d::ViewKind::PastCone;
+            view.t_c = t_c;
+            const Sampled v = sample(mesh, mesh4d::sliceWorld(world, view), exact, t_c, view.apex);
+            for (double rel : {1e-2, 1e-3}) {
+                mesh4d::SliceSettings settings;
+                settings.tolerance = rel * size;
+                const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view, settings);
+                const Sampled s = sample(mesh, out, exact, t_c, view.apex);
+                EXPECT_LE(s.output_to_exact, settings.tolerance + 1e-11) << c.name << " t_c " << t_c << " T = " << rel;
+                EXPECT_LE(s.exact_to_output, settings.tolerance + 1e-11) << c.name << " t_c " << t_c << " T = " << rel;
+                EXPECT_EQ(out.limited_triangles, 0u) << c.name;
+                EXPECT_FALSE(out.over_budget) << c.name;
+                expectClosed(out);
+                std::printf("[ tolerance ] %-24s t_c = %4.1f T = %g x size: err/T %.3f (vertex mode %.3g), 12 -> %zu triangles\n",
+                            c.name, t_c, rel, std::max(s.output_to_exact, s.exact_to_output) / settings.tolerance,
+                            std::max(v.output_to_exact, v.exact_to_output) / settings.tolerance, out.triangles.size());
+            }
+        }
+    }
+    plane = false;
+}
+
+// Two keys at constant velocity (0.6c, emission times between the keys): the worldlines are the
+// uniform model's, so the tolerance output lies within T of the exact surface and, at every sampled
+// rest point, within 2 T of the uniform model's tolerance output (each within T of the same
+// surface); the measured gap is printed.
+TEST(MotionTolerance, TwoKeysAtConstantSpeedMatchUniformMotion) {
+    const mesh4d::RestMesh mesh = box(0.5);
+    const double size = std::sqrt(3.0);
+    const TestPath line{{0, 20}, {{-6, 0, -5}, {6, 0, -5}}, {0, 0}};
+    plane = false;
+    for (bool lorentz : {true, false}) {
+        const mesh4d::Motion keyed = keyedMotion(line, lorentz);
+        const mesh4d::Motion uniform =
+            mesh4d::makeMotion(lorentz ? mesh4d::Kinematics::Lorentz : mesh4d::Kinematics::Galilean, 0, {-6, 0, -5}, {0.6, 0, 0});
+        const Worldline exact = keyedPath(line, lorentz);
+        const mesh4d::World4D wk = mesh4d::extrude(mesh, keyed, -1e3, 1e3, false, false);
+        const mesh4d::World4D wu = mesh4d::extrude(mesh, uniform, -1e3, 1e3, false, false);
+        mesh4d::ViewSurface view;
+        view.t_c = 15;
+        for (double rel : {1e-2, 1e-3}) {
+            mesh4d::SliceSettings settings;
+            settings.tolerance = rel * size;
+            const mesh4d::ApparentMesh ok = mesh4d::sliceWorld(wk, view, settings);
+            const mesh4d::ApparentMesh ou = mesh4d::sliceWorld(wu, view, settings);
+            const Sampled s = sample(mesh, ok, exact, view.t_c, view.apex);
+            EXPECT_LE(std::max(s.output_to_exact, s.exact_to_output), settings.tolerance + 1e-11) << lorentz << " " << rel;
+            std::map<uint32_t, std::vector<size_t>> bk, bu;
+            for (size_t t = 0; t < ok.triangles.size(); ++t) bk[ok.source_triangles[t]].push_back(t);
+            for (size_t t = 0; t < ou.triangles.size(); ++t) bu[ou.source_triangles[t]].push_back(t);
+            double gap = 0;
+            for (uint32_t f = 0; f < mesh.triangles.size(); ++f)
+                for (int i = 1; i < 10; ++i)
+                    for (int j = 1; i + j < 10; ++j) {
+                        const auto& tri = mesh.triangles[f];
+                        const Vec3 q = mesh.positions[tri[0]] * ((10.0 - i - j) / 10) + mesh.positions[tri[1]] * (i / 10.0) +
+                                       mesh.positions[tri[2]] * (j / 10.0);
+                        Vec3 pk, pu;
+                        ASSERT_TRUE(outputAt(ok, bk, f, q, &pk));
+                        ASSERT_TRUE(outputAt(ou, bu, f, q, &pu));
+                        gap = std::max(gap, mesh4d::norm(pk - pu));
+                    }
+            EXPECT_LE(gap, 2 * settings.tolerance) << lorentz << " " << rel;
+            std::printf("[ tolerance ] two keys at 0.6c, %-12s T = %g x size: err/T %.3f, gap to uniform/T %.3f, %zu vs %zu triangles\n",
+                        lorentz ? "relativistic" : "finite", rel, std::max(s.output_to_exact, s.exact_to_output) / settings.tolerance,
+                        gap / settings.tolerance, ok.triangles.size(), ou.triangles.size());
+        }
     }
 }

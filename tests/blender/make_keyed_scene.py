@@ -6,7 +6,7 @@
 # At 10 frames per second, a cube of edge 1 keyed at frame 0 at (-2, 0, 0) and at frame 100 at
 # (2, 0, 0) with a quarter turn about Blender's Z, LINEAR interpolation: 0.4 light-seconds per second
 # along +X for 10 s. The cube's custom property t0 = 0 makes it an object; the scene's tolerance =
-# "vertex" (keyframed objects are cut in vertex mode) and up = "z". A camera 10 units behind (-Y).
+# "vertex" (the fastest mode) and up = "z". A camera 10 units behind (-Y).
 import math
 import os
 import sys

@@ -1,7 +1,8 @@
 #!/bin/bash
 # `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
 # (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt, its frames by
-# reference, diff -r also finding any scratch file left; PLY; OBJ;
+# reference, diff -r also finding any scratch file left; meshopt with attributes; PLY; OBJ, also
+# without a .glb, each rank writing its own frames' files;
 # raytrace's PNG files and video; figure's sheet and video), a
 # failure on any rank ends the job with the one-process code and one line from rank 0 and no
 # output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
@@ -21,6 +22,7 @@ mpi() { timeout 300 mpirun --oversubscribe -n 3 "$apparent" "$@"; }
 # Step: byte-identical outputs.
 for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
     for options in "--format glb,ply,obj" "--compress draco --frames 40:160" "--compress meshopt --frames 40:160" \
+                   "--compress meshopt --attributes doppler,proper_time --frames 40:160" "--format ply,obj --frames 40:160" \
                    "--tolerance vertex --compress meshopt --model relativistic,finite"; do
         rm -rf "$work/one" "$work/three"
         "$apparent" render "$scene" --out "$work/one" --quiet $options || fail "one process: $scene $options"
@@ -110,6 +112,30 @@ got=$?
 [ "$one" = 3 ] && [ "$got" = 3 ] || fail "figure write failure: one process $one, mpirun $got (3 expected)"
 [ "$(grep -cxF -- "$(grep '^error: ' "$work/one.txt")" "$work/mpi.txt")" = 1 ] && [ "$(grep -c '^error: ' "$work/mpi.txt")" = 1 ] ||
     fail "figure write failure: not the one-process line once ($(cat "$work/mpi.txt"))"
+
+# A write failing on ranks 1 and 2 alone (a file size limit there; PLY frames, which each rank
+# writes itself): the job ends with code 3 and one line naming the file of frame 1, the first
+# frame of rank 1, as one process with that limit names its frame 0's; frame 0 (rank 0's) is
+# complete, nothing else is left (no temporary file).
+printf '#!/bin/sh\nulimit -f 64\nexec "$@"\n' > "$work/limited.sh"
+chmod +x "$work/limited.sh"
+limited=(render data/scenes/flanges.json --format ply --frames 40:160 --tolerance 1e-4x --quiet)
+"$apparent" "${limited[@]}" --out "$work/unlimited" || fail "one process, no limit"
+"$work/limited.sh" "$apparent" "${limited[@]}" --out "$work/limited1" > /dev/null 2> "$work/one.txt"
+one=$?
+timeout 300 mpirun --oversubscribe -n 1 "$apparent" "${limited[@]}" --out "$work/limited3" : \
+    -n 2 "$work/limited.sh" "$apparent" "${limited[@]}" --out "$work/limited3" > /dev/null 2> "$work/mpi.txt"
+got=$?
+[ "$one" = 3 ] && [ "$got" = 3 ] || fail "a rank's write failure: one process $one, mpirun $got (3 expected)"
+grep -q "^error: $work/limited1/relativistic/frame_00040.ply: cannot write (" "$work/one.txt" ||
+    fail "a rank's write failure, one process: $(cat "$work/one.txt")"
+[ "$(grep -c '^error: ' "$work/mpi.txt")" = 1 ] &&
+    grep -q "^error: $work/limited3/relativistic/frame_00041.ply: cannot write (.*File too large" "$work/mpi.txt" ||
+    fail "a rank's write failure: not one line naming frame 41 ($(cat "$work/mpi.txt"))"
+left=$(cd "$work/limited3/relativistic" && ls -A)
+[ "$left" = frame_00040.ply ] || fail "a rank's write failure left: $left"
+cmp -s "$work/limited3/relativistic/frame_00040.ply" "$work/unlimited/relativistic/frame_00040.ply" ||
+    fail "a rank's write failure: frame 40 not complete"
 
 # Step: SIGKILL to rank 1 mid-run: mpirun exits non-zero; every file present is complete (the
 # one-process run's bytes for it), no temporary is left beside them.
