@@ -8,6 +8,13 @@
 //   BM_ClosedFormOnly/N    the closed form alone (no output mesh bookkeeping), one core
 //   BM_CutTolerance/N      the same at tolerance 1e-3 x the object's size
 //   BM_ExportFrame/F       1.: one frame of the 1M-triangle torus cut and written: F = 0 .glb, 1 PLY
+//                          (the cut runs on one thread, it has no parallel step; the export on
+//                          TBB's default pool, every core)
+//   BM_ExportFrameOneThread/F  the same with TBB held to one thread: cut and export on one core,
+//                          as BM_CutVertexMode
+//   BM_GlbPrepare          the lone .glb frame's in-memory part alone (GlbSequenceWriter::prepare:
+//                          bounds, crease split, float32 conversion) on the frame cut once
+//   BM_PlySerialize        the PLY frame's bytes alone (serializePly), likewise
 //   BM_GlbSequenceFrame    2.: one more frame of a .glb sequence of the 1M-triangle torus, cut and
 //                          exported (the writer's buffers reused); finish_ms_per_frame: the file's
 //                          assembly at the end, per frame
@@ -30,6 +37,7 @@
 
 #include <sys/resource.h>
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -153,6 +161,45 @@ void BM_ExportFrame(benchmark::State& state) {
     state.counters["vertex_frames_per_s"] =
         benchmark::Counter(double(p.world.mesh.positions.size()), benchmark::Counter::kIsIterationInvariantRate);
     fs::remove_all(dir);
+}
+
+void BM_ExportFrameOneThread(benchmark::State& state) {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    BM_ExportFrame(state);
+}
+
+// The frame of BM_ExportFrame, cut once.
+const apparent::ExportFrame& exportFrame() {
+    static const apparent::ExportFrame frame = [] {
+        apparent::ExportFrame f;
+        f.objects.push_back(mesh4d::sliceWorld(passing(1'000'000).world, passing(1'000'000).view, {}));
+        return f;
+    }();
+    return frame;
+}
+
+void BM_GlbPrepare(benchmark::State& state) {
+    const apparent::ExportFrame& frame = exportFrame();
+    apparent::SequenceInfo info;
+    info.model = "relativistic";
+    info.fps = 10;
+    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, -1, ""});
+    const fs::path dir = fs::temp_directory_path() / "apparent_perf_prepare";
+    apparent::GlbSequenceWriter writer((dir / "f.glb").string(), info, {});  // nothing written: no add()
+    const double cpu0 = processCpuSeconds();
+    for (auto _ : state) benchmark::DoNotOptimize(writer.prepare(frame).get());
+    setProcessCpu(state, cpu0);
+}
+
+void BM_PlySerialize(benchmark::State& state) {
+    const apparent::ExportFrame& frame = exportFrame();
+    std::string bytes;
+    const double cpu0 = processCpuSeconds();
+    for (auto _ : state) {
+        apparent::serializePly(frame, &bytes);
+        benchmark::DoNotOptimize(bytes.data());
+    }
+    setProcessCpu(state, cpu0);
 }
 
 // A .glb sequence of the 1M-triangle torus, one frame per iteration (camera time advancing 0.05 s
@@ -316,6 +363,9 @@ BENCHMARK(BM_CutVertexMode)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'00
 BENCHMARK(BM_ClosedFormOnly)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CutTolerance)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExportFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ExportFrameOneThread)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GlbPrepare)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlySerialize)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GlbSequenceFrame)->Iterations(40)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Frames)->Arg(1)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_Culling)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);

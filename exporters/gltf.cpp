@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "exporters/atomic_file.h"
@@ -62,6 +63,10 @@ struct PrimitiveData {
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
     std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
+    // POSITION's bounds (of the float32 values, in vertex order), found by prepare()'s conversion;
+    // `bounded` false (frames decoded from bytes): plainPrimitive() finds them from `positions`.
+    bool bounded = false;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     std::vector<unsigned char> packed, packed_normals, packed_snorm;
     std::shared_ptr<const std::vector<uint32_t>> ordered;  // shared with the object's MeshoptOrder
     int qmin[3] = {0, 0, 0}, qmax[3] = {0, 0, 0};
@@ -77,6 +82,11 @@ struct PrimitiveData {
         double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // POSITION's bounds (of the float32 values)
         uint64_t index_hash[2] = {0, 0};              // indexHash(indices)
     } remote;
+    // Empties the float32 arrays and the index list (an object the frame does not show).
+    void clearArrays() {
+        for (auto* v : {&positions, &normals, &emission, &doppler, &proper_time, &colors}) v->clear();
+        indices.clear();
+    }
     size_t vertexCount() const { return remote.on ? size_t(remote.vertices) : emission.size(); }
     size_t indexCount() const { return remote.on ? size_t(remote.index_count) : indices.size(); }
     size_t packedVertices(size_t stride) const { return remote.on ? size_t(remote.packed_vertices) : packed.size() / stride; }
@@ -513,6 +523,9 @@ public:
         if (d.remote.on) {
             lo.assign(d.remote.lo, d.remote.lo + 3);
             hi.assign(d.remote.hi, d.remote.hi + 3);
+        } else if (d.bounded) {
+            lo.assign(d.lo, d.lo + 3);
+            hi.assign(d.hi, d.hi + 3);
         } else {
             bounds(d.positions, &lo, &hi);
         }
@@ -733,20 +746,43 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     exact.resize(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
     const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
-    const double worst = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, nv, 16384), 0.0,
-        [&](const tbb::blocked_range<size_t>& r, double w) {
+    // The largest rounding and the float32 positions' bounds. std::min and std::max keep the
+    // first of equal values (a signed zero) and the join takes the left part first, so the
+    // bounds are GlbBuilder::bounds()'s in vertex order, bit for bit, whatever the split.
+    struct Reduced {
+        double worst = 0;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    };
+    const Reduced reduced = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), Reduced{},
+        [&](const tbb::blocked_range<size_t>& r, Reduced red) {
+            // Local pointers: through the by-reference captures every array would be reloaded
+            // after each store.
+            const uint32_t* const source = map->source.data();
+            const mesh4d::Vec3* const pos = m.positions.data();
+            const mesh4d::Vec3* const nrm = map->normals.data();
+            float* const out_pos = d->positions.data();
+            float* const out_nrm = d->normals.data();
+            float* const out_emission = d->emission.data();
+            double* const out_exact = step > 0 ? exact.data() : nullptr;
+            const double s0 = shift[0], s1 = shift[1], s2 = shift[2];
+            double w = red.worst;
+            double lo[3] = {red.lo[0], red.lo[1], red.lo[2]}, hi[3] = {red.hi[0], red.hi[1], red.hi[2]};
             for (size_t k = r.begin(); k < r.end(); ++k) {
-                const uint32_t v = map->source[k];
+                const uint32_t v = source[k];
+                const double rel[3] = {s0 + pos[v].x, s1 + pos[v].y, s2 + pos[v].z};
                 for (int c = 0; c < 3; ++c) {
-                    const double rel = shift[c] + m.positions[v][c];
-                    const float fv = float(rel);
-                    d->positions[3 * k + c] = fv;
-                    w = std::max(w, std::fabs(double(fv) - rel));
-                    d->normals[3 * k + c] = float(map->normals[k][c]);
-                    if (step > 0) exact[3 * k + c] = rel;
+                    const float fv = float(rel[c]);
+                    out_pos[3 * k + c] = fv;
+                    w = std::max(w, std::fabs(double(fv) - rel[c]));
+                    lo[c] = std::min(lo[c], double(fv));
+                    hi[c] = std::max(hi[c], double(fv));
+                    if (out_exact) out_exact[3 * k + c] = rel[c];
                 }
-                d->emission[k] = float(m.absoluteTime(v));
+                out_nrm[3 * k] = float(nrm[k].x);
+                out_nrm[3 * k + 1] = float(nrm[k].y);
+                out_nrm[3 * k + 2] = float(nrm[k].z);
+                out_emission[k] = float(m.absoluteTime(v));
                 if (doppler) d->doppler[k] = float(m.doppler[v]);
                 if (proper_time) d->proper_time[k] = float(m.proper_time[v]);
                 if (shade) {
@@ -754,12 +790,31 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                     for (int j = 0; j < 3; ++j) d->colors[3 * k + size_t(j)] = float(c[size_t(j)]);
                 }
             }
-            return w;
+            red.worst = w;
+            for (int c = 0; c < 3; ++c) {
+                red.lo[c] = lo[c];
+                red.hi[c] = hi[c];
+            }
+            return red;
         },
-        [](double x, double y) { return std::max(x, y); });
-    *max_err = std::max(*max_err, worst);
+        [](Reduced a, const Reduced& b) {
+            a.worst = std::max(a.worst, b.worst);
+            for (int c = 0; c < 3; ++c) {
+                a.lo[c] = std::min(a.lo[c], b.lo[c]);
+                a.hi[c] = std::max(a.hi[c], b.hi[c]);
+            }
+            return a;
+        });
+    *max_err = std::max(*max_err, reduced.worst);
+    d->bounded = true;
+    for (int c = 0; c < 3; ++c) {
+        d->lo[c] = reduced.lo[c];
+        d->hi[c] = reduced.hi[c];
+    }
     d->indices.resize(3 * map->triangles.size());
-    if (!map->triangles.empty()) std::memcpy(d->indices.data(), map->triangles.data(), d->indices.size() * 4);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, map->triangles.size(), 65536), [&](const tbb::blocked_range<size_t>& r) {
+        std::memcpy(d->indices.data() + 3 * r.begin(), map->triangles.data() + r.begin(), r.size() * sizeof(map->triangles[0]));
+    });
     if (step > 0)
         *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), order,
                                                       &scratch->normals));
@@ -1087,7 +1142,7 @@ struct SequenceModel {
                 } else {
                     prim = b.plainPrimitive(data[o], shared[o]);
                 }
-                if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o]);
+                if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o], borrow_indices);
                 shown[o] = true;
                 prim.material = o < info.objects.size() ? int(o) : -1;
                 mesh.primitives.push_back(prim);
@@ -1370,32 +1425,47 @@ struct SequenceModel {
     enum class Compression { none, draco, meshopt } compression = Compression::none;
     // Per object, its index list in the previous frame and the accessor holding it (-1: none).
     // Frames by reference compare the lists' hashes (indexHash), frames of this process the lists.
+    // An object's index list in the last frame. Copied, or only pointed to while its frame is
+    // held in place (borrow_indices: the writer's first frame, BinSink::pinned), so that a lone
+    // frame never copies it; keepPrevious() copies it before that frame is let go.
     struct Previous {
         int accessor = -1;
         size_t vertices = 0;
         std::vector<uint32_t> indices;
+        const std::vector<uint32_t>* borrowed = nullptr;  // instead of `indices`
         bool remote = false;
         uint64_t count = 0, hash[2] = {0, 0};
         bool same(const PrimitiveData& d) const {
             if (vertices != d.vertexCount() || remote != d.remote.on) return false;
-            if (!remote) return indices == d.indices;
+            if (!remote) return (borrowed ? *borrowed : indices) == d.indices;
             return count == d.remote.index_count && hash[0] == d.remote.index_hash[0] && hash[1] == d.remote.index_hash[1];
         }
-        void take(int accessor_, const PrimitiveData& d) {
+        void take(int accessor_, const PrimitiveData& d, bool borrow) {
             accessor = accessor_;
             vertices = d.vertexCount();
             remote = d.remote.on;
+            borrowed = nullptr;
             if (remote) {
                 indices.clear();
                 count = d.remote.index_count;
                 hash[0] = d.remote.index_hash[0];
                 hash[1] = d.remote.index_hash[1];
+            } else if (borrow) {
+                borrowed = &d.indices;
             } else {
                 indices = d.indices;
             }
         }
+        void keep() {
+            if (borrowed) indices = *borrowed;
+            borrowed = nullptr;
+        }
     };
     std::vector<Previous> previous;
+    bool borrow_indices = false;  // the frame being added is held in place until keepPrevious()
+    void keepPrevious() {
+        for (Previous& p : previous) p.keep();
+    }
     struct Reflection {
         size_t frame;        // frame node 1 + frame is the parent
         std::string mirror;  // the mirror's name
@@ -1489,8 +1559,9 @@ struct GlbFrameData : PreparedFrame, std::enable_shared_from_this<GlbFrameData> 
         meshopt.remote = false;
         data.resize(objects);
         for (PrimitiveData& p : data) {
-            for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors}) v->clear();
-            p.indices.clear();
+            // The float32 arrays and the index list keep their size: prepare() empties those of
+            // the objects not shown, toPrimitive() sizes the others (no zero fill unless they grow).
+            p.bounded = false;
             p.ordered.reset();
             p.draco.bytes.clear();
             p.draco.error.clear();
@@ -1625,6 +1696,8 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f, b
         if (pool->free.size() < poolFrames()) pool->free.push_back(std::move(owned));
     });
     d->reset(f.objects.size());
+    for (size_t o = 0; o < f.objects.size(); ++o)
+        if (f.objects[o].triangles.empty()) d->data[o].clearArrays();  // not shown: no data
     std::unique_ptr<PrepareScratch> scratch;
     {
         std::lock_guard<std::mutex> lock(pool->mutex);
@@ -1778,11 +1851,15 @@ bool GlbSequenceWriter::add(const ExportFrame& f, const GlbFrameData& prepared, 
     // Step: the first frame is held (its own buffers kept, BinSink), a second one sends it to the
     // spill file.
     if (m.model.frames > 0) {
+        m.model.keepPrevious();  // the held frame's index lists copied before it is let go
+        if (m.plain) m.plain->keepPrevious();
         m.sink.spill();
     } else if (m.sink.holding) {
         m.sink.pinned = prepared.weak_from_this().lock();  // none (addEncoded's frame): copied instead
         if (m.sink.pinned) m.sink.borrowable = prepared.buffers();
     }
+    m.model.borrow_indices = m.sink.pinned != nullptr;
+    if (m.plain) m.plain->borrow_indices = m.model.borrow_indices;
     // Step: into the model (binary data to the spill file), and into the counted plain twin.
     if (!m.model.addFrame(f, data, origin, prepared.step > 0 ? prepared.step : 1.0, &prepared.meshopt, &m.stats,
                           error)) {
@@ -1859,6 +1936,10 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
         // The BIN chunk copied from the spill file after the head (copy_file_range: the kernel
         // copies between the two files' pages; pread and write where it cannot).
         static const char zeros[4] = {0, 0, 0, 0};
+        // The file's blocks reserved in one call first: page by page, ext4's delayed allocation
+        // cost the lone 1M-triangle frame's write more than copying its bytes. Only a hint: where
+        // it fails (a file system without it, no space), the writes below say what is wrong.
+        (void)::fallocate(fd, 0, 0, off_t(total));
         // A lone frame: from where it is held, written once (no spill file).
         ok = writeAll(fd, head.data(), head.size(), &werr) &&
              (m.sink.holding ? m.sink.writeHeld(fd, &werr) : copyRange(m.sink.fd, 0, bin, fd, &werr)) &&

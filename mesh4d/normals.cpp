@@ -5,6 +5,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "angles.h"
 
@@ -50,18 +51,26 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     // Step: face area vectors and their lengths (parallel); faces around each vertex (CSR layout).
     // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s hypot (the
     // output normals below still use norm()); unit() gives it where needed, the same bits each time.
+    // The same pass compares the triangles with the last call's (adjacency reuse), when the counts match.
     w->area.resize(nf);
     w->length.resize(nf);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t f = r.begin(); f < r.end(); ++f) {
-            const auto& t = mesh.triangles[f];
-            const Vec3 a = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
-            w->area[f] = a;
-            w->length[f] = std::sqrt(dot(a, a));
-        }
-    });
-    const bool same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1 &&
-                      (nf == 0 || std::memcmp(w->triangles.data(), mesh.triangles.data(), nf * sizeof(mesh.triangles[0])) == 0);
+    const bool may_be_same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1;
+    const bool same = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nf, kGrain), may_be_same,
+        [&](const tbb::blocked_range<size_t>& r, bool equal) {
+            const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
+            const Vec3* const pos = mesh.positions.data();
+            Vec3* const area = w->area.data();
+            double* const length = w->length.data();
+            for (size_t f = r.begin(); f < r.end(); ++f) {
+                const auto& t = tri[f];
+                const Vec3 a = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
+                area[f] = a;
+                length[f] = std::sqrt(dot(a, a));
+            }
+            return equal && std::memcmp(w->triangles.data() + r.begin(), tri + r.begin(), r.size() * sizeof(tri[0])) == 0;
+        },
+        [](bool a, bool b) { return a && b; });
     if (!same) {
         w->unsplit = false;
         w->vertices = nv;
@@ -102,18 +111,26 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     // triangle inequality); otherwise every pair is tested. The direction is the sum of the area
     // vectors (what the vertex's normal is made of), so the test reads each face's area vector and
     // length once: dot(a_f, s) >= cos_half |a_f| |s|.
-    const double cos_half = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
+    const double cos_half_ = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
     w->uniform.assign(nv, 0);
     w->vertex_normal.resize(nv);
     // Raw pointers: the stores to `uniform` (bytes, which may alias anything) would otherwise
     // reload every vector's data pointer in the inner loops.
-    const Vec3* const area_p = area.data();
-    const double* const length_p = length.data();
-    const uint32_t* const start_p = start.data();
-    const uint32_t* const faces_p = faces.data();
-    unsigned char* const uniform_p = w->uniform.data();
-    Vec3* const vertex_normal_p = w->vertex_normal.data();
+    const Vec3* const area_p_ = area.data();
+    const double* const length_p_ = length.data();
+    const uint32_t* const start_p_ = start.data();
+    const uint32_t* const faces_p_ = faces.data();
+    unsigned char* const uniform_p_ = w->uniform.data();
+    Vec3* const vertex_normal_p_ = w->vertex_normal.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        // Local copies: the captures are references, reloaded through the closure after every store.
+        const Vec3* const area_p = area_p_;
+        const double* const length_p = length_p_;
+        const uint32_t* const start_p = start_p_;
+        const uint32_t* const faces_p = faces_p_;
+        unsigned char* const uniform_p = uniform_p_;
+        Vec3* const vertex_normal_p = vertex_normal_p_;
+        const double cos_half = cos_half_;
         for (size_t v = r.begin(); v < r.end(); ++v) {
             const uint32_t first = start_p[v], end = start_p[v + 1];
             if (first == end) continue;
@@ -149,12 +166,12 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         for (size_t v = r.begin(); v < r.end(); v += 2) {
             const size_t b = std::min(v + 1, r.end() - 1);  // an odd end repeats its last vertex
             const Vec3 s0 = vertex_normal_p[v], s1 = vertex_normal_p[b];
-            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, length;
-            unitPair(x, y, z, &ux, &uy, &uz, &length);
+            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
+            unitPair(x, y, z, &ux, &uy, &uz, &len);
             for (int k = 0; k < 2; ++k) {
                 const size_t i = k == 0 ? v : b;
                 if (!uniform_p[i]) continue;
-                if (!(length[k] > 0)) uniform_p[i] = 0;
+                if (!(len[k] > 0)) uniform_p[i] = 0;
                 else vertex_normal_p[i] = {ux[k], uy[k], uz[k]};
             }
         }

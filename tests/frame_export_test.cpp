@@ -1,6 +1,8 @@
 // The PLY and OBJ frame writers, serialized in parallel blocks: the same bytes on 1 and 2 threads,
 // and the values read back independently (absolute lab positions and times, faces with the
-// objects' vertex offsets, triangles with a repeated corner left out).
+// objects' vertex offsets, triangles with a repeated corner left out). The lone .glb frame
+// likewise: the same bytes on 1 and 2 threads, and POSITION's bounds (found in the parallel
+// float32 conversion) those of the float32 values read back from its BIN chunk.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -13,6 +15,9 @@
 
 #include <tbb/task_arena.h>
 
+#include <nlohmann/json.hpp>
+
+#include "exporters/gltf.h"
 #include "exporters/obj.h"
 #include "exporters/ply.h"
 
@@ -102,4 +107,58 @@ TEST(FrameExport, PlyHoldsAbsoluteValuesAndOffsetFaces) {
     std::memcpy(idx, bytes.data() + bytes.size() - 12, 12);
     for (int c = 0; c < 3; ++c) EXPECT_EQ(uint32_t(idx[c]), last[c] + frame.objects[0].positions.size());
     fs::remove_all(dir);
+}
+
+TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
+    const ExportFrame frame = testFrame();
+    SequenceInfo info;
+    info.model = "relativistic";
+    info.fps = 10;
+    info.objects.push_back({"a", {0.8, 0.8, 0.8, 1}, -1, ""});
+    info.objects.push_back({"b", {0.5, 0.5, 0.5, 1}, -1, ""});
+    const fs::path dir = fs::temp_directory_path() / ("apparent_glb_bounds_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::string bytes[2];
+    for (int threads : {1, 2}) {
+        tbb::task_arena arena(threads);
+        std::string error;
+        bool ok = false;
+        const fs::path file = dir / ("t" + std::to_string(threads) + ".glb");
+        arena.execute([&] { ok = writeAnimatedGlb(file.string(), {frame}, info, {}, nullptr, &error); });
+        ASSERT_TRUE(ok) << error;
+        bytes[threads - 1] = readBytes(file);
+    }
+    fs::remove_all(dir);
+    EXPECT_TRUE(bytes[0] == bytes[1]);
+    // The chunks (glTF 2.0, section 4.4): 12-byte header, JSON chunk, BIN chunk.
+    const std::string& glb = bytes[0];
+    ASSERT_GT(glb.size(), 28u);
+    uint32_t json_length = 0, bin_length = 0;
+    std::memcpy(&json_length, glb.data() + 12, 4);
+    ASSERT_LE(20 + size_t(json_length) + 8, glb.size());
+    std::memcpy(&bin_length, glb.data() + 20 + json_length, 4);
+    const char* bin = glb.data() + 28 + json_length;
+    ASSERT_EQ(28 + size_t(json_length) + bin_length, glb.size());
+    const nlohmann::json json = nlohmann::json::parse(glb.substr(20, json_length));
+    size_t checked = 0;
+    for (const auto& mesh : json.at("meshes"))
+        for (const auto& prim : mesh.at("primitives")) {
+            const auto& accessor = json.at("accessors").at(prim.at("attributes").at("POSITION").get<size_t>());
+            const auto& view = json.at("bufferViews").at(accessor.at("bufferView").get<size_t>());
+            const size_t count = accessor.at("count"), offset = view.value("byteOffset", size_t(0));
+            ASSERT_LE(offset + 12 * count, size_t(bin_length));
+            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (size_t i = 0; i < 3 * count; ++i) {
+                float f = 0;
+                std::memcpy(&f, bin + offset + 4 * i, 4);
+                lo[i % 3] = std::min(lo[i % 3], double(f));
+                hi[i % 3] = std::max(hi[i % 3], double(f));
+            }
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_EQ(accessor.at("min")[c].get<double>(), lo[c]) << c;
+                EXPECT_EQ(accessor.at("max")[c].get<double>(), hi[c]) << c;
+            }
+            ++checked;
+        }
+    EXPECT_EQ(checked, 2u);  // both objects
 }
