@@ -81,6 +81,27 @@ struct Sampled {
     double exact_to_output = 0;  // largest distance from sampled exact points to the output's point of that rest point
 };
 
+// The output's point of rest point q on input triangle f (rest-frame barycentrics in the output
+// triangle of that source that holds q); false when none holds it.
+bool outputAt(const mesh4d::ApparentMesh& out, const std::map<uint32_t, std::vector<size_t>>& by_source, uint32_t f,
+              const Vec3& q, Vec3* p) {
+    const auto it = by_source.find(f);
+    if (it == by_source.end()) return false;
+    for (size_t t : it->second) {
+        const auto& o = out.triangles[t];
+        const Vec3 a = out.rest_points[o[0]], e1 = out.rest_points[o[1]] - a, e2 = out.rest_points[o[2]] - a;
+        const Vec3 d = q - a;
+        const double d11 = mesh4d::dot(e1, e1), d12 = mesh4d::dot(e1, e2), d22 = mesh4d::dot(e2, e2);
+        const double det = d11 * d22 - d12 * d12;
+        const double u = (d22 * mesh4d::dot(d, e1) - d12 * mesh4d::dot(d, e2)) / det;
+        const double v = (d11 * mesh4d::dot(d, e2) - d12 * mesh4d::dot(d, e1)) / det;
+        if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
+        *p = out.absolutePosition(o[0]) * (1 - u - v) + out.absolutePosition(o[1]) * u + out.absolutePosition(o[2]) * v;
+        return true;
+    }
+    return false;
+}
+
 // Both ways: (1) points of every output triangle (corners' rest points interpolated) against the
 // exact point of that rest point; (2) rest points sampled on every input triangle, located in the
 // output triangle of that source that holds them (rest-frame barycentrics), the exact point against
@@ -108,22 +129,9 @@ Sampled sample(const mesh4d::RestMesh& mesh, const mesh4d::ApparentMesh& out, co
         const auto& tri = mesh.triangles[f];
         for (const auto& l : probe) {
             const Vec3 q = mesh.positions[tri[0]] * l[0] + mesh.positions[tri[1]] * l[1] + mesh.positions[tri[2]] * l[2];
-            bool found = false;
-            for (size_t t : by_source[uint32_t(f)]) {
-                const auto& o = out.triangles[t];
-                const Vec3 a = out.rest_points[o[0]], e1 = out.rest_points[o[1]] - a, e2 = out.rest_points[o[2]] - a;
-                const Vec3 d = q - a;
-                const double d11 = mesh4d::dot(e1, e1), d12 = mesh4d::dot(e1, e2), d22 = mesh4d::dot(e2, e2);
-                const double det = d11 * d22 - d12 * d12;
-                const double u = (d22 * mesh4d::dot(d, e1) - d12 * mesh4d::dot(d, e2)) / det;
-                const double v = (d11 * mesh4d::dot(d, e2) - d12 * mesh4d::dot(d, e1)) / det;
-                if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
-                Vec3 rest;
-                const Vec3 p = at(t, 1 - u - v, u, v, &rest);
-                r.exact_to_output = std::max(r.exact_to_output, mesh4d::norm(exactPoint(wl, t_c, C, q) - p));
-                found = true;
-                break;
-            }
+            Vec3 p;
+            const bool found = outputAt(out, by_source, uint32_t(f), q, &p);
+            if (found) r.exact_to_output = std::max(r.exact_to_output, mesh4d::norm(exactPoint(wl, t_c, C, q) - p));
             EXPECT_TRUE(found) << "input triangle " << f << " not covered by the output";
         }
     }
@@ -411,27 +419,6 @@ std::vector<KeyedCase> keyedCases() {
             {"corner, contracted", corner, true, true, {5.0}},
             {"turn key, relativistic", turn, true, false, {9.0}},
             {"turn key, finite", turn, false, false, {9.0}}};
-}
-
-// The output's point of rest point q on input triangle f (rest-frame barycentrics in the output
-// triangle of that source that holds q); false when none holds it.
-bool outputAt(const mesh4d::ApparentMesh& out, const std::map<uint32_t, std::vector<size_t>>& by_source, uint32_t f,
-              const Vec3& q, Vec3* p) {
-    const auto it = by_source.find(f);
-    if (it == by_source.end()) return false;
-    for (size_t t : it->second) {
-        const auto& o = out.triangles[t];
-        const Vec3 a = out.rest_points[o[0]], e1 = out.rest_points[o[1]] - a, e2 = out.rest_points[o[2]] - a;
-        const Vec3 d = q - a;
-        const double d11 = mesh4d::dot(e1, e1), d12 = mesh4d::dot(e1, e2), d22 = mesh4d::dot(e2, e2);
-        const double det = d11 * d22 - d12 * d12;
-        const double u = (d22 * mesh4d::dot(d, e1) - d12 * mesh4d::dot(d, e2)) / det;
-        const double v = (d11 * mesh4d::dot(d, e2) - d12 * mesh4d::dot(d, e1)) / det;
-        if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
-        *p = out.absolutePosition(o[0]) * (1 - u - v) + out.absolutePosition(o[1]) * u + out.absolutePosition(o[2]) * v;
-        return true;
-    }
-    return false;
 }
 
 }  // namespace

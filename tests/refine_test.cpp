@@ -594,7 +594,9 @@ TEST(Refine, TemplateTilesItsPiece) {
         }
         EXPECT_NEAR(area, 0.5, 1e-12) << "N " << N << " n " << n[0] << " " << n[1] << " " << n[2];
         for (uint32_t p = 0; p < lay.count(); ++p) EXPECT_TRUE(used[p]) << "point " << p << " unused";
-        if (n[0] == N && n[1] == N && n[2] == N) EXPECT_EQ(tris.size(), size_t(N * N));
+        if (n[0] == N && n[1] == N && n[2] == N) {
+            EXPECT_EQ(tris.size(), size_t(N * N));
+        }
     }
 }
 
@@ -633,6 +635,20 @@ TEST(Refine, TemplateRingIsCheckedAgainstTheLimit) {
     EXPECT_GT(refused, 10);
 }
 
+namespace {
+
+// For the whole-piece form's random trials: a speed of 0.05 to 0.99 in a random direction, and a
+// piece size of 0.1 to 10 (the draws in this order).
+void randomSpeedAndSize(std::mt19937& rng, Vec3* velocity, double* size) {
+    std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
+    const double beta = 0.05 + 0.94 * w(rng);
+    Vec3 dir{u(rng), u(rng), u(rng)};
+    *velocity = dir / norm(dir) * beta;
+    *size = std::pow(10.0, 2 * u(rng) - 1);
+}
+
+}  // namespace
+
 // The whole-piece form (chord_error.h pieceForm) bounds every triangle inside the piece: random
 // pieces near and far from the camera, random triangles inside them, and the largest |F - L| of
 // each sampled against speed bubbleMax of the form on its sides.
@@ -641,12 +657,11 @@ TEST(Refine, PieceFormBoundsEveryTriangleInside) {
     std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
     int checked = 0;
     for (int trial = 0; trial < 200; ++trial) {
-        const double beta = 0.05 + 0.94 * w(rng);
-        Vec3 dir{u(rng), u(rng), u(rng)};
-        dir = dir / norm(dir);
-        const double size = std::pow(10.0, 2 * u(rng) - 1);
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
         const double distance = size * (trial % 4 == 0 ? 2.0 : std::pow(10.0, 0.5 + 1.5 * w(rng)));
-        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, dir * beta);
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, velocity);
         const ViewSurface view{ViewKind::PastCone, distance * (1 + u(rng)), {0, 0, 0}};
         const ViewAnchor anchor = viewAnchor(view, m);
         const Vec3 E = nowBase(view, m);
@@ -720,12 +735,11 @@ TEST(Refine, PieceFormDominatesTheHessianNearTheCamera) {
     std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
     int checked = 0;
     for (int trial = 0; trial < 300; ++trial) {
-        const double beta = 0.05 + 0.94 * w(rng);
-        Vec3 dir{u(rng), u(rng), u(rng)};
-        dir = dir / norm(dir);
-        const double size = std::pow(10.0, 2 * u(rng) - 1);
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
         const double distance = size * (1.2 + 4.8 * w(rng));
-        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, dir * beta);
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, velocity);
         const ViewSurface view{ViewKind::PastCone, distance * (1 + 0.5 * u(rng)), {0, 0, 0}};
         const Vec3 E = nowBase(view, m);
         Vec3 s[3];
