@@ -118,8 +118,10 @@ void buildNode(TraceWorld* trace, const std::vector<EventBox>& boxes, uint32_t i
 }
 
 // The ray parameters [*s_lo, *s_hi] inside `box` widened by `slack`, clipped to the input range;
-// false when empty. Origin o and direction D are in the box's coordinates (t, y).
-bool slab(const EventBox& box, double slack, const Vec4& o, const Vec4& D, double* s_lo, double* s_hi) {
+// false when empty. Origin o and direction D are in the box's coordinates (t, y). Inlined by
+// demand: it is the traversal's inner test, and with two instances of the traversal (one world,
+// slabs) GCC stopped inlining it by itself (raytrace_bench).
+[[gnu::always_inline]] inline bool slab(const EventBox& box, double slack, const Vec4& o, const Vec4& D, double* s_lo, double* s_hi) {
     const double lo[4] = {box.t_lo - slack, box.lo.x - slack, box.lo.y - slack, box.lo.z - slack};
     const double hi[4] = {box.t_hi + slack, box.hi.x + slack, box.hi.y + slack, box.hi.z + slack};
     for (size_t i = 0; i < 4; ++i) {
@@ -208,24 +210,53 @@ TraceWorld prepareSlabsTrace(const std::vector<const World4D*>& slabs) {
 
 namespace {
 
+// The nearest hit of a search so far, as plain numbers (one object: the search's lambda holds one
+// reference to it); its WorldHit is made once, at the end (makeHit). A WorldHit held in the search
+// was zeroed on every call (rep stos) and copied per hit, and a dozen separate captures were
+// stored per call: together about 5 % of a frame (raytrace_bench BM_TraceFrame/1/0).
+struct NearestSoFar {
+    double s = 0;
+    bool found = false;
+    size_t prism = 0;
+    uint32_t slab = 0, triangle = 0;
+    const World4D* world = nullptr;
+    std::array<uint32_t, 4> tet{};
+    std::array<double, 4> bary{};
+};
+
+// The WorldHit of `best` (found) for `ray` (4D direction d) in `trace`.
+WorldHit makeHit(const TraceWorld& trace, const Ray4D& ray, const Vec4& d, const NearestSoFar& best) {
+    const TraceWorld::Prism& p = trace.prisms[best.prism];
+    WorldHit w;
+    w.s = best.s;
+    w.event = ray.at(best.s);
+    w.triangle = best.triangle;
+    w.slab = best.slab;
+    // The side the ray arrives from is a 4D question: it meets the 3-flat coming from where
+    // N . (R(s) - V) has the sign of -N . D. The spatial test n . d alone flips the normal across
+    // a moving face wherever aberration makes d graze it (issue 20).
+    const Vec3 n{p.normal[1], p.normal[2], p.normal[3]};
+    const double len = norm(n);
+    const double facing = dot4(p.normal, d) > 0 ? -1.0 : 1.0;
+    w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
+    // Event index 2 i + cap: rest vertex i at tau_a (cap 0) or tau_b (cap 1).
+    for (size_t c = 0; c < 4; ++c) {
+        w.rest_point = w.rest_point + best.bary[c] * best.world->mesh.positions[best.tet[c] / 2];
+        w.own_time += best.bary[c] * (best.tet[c] % 2 ? best.world->tau_b : best.world->tau_a);
+    }
+    return w;
+}
+
 // intersectWorld for one world (kSlabs false) or for the slabs of a history (true).
 template <bool kSlabs>
 std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray, double s_max) {
     const Vec4 d = rayDirection(ray);
     const Vec4 o = toVec4(ray.origin);
-    std::optional<WorldHit> best;
-    double best_s = s_max;
-    // The best hit's tetrahedron, for its rest point and own time (filled in once, at the end).
-    const World4D* best_world = trace.world;
-    std::array<uint32_t, 4> best_tet;
-    std::array<double, 4> best_bary;
-    auto finish = [&]() {
-        if (!best) return;
-        // Event index 2 i + cap: rest vertex i at tau_a (cap 0) or tau_b (cap 1).
-        for (size_t c = 0; c < 4; ++c) {
-            best->rest_point = best->rest_point + best_bary[c] * best_world->mesh.positions[best_tet[c] / 2];
-            best->own_time += best_bary[c] * (best_tet[c] % 2 ? best_world->tau_b : best_world->tau_a);
-        }
+    NearestSoFar best;
+    best.s = s_max;
+    auto finish = [&]() -> std::optional<WorldHit> {
+        if (!best.found) return std::nullopt;
+        return makeHit(trace, ray, d, best);
     };
     auto testPrism = [&](size_t f) {
         const TraceWorld::Prism& p = trace.prisms[f];
@@ -236,7 +267,7 @@ std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray
         if (nd == 0) return;
         const double s_flat = (p.offset - dot4(p.normal, o)) / nd;
         const double slack_s = 1e-9 * (std::fabs(s_flat) + 1);
-        if (!(s_flat > -slack_s && s_flat < best_s + slack_s)) return;
+        if (!(s_flat > -slack_s && s_flat < best.s + slack_s)) return;
         const Event at = ray.at(s_flat);
         const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
         if (!p.box.contains(at, slack)) return;
@@ -252,31 +283,21 @@ std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray
         for (size_t j = 0; j < 3; ++j) {
             const auto t = world.tet(3 * size_t(triangle) + j);
             const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
-            const std::optional<TetHit> hit = intersectTet(ray, v, best_s);
+            const std::optional<TetHit> hit = intersectTet(ray, v, best.s);
             if (!hit) continue;
-            best_s = hit->s;
-            WorldHit w;
-            w.s = hit->s;
-            w.event = ray.at(hit->s);
-            w.triangle = triangle;
-            w.slab = slab;
-            // The side the ray arrives from is a 4D question: it meets the 3-flat coming from
-            // where N . (R(s) - V) has the sign of -N . D. The spatial test n . d alone flips the
-            // normal across a moving face wherever aberration makes d graze it (issue 20).
-            const Vec3 n{p.normal[1], p.normal[2], p.normal[3]};
-            const double len = norm(n);
-            const double facing = nd > 0 ? -1.0 : 1.0;
-            w.lab_normal = len > 0 ? (facing / len) * n : Vec3{0, 0, 0};
-            best = w;
-            best_world = &world;
-            best_tet = t;
-            best_bary = hit->bary;
+            best.s = hit->s;
+            best.found = true;
+            best.prism = f;
+            best.slab = slab;
+            best.triangle = triangle;
+            best.world = &world;
+            best.tet = t;
+            best.bary = hit->bary;
         }
     };
     if (trace.nodes.empty()) {
         for (size_t f = 0; f < trace.prisms.size(); ++f) testPrism(f);
-        finish();
-        return best;
+        return finish();
     }
     // Step: walk the hierarchy in co-moving coordinates, skipping nodes the ray meets only beyond
     // the best hit so far (slack as for the prism boxes: 1e-9 of the sizes involved).
@@ -291,7 +312,7 @@ std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray
     stack[top++] = 0;
     while (top > 0) {
         const TraceWorld::Node& node = trace.nodes[stack[--top]];
-        double s_lo = -slack, s_hi = best_s + slack * (1 + std::fabs(best_s));
+        double s_lo = -slack, s_hi = best.s + slack * (1 + std::fabs(best.s));
         if (!slab(node.box, slack, oy, Dy, &s_lo, &s_hi)) continue;
         if (node.left == 0) {
             for (uint32_t i = node.begin; i < node.end; ++i) testPrism(trace.order[i]);
@@ -302,8 +323,7 @@ std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray
             for (uint32_t i = node.begin; i < node.end; ++i) testPrism(trace.order[i]);
         }
     }
-    finish();
-    return best;
+    return finish();
 }
 
 }  // namespace
