@@ -2131,6 +2131,16 @@ void putSpan(FrameBytesOut* out, const FileSpan& s) {
 bool getSpan(FrameBytesIn* in, FileSpan* s) { return in->get(&s->source) && in->get(&s->offset) && in->get(&s->length); }
 
 void putText(FrameBytesOut* out, const std::string& text) { out->putVector(std::vector<char>(text.begin(), text.end())); }
+// A Draco-coded primitive's facts besides its bytes, as both forms of a frame send them.
+void putDracoFacts(FrameBytesOut* out, const DracoCoded& dc) {
+    out->put(dc.points);
+    out->put(dc.faces);
+    for (int c = 0; c < 3; ++c) out->put(dc.lo[c]);
+    for (int c = 0; c < 3; ++c) out->put(dc.hi[c]);
+    for (int32_t id : dc.ids) out->put(id);
+    out->put(dc.quantization_error);
+    putText(out, dc.error);
+}
 bool getText(FrameBytesIn* in, std::string* text) {
     std::vector<char> v;
     if (!in->getVector(&v)) return false;
@@ -2262,13 +2272,7 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmin[c]));
         for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmax[c]));
         const DracoCoded& dc = p.draco;
-        out.put(dc.points);
-        out.put(dc.faces);
-        for (int c = 0; c < 3; ++c) out.put(dc.lo[c]);
-        for (int c = 0; c < 3; ++c) out.put(dc.hi[c]);
-        for (int32_t id : dc.ids) out.put(id);
-        out.put(dc.quantization_error);
-        putText(&out, dc.error);
+        putDracoFacts(&out, dc);
     }
     out.put(may_run);
     out.put(targets);
@@ -2410,13 +2414,7 @@ std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& 
         for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmax[c]));
         const DracoCoded& dc = p.draco;
         out.putVector(dc.bytes);
-        out.put(dc.points);
-        out.put(dc.faces);
-        for (int c = 0; c < 3; ++c) out.put(dc.lo[c]);
-        for (int c = 0; c < 3; ++c) out.put(dc.hi[c]);
-        for (int32_t id : dc.ids) out.put(id);
-        out.put(dc.quantization_error);
-        out.putVector(std::vector<char>(dc.error.begin(), dc.error.end()));
+        putDracoFacts(&out, dc);
     }
     return bytes;
 }
