@@ -11,8 +11,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -949,6 +951,52 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsTheUniformModelsAtConstantSpeed) 
     EXPECT_GT(shifted, covered / 2);
 }
 
+namespace {
+
+// The Doppler pictures' check of the tests below: the stage traced at t = 0 without and with
+// --shade doppler (relativistic); at every pixel of object 0 where `factor` (of the pixel's ray
+// direction d) gives D, each channel of at least `least` levels in both pictures compared as the
+// ratio doppler / plain (linear light: the Lambert factor cancels) against dopplerColour(base, D) /
+// base.
+struct DopplerRatios {
+    long long checked = 0;
+    double worst = 0;  // largest |measured / expected - 1|
+    double smallest_d = INFINITY, largest_d = 0;
+};
+DopplerRatios dopplerRatios(const Stage& stage, int width, int height, int least,
+                            const std::function<std::optional<double>(const Vec3& d)>& factor) {
+    TracedFrame frame[2];
+    for (int i = 0; i < 2; ++i) {
+        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, Model::Relativistic, 0, 0);
+        tracer.setShadeDoppler(i == 1);
+        frame[i] = tracer.traceFrame(0, width, height);
+    }
+    const std::array<double, 4> base4 = objectBaseColor(stage.objects, 0);
+    const std::array<double, 3> base{base4[0], base4[1], base4[2]};
+    DopplerRatios r;
+    for (int py = 0; py < height; ++py)
+        for (int px = 0; px < width; ++px) {
+            const size_t p = size_t(py * width + px);
+            if (frame[0].object[p] < 0) continue;
+            const std::optional<double> D = factor(pixelDirection(stage.scene.camera, width, height, px, py));
+            if (!D) continue;
+            r.smallest_d = std::min(r.smallest_d, *D);
+            r.largest_d = std::max(r.largest_d, *D);
+            const std::array<double, 3> shifted = mesh4d::dopplerColour(base, *D);
+            for (int c = 0; c < 3; ++c) {
+                const uint8_t plain = frame[0].image.rgb[3 * p + size_t(c)], doppler = frame[1].image.rgb[3 * p + size_t(c)];
+                if (plain < least || doppler < least) continue;
+                const double expected = shifted[size_t(c)] / base[size_t(c)];
+                const double measured = srgbToLinear(doppler) / srgbToLinear(plain);
+                r.worst = std::max(r.worst, std::fabs(measured / expected - 1));
+                ++r.checked;
+            }
+        }
+    return r;
+}
+
+}  // namespace
+
 // The same for a path whose segments' velocities are not its mean velocity (which the uniform
 // model's factor would use): out along u = (0.4, 0, 0.3) until t = 0 and back by t = 40, mean
 // velocity 0. Every hit of the frame at t = 0 lies on the first segment, so each pixel's factor is
@@ -968,34 +1016,11 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsItsSegmentsVelocitys) {
     Stage stage;
     std::string error;
     ASSERT_TRUE(loadQuietStage(keyed.write(::testing::TempDir(), "doppler_segments"), &stage, &error)) << error;
-    const int w = 160, h = 90;
-    TracedFrame frame[2];
-    for (int i = 0; i < 2; ++i) {
-        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, Model::Relativistic, 0, 0);
-        tracer.setShadeDoppler(i == 1);
-        frame[i] = tracer.traceFrame(0, w, h);
-    }
-    const std::array<double, 4> base4 = objectBaseColor(stage.objects, 0);
-    const std::array<double, 3> base{base4[0], base4[1], base4[2]};
-    long long checked = 0;
-    double worst = 0, smallest_d = INFINITY;
-    for (int py = 0; py < h; ++py)
-        for (int px = 0; px < w; ++px) {
-            const size_t p = size_t(py * w + px);
-            if (frame[0].object[p] < 0) continue;
-            const Vec3 d = pixelDirection(stage.scene.camera, w, h, px, py);
-            const double D = std::sqrt(1 - mesh4d::dot(u, u)) / (1 + mesh4d::dot(u, d));
-            smallest_d = std::min(smallest_d, D);
-            const std::array<double, 3> shifted = mesh4d::dopplerColour(base, D);
-            for (int c = 0; c < 3; ++c) {
-                const uint8_t plain = frame[0].image.rgb[3 * p + size_t(c)], doppler = frame[1].image.rgb[3 * p + size_t(c)];
-                if (plain < 60 || doppler < 60) continue;
-                const double expected = shifted[size_t(c)] / base[size_t(c)];
-                const double measured = srgbToLinear(doppler) / srgbToLinear(plain);
-                worst = std::max(worst, std::fabs(measured / expected - 1));
-                ++checked;
-            }
-        }
+    const DopplerRatios r = dopplerRatios(stage, 160, 90, 60, [&](const Vec3& d) -> std::optional<double> {
+        return std::sqrt(1 - mesh4d::dot(u, u)) / (1 + mesh4d::dot(u, d));
+    });
+    const long long checked = r.checked;
+    const double worst = r.worst, smallest_d = r.smallest_d;
     std::cout << "[keyed doppler] segment velocity: " << checked << " channels checked, D >= " << smallest_d
               << ", worst relative difference " << worst << "\n";
     EXPECT_GT(checked, 200);
@@ -1030,38 +1055,14 @@ TEST(RaytraceShading, DopplerOfASpinningDiskIsItsRimVelocitys) {
     Stage stage;
     std::string error;
     ASSERT_TRUE(loadQuietStage((dir / "spin.json").string(), &stage, &error)) << error;
-    const int width = 160, height = 90;
-    TracedFrame frame[2];
-    for (int i = 0; i < 2; ++i) {
-        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, Model::Relativistic, 0, 0);
-        tracer.setShadeDoppler(i == 1);
-        frame[i] = tracer.traceFrame(0, width, height);
-    }
-    const std::array<double, 4> base4 = objectBaseColor(stage.objects, 0);
-    const std::array<double, 3> base{base4[0], base4[1], base4[2]};
-    long long checked = 0;
-    double worst = 0, smallest_d = INFINITY, largest_d = 0;
-    for (int py = 0; py < height; ++py)
-        for (int px = 0; px < width; ++px) {
-            const size_t p = size_t(py * width + px);
-            if (frame[0].object[p] < 0) continue;
-            const Vec3 d = pixelDirection(stage.scene.camera, width, height, px, py);
-            const Vec3 x = (x0.z / d.z) * d;
-            if (mesh4d::norm(x - x0) > 0.95) continue;
-            const Vec3 u = mesh4d::cross(w, x - x0);
-            const double D = std::sqrt(1 - mesh4d::dot(u, u)) / (1 + mesh4d::dot(u, d));
-            smallest_d = std::min(smallest_d, D);
-            largest_d = std::max(largest_d, D);
-            const std::array<double, 3> shifted = mesh4d::dopplerColour(base, D);
-            for (int c = 0; c < 3; ++c) {
-                const uint8_t plain = frame[0].image.rgb[3 * p + size_t(c)], doppler = frame[1].image.rgb[3 * p + size_t(c)];
-                if (plain < 100 || doppler < 100) continue;
-                const double expected = shifted[size_t(c)] / base[size_t(c)];
-                const double measured = srgbToLinear(doppler) / srgbToLinear(plain);
-                worst = std::max(worst, std::fabs(measured / expected - 1));
-                ++checked;
-            }
-        }
+    const DopplerRatios r = dopplerRatios(stage, 160, 90, 100, [&](const Vec3& d) -> std::optional<double> {
+        const Vec3 x = (x0.z / d.z) * d;
+        if (mesh4d::norm(x - x0) > 0.95) return std::nullopt;
+        const Vec3 u = mesh4d::cross(w, x - x0);
+        return std::sqrt(1 - mesh4d::dot(u, u)) / (1 + mesh4d::dot(u, d));
+    });
+    const long long checked = r.checked;
+    const double worst = r.worst, smallest_d = r.smallest_d, largest_d = r.largest_d;
     std::cout << "[spin doppler] " << checked << " channels checked, D in [" << smallest_d << ", " << largest_d
               << "], worst relative difference " << worst << "\n";
     EXPECT_GT(checked, 200);
