@@ -20,16 +20,12 @@
 #include "exporters/gltf.h"
 #include "exporters/obj.h"
 #include "exporters/ply.h"
+#include "file_bytes.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
 
 // Two objects, large enough for several blocks of each writer, with degenerate triangles.
 ExportFrame testFrame() {
@@ -58,7 +54,7 @@ std::string writeOn(int threads, bool ply, const ExportFrame& frame, const fs::p
     bool ok = false;
     arena.execute([&] { ok = ply ? writePly(file.string(), frame, &error) : writeObj(file.string(), frame, &error); });
     EXPECT_TRUE(ok) << error;
-    return readBytes(file);
+    return testio::readBytes(file);
 }
 
 }  // namespace
@@ -126,7 +122,7 @@ TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
         const fs::path file = dir / ("t" + std::to_string(threads) + ".glb");
         arena.execute([&] { ok = writeAnimatedGlb(file.string(), {frame}, info, {}, nullptr, &error); });
         ASSERT_TRUE(ok) << error;
-        bytes[threads - 1] = readBytes(file);
+        bytes[threads - 1] = testio::readBytes(file);
     }
     fs::remove_all(dir);
     EXPECT_TRUE(bytes[0] == bytes[1]);

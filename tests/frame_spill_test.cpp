@@ -22,16 +22,12 @@
 #include "exporters/frame_spill.h"
 #include "exporters/gltf.h"
 #include "exporters/ply.h"
+#include "file_bytes.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
 
 // A wavy n x n grid; `flip` cuts each quad along the other diagonal (another index list).
 mesh4d::ApparentMesh grid(int n, double phase, bool flip, double x0) {
@@ -124,7 +120,7 @@ Written write(const fs::path& file, const GlbOptions& options, bool by_reference
         installFrameSpill(-1, -1);  // the process's other tests encode frames whole
         ::close(spill);
     }
-    w.bytes = readBytes(file);
+    w.bytes = testio::readBytes(file);
     return w;
 }
 
@@ -284,7 +280,7 @@ TEST_F(FrameSpill, FrameFilesWrittenByTheirRankAreRenamedInPlace) {
     size_t files = 0;
     for (const auto& entry : fs::directory_iterator(direct)) {
         ++files;
-        EXPECT_TRUE(readBytes(entry.path()) == readBytes(ranks / entry.path().filename())) << entry.path();
+        EXPECT_TRUE(testio::readBytes(entry.path()) == testio::readBytes(ranks / entry.path().filename())) << entry.path();
     }
     EXPECT_EQ(files, 6u);
     EXPECT_EQ(size_t(std::distance(fs::directory_iterator(ranks), fs::directory_iterator())), 6u) << "a temporary left";
@@ -310,7 +306,7 @@ TEST_F(FrameSpill, FrameFilesWrittenByTheirRankAreRenamedInPlace) {
     f.index = 21;
     e = sink->encode(f, sink->prepare(f).get());
     sink->beforeSending(21, &e);
-    EXPECT_EQ(readBytes(planted), "planted");
+    EXPECT_EQ(testio::readBytes(planted), "planted");
     EXPECT_FALSE(sink->addEncoded(21, e, &completed, &error));
     EXPECT_EQ(error.rfind((ranks / "frame_00021.ply").string() + ": cannot create " + planted.string() + ": ", 0), 0u)
         << error;

@@ -26,6 +26,7 @@
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
 #include "pipeline/scene.h"
+#include "file_bytes.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -55,13 +56,6 @@ private:
     fs::path cwd_, root_;
     static inline int counter_ = 0;
 };
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 std::vector<fs::path> filesUnder(const fs::path& dir) {
     std::vector<fs::path> out;
@@ -200,7 +194,7 @@ TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
     ExportFrame small = frame;
     small.objects[0].triangles.resize(1);
     ASSERT_TRUE(writePly(path, small, &error)) << error;
-    const std::string previous = slurp(path);
+    const std::string previous = testio::readBytes(path);
 
     struct sigaction ignore {}, old_action {};
     ignore.sa_handler = SIG_IGN;
@@ -216,7 +210,7 @@ TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
 
     EXPECT_FALSE(ok);
     EXPECT_NE(error.find("frame_00000.ply: cannot write (4096 of "), std::string::npos) << error;
-    EXPECT_EQ(slurp(path), previous);
+    EXPECT_EQ(testio::readBytes(path), previous);
     EXPECT_EQ(filesUnder(box / "out").size(), 1u);
 }
 
@@ -251,7 +245,7 @@ TEST(HostileInput, MaterialLibrariesAreNeverReadAndOnlyRegularFilesAre) {
     fs::create_directories(box / "s");
     ::mkfifo((box / "s/pipe.mtl").c_str(), 0600);  // opening it for reading would block forever
     std::ofstream(box / "s/m.obj") << "mtllib ../../../../../../../../dev/zero\nmtllib pipe.mtl\nmtllib /etc/passwd\n"
-                                   << slurp(source("data/fixtures/tetra.obj"));
+                                   << testio::readBytes(source("data/fixtures/tetra.obj"));
     const std::string scene = writeScene(box / "s", "m.obj");
     fs::current_path(box / "s");
     CommandResult r = apparentRun({"render", scene, "--out", (box / "out").string()});
@@ -355,7 +349,7 @@ TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
     const CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out",
                                          (box / "out").string(), "--format", "glb,ply,obj", "--quiet"});
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_EQ(slurp(box / "victim.txt"), "precious");
+    EXPECT_EQ(testio::readBytes(box / "victim.txt"), "precious");
     EXPECT_FALSE(fs::is_symlink(box / "out/relativistic.glb"));
     EXPECT_TRUE(fs::is_regular_file(box / "out/relativistic.glb"));
     // Only the planted links and the outputs: no temporary file, no spill file left.
@@ -379,7 +373,7 @@ TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
         fs::remove(out.tempPath());
     }
     EXPECT_FALSE(fs::exists(box / "out/swap.ply"));
-    EXPECT_EQ(slurp(box / "victim.txt"), "precious");
+    EXPECT_EQ(testio::readBytes(box / "victim.txt"), "precious");
     // Two outputs to one final name get two temporary names.
     AtomicOutput a((box / "out/x.png").string()), b((box / "out/x.png").string());
     EXPECT_NE(a.tempPath(), b.tempPath());

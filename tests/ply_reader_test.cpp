@@ -12,6 +12,7 @@
 #include "pipeline/mesh_check.h"
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
+#include "file_bytes.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -22,13 +23,6 @@ std::string fixture(const std::string& name) { return std::string(APPARENT_SOURC
 
 Status read(const std::string& path, mesh4d::RestMesh* m, MeshWarnings* w, const MeshLimits& limits = {}) {
     return readPly(path, limits, m, w);
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
 }
 
 }  // namespace
@@ -186,7 +180,7 @@ TEST(PlyReader, TruncatedPrefixesNeverCrash) {
     fs::create_directories(dir);
     const std::string path = (dir / "prefix.ply").string();
     for (const char* name : {"tetra_binary.ply", "tetra_ascii.ply"}) {
-        const std::string bytes = slurp(fixture(name));
+        const std::string bytes = testio::readBytes(fixture(name));
         size_t loaded = 0;
         for (size_t n = 0; n <= bytes.size(); ++n) {
             std::ofstream(path, std::ios::binary) << bytes.substr(0, n);

@@ -15,6 +15,7 @@
 #include "pipeline/distribute.h"
 #include "pipeline/shards.h"
 #include "run_command.h"
+#include "file_bytes.h"
 
 namespace fs = std::filesystem;
 
@@ -24,17 +25,12 @@ using testcli::apparentRun;
 using testcli::source;
 using testcli::TempDir;
 
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 // Every file under `dir` (relative names), leaving out the shards folder.
 std::map<std::string, std::string> outputs(const fs::path& dir) {
     std::map<std::string, std::string> files;
     for (const auto& e : fs::recursive_directory_iterator(dir)) {
         const std::string rel = fs::relative(e.path(), dir).string();
-        if (e.is_regular_file() && rel.rfind("shards", 0) != 0) files[rel] = readBytes(e.path());
+        if (e.is_regular_file() && rel.rfind("shards", 0) != 0) files[rel] = testio::readBytes(e.path());
     }
     return files;
 }
@@ -212,7 +208,7 @@ TEST(Shards, MergeRefusesMissingForeignDuplicatedShards) {
     expectOneLine(apparentRun({"merge", dir.str()}), "shard 1/3 of model relativistic again");
     fs::remove(shards / "copy.shard");
     // A shard cut short (a copy gone wrong): refused, not merged.
-    const std::string whole = readBytes(shards / "relativistic.2-of-3.shard");
+    const std::string whole = testio::readBytes(shards / "relativistic.2-of-3.shard");
     std::ofstream(shards / "relativistic.2-of-3.shard", std::ios::binary) << whole.substr(0, whole.size() - 100);
     expectOneLine(apparentRun({"merge", dir.str()}), "relativistic.2-of-3.shard");
     EXPECT_FALSE(fs::exists(dir / "relativistic.glb"));

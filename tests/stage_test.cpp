@@ -17,6 +17,7 @@
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 #include "run_command.h"
+#include "file_bytes.h"
 
 using namespace apparent;
 using testcli::apparentRun;
@@ -24,11 +25,6 @@ using testcli::source;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 // FNV-1a, 64 bits: a fingerprint of a file's bytes (not a cryptographic hash).
 uint64_t fnv1a(const std::string& bytes) {
@@ -92,7 +88,7 @@ TEST(Stage, GlbBytesPinnedAcrossTheRefactor) {
         const auto r = apparentRun(args);
         ASSERT_EQ(r.code, 0) << r.err;
         for (const auto& [name, hash] : cases[c].files)
-            EXPECT_EQ(fnv1a(readBytes(out / name)), hash) << "case " << c << ": " << name << " changed";
+            EXPECT_EQ(fnv1a(testio::readBytes(out / name)), hash) << "case " << c << ": " << name << " changed";
     }
     fs::remove_all(dir);
 }
@@ -101,7 +97,7 @@ namespace {
 
 // The vertices of a binary little-endian PLY with double x y z quality, in file order.
 std::vector<std::array<double, 4>> readPlyDoubles(const fs::path& p, size_t* faces) {
-    const std::string bytes = readBytes(p);
+    const std::string bytes = testio::readBytes(p);
     const size_t end = bytes.find("end_header\n");
     EXPECT_NE(end, std::string::npos);
     const std::string header = bytes.substr(0, end);
