@@ -22,6 +22,7 @@
 #include "pipeline/physics.h"
 #include "pipeline/worlds.h"
 #include "quiet_stage.h"
+#include "slab_rays.h"
 
 using apparent::Model;
 using mesh4d::Vec3;
@@ -330,43 +331,26 @@ TEST(Keyframes, RaytracedHitsLieOnTheRestSurfaceThroughTimeSlabs) {
     const double b = mesh4d::norm(V), g = 1 / std::sqrt(1 - b * b);
     const std::vector<double> samples = mesh4d::slabSamples(box, m, lo, hi, chord / (g * (1 + b)), 4096);
     ASSERT_GT(samples.size(), 3u);
+    auto rest_point = [&](const mesh4d::Event& e) {
+        // The boost into the frame of V about (0, origin), written out.
+        const double dt = e.t;
+        const Vec3 dx = e.x - origin, u = V / b;
+        const double T = g * (dt - mesh4d::dot(V, dx));
+        const Vec3 Y = dx + u * ((g - 1) * mesh4d::dot(dx, u)) - V * (g * dt);
+        // The pose there: centre P and turn R (columns from the unit vectors), q = R^T (Y - P).
+        const Vec3 P = mesh4d::keyedLocal(*m.keyed, T, {0, 0, 0}).y;
+        const Vec3 rel = Y - P;
+        return Vec3{mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {1, 0, 0}).y - P, rel),
+                    mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {0, 1, 0}).y - P, rel),
+                    mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {0, 0, 1}).y - P, rel)};
+    };
     double worst[2] = {0, 0};
     for (int pass = 0; pass < 2; ++pass) {
-        const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(box, m, pass == 0 ? samples : std::vector<double>{lo, hi}, false, false);
-        std::vector<mesh4d::TraceWorld> traces;
-        for (const auto& w : slabs) traces.push_back(mesh4d::prepareTrace(w));
-        int hits = 0;
-        for (int iy = -30; iy <= 30; ++iy)
-            for (int ix = -30; ix <= 30; ++ix) {
-                Vec3 d = Vec3{0.02 * ix, 0.02 * iy, -1};
-                d = d / mesh4d::norm(d);
-                mesh4d::Ray4D ray;
-                ray.origin = {t_c, camera};
-                ray.direction = d;
-                std::optional<mesh4d::WorldHit> best;
-                for (const auto& tr : traces)
-                    if (auto h = mesh4d::intersectWorld(tr, ray, best ? best->s : INFINITY)) best = h;
-                if (!best) continue;
-                ++hits;
-                // The boost into the frame of V about (0, origin), written out.
-                const double dt = best->event.t;
-                const Vec3 dx = best->event.x - origin, u = V / b;
-                const double T = g * (dt - mesh4d::dot(V, dx));
-                const Vec3 Y = dx + u * ((g - 1) * mesh4d::dot(dx, u)) - V * (g * dt);
-                // The pose there: centre P and turn R (columns from the unit vectors), q = R^T (Y - P).
-                const Vec3 P = mesh4d::keyedLocal(*m.keyed, T, {0, 0, 0}).y;
-                Vec3 q;
-                const Vec3 rel = Y - P;
-                const double qc[3] = {mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {1, 0, 0}).y - P, rel),
-                                      mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {0, 1, 0}).y - P, rel),
-                                      mesh4d::dot(mesh4d::keyedLocal(*m.keyed, T, {0, 0, 1}).y - P, rel)};
-                q = {qc[0], qc[1], qc[2]};
-                const auto& t = box.triangles[best->triangle];
-                const Vec3 a = box.positions[t[0]], n_f = mesh4d::cross(box.positions[t[1]] - a, box.positions[t[2]] - a);
-                worst[pass] = std::max(worst[pass], std::fabs(mesh4d::dot(q - a, n_f / mesh4d::norm(n_f))));
-            }
+        const testslab::OffPlanes r =
+            testslab::slabHitsOffTheirPlanes(box, m, pass == 0 ? samples : std::vector<double>{lo, hi}, t_c, camera, rest_point);
+        worst[pass] = r.worst;
         if (pass == 0) {
-            EXPECT_GT(hits, 100);
+            EXPECT_GT(r.hits, 100);
         }
     }
     EXPECT_LE(worst[0], 2 * chord);
