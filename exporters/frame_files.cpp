@@ -3,14 +3,20 @@
 #include "exporters/atomic_file.h"
 #include "exporters/frame_spill.h"
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <system_error>
 #include <utility>
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 namespace apparent {
@@ -105,6 +111,76 @@ bool isWrittenFrame(const std::string& bytes) {
            std::memcmp(bytes.data(), kWrittenMarker, sizeof kWrittenMarker) == 0;
 }
 
+// The test hook (kKillAfterWritingVariable): whether this rank dies after writing `final_path`.
+bool killAfterWriting(const std::string& final_path) {
+    static const char* const victim = std::getenv(kKillAfterWritingVariable);
+    return victim != nullptr && final_path == victim;
+}
+
+// A rank's removal of every rank's temporaries on an interrupt (removeFrameTemporariesOnInterrupt):
+// fixed storage a signal handler reads; the folder count is published after the folders.
+constexpr int kFolders = 8;
+constexpr size_t kMaxPath = 4096;
+char g_folders[kFolders][kMaxPath];
+char g_infix[64];  // ".tmp-TOKEN."
+std::atomic<int> g_folder_count{0};
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+struct sigaction g_previous[std::size(kSignals)];
+
+// One entry as the getdents64 system call returns it (the kernel's struct linux_dirent64).
+struct DirectoryEntry {
+    uint64_t ino;
+    int64_t offset;
+    unsigned short length;
+    unsigned char type;
+    char name[1];
+};
+
+bool isRunTemporary(const char* name, const char* infix) {
+    return std::strncmp(name, ".frame_", 7) == 0 && std::strstr(name, infix) != nullptr;
+}
+
+// Async-signal-safe (system calls and string functions only): unlinks every run temporary in
+// `folder`, scanning again after a scan that removed some (entries removed during a scan may hide
+// others from it), at most four times.
+void removeRunTemporaries(const char* folder, const char* infix) {
+    const int fd = ::open(folder, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return;
+    alignas(8) char buffer[8192];
+    bool removed = true;
+    for (int scan = 0; removed && scan < 4; ++scan) {
+        removed = false;
+        if (::lseek(fd, 0, SEEK_SET) != 0) break;
+        for (;;) {
+            const long n = ::syscall(SYS_getdents64, fd, buffer, sizeof buffer);
+            if (n <= 0) break;
+            for (long at = 0; at < n;) {
+                const auto* e = reinterpret_cast<const DirectoryEntry*>(buffer + at);
+                if (isRunTemporary(e->name, infix) && ::unlinkat(fd, e->name, 0) == 0) removed = true;
+                at += e->length;
+            }
+        }
+    }
+    ::close(fd);
+}
+
+void onInterrupt(int sig) {
+    const int saved = errno;
+    const int folders = g_folder_count.load();
+    for (int i = 0; i < folders; ++i) removeRunTemporaries(g_folders[i], g_infix);
+    errno = saved;
+    for (size_t i = 0; i < std::size(kSignals); ++i) {
+        if (kSignals[i] != sig) continue;
+        const struct sigaction& before = g_previous[i];
+        if (before.sa_handler == SIG_DFL) {
+            ::signal(sig, SIG_DFL);
+            ::raise(sig);
+        } else if (before.sa_handler != SIG_IGN) {
+            before.sa_handler(sig);
+        }
+    }
+}
+
 }  // namespace
 
 std::string FrameFileSink::temporaryPath(long long k) const {
@@ -139,6 +215,7 @@ void FrameFileSink::beforeSending(long long index, EncodedOutput* frame) {
         if (::close(fd) != 0 && why.empty()) why = final_path + ": cannot write: " + std::strerror(errno);
         if (!why.empty()) ::unlink(temp.c_str());
     }
+    if (why.empty() && killAfterWriting(final_path)) ::raise(SIGKILL);
     // Step: its description replaces the bytes.
     std::string d(kWrittenMarker, sizeof kWrittenMarker);
     putU64(&d, why.empty() ? uint64_t(st.st_size) : 0);
@@ -147,27 +224,12 @@ void FrameFileSink::beforeSending(long long index, EncodedOutput* frame) {
     frame->bytes = std::move(d);
 }
 
-void FrameFileSink::expectEncoded(long long index) {
-    if (!frameSpillInstalled() || expected_.count(index)) return;
-    // At most kRegisteredMost names of other ranks' frames at once per sink: the interrupt
-    // cleanup's other slots stay for this process's own temporaries (the .glb's among them).
-    constexpr size_t kRegisteredMost = 16;
-    size_t registered = 0;
-    for (const auto& e : expected_) registered += e.second >= 0 ? 1 : 0;
-    expected_[index] = registered < kRegisteredMost ? registerTemporary(temporaryPath(index)) : -1;
-}
-
 void FrameFileSink::dropEncoded(long long first, long long last_excl) {
     if (!frameSpillInstalled() || frameRunToken().empty()) return;
     for (long long k = first; k < last_excl; ++k) ::unlink(temporaryPath(k).c_str());
-    for (const auto& e : expected_) unregisterTemporary(e.second);
-    expected_.clear();
 }
 
-FrameFileSink::~FrameFileSink() {
-    unregisterTemporary(sent_slot_);
-    for (const auto& e : expected_) unregisterTemporary(e.second);
-}
+FrameFileSink::~FrameFileSink() { unregisterTemporary(sent_slot_); }
 
 bool FrameFileSink::addEncoded(long long index, const EncodedOutput& frame, std::vector<std::string>* completed,
                                std::string* error) {
@@ -191,17 +253,37 @@ bool FrameFileSink::addEncoded(long long index, const EncodedOutput& frame, std:
             *error = p + ": cannot rename from " + temp + ": " + std::strerror(errno);
             return false;
         }
-        const auto e = expected_.find(index);
-        if (e != expected_.end()) {
-            unregisterTemporary(e->second);
-            expected_.erase(e);
-        }
         completed->push_back(p);
         return true;
     }
     AtomicOutput out(p);
     if (!out.commitBytes(frame.bytes, error)) return false;
     completed->push_back(p);
+    return true;
+}
+
+bool removeFrameTemporariesOnInterrupt(const std::string& token, const std::vector<std::string>& folders) {
+    const std::string infix = ".tmp-" + token + ".";
+    if (folders.size() > size_t(kFolders) || infix.size() >= sizeof g_infix) return false;
+    for (const std::string& f : folders)
+        if (f.size() >= kMaxPath) return false;
+    // Step: the folders, then their count (a handler sees either set whole).
+    g_folder_count.store(0);
+    std::memcpy(g_infix, infix.c_str(), infix.size() + 1);
+    for (size_t i = 0; i < folders.size(); ++i) std::memcpy(g_folders[i], folders[i].c_str(), folders[i].size() + 1);
+    g_folder_count.store(int(folders.size()));
+    // Step: once per process, the handlers, in front of those installed before.
+    static bool installed = false;
+    if (installed) return true;
+    installed = true;
+    for (size_t i = 0; i < std::size(kSignals); ++i) {
+        if (::sigaction(kSignals[i], nullptr, &g_previous[i]) != 0 || g_previous[i].sa_handler == SIG_IGN ||
+            (g_previous[i].sa_flags & SA_SIGINFO))
+            continue;
+        struct sigaction sa = g_previous[i];
+        sa.sa_handler = &onInterrupt;
+        ::sigaction(kSignals[i], &sa, nullptr);
+    }
     return true;
 }
 

@@ -8,19 +8,25 @@
 // (TOKEN: the run's random token; created exclusively, never through a link, synced), and sends
 // only its size and inode, or the write's error. Rank 0 checks the budget as for its own frames and
 // renames the file into place in frame order (addEncoded: the same bytes, messages and order as one
-// process). Nothing is left behind: rank 0 registers for its interrupt cleanup the name of each
-// rank's frame under way (expectEncoded: the next frame of a rank, from the receipt of its previous
-// one; a rank writes one frame at a time) and of each one received and not yet renamed, and
-// removes every such name of the sequence when the run fails (dropEncoded). A rank killed by
-// SIGKILL while rank 0 lives leaves its frame under way to rank 0's cleanup when mpirun ends rank 0
-// with SIGTERM. Rank 0 registers at most 16 such names per sink at once (the cleanup has 64 slots,
-// shared with its own temporaries): from about 14 ranks on, a killed rank's frame under way may
-// stay, as AtomicOutput's temporary does after SIGKILL (a hidden .tmp- name, never a final file).
+// process). Nothing is left behind: every rank registers every model's frame folder before any
+// rank writes a file there (removeFrameTemporariesOnInterrupt, from pipeline/distribute.cpp's
+// shareFrameSpills): on SIGINT, SIGTERM or SIGHUP a rank removes every temporary of the run there
+// by its name's pattern, whichever rank made it and however many ranks there are. A rank killed by
+// SIGKILL (the OOM killer) leaves its frame under way to the others, which mpirun then ends with
+// SIGTERM (also the first frame of the next model, `--model all`, made before rank 0 is done with
+// the model before). When the run fails, rank 0 removes every such name of the sequence after the
+// other ranks stopped sending (dropEncoded). Bounds: Open MPI 4.1's mpirun sent its SIGKILL 3 ms
+// after its SIGTERM here (strace; odls_base_sigkill_timeout 1 s notwithstanding), so the removal
+// needs one rank, any, to run its handler in that time (24 runs of 3 and of 20 ranks on 2 cores
+// left no temporary; tests/mpi/mpi_test.sh; with rank 0 alone removing, 20 ranks left some in 5
+// runs of 6); a launcher that waits (Slurm's KillWait, 30 s by default) leaves time enough. Every rank killed at once by SIGKILL can
+// leave the temporaries of frames under way, as AtomicOutput leaves its own (hidden .tmp- names,
+// never a final file).
 // Without shared spills the bytes travel to rank 0, which commits them (addEncoded).
 #pragma once
 
-#include <map>
 #include <string>
+#include <vector>
 
 #include "exporters/frame_sink.h"
 
@@ -47,7 +53,6 @@ public:
                     std::string* error) override;
     bool beginEncoding(const SequenceInfo& info, std::string* error) override;
     void beforeSending(long long index, EncodedOutput* frame) override;
-    void expectEncoded(long long index) override;
     void dropEncoded(long long first, long long last_excl) override;
     ~FrameFileSink() override;
 
@@ -55,10 +60,24 @@ private:
     std::string path(long long k) const;
     std::string temporaryPath(long long k) const;  // a rank's file for frame k (shared spills only)
     int sent_slot_ = -1;                            // a rank: its last frame's name, for its interrupt cleanup
-    std::map<long long, int> expected_;             // rank 0: frames of other ranks under way -> their slots
     std::string dir_, extension_;
     FrameWriter write_;
     FrameSerializer serialize_;
 };
+
+// Each rank of a run whose ranks write frame files (above): from now on an interrupt (SIGINT,
+// SIGTERM, SIGHUP) removes, before exporters/atomic_file.h's cleanup runs, every file named
+// ".frame_*.tmp-TOKEN.*" in each of `folders` (TOKEN: `token`, the run's frameRunToken()). To be
+// called before any rank can write such a file; a later call replaces the folders. At most 8
+// folders (one per model), each path under 4096 bytes: false, and nothing registered, beyond. The
+// handlers run before the ones installed before (installInterruptCleanup's); a signal ignored
+// stays ignored, one left to its default action takes it after the removal.
+bool removeFrameTemporariesOnInterrupt(const std::string& token, const std::vector<std::string>& folders);
+
+// Test hook of tests/mpi/mpi_test.sh: when the environment variable APPARENT_KILL_AFTER_WRITING
+// names a frame file's final path, the rank that writes that frame (beforeSending) sends itself
+// SIGKILL once the file's temporary is written and closed, before sending: a rank killed with its
+// frame under way, at a frame the test chooses.
+constexpr const char* kKillAfterWritingVariable = "APPARENT_KILL_AFTER_WRITING";
 
 }  // namespace apparent

@@ -98,9 +98,6 @@ public:
     // cut frame `index`, in frame order just before the frame is sent: the sink may write it where
     // the writing process finds it, leaving a description in `frame` (the default: nothing).
     virtual void beforeSending(long long /*index*/, EncodedOutput* /*frame*/) {}
-    // On the writing process: another process may write for frame `index` from now on (called
-    // once per such frame, before it arrives; the default: nothing).
-    virtual void expectEncoded(long long /*index*/) {}
     // On the writing process when the loop ends without finishing, after every other process
     // stopped sending: whatever they wrote for frames [first, last_excl) and was not taken goes.
     virtual void dropEncoded(long long /*first*/, long long /*last_excl*/) {}

@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include "exporters/frame_files.h"
 #include "exporters/frame_spill.h"
 
 namespace apparent {
@@ -98,7 +99,7 @@ bool FrameGroup::receiveFrame(int from, std::string* bytes, int* code, std::stri
     return true;
 }
 
-bool shareFrameSpills(const std::string& dir, std::string* why) {
+bool shareFrameSpills(const std::string& dir, const std::vector<std::string>& frame_folders, std::string* why) {
     FrameGroup& group = frameGroup();
     // Step: one name per rank, from a token rank 0 draws (names of other runs cannot clash).
     std::string token;
@@ -111,11 +112,14 @@ bool shareFrameSpills(const std::string& dir, std::string* why) {
     auto name = [&](int rank) {
         return (std::filesystem::path(dir) / (".apparent-frames-" + token + "." + std::to_string(rank))).string();
     };
-    // Step: every rank its own file.
+    // Step: every rank its own file; and from now on, before any rank can make a frame file (they
+    // make them after the agreements below), an interrupt on any rank removes every rank's.
     const std::string mine = name(group.rank());
     const int fd = ::open(mine.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
     std::string error = fd < 0 ? mine + ": cannot create: " + std::strerror(errno) : std::string();
-    int code = group.agree(fd < 0 ? 1 : 0, &error);
+    if (fd >= 0 && !removeFrameTemporariesOnInterrupt(token, frame_folders))
+        error = dir + ": too many frame folders or too long a path for the interrupt cleanup";
+    int code = group.agree(error.empty() ? 0 : 1, &error);
     // Step: rank 0 opens them all, then no name is left.
     if (code == 0 && group.rank() == 0) {
         for (int r = 0; r < group.size(); ++r) {

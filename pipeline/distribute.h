@@ -120,8 +120,12 @@ public:
 // as rank 0's frame placer); its PLY and OBJ files are written by the rank, renamed by rank 0.
 // False on every rank, the reason in `why` on rank 0, when a rank cannot create its file or rank 0
 // cannot see it (the folder is not on a file system every rank shares): the frames then travel
-// whole, as to a writer without spills. Collective.
-bool shareFrameSpills(const std::string& dir, std::string* why);
+// whole, as to a writer without spills. `frame_folders`: every folder the ranks may write PLY or
+// OBJ frames into (one per model), registered on every rank before any rank can (an interrupt of
+// any rank removes every rank's frame under way: removeFrameTemporariesOnInterrupt,
+// exporters/frame_files.h).
+// Collective.
+bool shareFrameSpills(const std::string& dir, const std::vector<std::string>& frame_folders, std::string* why);
 
 // The group of this process (single until setFrameGroup installs another).
 FrameGroup& frameGroup();

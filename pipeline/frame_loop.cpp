@@ -145,9 +145,6 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     const bool sender = settings.distributed && group.rank() > 0;
     const bool receiver = settings.distributed && group.rank() == 0 && group.size() > 1;
     const FrameSplit split = settings.split;
-    // Every other rank may make its first frame as soon as it has its worlds (FrameSink::expectEncoded).
-    for (long long k = first + 1; receiver && k < std::min(last_excl, first + group.size()); ++k)
-        for (FrameSink* sink : sinks) sink->expectEncoded(k);
     // Step: the static 4D worlds and the mirrors' reflections, once per model.
     const std::vector<mesh4d::World4D> worlds = take && stage.mirrors.empty()
                                                     ? takeWorlds(take, model, scene, first, last_excl - 1)
@@ -340,10 +337,6 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         for (; !stop && remote_next < until; ++remote_next) {
             const int from = FrameSplit{0, group.size()}.partOf(remote_next, first);
             if (from == 0) continue;
-            // The rank may make its next frame once this one's send is matched (FrameSink::
-            // expectEncoded): registered before the receive, so that no file of it can exist unregistered.
-            if (remote_next + group.size() < last_excl)
-                for (FrameSink* sink : sinks) sink->expectEncoded(remote_next + group.size());
             std::vector<std::string> parts;
             auto w = std::make_shared<Work>();
             w->encoded = std::make_unique<EncodedFrame>();

@@ -124,10 +124,11 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
 
     // DIR/<model> folders of per-frame files that did not exist (seen before the ranks start: they
     // make them too, exporters/frame_files.h)
-    std::vector<std::string> created;
+    std::vector<std::string> created, model_folders;
     for (Model model : stage.models) {
         const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
         if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
+        model_folders.push_back(folder);
     }
     if (settings.sharded) {
         const std::string shards = (std::filesystem::path(settings.out_dir) / "shards").string();
@@ -136,7 +137,7 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
     // Step (MPI): the ranks write their frames' data (the .glb's) and files (PLY, OBJ) themselves
     // when rank 0 sees their files.
     const bool glb = std::find(settings.formats.begin(), settings.formats.end(), "glb") != settings.formats.end();
-    if (distributed && !shareFrameSpills(settings.out_dir, &error) && !settings.quiet)
+    if (distributed && !shareFrameSpills(settings.out_dir, model_folders, &error) && !settings.quiet)
         err << "warning: " << error << "; the " << (glb ? ".glb's frame data" : "frames' files")
             << " goes through rank 0 instead (slower)\n";
 

@@ -5,7 +5,8 @@
 # without a .glb, each rank writing its own frames' files;
 # raytrace's PNG files and video; figure's sheet and video), a
 # failure on any rank ends the job with the one-process code and one line from rank 0 and no
-# output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file.
+# output, and a rank killed with SIGKILL mid-run ends the job non-zero with no truncated file and
+# no temporary (also at a model switch and with 20 ranks: 20 ranks give the one-process bytes too).
 # Usage: mpi_test.sh APPARENT SOURCE_DIR   (ctest sets OpenMPI's run-as-root variables for it)
 set -u
 # Under scripts/sanitize.sh: AddressSanitizer's checks stay on in every rank, its leak report off
@@ -177,6 +178,48 @@ while IFS= read -r -d '' f; do
     esac
 done < <(find "$work/killed" -type f -print0 2>/dev/null)
 echo "killed run: mpirun exit $code, $written complete files, none truncated"
+
+# Step: a rank killed at a frame chosen here (APPARENT_KILL_AFTER_WRITING, exporters/frame_files.h:
+# the rank that writes that frame's file sends itself SIGKILL once the file's temporary is
+# written, before sending it): mpirun exits non-zero, the frame's temporary is gone (rank 0
+# removes the run's temporaries by their names' pattern when mpirun ends it), every file present is
+# complete. Two cases: the first frame of the second model, made by rank 1 after the first
+# model's end (`--model A,B`: the model switch); and with 20 ranks the first frame of rank 19,
+# 19 frames of other ranks under way at once (rank 0 once registered 16 names at most).
+kill_at() {  # RANKS FRAME_FILE (relative to the output folder) ARGS...
+    local ranks=$1 victim=$2
+    shift 2
+    rm -rf "$work/chosen" "$work/chosen.one"
+    "$apparent" "$@" --out "$work/chosen.one" --quiet || fail "one process: $*"
+    APPARENT_KILL_AFTER_WRITING="$work/chosen/$victim" timeout 300 mpirun --oversubscribe -n "$ranks" \
+        -x APPARENT_KILL_AFTER_WRITING "$apparent" "$@" --out "$work/chosen" --quiet --threads 1 > /dev/null 2>&1
+    local code=$? files=0
+    [ "$code" != 0 ] || fail "killed at $victim, $ranks ranks: mpirun exited 0"
+    [ ! -e "$work/chosen/$victim" ] || fail "killed at $victim, $ranks ranks: the frame was renamed into place"
+    while IFS= read -r -d '' f; do
+        rel=${f#"$work/chosen/"}
+        case "$rel" in
+            *.tmp-*) fail "killed at $victim, $ranks ranks: temporary file left: $rel" ;;
+            *) cmp -s "$f" "$work/chosen.one/$rel" || fail "killed at $victim: not complete: $rel"; files=$((files + 1)) ;;
+        esac
+    done < <(find "$work/chosen" -type f -print0 2>/dev/null)
+    echo "killed at $victim with $ranks ranks: mpirun exit $code, $files complete files, no temporary"
+}
+kill_at 3 instant/frame_00041.ply render data/scenes/flanges.json --format ply --frames 40:100 --model relativistic,instant
+kill_at 3 instant/frame_00041.obj render data/scenes/flanges.json --format obj,glb --frames 40:100 --model relativistic,instant
+kill_at 20 relativistic/frame_00059.ply render data/scenes/flanges.json --format ply,glb --frames 40:100
+
+# More ranks than rank 0 once kept names for (16 per sink): 20 processes, the same bytes, also
+# with fewer frames than processes (ranks without a frame).
+for frames in 40:100 40:50; do
+    rm -rf "$work/one" "$work/twenty"
+    "$apparent" render data/scenes/flanges.json --out "$work/one" --quiet --format ply,obj,glb --frames $frames ||
+        fail "one process: frames $frames"
+    timeout 300 mpirun --oversubscribe -n 20 "$apparent" render data/scenes/flanges.json --out "$work/twenty" --quiet \
+        --threads 1 --format ply,obj,glb --frames $frames 2> "$work/stderr.txt" ||
+        fail "mpirun -n 20, frames $frames: $(cat "$work/stderr.txt")"
+    diff -r "$work/one" "$work/twenty" > /dev/null || fail "outputs differ with 20 processes, frames $frames"
+done
 
 [ "$failures" = 0 ] && echo "mpi_test: all passed"
 exit $((failures > 0))
