@@ -255,6 +255,42 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
     return j == j ? j : INFINITY;
 }
 
+// The kink term of key i over the triangle on a hyperplane (header, "On a hyperplane"): with
+// g_k = t_c - t(s_i, q_k) at the corners (g is affine in q there), a = max(g_k, 0), b = max(-g_k, 0)
+// at their largest, the term is D_hi a b / (a + b), D_hi = the least corner D plus L_D d (D's
+// Lipschitz bound of keyKink above, no n). 0 when the corners do not straddle the plane; INFINITY
+// when the carried bounds do not close.
+double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const CornerCrossing c[3], double d) {
+    const KeyedMotion& k = *m.keyed;
+    const bool lorentz = m.kinematics == Kinematics::Lorentz;
+    const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
+    const Vec3 V = lorentz ? m.velocity : Vec3{0, 0, 0};
+    const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
+    auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
+    auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
+    double above = 0, below = 0, D_min = INFINITY, x_max = 0, lam_min = INFINITY;
+    for (int q = 0; q < 3; ++q) {
+        const double gk = view.t_c - worldlineEvent(m, s, c[q].q).t;
+        above = std::max(above, gk);
+        below = std::max(below, -gk);
+        const Vec3 dya = keyedSegmentLocal(k, i, s, c[q].q).dy, dyb = keyedSegmentLocal(k, i + 1, s, c[q].q).dy;
+        const double ta = labT(dya), tb = labT(dyb);
+        const Vec3 xa = labX(dya), xb = labX(dyb);
+        if (!(ta > 0) || !(tb > 0)) return INFINITY;
+        D_min = std::min(D_min, norm(xb / tb - xa / ta));  // the shear's part: |t_s / Lambda| = 1 on both sides
+        x_max = std::max({x_max, norm(xa), norm(xb)});
+        lam_min = std::min({lam_min, ta, tb});
+    }
+    if (!(above > 0) || !(below > 0)) return 0;  // no straddle: no crossing on any segment p -> q_l
+    const double X = x_max + g * w * d;
+    const double L_lam = g * b * w;
+    const double lam_lo = lam_min - L_lam * d;
+    if (!(lam_lo > 0)) return INFINITY;
+    const double L_D = 2 * (g * w / lam_lo + X * L_lam / (lam_lo * lam_lo));
+    const double term = (D_min + L_D * d) * above * below / (above + below);
+    return term == term ? term : INFINITY;
+}
+
 }  // namespace
 
 PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
@@ -335,15 +371,16 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
             PieceBound out;
             out.K = K == K ? K : INFINITY;
             if (m.keyed) {
-                // The kinks (header): m_i j_i for each key in the window whose curve may meet the
-                // triangle.
+                // The kinks (header): on the cone m_i j_i d / sqrt(3) for each key in the window
+                // whose curve may meet the triangle; on a hyperplane the straddle term of each key.
                 const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
-                double kinks = 0;
+                double kinks = 0, plane = 0;
                 for (size_t i = span.first; i < span.last; ++i) {
-                    if (!keyMayCross(m, view, i, c)) continue;
-                    kinks += (cone ? 2 : 1) * keyKink(m, view, shear_speed, i, c, d);
+                    if (!cone) plane += keyKinkOnPlane(m, view, i, c, d);
+                    else if (keyMayCross(m, view, i, c)) kinks += 2 * keyKink(m, view, shear_speed, i, c, d);
                 }
-                out.kinks = kinks == kinks ? kinks : INFINITY;
+                const double kink = kinks * std::sqrt(d2 / 3) + plane;
+                out.kink = kink == kink ? kink : INFINITY;
             }
             return out;
         }

@@ -419,7 +419,8 @@ std::vector<KeyedCase> keyedCases() {
             {"corner, finite", corner, false, false, {11.0, 16.0}},
             {"corner, contracted", corner, true, true, {5.0}},
             {"turn key, relativistic", turn, true, false, {9.0}},
-            {"turn key, finite", turn, false, false, {9.0}}};
+            {"turn key, finite", turn, false, false, {9.0}},
+            {"turn key, contracted", turn, true, true, {4.0}}};
 }
 
 }  // namespace
