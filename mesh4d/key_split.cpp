@@ -130,7 +130,7 @@ struct Splitter {
         const PieceBound b = pieceBound(m, view, shear, c);
         double d2 = 0;
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
-        if (b.K < INFINITY) return b.kinks * std::sqrt(d2 / 3) > kKinkShare * T;
+        if (b.K < INFINITY) return b.kink > kKinkShare * T;
         const double lo = std::min({c[0].s, c[1].s, c[2].s}), hi = std::max({c[0].s, c[1].s, c[2].s});
         return keyedSegment(*m.keyed, lo) != keyedSegment(*m.keyed, hi);
     }

@@ -9,7 +9,7 @@
 // crosses. Split here first, only where the kink term is large, the pieces cluster along the curve:
 // O(1/T) triangles per unit length of it.
 //
-// The scheme. A triangle is split when its kink term (pieceBound: kinks d / sqrt(3), from its
+// The scheme. A triangle is split when its kink term (pieceBound's kink, from its
 // corners' exact crossings) exceeds 8 T, or when its bound does not close (K infinite) while its
 // corners' emission times straddle a key. worldline_refine.h's test then measures the error at a
 // sub-grid of up to 16 x 16 exact points and bounds only the sub-pieces, whose kink terms are at

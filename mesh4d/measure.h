@@ -1,7 +1,10 @@
 // Measured distance between an apparent mesh and the exact apparent surface, both directions,
-// shared by the tests, the accuracy benchmark and `apparent trade`. The exact surface is evaluated point by point
-// with the direct closed form (exactRelative below), independently of how the mesh was refined and
-// of the anchored form that made its points.
+// shared by the tests, the accuracy benchmark and `apparent trade`. The exact surface is evaluated
+// point by point, independently of how the mesh was refined: for uniform motion by the direct
+// closed form (not the anchored form that made the mesh's points); for the motions beyond uniform
+// (worldline.h: spin, rolling, acceleration, keyframed paths) by a root search of this file's own
+// (crossingBySearch: bracketing and plain bisection on the true worldline, worldlineEvent), not
+// by crossWorldline's Newton search nor by the refinement's grid points.
 #pragma once
 
 #include <algorithm>
@@ -10,14 +13,57 @@
 #include <vector>
 
 #include "slice.h"
+#include "worldline.h"
 
 namespace mesh4d::measure {
 
+// The crossing of rest point q's worldline with the view surface, by bisection. h(s) = (t_c - t(s))
+// - |x(s) - C| (cone) or t_c - t(s) (hyperplane), (t, x) = worldlineEvent(m, s, q), decreases
+// strictly along a timelike worldline (worldline.h), so its one root is bracketed by steps that
+// double from the guess s0 = t_c - t0 - |X0 + q - C| (1, 2, 4, ... up to 2^200 either way) and then
+// halved until the midpoint is one of the bracket's ends: s to the last bit of a double, the
+// event's rounding aside. About 60 worldline evaluations a point. Returns the lab event; ok = false
+// when no bracket was found (NaN or infinite input).
+inline Event crossingBySearch(const ViewSurface& view, const Motion& m, const Vec3& q, bool* ok = nullptr) {
+    const bool cone = view.kind == ViewKind::PastCone;
+    auto h = [&](double s) {
+        const Event e = worldlineEvent(m, s, q);
+        return (view.t_c - e.t) - (cone ? norm(e.x - view.apex) : 0.0);
+    };
+    const double s0 = view.t_c - m.t0 - (cone ? norm(m.origin + q - view.apex) : 0.0);
+    double lo = s0, hi = s0;
+    bool found = false;
+    if (h(s0) > 0) {
+        for (double step = 1; step < 1e60 && !found; step *= 2) {
+            hi = s0 + step;
+            if (h(hi) > 0) lo = hi;
+            else found = true;
+        }
+    } else {
+        for (double step = 1; step < 1e60 && !found; step *= 2) {
+            lo = s0 - step;
+            if (h(lo) <= 0) hi = lo;
+            else found = true;
+        }
+    }
+    if (ok) *ok = found;
+    for (int i = 0; i < 2200 && found; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        if (h(mid) > 0) lo = mid;
+        else hi = mid;
+    }
+    return worldlineEvent(m, std::fabs(h(lo)) <= std::fabs(h(hi)) ? lo : hi, q);
+}
 
-// The exact apparent point of rest point q relative to `origin`, by the direct closed form of the
-// cut from where the point is now (lightcone.h cutRestWorldline: one quadratic in the whole delay),
-// not by the anchored form (delay of the origin plus a second quadratic) that the mesh is made with.
+
+// The exact apparent point of rest point q relative to `origin`. Uniform motion: by the direct
+// closed form of the cut from where the point is now (lightcone.h cutRestWorldline: one quadratic
+// in the whole delay), not by the anchored form (delay of the origin plus a second quadratic) that
+// the mesh is made with. Other motions: crossingBySearch (their outputs are never sheared: the
+// callers refuse a moving camera for them).
 inline Vec3 exactRelative(const World4D& w, const ViewSurface& view, const Vec3& q, const Vec3& origin) {
+    if (!isUniform(w.motion)) return crossingBySearch(view, w.motion, q).x - origin;
     return cutRestWorldline(view, w.motion, nowBase(view, w.motion), q).x - origin;
 }
 

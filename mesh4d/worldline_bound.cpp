@@ -168,18 +168,15 @@ LabPair keyedFirstRates(const CornerCrossing c[3], const Motion& m, double s_lo,
 }
 
 // Whether the curve sigma = s_i may meet the triangle (header): the sign of
-// g(s_i, q) = t_c - t - |x - C| (t_c - t on a hyperplane) at the corners' events at s_i. t and x are
+// g(s_i, q) = t_c - t - |x - C| (t_c - t on a hyperplane) at the corners' events at s_i, e. t and x are
 // affine in q at a fixed s, so g is concave (affine on a hyperplane): corners all inside the cone
 // (g > 0) keep the whole triangle inside; corners all outside keep it outside when one corner's
 // tangent plane, g_a - (t_b - t_a) - n_a.(x_b - x_a) at the corners b, lies below 0 (a concave
 // function lies below its tangent planes; affine: the corners decide). Near 0 counts as crossing.
-bool keyMayCross(const Motion& m, const ViewSurface& view, size_t i, const CornerCrossing c[3]) {
+bool keyMayCross(const ViewSurface& view, const Event e[3]) {
     const bool cone = view.kind == ViewKind::PastCone;
-    const double s = m.keyed->s[i];
-    Event e[3];
     double g[3], scale = 1;
     for (int k = 0; k < 3; ++k) {
-        e[k] = worldlineEvent(m, s, c[k].q);
         g[k] = view.t_c - e[k].t - (cone ? norm(e[k].x - view.apex) : 0.0);
         scale = std::max(scale, std::fabs(view.t_c - e[k].t));
     }
@@ -200,9 +197,10 @@ bool keyMayCross(const Motion& m, const ViewSurface& view, size_t i, const Corne
 }
 
 // The kink's size per unit length at key i over the triangle (header): j(q) = |c(q)| D(q) at q's
-// event at s_i, exact at the corners, carried over the triangle by its Lipschitz bound. INFINITY
+// event at s_i (ev), exact at the corners, carried over the triangle by its Lipschitz bound. INFINITY
 // when the carried bounds do not close (the triangle may reach the camera or a Lambda 0).
-double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const CornerCrossing c[3], double d) {
+double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const CornerCrossing c[3],
+               const Event ev[3], double d) {
     const KeyedMotion& k = *m.keyed;
     const bool cone = view.kind == ViewKind::PastCone, lorentz = m.kinematics == Kinematics::Lorentz;
     const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
@@ -212,7 +210,7 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
     auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
     double rho_min = INFINITY, j_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0, lam_min = INFINITY;
     for (int q = 0; q < 3; ++q) {
-        const Event e = worldlineEvent(m, s, c[q].q);
+        const Event& e = ev[q];
         Vec3 n{0, 0, 0};
         if (cone) {
             const Vec3 r = e.x - view.apex;
@@ -255,6 +253,43 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
     return j == j ? j : INFINITY;
 }
 
+// The kink term of key i over the triangle on a hyperplane (header, "On a hyperplane"): with
+// g_k = t_c - t(s_i, q_k) at the corners' events ev at s_i (g is affine in q there), a = max(g_k, 0), b = max(-g_k, 0)
+// at their largest, the term is D_hi a b / (a + b), D_hi = the least corner D plus L_D d (D's
+// Lipschitz bound of keyKink above, no n). 0 when the corners do not straddle the plane; INFINITY
+// when the carried bounds do not close.
+double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const CornerCrossing c[3], const Event ev[3],
+                      double d) {
+    const KeyedMotion& k = *m.keyed;
+    const bool lorentz = m.kinematics == Kinematics::Lorentz;
+    const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
+    const Vec3 V = lorentz ? m.velocity : Vec3{0, 0, 0};
+    const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
+    auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
+    auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
+    double above = 0, below = 0, D_min = INFINITY, x_max = 0, lam_min = INFINITY;
+    for (int q = 0; q < 3; ++q) {
+        const double gk = view.t_c - ev[q].t;
+        above = std::max(above, gk);
+        below = std::max(below, -gk);
+        const Vec3 dya = keyedSegmentLocal(k, i, s, c[q].q).dy, dyb = keyedSegmentLocal(k, i + 1, s, c[q].q).dy;
+        const double ta = labT(dya), tb = labT(dyb);
+        const Vec3 xa = labX(dya), xb = labX(dyb);
+        if (!(ta > 0) || !(tb > 0)) return INFINITY;
+        D_min = std::min(D_min, norm(xb / tb - xa / ta));  // the shear's part: |t_s / Lambda| = 1 on both sides
+        x_max = std::max({x_max, norm(xa), norm(xb)});
+        lam_min = std::min({lam_min, ta, tb});
+    }
+    if (!(above > 0) || !(below > 0)) return 0;  // no straddle: no crossing on any segment p -> q_l
+    const double X = x_max + g * w * d;
+    const double L_lam = g * b * w;
+    const double lam_lo = lam_min - L_lam * d;
+    if (!(lam_lo > 0)) return INFINITY;
+    const double L_D = 2 * (g * w / lam_lo + X * L_lam / (lam_lo * lam_lo));
+    const double term = (D_min + L_D * d) * above * below / (above + below);
+    return term == term ? term : INFINITY;
+}
+
 }  // namespace
 
 PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
@@ -281,14 +316,20 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
         for (int i = 0; i < 3; ++i) nu_c = std::max(nu_c, dot(m.velocity, c[i].event.x - view.apex) / c[i].rho);
     double nu = std::min(b, nu_c + 0.01 * (b - nu_c));
     double spread = std::max(s_hi - s_lo, 1e-300);  // the window's margin about the corners' s
-    if (m.keyed) lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
-    if (!(lam_c > 0)) return none;
-    double lam_min = 0.9 * lam_c;
     // A keyframed path's rates depend on the window only through the segments it meets: taken
-    // again when those change.
+    // here and again when those change.
     SegmentSpan held{1, 0};
     FrameRates keyed_f;
     LabPair keyed_s1{0, 0, 0};
+    if (m.keyed) {
+        lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
+        if (!(lam_c > 0)) return none;
+        keyed_f = frameRates(m, c, s_lo - spread, s_hi + spread);
+        keyed_s1 = keyedFirstRates(c, m, s_lo - spread, s_hi + spread);  // its .c is not used
+        held = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
+    }
+    if (!(lam_c > 0)) return none;
+    double lam_min = 0.9 * lam_c;
     for (int iter = 0; iter < 24; ++iter) {
         FrameRates f;
         LabPair s1;
@@ -335,15 +376,18 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
             PieceBound out;
             out.K = K == K ? K : INFINITY;
             if (m.keyed) {
-                // The kinks (header): m_i j_i for each key in the window whose curve may meet the
-                // triangle.
+                // The kinks (header): on the cone m_i j_i d / sqrt(3) for each key in the window
+                // whose curve may meet the triangle; on a hyperplane the straddle term of each key.
                 const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
-                double kinks = 0;
+                double kinks = 0, plane = 0;
                 for (size_t i = span.first; i < span.last; ++i) {
-                    if (!keyMayCross(m, view, i, c)) continue;
-                    kinks += (cone ? 2 : 1) * keyKink(m, view, shear_speed, i, c, d);
+                    Event ev[3];  // the corners' events at the key's time, shared by the tests below
+                    for (int q = 0; q < 3; ++q) ev[q] = worldlineEvent(m, m.keyed->s[i], c[q].q);
+                    if (!cone) plane += keyKinkOnPlane(m, view, i, c, ev, d);
+                    else if (keyMayCross(view, ev)) kinks += 2 * keyKink(m, view, shear_speed, i, c, ev, d);
                 }
-                out.kinks = kinks == kinks ? kinks : INFINITY;
+                const double kink = kinks * std::sqrt(d2 / 3) + plane;
+                out.kink = kink == kink ? kink : INFINITY;
             }
             return out;
         }

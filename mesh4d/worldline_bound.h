@@ -114,6 +114,26 @@
 // straddles a key passes once it is about T / (m j) wide, so refinement concentrates where the
 // emission time crosses a key, and a sampled CUBICSPLINE path (many keys, each with a small jump)
 // pays for the sum of its small jumps, about its velocity change over the window, not for the count.
+// On a hyperplane (the contracted model) the kink term is taken exactly instead, term by term:
+//   - g_i(q) = t_c - t(s_i, q) is affine in q (t is, at a fixed s), so Gamma_i is a plane and its
+//     normal is the kink's own direction: c = t_q = -grad g_i, and [grad F] u = -(c.u) Dv with
+//     Dv = x_s+ / Lambda+ - x_s- / Lambda- (Lambda = t_s), |Dv| = D above.
+//   - the segment from p to corner q_l crosses Gamma_i once exactly when g_i(p), g_i(q_l) differ in
+//     sign, at a point y with g_i(y) = 0; its remainder there is |[grad F] (q_l - y)| =
+//     D(y) |c.(q_l - y)| = D(y) |g_i(q_l) - g_i(y)| = D(y) |g_i(q_l)|: no |c| |q_l - y| (Cauchy-Schwarz
+//     on a direction the plane may not be across) and no per-length constant at all.
+//   - summed with the weights l_l, with g_i(p) = sum_l l_l g_l (affine): the corners on the other
+//     side of p weigh min(P, N), P = sum_{g_l > 0} l_l g_l <= lambda a, N = sum_{g_l < 0} l_l |g_l|
+//     <= (1 - lambda) b (a, b the largest g_l and -g_l, lambda the weight of the positive corners),
+//     and min(lambda a, (1 - lambda) b) <= a b / (a + b) (equal at lambda = b / (a + b)).
+//   - D(y) at a point of the triangle: at most min_k D(q_k) + L_D d, L_D of the cone's argument
+//     with n = 0 (Lambda = t_s moves at most g b w per unit length); the shear's part of D is 0
+//     there (t_s / Lambda = 1 on both sides).
+// So on a hyperplane |F(p) - L(p)| <= K d^2 / 6 + sum_i (min_k D_i(q_k) + L_D d) a_i b_i / (a_i + b_i),
+// 0 for a key whose plane the corners do not straddle (a_i b_i = 0). For a plane across the
+// triangle (a = b = |c| d / 2 at most) that is D |c| d / 4 against the cone's D |c| d / sqrt(3), and
+// smaller still for a plane that cuts a corner off; the corners' a, b are exact (no Lipschitz
+// carry of c), and without a turn D is constant (L_D = 0).
 // For uniform motion (no curvature terms) K is the light delay's Hessian term of chord_error.h,
 // looser by the worst angles taken separately (G, L_F); worldline_refine.h therefore measures the
 // error at a sub-grid of exact points and uses K only for what lies between them.
@@ -139,12 +159,13 @@ struct CornerCrossing {
 // ok = false when the search failed (NaN or infinite input).
 CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Vec3& q, bool* ok);
 
-// The bound of one rest triangle: K above (per |u|^2) and, for a keyframed path, the sum over the
-// keys its emission times may cross of m_i j_i (per unit length; 0 for the other motions), so that
-// |F - L| <= K d^2 / 6 + kinks d / sqrt(3) on the triangle, d its longest side.
+// The bound of one rest triangle: K above (per |u|^2) and, for a keyframed path, the kink term
+// over the keys its emission times may cross (light-seconds; on the cone sum_i m_i j_i d / sqrt(3),
+// on a hyperplane the straddle term above; 0 for the other motions), so that
+// |F - L| <= K d^2 / 6 + kink on the triangle, d its longest side.
 struct PieceBound {
     double K = INFINITY;
-    double kinks = 0;
+    double kink = 0;
 };
 
 // The bound for the rest triangle with these corners (K = INFINITY when none holds: a triangle

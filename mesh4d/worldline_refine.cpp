@@ -97,7 +97,7 @@ struct Refiner {
         double d2 = 0;
         for (int i = 0; i < 3; ++i) d2 = std::max(d2, norm2(c[(i + 1) % 3].q - c[i].q));
         const PieceBound whole = pieceBound(m, view, shear, c);
-        if (whole.K * d2 / 6 + whole.kinks * std::sqrt(d2 / 3) <= T) return true;
+        if (whole.K * d2 / 6 + whole.kink <= T) return true;
         const Vec3 F[3] = {image(c[0]), image(c[1]), image(c[2])};
         std::vector<CornerCrossing> g, coarse;
         double eps = 0;  // measured at the points of every sub-grid so far (each holds the one before)
@@ -127,11 +127,11 @@ struct Refiner {
                 }
             if (!(eps <= T)) return false;  // measured over: no finer sub-grid can pass it
             // What lies between: each sub-piece's own bound K (its corners exact, its side d / sub).
-            const double scale = d2 / (6.0 * sub * sub), width = std::sqrt(d2 / 3) / sub;
+            const double scale = d2 / (6.0 * sub * sub);
             double rem = 0;
             auto bound = [&](const CornerCrossing piece[3]) {
                 const PieceBound pb = pieceBound(m, view, shear, piece);
-                return pb.K * scale + pb.kinks * width;
+                return pb.K * scale + pb.kink;
             };
             for (int b = 0; b < sub && eps + rem <= T; ++b)
                 for (int a = 0; a + b < sub && eps + rem <= T; ++a) {

@@ -5,17 +5,17 @@
 // The scheme. Each mesh triangle gets a level n, a power of two (1 = the triangle itself): it is
 // cut into the n x n grid of its barycentric coordinates (n^2 pieces), every grid point the exact
 // crossing of its worldline (crossWorldline). A piece passes when
-//     B(d) = K d^2 / 6 + J d / sqrt(3) <= T   (K and J the bounds of worldline_bound.h pieceBound
-//                       over the piece: the map's second derivative, and the kinks where a keyframed
+//     B = K d^2 / 6 + J <= T    (K and J the bounds of worldline_bound.h pieceBound over the
+//                       piece: the map's second derivative, and the kink term where a keyframed
 //                       path's emission time crosses a key, J = 0 for the other motions; d the
 //                       piece's longest rest side: no further cut), or, for the first m in
 //                       2, 4, 8, 16 where it holds,
-//     eps + max_k B_k(d / m) <= T,
+//     eps + max_k B_k <= T,
 // eps the largest measured |F - L| at the points of the piece's m x m sub-grid (exact crossings
-// against the piece's linear interpolant L), B_k the bound over sub-piece k from its own exact
-// corners. Sound: e = F - L has the second derivative and the kinks of F, so on sub-piece k, e lies
-// within B_k(d / m) of its linear interpolant there, whose largest value is at the sub-grid points
-// (worldline_bound.h gives the Taylor argument, kinks included); so |F - L| <= eps + max_k B_k(d / m)
+// against the piece's linear interpolant L), B_k the bound over sub-piece k (side d / m) from its
+// own exact corners. Sound: e = F - L has the second derivative and the kinks of F, so on sub-piece k, e lies
+// within B_k of its linear interpolant there, whose largest value is at the sub-grid points
+// (worldline_bound.h gives the Taylor argument, kinks included); so |F - L| <= eps + max_k B_k
 // on the whole piece. A piece with eps > T fails at once (that is a measured error). The measured term is
 // what makes the bound tight (K takes the worst angles separately; eps does not), and the sub-pieces'
 // own K (their Doppler term carried over a short distance only) what keeps K finite.

@@ -144,21 +144,6 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
     return tolerance_ok();
 }
 
-Status checkToleranceDial(const Scene& scene, const char* command) {
-    for (const ObjectSpec& s : scene.objects) {
-        if (s.keys)
-            return Status::failure(scene.path + ": " + s.keys_field + ": `apparent " + command +
-                                   "` sweeps the tolerance over uniform motion only (its families and cost model are "
-                                   "uniform motion's)");
-        const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
-        if (spin || accel)
-            return Status::failure(scene.path + ": " + s.field_path + (spin ? ".angular_velocity" : ".acceleration") +
-                                   ": `apparent " + command + "` sweeps the tolerance over uniform motion only (its "
-                                   "families and cost model are uniform motion's)");
-    }
-    return Status::success();
-}
-
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene) {
     return mesh4d::makeCameraMotion(scene.camera.position, scene.camera.velocity);
 }

@@ -35,10 +35,6 @@ constexpr double kMaxRapidity = 35.2;
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame);
 
-// For commands that sweep the tolerance (`apparent trade`): every object in uniform motion, else one
-// line naming the first spinning or accelerated object's field (the sweep's families are uniform motion's).
-Status checkToleranceDial(const Scene& scene, const char* command);
-
 // The camera's worldline (scene camera.position and camera.velocity).
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene);
 

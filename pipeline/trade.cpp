@@ -182,16 +182,20 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
         err << "error: " << error << "\n";
         return kExitBadInput;
     }
-    if (Status s = checkToleranceDial(stage.scene, "trade"); !s.ok) {
-        err << "error: " << s.message << "\n";
-        return kExitBadInput;
-    }
     if (stage.models.size() != 1) {
         err << "error: --model: trade measures one model at a time\n";
         return kExitBadInput;
     }
     const Model model = stage.models.front();
     const Scene& scene = stage.scene;
+    // Motions beyond uniform (spin, rolling, acceleration, keyframed paths) take the tolerance
+    // ladder only where `apparent render --tolerance` would (physics.h checkObjectMotion with a
+    // tolerance: no real cap, no mirror).
+    for (const auto& o : stage.objects)
+        if (Status s = checkObjectMotion(o, model, scene, 1.0, stage.first, stage.last_excl - 1); !s.ok) {
+            err << "error: " << s.message << " (`apparent trade` sweeps the tolerance)\n";
+            return kExitBadInput;
+        }
     std::vector<long long> frames;
     if (settings.has_frames) {
         for (long long k = stage.first; k < stage.last_excl; ++k) frames.push_back(k);
@@ -200,18 +204,27 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
         const long long n = std::min<long long>(5, total);
         for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
     }
-    if (model == Model::Instant || model == Model::Contracted) {
+    const std::vector<PreparedObject>& objects = stage.objects;
+    // Non-uniform: spinning, accelerated or keyframed (mesh4d/worldline.h).
+    auto beyondUniform = [](const ObjectSpec& s) {
+        return s.keys || mesh4d::norm(s.angular_velocity) > 0 || mesh4d::norm(s.acceleration) > 0;
+    };
+    const bool any_beyond = std::any_of(objects.begin(), objects.end(), [&](const PreparedObject& o) { return beyondUniform(o.spec); });
+    // The instant model cuts at one lab time, where every motion of worldline.h places the rest
+    // mesh affinely (one object time s for all its points); the contracted model too for uniform
+    // motion, but not for the others (s then varies over the body).
+    if (model == Model::Instant || (model == Model::Contracted && !any_beyond)) {
         out << "The " << modelName(model) << " model cuts the histories with a hyperplane: the map from the rest "
             << "mesh is affine, so vertex mode is exact (error 0) and no tolerance or subdivision changes it.\n";
         return kExitOk;
     }
-    const std::vector<PreparedObject>& objects = stage.objects;
     // The size tolerances are relative to: the largest moving object (objects at rest map affinely
     // and are never refined), or the largest object when none moves.
     double size = 0, size_any = 0;
     for (const auto& o : objects) {
         size_any = std::max(size_any, restSize(o.rest));
-        if (mesh4d::norm(o.spec.velocity) > 0 || o.spec.speed != ObjectSpec::Speed::Velocity) size = std::max(size, restSize(o.rest));
+        if (mesh4d::norm(o.spec.velocity) > 0 || o.spec.speed != ObjectSpec::Speed::Velocity || beyondUniform(o.spec))
+            size = std::max(size, restSize(o.rest));
     }
     if (size == 0) size = size_any;
     std::error_code ec;

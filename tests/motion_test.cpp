@@ -351,15 +351,6 @@ TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
                   std::string::npos)
             << error;
     }
-    {
-        apparent::Stage dial;
-        ASSERT_TRUE(apparent::loadQuietStage(ok, &dial, &error)) << error;
-        const apparent::Status t = apparent::checkToleranceDial(dial.scene, "trade");
-        EXPECT_FALSE(t.ok);
-        EXPECT_NE(t.message.find("ok.json: objects[0].angular_velocity: `apparent trade` sweeps the tolerance"),
-                  std::string::npos)
-            << t.message;
-    }
     apparent::Stage s6;
     EXPECT_FALSE(apparent::loadQuietStage(write("mirror.json", scene(", \"mirror\": true, \"angular_velocity\": [0, 0, 0.5]", "")),
                                           &s6, &error));

@@ -4,6 +4,7 @@
 // refused with one line; the affine models said to need nothing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -87,4 +88,53 @@ TEST(Trade, AffineModelsAndBadOptions) {
     const auto help = apparentRun({"trade", "--help"});
     EXPECT_EQ(help.code, 0);
     EXPECT_NE(help.out.find("--tolerances"), std::string::npos);
+}
+
+// Motions beyond uniform (issue 18): the shipped spinning wheel (rim at 0.9c, seen along its axis)
+// gets all three families; every tolerance row lies within its T (measured against the exact
+// surface from the true worldlines, measure.h crossingBySearch), and the error falls as T does and
+// as the uniform level rises. An object that cannot take a tolerance (a spinning one that begins
+// existing within the frames) is refused with one line naming its field.
+TEST(Trade, SpinningWheelAllFamiliesErrorFallsWithT) {
+    testcli::TempDir dir;
+    const auto r = apparentRun({"trade", source("data/scenes/spinning_wheel.json"), "--out", dir.str(), "--frames", "3:4",
+                                "--levels", "2", "--tolerances", "3e-2,1e-2,3e-3", "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(dir / "trade.csv");
+    ASSERT_EQ(rows.size(), 1u + 2u + 3u);
+    std::map<std::string, int> count;
+    double previous_uniform = INFINITY, previous_tolerance = INFINITY;
+    for (const auto& row : rows) {
+        ++count[row.at("family")];
+        const double error = std::stod(row.at("error_ls")), parameter = std::stod(row.at("parameter"));
+        EXPECT_GT(error, 0);
+        EXPECT_EQ(row.at("skipped"), "0");
+        if (row.at("family") == "uniform") {
+            EXPECT_LT(error, previous_uniform) << "level " << parameter;
+            previous_uniform = error;
+        }
+        if (row.at("family") == "tolerance") {
+            EXPECT_LE(error, parameter) << "T " << parameter;
+            EXPECT_LT(error, previous_tolerance) << "T " << parameter;
+            previous_tolerance = error;
+        }
+    }
+    EXPECT_EQ(count["vertex"], 1);
+    EXPECT_EQ(count["uniform"], 2);
+    EXPECT_EQ(count["tolerance"], 3);
+    EXPECT_NE(r.out.find("T = 0.003 x size"), std::string::npos) << r.out;
+
+    std::ifstream in(source("data/scenes/spinning_wheel.json"));
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string scene = text.str();
+    scene.replace(scene.find("\"../meshes/wheel.obj\""), 21, "\"" + source("data/meshes/wheel.obj") + "\", \"exists\": [0.3, 100]");
+    const fs::path path = dir / "exists.json";
+    std::ofstream(path) << scene;
+    const auto refused = apparentRun({"trade", path.string(), "--out", dir.str(), "--quiet"});
+    EXPECT_EQ(refused.code, 2);
+    EXPECT_NE(refused.err.find("exists.json: objects[0].angular_velocity: a spinning object that begins or ends existing"),
+              std::string::npos)
+        << refused.err;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
 }
