@@ -45,10 +45,11 @@
 //     bisected further but filled by a template (tessellate.h): the regular grid of level n
 //     (each triangle within T by the form), stitched along its sides to the equal segments its
 //     neighbours share (each edge cut into the largest level of the pieces around it; every
-//     stitched triangle checked against the form). A template of level 8 or more is kept whole:
-//     a neighbour whose split would halve it is filled by its own template instead. When such
-//     pieces would make less than half of the output, they are bisected like the rest
-//     (slice.cpp, "Templates").
+//     stitched triangle checked against the form). A template is kept whole: a neighbour whose
+//     split would halve it is filled by its own template instead, unless that one would make
+//     more than twice the triangles the neighbour's bisection is expected to (then the split
+//     is made and the template's halves are judged again). When such pieces would make less
+//     than half of the output, they are bisected like the rest (slice.cpp, "Templates").
 // |F - L| bounds both one-sided distances between the output and the exact surface, so the
 // two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
 // no triangle needs refining, identical to vertex mode's. Output order: the visible input
