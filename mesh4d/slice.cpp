@@ -1126,12 +1126,29 @@ struct FrameBuilder {
             if (displaced || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
                 candidates.push_back(uint32_t(f));
         }
+        // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits:
+        // ends in id order), when the candidates are enough to pay for the edge records' reset
+        // (a large mesh with a few candidates computes their edges per triangle instead).
+        const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
+        if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
         for (uint32_t f : candidates) {
             double c[3], xc[3];
             Vec3 sc[3];
             for (int k = 0; k < 3; ++k) {
-                const Edge& ed = world.edges[world.triangle_edges[f][k]];
-                c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                const uint32_t e = world.triangle_edges[f][k];
+                const Edge& ed = world.edges[e];
+                if (keep_edges) {
+                    REdge& re = r_edges[e];
+                    if (re.len != re.len) {
+                        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]);
+                        re.len = eb.length;
+                        re.c = eb.c;
+                        re.xm_mid = eb.xm_mid;
+                    }
+                    c[k] = re.c;
+                } else {
+                    c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                }
                 const uint32_t v = world.mesh.triangles[f][k];
                 sc[k] = r_terms[v].s;
                 xc[k] = r_terms[v].xm;
@@ -1159,7 +1176,7 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
+            if (!keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
             // Room for the pieces and points the refinement is expected to make (growth would copy them).
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
