@@ -60,11 +60,12 @@
 // appended; a templated piece gives its template's triangles in its place).
 // Cost: per output triangle of the bisection about two edge bounds, one and a fifth triangle
 // bounds, half a split (its point's square root and the slot bookkeeping) and the output; about
-// 1200 to 1600 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost
-// per output triangle", "Templates"), of which the two bounds' arithmetic is about 500. A
-// templated piece costs one form and its grid: a few tens of instructions per output triangle
-// besides its share of the batched cut (200 to 300 per output triangle where templates make most
-// of the output, 700 to 800 on the box 2 ls from the camera at T = 1e-4, 1e-5 x size).
+// 1300 to 1450 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost
+// per output triangle", "Coarse tolerances near the camera"), of which the two bounds are about
+// 450 and the records and the loop about 650. A templated piece costs one form and its grid: a
+// few tens of instructions per output triangle besides its share of the batched cut (200 to 360
+// per output triangle where templates make most of the output, the box 2 ls from the camera at
+// T = 1e-4, 1e-5 x size included).
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
 // grew them past 256 MiB.
