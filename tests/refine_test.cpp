@@ -836,8 +836,8 @@ TEST(Refine, TemplatedPiecesStayWatertightAndWithinTolerance) {
 // Near the camera every template is kept whole (slice.cpp, "Templates": a neighbour whose split
 // would halve one is filled by its own forced template, unless that would make more than
 // kForceRatio times the triangles its bisection is expected to): the box passing 2 ls from the
-// camera at closest approach, whose output at these tolerances is mostly such templates
-// (docs/ACCURACY.md, "Coarse tolerances near the camera"), stays one closed surface of genus 0,
+// camera at closest approach (at T = 1e-4 x size its output is mostly such templates:
+// docs/ACCURACY.md, "Coarse tolerances near the camera"), stays one closed surface of genus 0,
 // deterministic, and within T both ways (measured), the measured error at least half of T.
 TEST(Refine, KeptTemplatesNearTheCameraStayClosedAndWithinTolerance) {
     const TradeScene sc = boxNear();
