@@ -665,13 +665,20 @@ struct FrameBuilder {
             const int split = splitLongestPath(id, stack);
             if (split == kSplitBlocked) {
                 // The split would halve a piece a template fills: this piece is filled by its own
-                // template instead (any level its form asks for), so the template stays whole.
+                // template instead (any level its form asks for), so the template stays whole,
+                // unless that template would make more than kForceRatio times the triangles its
+                // bisection is expected to (then the split is made: the template's halves are
+                // judged again).
                 const uint32_t* v = rt[id].v;
                 const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
                 if (coarseForm(id, s, true)) {
-                    rt[id].state = kCoarse;
-                    scratch.coarse.push_back(id);
-                    continue;
+                    if (forcedTemplatePays(id)) {
+                        rt[id].state = kCoarse;
+                        scratch.coarse.push_back(id);
+                        continue;
+                    }
+                    scratch.form_of[id] = kUnset;
+                    scratch.forms.pop_back();
                 }
                 if (splitLongestPath(id, stack, false) == kSplitOther) stack.push_back(id);
             } else if (split == kSplitOther) {
@@ -770,11 +777,17 @@ struct FrameBuilder {
     // (second-order slack along the line of sight) this holds near the camera too.
     // A split that would halve a piece marked kCoarse at a level of kKeptLevel or more (the
     // longest-edge path of a neighbour reaching it) is not made: the neighbour is filled by its
-    // own template instead (splitLongestPath's guard), so a large template, once chosen, stays
-    // whole (near the camera the bisection would otherwise cut every template its neighbours
-    // reach). Smaller ones are halved as before (their halves judged again): guarding them too
-    // templated the box's closest frame at T = 1e-3 x size into more triangles than uniform
-    // subdivision's (the neighbours' forced templates round their levels up).
+    // own template instead (splitLongestPath's guard), so a template, once chosen, stays whole
+    // (near the camera the bisection would otherwise cut every template its neighbours reach,
+    // and each piece cut so pays the bisection's records instead of the template's few tens of
+    // instructions per triangle). The neighbour's forced template rounds its level up, and the
+    // neighbour may be stretched in the form's metric (no shape rule): where that template
+    // would make more than kForceRatio times the triangles its bisection is expected to make
+    // (its bubbles' bound over T, about the pieces halving down to T leaves), the split is made
+    // after all and the template's halves are judged again (forcedTemplatePays). Guarding every
+    // level without that rule templated the box's closest frame at T = 1e-3 x size into more
+    // triangles than uniform subdivision's; guarding level 8 and more only left the box at
+    // T = 1e-4 x size mostly bisected (docs/ACCURACY.md, "Templates").
     // The grid triangles of a piece at level n (the piece scaled by 1/n) are within T
     // (chord_error.h PieceForm). Each edge record gets the largest level of the pieces around
     // it, and both sides cut it into that many equal segments: no T-junctions, and the counts
@@ -795,7 +808,8 @@ struct FrameBuilder {
     static constexpr double kCoarseSlack = 1.1;
     static constexpr double kRounding = 0.3;
     static constexpr double kTemplateShare = 0.5;  // least share of the leaves the templates' triangles must make (refineFrame)
-    static constexpr uint32_t kKeptLevel = 8;      // least level of a template the guard keeps whole
+    static constexpr uint32_t kKeptLevel = 2;      // least level of a template the guard keeps whole
+    static constexpr double kForceRatio = 2;       // a forced template's triangles over its bisection's expected count, at most
     static constexpr uint32_t kNoCap = 1u << 20;   // formLevel without the max_segments cap
 
     // True when the whole-piece form of the piece with corners' shape offsets a, b, c (chord_error.h
@@ -807,6 +821,18 @@ struct FrameBuilder {
         const Vec3 s[3] = {a, b, c};
         const PieceForm pf = pieceForm(world.motion, r_now, s);
         return pf.finite && bound_speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]) <= settings.tolerance;
+    }
+
+    // Whether piece id's forced template (its form made by coarseForm(id, s, true)) makes at
+    // most kForceRatio times the triangles its bisection is expected to: n^2 against its
+    // bubbles' bound over T (at least 1).
+    bool forcedTemplatePays(uint32_t id) {
+        const uint32_t* v = rt[id].v;
+        const double n = formLevel(scratch.forms[scratch.form_of[id]], kNoCap);
+        const double c[3] = {edgeOf(id, 0).c, edgeOf(id, 1).c, edgeOf(id, 2).c};
+        const ChordError ce = pointsBound(c, r_term_data[v[0]], r_term_data[v[1]], r_term_data[v[2]]);
+        const double expected = std::max(1.0, ce.quadratic / settings.tolerance);
+        return n * n <= kForceRatio * expected;
     }
 
     // The form of piece id (its corners' shape offsets s) when it is finite and (unless `force`:
@@ -1100,12 +1126,29 @@ struct FrameBuilder {
             if (displaced || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
                 candidates.push_back(uint32_t(f));
         }
+        // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits:
+        // ends in id order), when the candidates are enough to pay for the edge records' reset
+        // (a large mesh with a few candidates computes their edges per triangle instead).
+        const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
+        if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
         for (uint32_t f : candidates) {
             double c[3], xc[3];
             Vec3 sc[3];
             for (int k = 0; k < 3; ++k) {
-                const Edge& ed = world.edges[world.triangle_edges[f][k]];
-                c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                const uint32_t e = world.triangle_edges[f][k];
+                const Edge& ed = world.edges[e];
+                if (keep_edges) {
+                    REdge& re = r_edges[e];
+                    if (re.len != re.len) {
+                        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]);
+                        re.len = eb.length;
+                        re.c = eb.c;
+                        re.xm_mid = eb.xm_mid;
+                    }
+                    c[k] = re.c;
+                } else {
+                    c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                }
                 const uint32_t v = world.mesh.triangles[f][k];
                 sc[k] = r_terms[v].s;
                 xc[k] = r_terms[v].xm;
@@ -1133,7 +1176,7 @@ struct FrameBuilder {
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
-            r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
+            if (!keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
             // Room for the pieces and points the refinement is expected to make (growth would copy them).
             // At most a million: reserving is only a saving, never a bound (max_triangles is).
             size_t expect = size_t(std::min(2 * expected_pieces, 1e6));

@@ -45,10 +45,11 @@
 //     bisected further but filled by a template (tessellate.h): the regular grid of level n
 //     (each triangle within T by the form), stitched along its sides to the equal segments its
 //     neighbours share (each edge cut into the largest level of the pieces around it; every
-//     stitched triangle checked against the form). A template of level 8 or more is kept whole:
-//     a neighbour whose split would halve it is filled by its own template instead. When such
-//     pieces would make less than half of the output, they are bisected like the rest
-//     (slice.cpp, "Templates").
+//     stitched triangle checked against the form). A template is kept whole: a neighbour whose
+//     split would halve it is filled by its own template instead, unless that one would make
+//     more than twice the triangles the neighbour's bisection is expected to (then the split
+//     is made and the template's halves are judged again). When such pieces would make less
+//     than half of the output, they are bisected like the rest (slice.cpp, "Templates").
 // |F - L| bounds both one-sided distances between the output and the exact surface, so the
 // two-sided distance stays <= T. The output is deterministic (no dependence on threads) and, when
 // no triangle needs refining, identical to vertex mode's. Output order: the visible input
@@ -59,11 +60,12 @@
 // appended; a templated piece gives its template's triangles in its place).
 // Cost: per output triangle of the bisection about two edge bounds, one and a fifth triangle
 // bounds, half a split (its point's square root and the slot bookkeeping) and the output; about
-// 1200 to 1600 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost
-// per output triangle", "Templates"), of which the two bounds' arithmetic is about 500. A
-// templated piece costs one form and its grid: a few tens of instructions per output triangle
-// besides its share of the batched cut (200 to 300 per output triangle where templates make most
-// of the output, 700 to 800 on the box 2 ls from the camera at T = 1e-4, 1e-5 x size).
+// 1300 to 1450 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost
+// per output triangle", "Coarse tolerances near the camera"), of which the two bounds are about
+// 450 and the records and the loop about 650. A templated piece costs one form and its grid: a
+// few tens of instructions per output triangle besides its share of the batched cut (200 to 360
+// per output triangle where templates make most of the output, the box 2 ls from the camera at
+// T = 1e-4, 1e-5 x size included).
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
 // grew them past 256 MiB.
