@@ -224,7 +224,9 @@ constexpr size_t kPage = 4096;
 
 // All of `n` bytes at `offset`; once O_DIRECT is refused (EINVAL), the flag is dropped (*direct
 // false) and the rest is written through the page cache.
-bool putAt(int fd, const char* p, size_t n, uint64_t offset, int flags, bool* direct, std::string* error) {
+// *done counts the bytes written.
+bool putAt(int fd, const char* p, size_t n, uint64_t offset, int flags, bool* direct, std::string* error,
+           size_t* done) {
     while (n > 0) {
         const ssize_t w = ::pwrite(fd, p, n, off_t(offset));
         if (w < 0 && errno == EINTR) continue;
@@ -243,12 +245,13 @@ bool putAt(int fd, const char* p, size_t n, uint64_t offset, int flags, bool* di
         p += w;
         n -= size_t(w);
         offset += uint64_t(w);
+        *done += size_t(w);
     }
     return true;
 }
 
 // Buffered: the file's blocks reserved, then writev, retrying short and interrupted writes.
-bool writeBuffered(int fd, const iovec* pieces, size_t count, size_t total, std::string* error) {
+bool writeBuffered(int fd, const iovec* pieces, size_t count, size_t total, std::string* error, size_t* written) {
     (void)::fallocate(fd, 0, 0, off_t(total));
     size_t i = 0, skip = 0;  // the first piece not yet written whole, and its bytes written
     std::vector<iovec> batch;
@@ -267,6 +270,7 @@ bool writeBuffered(int fd, const iovec* pieces, size_t count, size_t total, std:
             *error = std::strerror(w < 0 ? errno : EIO);
             return false;
         }
+        *written += size_t(w);
         size_t done = size_t(w) + skip;  // from the start of piece i
         while (i < count && done >= pieces[i].iov_len) done -= pieces[i++].iov_len;
         skip = done;
@@ -275,12 +279,15 @@ bool writeBuffered(int fd, const iovec* pieces, size_t count, size_t total, std:
 
 }  // namespace
 
-bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error) {
+bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, size_t* written) {
+    size_t ignored = 0;
+    if (!written) written = &ignored;
+    *written = 0;
     size_t total = 0;
     for (size_t k = 0; k < count; ++k) total += pieces[k].iov_len;
     const int flags = ::fcntl(fd, F_GETFL);
     if (total < kDirectLeast || flags < 0 || ::fcntl(fd, F_SETFL, flags | O_DIRECT) != 0)
-        return writeBuffered(fd, pieces, count, total, error);
+        return writeBuffered(fd, pieces, count, total, error, written);
     DirectBuffers& pool = directBuffers();
     void* buffer = nullptr;
     {
@@ -293,7 +300,7 @@ bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error) {
     if (!buffer && ::posix_memalign(&buffer, kPage, kDirectChunk) != 0) buffer = nullptr;
     if (!buffer) {
         (void)::fcntl(fd, F_SETFL, flags);
-        return writeBuffered(fd, pieces, count, total, error);
+        return writeBuffered(fd, pieces, count, total, error, written);
     }
     // Chunks of kDirectChunk bytes (the last padded with zeros to a whole page, cut off below).
     char* const stage = static_cast<char*>(buffer);
@@ -310,7 +317,7 @@ bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error) {
             p += take;
             left -= take;
             if (fill == kDirectChunk) {
-                ok = putAt(fd, stage, fill, offset, flags, &direct, error);
+                ok = putAt(fd, stage, fill, offset, flags, &direct, error, written);
                 offset += fill;
                 fill = 0;
             }
@@ -319,8 +326,9 @@ bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error) {
     if (ok && fill > 0) {
         const size_t padded = (fill + kPage - 1) / kPage * kPage;
         std::memset(stage + fill, 0, padded - fill);
-        ok = putAt(fd, stage, padded, offset, flags, &direct, error) &&
+        ok = putAt(fd, stage, padded, offset, flags, &direct, error, written) &&
              (padded == fill || ::ftruncate(fd, off_t(offset + fill)) == 0 || (*error = std::strerror(errno), false));
+        *written = std::min(*written, total);  // not the padding
     }
     if (direct && ::fcntl(fd, F_SETFL, flags) != 0 && ok) {
         *error = std::strerror(errno);

@@ -63,10 +63,11 @@ bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* wr
 // is later replaced: about half the CPU of writing a 26 MB file buffered (docs/PERFORMANCE.md),
 // the same bytes and the same durability (the caller's fsync). Where O_DIRECT is refused (the flag
 // or a write fails with EINVAL), and for smaller files, buffered writes after fallocate reserves
-// the file's blocks in one call (only a hint). False with errno's message on failure.
+// the file's blocks in one call (only a hint). False with errno's message on failure, and the
+// bytes written by then in `*written` (when given).
 constexpr size_t kDirectLeast = size_t(4) << 20;
 constexpr size_t kDirectChunk = size_t(8) << 20;
-bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error);
+bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, size_t* written = nullptr);
 
 // A file for scratch data in `dir` that has no name from the start (O_TMPFILE; where the file
 // system lacks it, created exclusively under a random name and unlinked at once): nothing is left

@@ -168,7 +168,8 @@ TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
 // writeWhole gives the file exactly its pieces' bytes in order: below kDirectLeast (buffered) and
 // above it (in kDirectChunk chunks through a page-aligned buffer, O_DIRECT where the file system
 // takes it), with empty pieces, pieces across chunk boundaries and a length that is no whole
-// number of pages; and a write that fails (RLIMIT_FSIZE: EFBIG, as a full disk gives ENOSPC) says so.
+// number of pages; and a write that fails (RLIMIT_FSIZE: EFBIG, as a full disk gives ENOSPC) says
+// so, with the bytes written up to the limit.
 TEST(FrameExport, WriteWholeWritesThePiecesInOrder) {
     const fs::path dir = fs::temp_directory_path() / ("apparent_write_whole_" + std::to_string(::getpid()));
     fs::create_directories(dir);
@@ -217,11 +218,13 @@ TEST(FrameExport, WriteWholeWritesThePiecesInOrder) {
     const int fd = ::open((dir / "limited.bin").c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
     ASSERT_GE(fd, 0);
     ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
-    const bool ok = writeWhole(fd, &one, 1, &error);
+    size_t written = 0;
+    const bool ok = writeWhole(fd, &one, 1, &error, &written);
     ::setrlimit(RLIMIT_FSIZE, &old_limit);
     ::sigaction(SIGXFSZ, &old_action, nullptr);
     ::close(fd);
     EXPECT_FALSE(ok);
     EXPECT_EQ(error, std::strerror(EFBIG));
+    EXPECT_EQ(written, limit.rlim_cur);  // up to the limit, then refused
     fs::remove_all(dir);
 }
