@@ -1,15 +1,22 @@
 #include "exporters/atomic_file.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <random>
+#include <vector>
 
 #include <sys/stat.h>
+#include <sys/uio.h>
 
 #include <fcntl.h>
 #include <pthread.h>
@@ -200,6 +207,136 @@ bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* wr
     }
     if (written) *written = done;
     return true;
+}
+
+namespace {
+
+// writeWhole's page-aligned buffers, kept by the process (one per writer running at once).
+struct DirectBuffers {
+    std::mutex mutex;
+    std::vector<void*> free;
+};
+DirectBuffers& directBuffers() {
+    static DirectBuffers* buffers = new DirectBuffers;  // never destroyed: writers may run at exit
+    return *buffers;
+}
+constexpr size_t kPage = 4096;
+
+// All of `n` bytes at `offset`; once O_DIRECT is refused (EINVAL), the flag is dropped (*direct
+// false) and the rest is written through the page cache.
+// *done counts the bytes written.
+bool putAt(int fd, const char* p, size_t n, uint64_t offset, int flags, bool* direct, std::string* error,
+           size_t* done) {
+    while (n > 0) {
+        const ssize_t w = ::pwrite(fd, p, n, off_t(offset));
+        if (w < 0 && errno == EINTR) continue;
+        if (w < 0 && errno == EINVAL && *direct) {
+            *direct = false;
+            if (::fcntl(fd, F_SETFL, flags) != 0) {
+                *error = std::strerror(errno);
+                return false;
+            }
+            continue;
+        }
+        if (w <= 0) {
+            *error = std::strerror(w < 0 ? errno : EIO);
+            return false;
+        }
+        p += w;
+        n -= size_t(w);
+        offset += uint64_t(w);
+        *done += size_t(w);
+    }
+    return true;
+}
+
+// Buffered: the file's blocks reserved, then writev, retrying short and interrupted writes.
+bool writeBuffered(int fd, const iovec* pieces, size_t count, size_t total, std::string* error, size_t* written) {
+    (void)::fallocate(fd, 0, 0, off_t(total));
+    size_t i = 0, skip = 0;  // the first piece not yet written whole, and its bytes written
+    std::vector<iovec> batch;
+    for (;;) {
+        while (i < count && skip == pieces[i].iov_len) {
+            ++i;
+            skip = 0;
+        }
+        if (i == count) return true;
+        batch.clear();
+        batch.push_back({static_cast<char*>(pieces[i].iov_base) + skip, pieces[i].iov_len - skip});
+        for (size_t k = i + 1; k < count && batch.size() < size_t(IOV_MAX); ++k) batch.push_back(pieces[k]);
+        const ssize_t w = ::writev(fd, batch.data(), int(batch.size()));
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            *error = std::strerror(w < 0 ? errno : EIO);
+            return false;
+        }
+        *written += size_t(w);
+        size_t done = size_t(w) + skip;  // from the start of piece i
+        while (i < count && done >= pieces[i].iov_len) done -= pieces[i++].iov_len;
+        skip = done;
+    }
+}
+
+}  // namespace
+
+bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, size_t* written) {
+    size_t ignored = 0;
+    if (!written) written = &ignored;
+    *written = 0;
+    size_t total = 0;
+    for (size_t k = 0; k < count; ++k) total += pieces[k].iov_len;
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (total < kDirectLeast || flags < 0 || ::fcntl(fd, F_SETFL, flags | O_DIRECT) != 0)
+        return writeBuffered(fd, pieces, count, total, error, written);
+    DirectBuffers& pool = directBuffers();
+    void* buffer = nullptr;
+    {
+        std::lock_guard<std::mutex> lock(pool.mutex);
+        if (!pool.free.empty()) {
+            buffer = pool.free.back();
+            pool.free.pop_back();
+        }
+    }
+    if (!buffer && ::posix_memalign(&buffer, kPage, kDirectChunk) != 0) buffer = nullptr;
+    if (!buffer) {
+        (void)::fcntl(fd, F_SETFL, flags);
+        return writeBuffered(fd, pieces, count, total, error, written);
+    }
+    // Chunks of kDirectChunk bytes (the last padded with zeros to a whole page, cut off below).
+    char* const stage = static_cast<char*>(buffer);
+    bool direct = true, ok = true;
+    uint64_t offset = 0;
+    size_t fill = 0;
+    for (size_t k = 0; k < count && ok; ++k) {
+        const char* p = static_cast<const char*>(pieces[k].iov_base);
+        size_t left = pieces[k].iov_len;
+        while (left > 0 && ok) {
+            const size_t take = std::min(left, kDirectChunk - fill);
+            std::memcpy(stage + fill, p, take);
+            fill += take;
+            p += take;
+            left -= take;
+            if (fill == kDirectChunk) {
+                ok = putAt(fd, stage, fill, offset, flags, &direct, error, written);
+                offset += fill;
+                fill = 0;
+            }
+        }
+    }
+    if (ok && fill > 0) {
+        const size_t padded = (fill + kPage - 1) / kPage * kPage;
+        std::memset(stage + fill, 0, padded - fill);
+        ok = putAt(fd, stage, padded, offset, flags, &direct, error, written) &&
+             (padded == fill || ::ftruncate(fd, off_t(offset + fill)) == 0 || (*error = std::strerror(errno), false));
+        *written = std::min(*written, total);  // not the padding
+    }
+    if (direct && ::fcntl(fd, F_SETFL, flags) != 0 && ok) {
+        *error = std::strerror(errno);
+        ok = false;
+    }
+    std::lock_guard<std::mutex> lock(pool.mutex);
+    pool.free.push_back(buffer);
+    return ok;
 }
 
 void installInterruptCleanup() {

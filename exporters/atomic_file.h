@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <string>
 
+#include <sys/uio.h>
+
 namespace apparent {
 
 //
@@ -51,6 +53,21 @@ private:
 // Writes all `n` bytes to `fd`, retrying short and interrupted writes. On failure: false, errno's
 // message in `error` and the bytes written so far in `*written` (when given).
 bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* written = nullptr);
+
+// Writes the `count` pieces one after another from the start of the empty file `fd` (the caller
+// then fsyncs and commits). A file of at least kDirectLeast bytes goes past the page cache where
+// the file system allows it: the pieces are copied, kDirectChunk bytes at a time, into a
+// page-aligned buffer of the process (kept for the next file: no fresh pages to fault in) and
+// written with O_DIRECT in whole pages, the file then cut to its length. That spares the kernel's
+// copy into the page cache, fsync's writeback of it and the freeing of those pages when the file
+// is later replaced: about half the CPU of writing a 26 MB file buffered (docs/PERFORMANCE.md),
+// the same bytes and the same durability (the caller's fsync). Where O_DIRECT is refused (the flag
+// or a write fails with EINVAL), and for smaller files, buffered writes after fallocate reserves
+// the file's blocks in one call (only a hint). False with errno's message on failure, and the
+// bytes written by then in `*written` (when given).
+constexpr size_t kDirectLeast = size_t(4) << 20;
+constexpr size_t kDirectChunk = size_t(8) << 20;
+bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, size_t* written = nullptr);
 
 // A file for scratch data in `dir` that has no name from the start (O_TMPFILE; where the file
 // system lacks it, created exclusively under a random name and unlinked at once): nothing is left

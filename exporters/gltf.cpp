@@ -31,7 +31,6 @@
 #include "mesh4d/normals.h"
 
 #include <fcntl.h>
-#include <limits.h>
 #include <sys/uio.h>
 #include <unistd.h>
 
@@ -419,34 +418,9 @@ struct BinSink {
         borrowable.clear();
         pinned.reset();
     }
-    // Writes the held data to `out` (finish() of a lone frame); false with the message in *werr.
-    bool writeHeld(int out, std::string* werr) const {
-        std::vector<iovec> iov;
-        iov.reserve(held.size());
-        for (const Held& h : held) iov.push_back({const_cast<char*>(h.data ? h.data : own.data() + h.offset), h.n});
-        for (size_t i = 0; i < iov.size(); i += IOV_MAX) {
-            const size_t count = std::min<size_t>(IOV_MAX, iov.size() - i);
-            size_t total = 0;
-            for (size_t k = i; k < i + count; ++k) total += iov[k].iov_len;
-            const ssize_t w = ::writev(out, &iov[i], int(count));
-            if (w == ssize_t(total)) continue;
-            if (w < 0 && errno != EINTR) {
-                *werr = std::strerror(errno);
-                return false;
-            }
-            // Short write or interrupted: the rest of this batch one piece at a time.
-            size_t done = w > 0 ? size_t(w) : 0;
-            for (size_t k = i; k < i + count; ++k) {
-                const size_t len = iov[k].iov_len;
-                if (done >= len) {
-                    done -= len;
-                    continue;
-                }
-                if (!writeAll(out, static_cast<char*>(iov[k].iov_base) + done, len - done, werr)) return false;
-                done = 0;
-            }
-        }
-        return true;
+    // The held data in order, appended to `out` (finish() of a lone frame writes them).
+    void heldPieces(std::vector<iovec>* out) const {
+        for (const Held& h : held) out->push_back({const_cast<char*>(h.data ? h.data : own.data() + h.offset), h.n});
     }
     void pad(size_t n) {
         static const char zeros[4] = {0, 0, 0, 0};
@@ -1933,17 +1907,24 @@ bool GlbSequenceWriter::finish(GlbStats* stats, std::string* error, const FrameS
     std::string werr;
     bool ok = true;
     if (!m.sink.in_pieces) {
-        // The BIN chunk copied from the spill file after the head (copy_file_range: the kernel
-        // copies between the two files' pages; pread and write where it cannot).
         static const char zeros[4] = {0, 0, 0, 0};
-        // The file's blocks reserved in one call first: page by page, ext4's delayed allocation
-        // cost the lone 1M-triangle frame's write more than copying its bytes. Only a hint: where
-        // it fails (a file system without it, no space), the writes below say what is wrong.
-        (void)::fallocate(fd, 0, 0, off_t(total));
-        // A lone frame: from where it is held, written once (no spill file).
-        ok = writeAll(fd, head.data(), head.size(), &werr) &&
-             (m.sink.holding ? m.sink.writeHeld(fd, &werr) : copyRange(m.sink.fd, 0, bin, fd, &werr)) &&
-             writeAll(fd, zeros, padded4(bin) - bin, &werr);
+        if (m.sink.holding) {
+            // A lone frame: head, frame data from where it is held and padding as one file
+            // (writeWhole: past the page cache when large; no spill file).
+            std::vector<iovec> pieces{{head.data(), head.size()}};
+            m.sink.heldPieces(&pieces);
+            pieces.push_back({const_cast<char*>(zeros), padded4(bin) - bin});
+            ok = writeWhole(fd, pieces.data(), pieces.size(), &werr);
+        } else {
+            // The BIN chunk copied from the spill file after the head (copy_file_range: the
+            // kernel copies between the two files' pages; pread and write where it cannot). The
+            // file's blocks reserved in one call first: page by page, ext4's delayed allocation
+            // costs more than copying the bytes. Only a hint: where it fails (a file system
+            // without it, no space), the writes below say what is wrong.
+            (void)::fallocate(fd, 0, 0, off_t(total));
+            ok = writeAll(fd, head.data(), head.size(), &werr) && copyRange(m.sink.fd, 0, bin, fd, &werr) &&
+                 writeAll(fd, zeros, padded4(bin) - bin, &werr);
+        }
     } else {
         // Frames by reference: the file at its whole size (zeros: the alignment runs and the
         // chunk's padding), the head, this spill's pieces, then every other range placed at its

@@ -111,7 +111,8 @@ struct GlbStats {
 // under a temporary name (the BIN chunk placed by copy_file_range) and renames it into place.
 // The first frame's data waits in its own buffers instead (the prepared frame is kept; frames
 // from addEncoded() are copied) until a second frame comes: a lone frame's file is then written
-// once, in place after its JSON chunk, with no spill file at all.
+// once, in place after its JSON chunk, with no spill file at all (writeWhole, atomic_file.h: past
+// the page cache when large).
 // Memory does not grow with the frame data: besides the JSON side it keeps the previous frame's
 // index lists (to share equal ones). Frame buffers come from a pool shared by every writer of
 // the process (at most max(4, 2 x cores) kept), so neither the frames of a sequence nor a lone

@@ -1,11 +1,13 @@
 #include "exporters/ply.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <utility>
 
-#include <fcntl.h>
+#include <unistd.h>
 
 #include <tbb/parallel_for.h>
 
@@ -125,12 +127,26 @@ void serializePly(const ExportFrame& frame, std::string* out) {
 bool writePly(const std::string& path, const ExportFrame& frame, std::string* error) {
     thread_local std::string bytes;  // kept between frames: no reallocation while frames do not grow
     serializePly(frame, &bytes);
-    // Step: the file's blocks reserved in one call (page by page, ext4's delayed allocation costs
-    // more than the copy; only a hint: where it fails, the write says what is wrong), written with
-    // every write, fsync and close checked, then renamed into place.
+    // Step: written whole (writeWhole: past the page cache when large, else buffered after its
+    // blocks are reserved), with every write, fsync and close checked, then renamed into place.
     AtomicOutput out(path);
-    if (out.fd() >= 0) (void)::fallocate(out.fd(), 0, 0, off_t(bytes.size()));
-    return out.commitBytes(bytes, error);
+    if (out.fd() < 0) {
+        *error = out.openError();
+        return false;
+    }
+    const iovec whole{bytes.data(), bytes.size()};
+    size_t done = 0;
+    std::string why;
+    if (!writeWhole(out.fd(), &whole, 1, &why, &done)) {
+        *error = path + ": cannot write (" + std::to_string(done) + " of " + std::to_string(bytes.size()) +
+                 " bytes written): " + why;
+        return false;
+    }
+    if (::fsync(out.fd()) != 0) {
+        *error = path + ": cannot write: " + std::strerror(errno);
+        return false;
+    }
+    return out.commit(error);
 }
 
 std::unique_ptr<FrameSink> plySink(std::string dir) {

@@ -42,18 +42,94 @@ void unitPair(Pair x, Pair y, Pair z, Pair* ux, Pair* uy, Pair* uz, Pair* length
     *uy = y / d;
     *uz = z / d;
 }
+
+// The per-vertex step of creaseSplitMap: whether a vertex's faces are all within the crease
+// angle of one another (the vertex then has one normal), and the sum of their area vectors in CSR
+// order (what every corner would sum). Raw pointers: through references every array would be
+// reloaded after each store.
+struct VertexPass {
+    const Vec3* area;
+    const uint32_t* start;
+    const uint32_t* faces;
+    double cos_crease;
+    // Quick sufficient test: every face within half the crease angle (less a margin far above
+    // rounding) of the first face, so every pair within the crease angle (angles obey the
+    // triangle inequality); as squares, cos_half2 |a_f|^2 |a_0|^2 <= (a_f . a_0)^2 with a_f . a_0 > 0,
+    // no square root and one pass with the sum. Only for squared areas in [kLeast, kMost], where
+    // neither the squares nor their products leave the normal range of doubles; the exact
+    // pairwise test decides the rest.
+    double cos_half2;
+    static constexpr double kLeast = 1e-100, kMost = 1e100;
+
+    // Face f's unit normal (zero for a face of zero area, which is within no angle of another):
+    // area / sqrt(area . area), the same bits wherever it is taken.
+    Vec3 unit(uint32_t f) const {
+        const double length = std::sqrt(dot(area[f], area[f]));
+        return length > 0 ? area[f] / length : Vec3{0, 0, 0};
+    }
+
+    bool allWithin(uint32_t v, Vec3* sum_out) const {
+        const uint32_t first = start[v], end = start[v + 1];
+        const Vec3 a0 = area[faces[first]];
+        const double n0 = dot(a0, a0);
+        bool quick = n0 >= kLeast && n0 <= kMost;
+        const double bound = cos_half2 * n0;
+        Vec3 sum{0, 0, 0};
+        for (uint32_t k = first; k < end; ++k) {
+            const Vec3 a = area[faces[k]];
+            sum += a;
+            const double d = dot(a, a0), n = dot(a, a);
+            quick &= (d > 0) & (d * d >= bound * n) & (n >= kLeast) & (n <= kMost);
+        }
+        *sum_out = sum;
+        if (quick) return true;
+        for (uint32_t a = first; a < end; ++a) {
+            const uint32_t f = faces[a];
+            const Vec3 uf = unit(f);
+            for (uint32_t b = first; b < end; ++b) {
+                const uint32_t g = faces[b];
+                if (g != f && !(dot(unit(g), uf) >= cos_crease)) return false;
+            }
+        }
+        return true;
+    }
+
+    // Vertices order[i] (i itself without `order`) for i in [lo, hi): uniform[v] set where every
+    // pair of v's faces is within the crease angle and their sum is not zero, and then
+    // normal[i] = sum / norm(sum) (norm(): std::hypot, bit for bit, two vertices at a time).
+    void run(size_t lo, size_t hi, const uint32_t* order, unsigned char* uniform, Vec3* normal) const {
+        for (size_t i = lo; i < hi; ++i) {
+            const uint32_t v = order ? order[i] : uint32_t(i);
+            if (start[v] == start[v + 1]) continue;
+            Vec3 sum;
+            if (!allWithin(v, &sum)) continue;
+            uniform[v] = 1;
+            normal[i] = sum;  // normalized below
+        }
+        for (size_t i = lo; i < hi; i += 2) {
+            const size_t j = std::min(i + 1, hi - 1);  // an odd end repeats its last vertex
+            const Vec3 s0 = normal[i], s1 = normal[j];
+            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
+            unitPair(x, y, z, &ux, &uy, &uz, &len);
+            for (int k = 0; k < 2; ++k) {
+                const size_t at = k == 0 ? i : j;
+                const uint32_t v = order ? order[at] : uint32_t(at);
+                if (!uniform[v]) continue;
+                if (!(len[k] > 0)) uniform[v] = 0;  // a zero sum: each corner falls back to its own face
+                else normal[at] = {ux[k], uy[k], uz[k]};
+            }
+        }
+    }
+};
 }  // namespace
 
 void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out, CreaseWork* w) {
     const double cos_crease = std::cos(crease_deg * kPi / 180.0);
     const size_t nf = mesh.triangles.size(), nv = mesh.positions.size();
 
-    // Step: face area vectors and their lengths (parallel); faces around each vertex (CSR layout).
-    // The direction only feeds the crease tests: sqrt of the dot product, not norm()'s hypot (the
-    // output normals below still use norm()); unit() gives it where needed, the same bits each time.
-    // The same pass compares the triangles with the last call's (adjacency reuse), when the counts match.
+    // Step: face area vectors (parallel); faces around each vertex (CSR layout). The same pass
+    // compares the triangles with the last call's (adjacency reuse), when the counts match.
     w->area.resize(nf);
-    w->length.resize(nf);
     const bool may_be_same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1;
     const bool same = tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, nf, kGrain), may_be_same,
@@ -61,12 +137,9 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
             const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
             const Vec3* const pos = mesh.positions.data();
             Vec3* const area = w->area.data();
-            double* const length = w->length.data();
             for (size_t f = r.begin(); f < r.end(); ++f) {
                 const auto& t = tri[f];
-                const Vec3 a = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
-                area[f] = a;
-                length[f] = std::sqrt(dot(a, a));
+                area[f] = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
             }
             return equal && std::memcmp(w->triangles.data() + r.begin(), tri + r.begin(), r.size() * sizeof(tri[0])) == 0;
         },
@@ -84,111 +157,53 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         for (size_t f = 0; f < nf; ++f)
             for (uint32_t v : mesh.triangles[f]) w->faces[w->fill[v]++] = uint32_t(f);
     }
-    const std::vector<Vec3>& area = w->area;
-    const std::vector<double>& length = w->length;
-    const std::vector<uint32_t>& start = w->start;
-    const std::vector<uint32_t>& faces = w->faces;
-    // Face f's unit normal (zero for a face of zero area, which is within no angle of another).
-    auto unit = [&](size_t f) { return length[f] > 0 ? area[f] / length[f] : Vec3{0, 0, 0}; };
-
-    // The normal of the corner of face f at vertex v: the faces around v within the crease angle
-    // of f, summed in CSR order.
-    auto cornerNormal = [&](size_t f, uint32_t v) {
-        Vec3 sum{0, 0, 0};
-        const Vec3 uf = unit(f);
-        for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
-            const uint32_t g = faces[k];
-            if (g == f || dot(unit(g), uf) >= cos_crease) sum += area[g];
-        }
-        return unitOr(sum, unitOr(area[f], {0, 0, 1}));
-    };
+    const VertexPass pass{w->area.data(), w->start.data(), w->faces.data(), cos_crease,
+                          std::pow(std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6), 2)};
 
     // Step (parallel): a vertex whose faces are all within the crease angle of one another gives
     // every corner the same sum, so one normal (the sum of all its faces, in the same order);
     // unless that sum is zero, where each corner falls back to its own face.
-    // Quick sufficient test first: when every face is within half the crease angle (less a margin
-    // far above rounding) of one direction, every pair is within the crease angle (angles obey the
-    // triangle inequality); otherwise every pair is tested. The direction is the sum of the area
-    // vectors (what the vertex's normal is made of), so the test reads each face's area vector and
-    // length once: dot(a_f, s) >= cos_half |a_f| |s|.
-    const double cos_half_ = std::cos(0.5 * crease_deg * kPi / 180.0 - 1e-6);
+    // When the last call on the same triangles split no vertex, the vertices are taken in `out`'s
+    // numbering and their normals written straight into `out` (no vertex split then or now: the
+    // numbering and triangles stand, only the normals change); a vertex split now sends the
+    // normals back to vertex order for the numbering below.
     w->uniform.assign(nv, 0);
-    w->vertex_normal.resize(nv);
-    // Raw pointers: the stores to `uniform` (bytes, which may alias anything) would otherwise
-    // reload every vector's data pointer in the inner loops.
-    const Vec3* const area_p_ = area.data();
-    const double* const length_p_ = length.data();
-    const uint32_t* const start_p_ = start.data();
-    const uint32_t* const faces_p_ = faces.data();
-    unsigned char* const uniform_p_ = w->uniform.data();
-    Vec3* const vertex_normal_p_ = w->vertex_normal.data();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        // Local copies: the captures are references, reloaded through the closure after every store.
-        const Vec3* const area_p = area_p_;
-        const double* const length_p = length_p_;
-        const uint32_t* const start_p = start_p_;
-        const uint32_t* const faces_p = faces_p_;
-        unsigned char* const uniform_p = uniform_p_;
-        Vec3* const vertex_normal_p = vertex_normal_p_;
-        const double cos_half = cos_half_;
-        for (size_t v = r.begin(); v < r.end(); ++v) {
-            const uint32_t first = start_p[v], end = start_p[v + 1];
-            if (first == end) continue;
-            // The sum of the area vectors in CSR order (what every corner would sum).
-            Vec3 sum{0, 0, 0};
-            for (uint32_t a = first; a < end; ++a) sum += area_p[faces_p[a]];
-            const double bound = cos_half * std::sqrt(dot(sum, sum));  // the sufficient test alone (margin above)
-            bool all = bound > 0;
-            for (uint32_t a = first; a < end && all; ++a) {
-                const uint32_t f = faces_p[a];
-                all = length_p[f] > 0 && dot(area_p[f], sum) >= bound * length_p[f];
-            }
-            if (!all) {
-                all = true;
-                for (uint32_t a = start[v]; a < start[v + 1] && all; ++a) {
-                    const uint32_t f = faces[a];
-                    const Vec3 uf = unit(f);
-                    for (uint32_t b = start[v]; b < start[v + 1]; ++b) {
-                        const uint32_t g = faces[b];
-                        if (g != f && !(dot(unit(g), uf) >= cos_crease)) {
-                            all = false;
-                            break;
-                        }
-                    }
-                }
-            }
-            if (!all) continue;
-            uniform_p[v] = 1;
-            vertex_normal_p[v] = sum;  // normalized below, two at a time
-        }
-        // sum / norm(sum), or not uniform after all where the sum is zero (each corner then
-        // falls back to its own face).
-        for (size_t v = r.begin(); v < r.end(); v += 2) {
-            const size_t b = std::min(v + 1, r.end() - 1);  // an odd end repeats its last vertex
-            const Vec3 s0 = vertex_normal_p[v], s1 = vertex_normal_p[b];
-            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
-            unitPair(x, y, z, &ux, &uy, &uz, &len);
-            for (int k = 0; k < 2; ++k) {
-                const size_t i = k == 0 ? v : b;
-                if (!uniform_p[i]) continue;
-                if (!(len[k] > 0)) uniform_p[i] = 0;
-                else vertex_normal_p[i] = {ux[k], uy[k], uz[k]};
-            }
-        }
-    });
-    // No vertex split (every used vertex uniform, none unused), as in the last call on the same
-    // triangles: the numbering and triangles in `out` stand; only the normals change.
-    size_t used = 0;
-    for (size_t v = 0; v < nv; ++v) used += w->uniform[v];
-    const bool unsplit = used == nv;
-    if (same && unsplit && w->unsplit && out->source.size() == nv) {
+    unsigned char* const uniform = w->uniform.data();
+    const bool renumbered = !(same && w->unsplit && out->source.size() == nv);
+    const uint32_t* const order = renumbered ? nullptr : out->source.data();
+    Vec3* normal;
+    if (renumbered) {
+        w->vertex_normal.resize(nv);
+        normal = w->vertex_normal.data();
+    } else {
         out->normals.resize(nv);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t k = r.begin(); k < r.end(); ++k) out->normals[k] = w->vertex_normal[out->source[k]];
-        });
-        return;
+        normal = out->normals.data();
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        pass.run(r.begin(), r.end(), order, uniform, normal);
+    });
+    size_t used = 0;
+    for (size_t v = 0; v < nv; ++v) used += uniform[v];
+    const bool unsplit = used == nv;
+    if (!renumbered) {
+        if (unsplit) return;
+        w->vertex_normal.resize(nv);
+        for (size_t k = 0; k < nv; ++k) w->vertex_normal[out->source[k]] = out->normals[k];
     }
     w->unsplit = unsplit;
+
+    // The normal of the corner of face f at vertex v: the faces around v within the crease angle
+    // of f, summed in CSR order.
+    const std::vector<Vec3>& area = w->area;
+    auto cornerNormal = [&](size_t f, uint32_t v) {
+        Vec3 sum{0, 0, 0};
+        const Vec3 uf = pass.unit(uint32_t(f));
+        for (uint32_t k = w->start[v]; k < w->start[v + 1]; ++k) {
+            const uint32_t g = w->faces[k];
+            if (g == f || dot(pass.unit(g), uf) >= cos_crease) sum += area[g];
+        }
+        return unitOr(sum, unitOr(area[f], {0, 0, 1}));
+    };
 
     // Step: split vertices numbered in order of their first corner (faces in order); corners of a
     // vertex with bit-identical normals share one split vertex.

@@ -37,8 +37,7 @@ struct CreaseMap {
     std::vector<std::array<uint32_t, 3>> triangles;
 };
 struct CreaseWork {
-    std::vector<Vec3> area;      // per face: edge cross product (twice the area vector)
-    std::vector<double> length;  // and its length (sqrt of its dot product with itself)
+    std::vector<Vec3> area;  // per face: edge cross product (twice the area vector)
     std::vector<Vec3> vertex_normal;
     std::vector<uint32_t> start, faces, fill, first_copy, next_copy;
     std::vector<unsigned char> uniform;

@@ -2,10 +2,15 @@
 // and the values read back independently (absolute lab positions and times, faces with the
 // objects' vertex offsets, triangles with a repeated corner left out). The lone .glb frame
 // likewise: the same bytes on 1 and 2 threads, and POSITION's bounds (found in the parallel
-// float32 conversion) those of the float32 values read back from its BIN chunk.
+// float32 conversion) those of the float32 values read back from its BIN chunk. Whole files
+// (writeWhole, the lone .glb frame's write): the pieces' bytes in order, past the page cache or not.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <cstring>
 #include <filesystem>
@@ -17,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "exporters/atomic_file.h"
 #include "exporters/gltf.h"
 #include "exporters/obj.h"
 #include "exporters/ply.h"
@@ -157,4 +163,68 @@ TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
             ++checked;
         }
     EXPECT_EQ(checked, 2u);  // both objects
+}
+
+// writeWhole gives the file exactly its pieces' bytes in order: below kDirectLeast (buffered) and
+// above it (in kDirectChunk chunks through a page-aligned buffer, O_DIRECT where the file system
+// takes it), with empty pieces, pieces across chunk boundaries and a length that is no whole
+// number of pages; and a write that fails (RLIMIT_FSIZE: EFBIG, as a full disk gives ENOSPC) says
+// so, with the bytes written up to the limit.
+TEST(FrameExport, WriteWholeWritesThePiecesInOrder) {
+    const fs::path dir = fs::temp_directory_path() / ("apparent_write_whole_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::mt19937_64 rng(5);
+    auto bytes = [&](size_t n) {
+        std::string b(n, '\0');
+        for (char& c : b) c = char(rng());
+        return b;
+    };
+    const std::vector<std::vector<size_t>> cases = {
+        {5, 0, 1000},
+        {0, 1, 4093, kDirectChunk - 4094 + 7, 3, 0, kDirectChunk + 12345, 17},
+        {kDirectLeast},
+        {kDirectChunk, kDirectChunk},
+    };
+    int k = 0;
+    for (const auto& sizes : cases) {
+        std::vector<std::string> pieces;
+        std::string expected;
+        for (size_t n : sizes) {
+            pieces.push_back(bytes(n));
+            expected += pieces.back();
+        }
+        std::vector<iovec> iov;
+        for (std::string& p : pieces) iov.push_back({p.data(), p.size()});
+        const fs::path file = dir / ("whole" + std::to_string(k++) + ".bin");
+        const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
+        ASSERT_GE(fd, 0);
+        std::string error;
+        EXPECT_TRUE(writeWhole(fd, iov.data(), iov.size(), &error)) << error;
+        EXPECT_EQ(::fsync(fd), 0);
+        ::close(fd);
+        EXPECT_EQ(fs::file_size(file), expected.size()) << k;
+        EXPECT_TRUE(testio::readBytes(file) == expected) << k;
+    }
+
+    struct sigaction ignore {}, old_action {};
+    ignore.sa_handler = SIG_IGN;
+    ::sigaction(SIGXFSZ, &ignore, &old_action);
+    rlimit old_limit{};
+    ::getrlimit(RLIMIT_FSIZE, &old_limit);
+    rlimit limit = old_limit;
+    limit.rlim_cur = 3 * 4096;
+    std::string big = bytes(kDirectLeast + 100), error;
+    const iovec one{big.data(), big.size()};
+    const int fd = ::open((dir / "limited.bin").c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
+    size_t written = 0;
+    const bool ok = writeWhole(fd, &one, 1, &error, &written);
+    ::setrlimit(RLIMIT_FSIZE, &old_limit);
+    ::sigaction(SIGXFSZ, &old_action, nullptr);
+    ::close(fd);
+    EXPECT_FALSE(ok);
+    EXPECT_EQ(error, std::strerror(EFBIG));
+    EXPECT_EQ(written, limit.rlim_cur);  // up to the limit, then refused
+    fs::remove_all(dir);
 }
