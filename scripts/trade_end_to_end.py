@@ -13,10 +13,14 @@ process start, loading and the .glb's assembly weigh as much as the frames in th
 so the CPU per frame is reported too: the same scene at --fps-factor times the frame rate (the same span of
 time, so its frames sample the same motion) minus the scene itself, over the frames it adds.
 
-Usage: scripts/trade_end_to_end.py BUILD_DIR [--runs N] [--fps-factor F] [--peer APPARENT]
+Usage: scripts/trade_end_to_end.py BUILD_DIR [--runs N] [--fps-factor F] [--peer APPARENT] [--count]
   > docs/trade/end_to_end.md
 --peer: a second binary (e.g. the main branch's, copied aside) whose tolerance runs are alternated with the
-same row's, for a before/after in one session: adds its time and its ratio against this build's uniform run."""
+same row's, for a before/after in one session: adds its time and its ratio against this build's uniform run.
+--count: a second table, where the instructions go (valgrind --tool=callgrind, which counts the same on a
+loaded machine): each run of the first table split into the cut (mesh4d::sliceWorld: in tolerance mode the
+refinement), the light factors, the .glb (the sinks' prepare, add and finish), loading with the 4D worlds,
+and the rest (process start, scene parsing)."""
 import argparse
 import csv
 import json
@@ -89,6 +93,34 @@ def alternate(runs, commands):
     return times
 
 
+# Inclusive instruction counts of the phases of a run (callgrind_annotate's function names).
+PHASES = [("cut", ["mesh4d::sliceWorld("]), ("light", ["mesh4d::addLightFactors("]),
+          ("glb", ["apparent::GlbSink::prepare(", "apparent::GlbSink::add(", "apparent::GlbSink::finish("]),
+          ("load", ["apparent::loadStage(", "apparent::takeWorlds("])]
+
+
+def count_phases(args, tmp):
+    """Instructions of one run: total and per phase (PHASES), from callgrind's inclusive costs."""
+    out = os.path.join(tmp, "callgrind.out")
+    subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + out] + args,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+    text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", out],
+                          capture_output=True, text=True, check=True).stdout
+    os.remove(out)
+
+    def cost(name):
+        for line in text.split("\n"):
+            if name in line and re.match(r"^\s*[\d,]+ ", line):
+                return int(line.split()[0].replace(",", ""))
+        return 0
+
+    total = int(re.search(r"^\s*([\d,]+) .*PROGRAM TOTALS", text, re.M).group(1).replace(",", ""))
+    counts = {phase: sum(cost(n) for n in names) for phase, names in PHASES}
+    counts["rest"] = total - sum(counts.values())
+    counts["total"] = total
+    return counts
+
+
 def write_scene(spec, mesh, fps_factor, path):
     s = json.loads(json.dumps(spec))
     s["objects"][0]["mesh"] = mesh
@@ -103,6 +135,8 @@ def main():
     ap.add_argument("--runs", type=int, default=11, help="repetitions of every run (the least is reported)")
     ap.add_argument("--fps-factor", type=int, default=10, help="frame rate factor of the runs that give the CPU per frame")
     ap.add_argument("--peer", help="a second apparent binary whose tolerance runs are alternated with this build's")
+    ap.add_argument("--max-level", type=int, default=4, help="the finest uniform level compared (1 - 4)")
+    ap.add_argument("--count", action="store_true", help="also count instructions per phase (callgrind)")
     args = ap.parse_args()
     apparent = os.path.join(os.path.abspath(args.build), "apparent")
     peer = os.path.abspath(args.peer) if args.peer else None
@@ -118,6 +152,7 @@ def main():
         head += " peer's tolerance: s | peer's ratio | peer's per-frame ratio |"
     print(head)
     print("|---" * (head.count("|") - 1) + "|")
+    counted = []
     with tempfile.TemporaryDirectory() as tmp:
         for scene, mesh in SCENES:
             rows = list(csv.DictReader(open(os.path.join(ROOT, "docs", "trade", scene, "trade.csv"))))
@@ -126,7 +161,7 @@ def main():
             V, F = load_obj(mesh_path)
             base = write_scene(spec, mesh_path, 1, os.path.join(tmp, scene + ".json"))
             base_k = write_scene(spec, mesh_path, k, os.path.join(tmp, f"{scene}_x{k}.json"))
-            for level in range(1, 5):
+            for level in range(1, args.max_level + 1):
                 V, F = subdivide(V, F)
                 row = next((r for r in rows if r["family"] == "uniform" and int(float(r["parameter"])) == level), None)
                 if row is None or row["skipped"] == "1":
@@ -166,9 +201,25 @@ def main():
                     line += (f" {best['p']:.4f} ({spread(t['p']):.0f}%) | {best['p'] / best['u']:.2f} | "
                              f"{per_frame['p'] / per_frame['u']:.2f} |")
                 print(line, flush=True)
+                if args.count:
+                    cu, ca = count_phases(commands["u"], tmp), count_phases(commands["a"], tmp)
+                    counted.append(f"| {scene} | {level} | " + " | ".join(
+                        f"{cu[p] / 1e6:.1f}, {ca[p] / 1e6:.1f}" for p in ("total", "cut", "light", "glb", "load", "rest")) +
+                        f" | {ca['total'] / cu['total']:.2f} | {(ca['cut'] - (ca['total'] - cu['total'])) / ca['cut']:.2f} |")
     print()
     print(f"Least CPU time (user + system) of {args.runs} alternated runs each; spread: the median over the least. "
           f"CPU per frame: (least of the run at {k}x the frame rate - least of the run) / the frames it adds.")
+    if counted:
+        print()
+        print("| scene | k | instructions, M: uniform, tolerance | cut | light factors | .glb | load and 4D worlds | "
+              "rest | instruction ratio | cut at parity / cut |")
+        print("|---" * 10 + "|")
+        print("\n".join(counted))
+        print()
+        print("Instructions of the first table's runs (callgrind, inclusive): the cut is mesh4d::sliceWorld (in "
+              "tolerance mode the refinement), .glb the sinks' prepare, add and finish, rest the process start and "
+              "the scene. Cut at parity: the share of the tolerance run's cut it may keep for the whole run to count "
+              "no more instructions than the uniform one (above 1: already fewer).")
 
 
 if __name__ == "__main__":
