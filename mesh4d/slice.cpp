@@ -222,6 +222,16 @@ struct FrameBuilder {
     void classifyVertices(const std::vector<uint8_t>* live) {
         const size_t nv = world.mesh.positions.size();
         side.assign(nv, Side::Inside);
+        // No real cap, nothing culled, every vertex used, the refinement's batch cut made: output
+        // vertex i is the image of vertex i, copied in bulk (the same points vertexPoint emits).
+        if (!world.cap_a_real && !world.cap_b_real && !live && world.simple && r_pos.size() == nv && out.positions.empty()) {
+            out.positions.assign(r_pos.begin(), r_pos.end());
+            out.emission_times.assign(r_time.begin(), r_time.end());
+            out.rest_points = world.mesh.positions;
+            vertex_out.resize(nv);
+            for (size_t i = 0; i < nv; ++i) vertex_out[i] = uint32_t(i);
+            return;
+        }
         vertex_out.assign(nv, kUnset);
         std::vector<uint8_t> needed;
         if (live) {

@@ -143,8 +143,12 @@ if os.path.exists(e2e):
     end_to_end = ["## End to end at equal error", "",
                   "`scripts/trade_end_to_end.py`: `apparent render` of the whole scene (every frame, one thread, .glb "
                   "written), the input subdivided k times in vertex mode against the original input at --tolerance = "
-                  "uniform level k's measured error; best of 7 CPU times of the process (user + system: process start and mesh "
-                  "loading included; time spent waiting for a core on the shared machine left out).", ""]
+                  "uniform level k's measured error. The CPU time of the process (user + system: process start and mesh "
+                  "loading included; time spent waiting for a core on the shared machine left out), the runs of a row "
+                  "alternated, the least of 11 with the spread; beside the whole run, the CPU per frame (the same scene "
+                  "at 10x the frame rate, minus the scene, over the frames it adds), since process start, loading and "
+                  "the .glb's assembly weigh as much as the 40 frames. The second table counts where the instructions "
+                  "go (callgrind).", ""]
     end_to_end += open(e2e).read().rstrip().split("\n") + [""]
 templates = ["## Templates: where the per-triangle cost falls, and where it does not", "",
              "The refinement bisects (Rivara, in the map's metric) until a piece passes its bound, or until a piece "

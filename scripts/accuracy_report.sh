@@ -53,7 +53,8 @@ else
   rm -f "$out/instructions.csv"
 fi
 echo "== end to end at equal error (apparent render, every frame)"
-python3 "$root/scripts/trade_end_to_end.py" "$build" | tee "$out/end_to_end.md"
+count=$(command -v valgrind >/dev/null && echo --count || true)
+python3 "$root/scripts/trade_end_to_end.py" "$build" $count | tee "$out/end_to_end.md"
 python3 "$root/scripts/accuracy_report.py" "$out" "$root/docs"
 (cd "$root/docs" && gnuplot accuracy.gp)
 echo "wrote docs/ACCURACY.md, docs/accuracy.png and docs/trade/"
