@@ -1221,3 +1221,25 @@ TEST(RaytraceSpan, WindowsOfFramesTraceWhatOneWindowTraces) {
         EXPECT_TRUE(one.images[i].rgb == windows.images[i].rgb) << frames[i];
     }
 }
+
+// Issue 18: only a frame that alone needs more slabs than one window may hold is refused, with one
+// line naming the field, the count and the frame (exit 2): the rolling wheel at 0.99c (w R = |v|).
+TEST(RaytraceSpan, AFrameThatAloneNeedsTooManySlabsIsRefused) {
+    const std::string dir = ::testing::TempDir() + "span_fast_wheel_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(source("data/meshes/wheel.obj"), dir + "/wheel.obj",
+                               std::filesystem::copy_options::overwrite_existing);
+    std::ofstream(dir + "/wheel.json") << R"({ "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 70},
+  "frames": {"start": 0, "end": 16, "fps": 10}, "model": "relativistic",
+  "objects": [{"mesh": "wheel.obj", "position": [-4.5, 0, 0], "t0": 0, "velocity": [0.99, 0, 0],
+               "angular_velocity": [0, 0, -0.99]}] })";
+    const CommandRun r = run({"raytrace", dir + "/wheel.json", "--out", dir + "/out", "--frames", "100:101", "--size", "8x4"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("wheel.json: objects[0].angular_velocity: the raytracer would need more than 4096 time slabs of 792 "
+                         "prisms for frame 100 alone"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out/relativistic/frame_00100.png"));
+    std::filesystem::remove_all(dir);
+}
