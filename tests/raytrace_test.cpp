@@ -1124,7 +1124,7 @@ std::string writeSmallRocketScene(const std::string& dir) {
     std::filesystem::copy_file(source("data/meshes/box.obj"), dir + "/box.obj",
                                std::filesystem::copy_options::overwrite_existing);
     const std::string path = dir + "/small_rocket.json";
-    std::ofstream(path) << R"({ "camera": {"position": [0, 0, 6], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 20},
+    std::ofstream(path) << R"({ "camera": {"position": [0, 0, 6], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 20, "instant_delay": 6},
   "frames": {"start": 0, "end": 16, "fps": 10}, "model": "relativistic",
   "objects": [{"mesh": "box.obj", "scale": [0.3, 0.3, 0.3], "position": [-1, 0, 0], "t0": 0,
                "acceleration": [0.2, 0, 0]}] })";
@@ -1175,7 +1175,11 @@ TEST(RaytraceSpan, SeenSpanTracesWhatThePaddedSpanTraces) {
     const std::vector<Case> cases = {
         {source("data/scenes/keyed.gltf"), Model::Relativistic, {40, 80, 120}, 2},
         {source("data/scenes/keyed.gltf"), Model::Finite, {60, 100}, 2},
+        {source("data/scenes/keyed.gltf"), Model::Contracted, {100}, 1},
+        {source("data/scenes/keyed.gltf"), Model::Instant, {100}, 1},
         {writeSmallRocketScene(dir), Model::Relativistic, {70, 110}, 1},
+        {writeSmallRocketScene(dir), Model::Finite, {110}, 1},
+        {writeSmallRocketScene(dir), Model::Contracted, {110}, 1},
     };
     for (const Case& c : cases) {
         Stage stage;
