@@ -74,8 +74,9 @@ void BM_TraceFrame(benchmark::State& state) {
         return;
     }
     const long long k = sphere ? 48 : 100;  // t = 5 s (12 fps, start 1) and t = 10 s
-    const apparent::SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, apparent::Model::Relativistic, k, k,
-                                       hierarchy);
+    apparent::TracerOptions options;
+    options.hierarchy = hierarchy;
+    apparent::SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, apparent::Model::Relativistic, k, k, options);
     tbb::task_arena one(1);
     for (auto _ : state) {
         apparent::TracedFrame frame;

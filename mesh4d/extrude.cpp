@@ -204,25 +204,46 @@ double stepWithin(double K, double M, double chord) {
     return 4 * chord / root;
 }
 
-}  // namespace
+// Segment j's step of a keyframed path (keyframes.h): between two keys the path is straight in its
+// own frame plus a turn at the segment's rate about the segment's axis, so the spin's bound: K the
+// rate times the largest |axis x e|, M the rate^2 times rho (every |q| bounding its distance from
+// any axis); infinity without a turn (the worldlines are straight between keys).
+double keyedSegmentStep(const RestMesh& mesh, const KeyedMotion& k, size_t j, double rho, double chord) {
+    if (!(k.rate[j] > 0)) return INFINITY;
+    return stepWithin(k.rate[j] * largestTurningEdge(mesh, k.axis[j]), k.rate[j] * k.rate[j] * rho, chord);
+}
 
-// A keyframed path (keyframes.h) between two keys: straight in its own frame plus a turn at the
-// segment's rate about the segment's axis, so the spin's bound with the segments over
-// [tau_a, tau_b]: K the largest rate |axis x e|, M the largest rate^2 |q| (every |q| bounding its
-// distance from any axis); without a turn the worldlines are straight between keys, where
-// slabSamples puts a sample.
-double keyedSlabSpacing(const RestMesh& mesh, const KeyedMotion& k, double tau_a, double tau_b, double chord) {
+// An acceleration's step over times with |s| <= s_max: M = sqrt(2) |a|^2 xi_max cosh(|a| s_max)
+// (extrude.h), K = 0.
+double accelerationStep(double a, double xi_max, double s_max, double chord) {
+    return stepWithin(0, std::sqrt(2.0) * a * a * xi_max * std::cosh(a * s_max), chord);
+}
+
+double largestRadius(const RestMesh& mesh) {
     double rho = 0;
     for (const Vec3& q : mesh.positions) rho = std::max(rho, norm(q));
-    double K = 0, M = 0;
-    for (size_t j = 1; j < k.s.size(); ++j)
-        if (k.s[j] > tau_a && k.s[j - 1] < tau_b && k.rate[j] > 0) {
-            K = std::max(K, k.rate[j] * largestTurningEdge(mesh, k.axis[j]));
-            M = std::max(M, k.rate[j] * k.rate[j] * rho);
-        }
-    if (!(M > 0)) return INFINITY;
-    return stepWithin(K, M, chord);
+    return rho;
 }
+
+double largestHorizonDistance(const RestMesh& mesh, const Motion& motion) {
+    double xi = 0;
+    for (const Vec3& q : mesh.positions) xi = std::max(xi, horizonDistance(motion, q));
+    return xi;
+}
+
+// A cell of the grid split into more steps than this is "too fine": slabSamples gives up first.
+constexpr double kMaxCellSteps = 1e15;
+
+// A keyframed path: the segments over [tau_a, tau_b], each with its own bound (keyedSegmentStep).
+double keyedSlabSpacing(const RestMesh& mesh, const KeyedMotion& k, double tau_a, double tau_b, double chord) {
+    const double rho = largestRadius(mesh);
+    double ds = INFINITY;
+    for (size_t j = 1; j < k.s.size(); ++j)
+        if (k.s[j] > tau_a && k.s[j - 1] < tau_b) ds = std::min(ds, keyedSegmentStep(mesh, k, j, rho, chord));
+    return ds;
+}
+
+}  // namespace
 
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord) {
     if (isUniform(motion)) return INFINITY;
@@ -233,35 +254,126 @@ double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, dou
     const double w = norm(motion.angular_velocity);
     const double a = norm(motion.acceleration);
     const double s_max = std::max(std::fabs(tau_a), std::fabs(tau_b));
-    const double ch = a > 0 ? std::cosh(a * s_max) : 1.0;
+    if (a > 0) return accelerationStep(a, largestHorizonDistance(mesh, motion), s_max, chord);
     double M = 0;
-    for (const Vec3& q : mesh.positions)
-        M = std::max(M, a > 0 ? std::sqrt(2.0) * a * a * horizonDistance(motion, q) * ch : w * spinSpeed(motion, q));
+    for (const Vec3& q : mesh.positions) M = std::max(M, w * spinSpeed(motion, q));
     // An acceleration's E_i' - E_q' = |a| (xi_i - xi_q) (cosh, k sinh) is parallel to E_q': along
-    // the history, not off it, so it adds no distance to the history (K = 0). A spin's is
-    // w x R (q_i - q), at most |w x e| over the triangle's edges e.
-    const double K = a > 0 || !(w > 0) ? 0.0 : w * largestTurningEdge(mesh, motion.angular_velocity / w);
+    // the history, not off it, so it adds no distance to the history (K = 0, accelerationStep). A
+    // spin's is w x R (q_i - q), at most |w x e| over the triangle's edges e.
+    const double K = !(w > 0) ? 0.0 : w * largestTurningEdge(mesh, motion.angular_velocity / w);
     return stepWithin(K, M, chord);
+}
+
+SlabGrid::SlabGrid(const RestMesh& mesh, const Motion& motion, double chord) : chord_(chord) {
+    if (isUniform(motion)) return;
+    if (motion.keyed) {
+        const KeyedMotion& k = *motion.keyed;
+        const double rho = largestRadius(mesh);
+        kind_ = Kind::Keyed;
+        keys_ = k.s;
+        counts_.assign(k.s.size(), 1.0);
+        for (size_t j = 1; j < k.s.size(); ++j) {
+            const double n = std::ceil((k.s[j] - k.s[j - 1]) / keyedSegmentStep(mesh, k, j, rho, chord));
+            counts_[j] = std::isnan(n) ? kMaxCellSteps : std::clamp(n, 1.0, kMaxCellSteps);
+        }
+        return;
+    }
+    const double a = norm(motion.acceleration);
+    if (a > 0) {
+        kind_ = Kind::Acceleration;
+        accel_ = a;
+        step_ = 1 / (8 * a);
+        xi_max_ = largestHorizonDistance(mesh, motion);
+        return;
+    }
+    step_ = slabSpacing(mesh, motion, 0, 0, chord);
+    if (step_ > 0 && step_ < INFINITY) kind_ = Kind::Spin;
+}
+
+double SlabGrid::blockCount(double j) const {
+    const double n = std::ceil(step_ / accelerationStep(accel_, xi_max_, (j + 1) * step_, chord_));
+    return std::isnan(n) ? kMaxCellSteps : std::clamp(n, 1.0, kMaxCellSteps);
+}
+
+void SlabGrid::cellOf(double s, double* lo, double* hi, double* n) const {
+    *lo = -INFINITY;
+    *hi = INFINITY;
+    *n = 1;
+    // Cells of equal length L = step_ from 0: j with j L <= s < (j + 1) L, the floor corrected for
+    // the rounding of s / L.
+    auto block = [&](double L) {
+        double j = std::floor(s / L);
+        while (j * L > s) j -= 1;
+        while ((j + 1) * L <= s) j += 1;
+        *lo = j * L;
+        *hi = (j + 1) * L;
+        return j;
+    };
+    switch (kind_) {
+    case Kind::None:
+        return;
+    case Kind::Spin:
+        block(step_);
+        return;
+    case Kind::Acceleration:
+        if (s < 0) {
+            *hi = 0;
+            return;
+        }
+        *n = blockCount(block(step_));
+        return;
+    case Kind::Keyed: {
+        const size_t j = size_t(std::upper_bound(keys_.begin(), keys_.end(), s) - keys_.begin());
+        if (j > 0) *lo = keys_[j - 1];
+        if (j < keys_.size()) *hi = keys_[j];
+        if (j > 0 && j < keys_.size()) *n = counts_[j];
+        return;
+    }
+    }
+}
+
+double SlabGrid::after(double s) const {
+    double lo, hi, n;
+    cellOf(s, &lo, &hi, &n);
+    if (!(lo > -INFINITY) || !(hi < INFINITY)) return hi;
+    // Step i of the cell's n: lo + i h, the least > s.
+    const double h = (hi - lo) / n;
+    double i = std::floor((s - lo) / h) + 1;
+    while (i > 1 && lo + (i - 1) * h > s) i -= 1;
+    while (i < n && lo + i * h <= s) i += 1;
+    return i >= n ? hi : lo + i * h;
+}
+
+double SlabGrid::atOrBefore(double s) const {
+    double lo, hi, n;
+    cellOf(s, &lo, &hi, &n);
+    if (!(lo > -INFINITY) || !(hi < INFINITY)) return lo;
+    const double h = (hi - lo) / n;
+    double i = std::clamp(std::floor((s - lo) / h), 0.0, n - 1);
+    while (i > 0 && lo + i * h > s) i -= 1;
+    while (i + 1 < n && lo + (i + 1) * h <= s) i += 1;
+    return lo + i * h;
+}
+
+double SlabGrid::atOrAfter(double s) const {
+    const double before = atOrBefore(s);
+    return before == s ? s : after(s);
+}
+
+std::vector<double> SlabGrid::samples(double tau_a, double tau_b, size_t max_slabs) const {
+    std::vector<double> out{tau_a};
+    for (double s = after(tau_a); s < tau_b; s = after(s)) {
+        if (out.size() > max_slabs || !(s > out.back())) return {};
+        out.push_back(s);
+    }
+    out.push_back(tau_b);
+    if (out.size() - 1 > max_slabs) return {};
+    return out;
 }
 
 std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord,
                                 size_t max_slabs) {
-    std::vector<double> samples{tau_a};
-    double s = tau_a;
-    while (s < tau_b) {
-        // The step bounded at s alone, then over [s, s + that step] (never longer: the bound grows with |s|).
-        const double first = slabSpacing(mesh, motion, s, s, chord);
-        double end = tau_b;  // a keyframed path's next key: its worldlines bend there
-        if (motion.keyed)
-            for (double key : motion.keyed->s)
-                if (key > s && key < end) end = key;
-        const double ds = slabSpacing(mesh, motion, s, std::min(end, s + first), chord);
-        if (!(ds > 0) || samples.size() > max_slabs) return {};
-        s = ds >= end - s ? end : s + ds;
-        samples.push_back(s);
-    }
-    if (samples.size() - 1 > max_slabs) return {};
-    return samples;
+    return SlabGrid(mesh, motion, chord).samples(tau_a, tau_b, max_slabs);
 }
 
 std::vector<World4D> extrudeSlabs(const RestMesh& mesh, const Motion& motion, const std::vector<double>& samples,

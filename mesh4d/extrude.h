@@ -130,9 +130,51 @@ World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_
 // ds over the interval [tau_a, tau_b] of s (s_max = max(|tau_a|, |tau_b|)).
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord);
 
-// The sample times tau_a = s_0 < s_1 < ... < s_n = tau_b, each step slabSpacing over its own
-// interval (steps shrink where the bound grows: an acceleration's cosh(|a| s)); empty when more
-// than max_slabs slabs would be needed.
+// The slab grid (issue 18): sample times fixed by the motion, the mesh and the chord alone, never by
+// the span asked for, so that the slabs of any two spans are the same slabs where they overlap. A
+// narrower span (the one the frames see, pipeline/worlds.h) or a window of a long frame range
+// (pipeline/raytrace.h) then traces the very tetrahedra a wider span would: the same pictures, byte
+// for byte. The grid points, each step within slabSpacing over its own cell:
+//   spin: k ds for every integer k, ds = slabSpacing (constant: the bound does not depend on s);
+//   acceleration: none before t0 (s < 0: uniform motion, straight worldlines); from s = 0 on,
+//     blocks [j L, (j + 1) L], L = 1 / (8 |a|), block j cut into n_j = ceil(L / ds_j) equal steps,
+//     ds_j = slabSpacing over the block (cosh(|a| s) grows by at most e^(1/8) across a block, so
+//     the steps are within about 6 % of slabSpacing's at each s, and shrink as it does);
+//   keyframed path: every key, and between keys j - 1 and j, n_j = ceil((s_j - s_{j-1}) / ds_j)
+//     equal steps, ds_j the spin's bound with that segment's turn (infinity without one: n_j = 1);
+//     none before the first key or after the last (the body rests there in the lab).
+// The points are computed from their indices (k ds, j L + i (L / n_j)), never by accumulating
+// steps, so that every span gets bit-identical times. Uniform motion has no grid points.
+class SlabGrid {
+public:
+    SlabGrid() = default;  // no grid points
+    // Precondition: chord > 0; mesh as for slabSpacing.
+    SlabGrid(const RestMesh& mesh, const Motion& motion, double chord);
+    // The least grid point > s (INFINITY when there is none).
+    double after(double s) const;
+    // The greatest grid point <= s (-INFINITY when there is none).
+    double atOrBefore(double s) const;
+    // The least grid point >= s (INFINITY when there is none).
+    double atOrAfter(double s) const;
+    // tau_a, the grid points strictly between tau_a and tau_b, tau_b; empty when more than
+    // max_slabs slabs would be needed. Precondition: tau_a < tau_b.
+    std::vector<double> samples(double tau_a, double tau_b, size_t max_slabs) const;
+
+private:
+    enum class Kind { None, Spin, Acceleration, Keyed };
+    Kind kind_ = Kind::None;
+    double step_ = INFINITY;  // spin: ds; acceleration: the block length L
+    double accel_ = 0, xi_max_ = 0, chord_ = 0;  // acceleration: |a|, the largest horizon distance
+    std::vector<double> keys_;    // keyframed: the key times s_k
+    std::vector<double> counts_;  // keyframed: n_j for segment j (between keys j - 1 and j), index j
+    double blockCount(double j) const;  // acceleration: n_j of block j (an integer, >= 1)
+    // The cell [lo, hi) of s and its n equal steps (lo = -INFINITY or hi = INFINITY: no cell).
+    void cellOf(double s, double* lo, double* hi, double* n) const;
+};
+
+// The sample times tau_a = s_0 < s_1 < ... < s_n = tau_b: SlabGrid(mesh, motion, chord).samples
+// (every step within slabSpacing over its own interval); empty when more than max_slabs slabs
+// would be needed.
 std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord,
                                 size_t max_slabs);
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <memory>
 #include <ostream>
 #include <sstream>
@@ -42,11 +43,8 @@ uint8_t toSrgb8(double linear) {
 
 // Time slabs for a motion that is not uniform (mesh4d/extrude.h): each vertex's sampled worldline
 // within kSlabChordRelative of the object's bounding-box diagonal of its true one in the lab (the
-// own-frame chord divided by the boost's or carry's largest stretch, gamma (1 + b)); at most
-// kMaxSlabs slabs and kMaxSlabPrisms prisms over all slabs of one object.
+// own-frame chord divided by the boost's or carry's largest stretch, gamma (1 + b)).
 constexpr double kSlabChordRelative = 1e-3;
-constexpr size_t kMaxSlabs = 4096;
-constexpr size_t kMaxSlabPrisms = 20000000;
 
 // The slabs' chord in the object's own frame (above) for `mesh` moving with `motion`.
 double slabChord(const mesh4d::RestMesh& mesh, const mesh4d::Motion& motion) {
@@ -56,42 +54,12 @@ double slabChord(const mesh4d::RestMesh& mesh, const mesh4d::Motion& motion) {
     return kSlabChordRelative * box.diagonal() / (g * (1 + motion.beta));
 }
 
-// A spinning object's world over only the times its frames can see (worlds.h spinSpanSeen), from
-// the camera and from each mirror image of it (the camera is at rest: spin needs it), cut to the
-// object's existence. The padded span of buildWorld (light-crossing time over 1 - b) would be
-// 58.5 s of the rolling wheel's time for frames 100:102, where this one is 2.1 s.
-mesh4d::World4D spinTraceWorld(const PreparedObject& object, Model model, const Scene& scene,
-                               const std::vector<MirrorPlane>& mirrors, long long first, long long last) {
-    const mesh4d::MotionInCameraFrame in_cut = cutMotionOf(object.spec, model, scene);
-    mesh4d::RestMesh rotated;
-    const mesh4d::RestMesh& rest = restInCameraFrame(object.rest, in_cut, &rotated);
-    const double offset = slabChord(rest, in_cut.motion);
-    mesh4d::ProperTimeSpan span = spinSpanSeen(rest, in_cut.motion, viewForFrame(scene, model, first),
-                                               viewForFrame(scene, model, last), offset);
-    for (const MirrorPlane& m : mirrors) {
-        Scene image = scene;
-        image.camera.position = reflectPoint(m, scene.camera.position);
-        const mesh4d::ProperTimeSpan seen = spinSpanSeen(rest, in_cut.motion, viewForFrame(image, model, first),
-                                                         viewForFrame(image, model, last), offset);
-        span = {std::min(span.lo, seen.lo), std::max(span.hi, seen.hi)};
-    }
-    const ObjectSpec& s = object.spec;
-    const bool cap_a_real = s.exists_from > span.lo, cap_b_real = s.exists_to < span.hi;
-    const double tau_a = cap_a_real ? s.exists_from : span.lo, tau_b = cap_b_real ? s.exists_to : span.hi;
-    if (!(tau_a < tau_b)) {
-        mesh4d::World4D empty;
-        empty.motion = in_cut.motion;
-        return empty;
-    }
-    return mesh4d::extrude(rest, in_cut.motion, tau_a, tau_b, cap_a_real, cap_b_real);
-}
-
 // The world of `object` extruded over the union of the spans seen from the camera and from each
 // mirror image of the camera, so that reflected rays, which reach further into the past, stay
-// inside the history. Existence caps stay real where they clip either span.
+// inside the history. Existence caps stay real where they clip either span. buildWorld's span,
+// padded by the light-crossing time over 1 - b: what a uniform motion is traced over.
 mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scene& scene,
                            const std::vector<MirrorPlane>& mirrors, long long first, long long last) {
-    if (mesh4d::norm(object.spec.angular_velocity) != 0) return spinTraceWorld(object, model, scene, mirrors, first, last);
     mesh4d::World4D direct = buildWorld(object, model, scene, first, last);
     if (mirrors.empty()) return direct;
     double tau_a = direct.empty() ? INFINITY : direct.tau_a, tau_b = direct.empty() ? -INFINITY : direct.tau_b;
@@ -117,29 +85,175 @@ mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scen
     return mesh4d::extrude(rest, direct.motion, tau_a, tau_b, real_a, real_b);
 }
 
-// The sample times of w's slabs: {tau_a, tau_b} for uniform motion, empty beyond kMaxSlabs.
-std::vector<double> slabTimes(const mesh4d::World4D& w) {
-    if (mesh4d::isUniform(w.motion) || w.empty()) return {w.tau_a, w.tau_b};
-    return mesh4d::slabSamples(w.mesh, w.motion, w.tau_a, w.tau_b, slabChord(w.mesh, w.motion), kMaxSlabs);
+bool isSlabbed(const ObjectSpec& spec) {
+    return mesh4d::norm(spec.angular_velocity) != 0 || mesh4d::norm(spec.acceleration) != 0 || spec.keys;
 }
 
-// One line when an object would need more slabs than the limits allow.
-Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, long long first, long long last) {
-    for (Model model : models)
-        for (const PreparedObject& o : stage.objects) {
-            if (mesh4d::norm(o.spec.angular_velocity) == 0 && mesh4d::norm(o.spec.acceleration) == 0 && !o.spec.keys) continue;
-            const std::vector<double> times = slabTimes(traceWorld(o, model, stage.scene, stage.mirrors, first, last));
-            const size_t n = times.empty() ? kMaxSlabs + 1 : times.size() - 1;
-            if (n > kMaxSlabs || n * o.rest.triangles.size() > kMaxSlabPrisms)
-                return Status::failure(stage.scene.path + ": " +
-                                       (o.spec.keys ? o.spec.keys_field
-                                                    : o.spec.field_path + (mesh4d::norm(o.spec.angular_velocity) != 0 ? ".angular_velocity" : ".acceleration")) +
-                                       ": the raytracer would need " + (n > kMaxSlabs ? "more than " + std::to_string(kMaxSlabs)
-                                                                                      : std::to_string(n)) +
-                                       " time slabs of " + std::to_string(o.rest.triangles.size()) + " prisms (limits " +
-                                       std::to_string(kMaxSlabs) + " slabs, " + std::to_string(kMaxSlabPrisms) +
-                                       " prisms) for model " + modelName(model) + ": trace fewer frames (--frames) or use `apparent render`");
+}  // namespace
+
+// The objects of a scene whose motion is not uniform, for one model: the span of their time a
+// window of frames sees, and its slabs on each motion's grid (mesh4d/extrude.h SlabGrid).
+class SlabPlanner {
+public:
+    struct Slabbed {
+        size_t object = 0;          // index among the scene's objects
+        PreparedObject prepared;    // as given (the padded peer builds from it)
+        mesh4d::RestMesh rest;      // in the frame of the cut
+        mesh4d::Motion motion;      // there
+        double chord = 0;           // slabChord
+        mesh4d::SlabGrid grid;
+    };
+    // A span of the object's time to extrude; a real cap is one of the object's existence.
+    struct Span {
+        double tau_a = 0, tau_b = 0;
+        bool real_a = false, real_b = false;
+        bool empty() const { return !(tau_a < tau_b); }
+    };
+
+    SlabPlanner(const Scene& scene, const std::vector<PreparedObject>& objects, const std::vector<MirrorPlane>& mirrors,
+                Model model, bool padded)
+        : scene_(scene), mirrors_(mirrors), model_(model), padded_(padded) {
+        for (size_t i = 0; i < objects.size(); ++i) {
+            if (!isSlabbed(objects[i].spec)) continue;
+            Slabbed o;
+            o.object = i;
+            o.prepared = objects[i];
+            const mesh4d::MotionInCameraFrame in_cut = cutMotionOf(objects[i].spec, model, scene);
+            mesh4d::RestMesh rotated;
+            o.rest = restInCameraFrame(objects[i].rest, in_cut, &rotated);
+            o.motion = in_cut.motion;
+            o.chord = slabChord(o.rest, o.motion);
+            o.grid = mesh4d::SlabGrid(o.rest, o.motion, o.chord);
+            slabbed_.push_back(std::move(o));
         }
+    }
+    const std::vector<Slabbed>& objects() const { return slabbed_; }
+
+    // The span frames a..b see of o, from the camera and from each mirror image of it (the camera
+    // is at rest for these motions), its open ends moved out to the grid, cut to o's existence.
+    Span span(const Slabbed& o, long long a, long long b) const {
+        double lo = INFINITY, hi = -INFINITY;
+        bool padded = padded_;
+        if (!padded) {
+            std::vector<Scene> views{scene_};
+            for (const MirrorPlane& m : mirrors_) {
+                views.push_back(scene_);
+                views.back().camera.position = reflectPoint(m, scene_.camera.position);
+            }
+            for (const Scene& v : views) {
+                const mesh4d::ViewSurface first = viewForFrame(v, model_, a), last = viewForFrame(v, model_, b);
+                mesh4d::ProperTimeSpan seen;
+                if (mesh4d::norm(o.motion.angular_velocity) != 0) {
+                    seen = spinSpanSeen(o.rest, o.motion, first, last, o.chord);
+                } else {
+                    const SeenSpan path = pathSpanSeen(o.rest, o.motion, first, last, o.chord);
+                    padded = padded || !path.ok;
+                    seen = path.span;
+                }
+                lo = std::min(lo, seen.lo);
+                hi = std::max(hi, seen.hi);
+            }
+        }
+        if (padded) {  // the peer, or a seen span that did not close: buildWorld's padded span
+            const mesh4d::World4D w = traceWorld(o.prepared, model_, scene_, mirrors_, a, b);
+            if (w.empty()) return {};
+            lo = w.tau_a;
+            hi = w.tau_b;
+        }
+        // Step: open ends out to the grid (where it has a point beyond), then the existence.
+        const double grid_lo = o.grid.atOrBefore(lo), grid_hi = o.grid.atOrAfter(hi);
+        if (grid_lo > -INFINITY) lo = grid_lo;
+        if (grid_hi < INFINITY) hi = grid_hi;
+        const ObjectSpec& s = o.prepared.spec;
+        Span out;
+        out.real_a = s.exists_from > lo;
+        out.real_b = s.exists_to < hi;
+        out.tau_a = out.real_a ? s.exists_from : lo;
+        out.tau_b = out.real_b ? s.exists_to : hi;
+        return out;
+    }
+
+    // The sample times of o's slabs over `span` (empty beyond max_slabs; none for an empty span).
+    std::vector<double> samples(const Slabbed& o, const Span& span, size_t max_slabs) const {
+        if (span.empty()) return {};
+        return o.grid.samples(span.tau_a, span.tau_b, max_slabs);
+    }
+
+    // Whether every object's slabs for frames a..b fit max_slabs and kMaxTraceSlabPrisms; if not,
+    // *worst is the first object that does not fit, *count its slabs (max_slabs + 1: more).
+    bool fits(long long a, long long b, size_t max_slabs, size_t* worst = nullptr, size_t* count = nullptr) const {
+        for (size_t i = 0; i < slabbed_.size(); ++i) {
+            const Span sp = span(slabbed_[i], a, b);
+            if (sp.empty()) continue;
+            const std::vector<double> times = samples(slabbed_[i], sp, max_slabs);
+            const size_t n = times.empty() ? max_slabs + 1 : times.size() - 1;
+            if (n > max_slabs || n * slabbed_[i].rest.triangles.size() > kMaxTraceSlabPrisms) {
+                if (worst) *worst = i;
+                if (count) *count = n;
+                return false;
+            }
+        }
+        return true;
+    }
+
+    // The last frame of the longest window k..end (end <= last) that fits (fits above); k - 1 when
+    // frame k alone does not. The spans grow with the window, so a window that fits holds every
+    // shorter one: doubling, then bisection.
+    long long windowEnd(long long k, long long last, size_t max_slabs) const {
+        if (!fits(k, k, max_slabs)) return k - 1;
+        long long good = k, bad = last + 1;
+        for (long long step = 1; good + step <= last; step *= 2) {
+            if (!fits(k, good + step, max_slabs)) {
+                bad = good + step;
+                break;
+            }
+            good += step;
+        }
+        while (bad - good > 1) {
+            const long long mid = good + (bad - good) / 2;
+            if (fits(k, mid, max_slabs)) good = mid;
+            else bad = mid;
+        }
+        return good;
+    }
+
+private:
+    Scene scene_;
+    std::vector<MirrorPlane> mirrors_;
+    Model model_;
+    bool padded_;
+    std::vector<Slabbed> slabbed_;
+};
+
+namespace {
+
+// One line when some frame alone would need more slabs than the limits allow (a window of one
+// frame, SceneTracer); longer ranges are traced in windows.
+Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, long long first, long long last) {
+    for (Model model : models) {
+        const SlabPlanner planner(stage.scene, stage.objects, stage.mirrors, model, false);
+        if (planner.objects().empty()) continue;
+        for (long long k = first; k <= last;) {
+            const long long end = planner.windowEnd(k, last, kMaxTraceSlabs);
+            if (end >= k) {
+                k = end + 1;
+                continue;
+            }
+            size_t worst = 0, n = 0;
+            planner.fits(k, k, kMaxTraceSlabs, &worst, &n);
+            const SlabPlanner::Slabbed& o = planner.objects()[worst];
+            const ObjectSpec& spec = o.prepared.spec;
+            return Status::failure(stage.scene.path + ": " +
+                                   (spec.keys ? spec.keys_field
+                                              : spec.field_path + (mesh4d::norm(spec.angular_velocity) != 0 ? ".angular_velocity" : ".acceleration")) +
+                                   ": the raytracer would need " + (n > kMaxTraceSlabs ? "more than " + std::to_string(kMaxTraceSlabs)
+                                                                                       : std::to_string(n)) +
+                                   " time slabs of " + std::to_string(o.rest.triangles.size()) + " prisms for frame " +
+                                   std::to_string(k) + " alone (limits " + std::to_string(kMaxTraceSlabs) + " slabs, " +
+                                   std::to_string(kMaxTraceSlabPrisms) + " prisms) for model " + modelName(model) +
+                                   ": use `apparent render`");
+        }
+    }
     return Status::success();
 }
 
@@ -169,55 +283,80 @@ Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int
 
 SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects,
                          const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
-                         long long last_frame, bool hierarchy)
-    : scene_(scene), model_(model), mirrors_(mirrors), mirror_of_object_(objects.size(), -1) {
+                         long long last_frame, TracerOptions options)
+    : scene_(scene), model_(model), options_(options), first_(first_frame), last_(last_frame), mirrors_(mirrors),
+      mirror_of_object_(objects.size(), -1) {
     for (size_t m = 0; m < mirrors_.size(); ++m) mirror_of_object_[mirrors_[m].object] = int32_t(m);
-    // Step: build the static worlds once, then their per-prism trace data (which points into worlds_).
-    // A motion that is not uniform is traced through its time slabs (mesh4d/extrude.h), one world
-    // each, all owned by the object.
-    worlds_.reserve(objects.size());
+    // Step: the uniform motions' worlds once, over the whole range, with their traces (which point
+    // into the worlds); the others' time slabs per window of frames (buildWindow), the first now.
+    objects_.resize(objects.size());
     for (size_t i = 0; i < objects.size(); ++i) {
         colors_.push_back(objectBaseColor(objects, i));
         lab_motions_.push_back(motionOf(objects[i].spec, model));
-        mesh4d::World4D w = traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame);
-        motions_.push_back(w.motion);
-        const std::vector<double> times = slabTimes(w);
-        if (times.size() <= 2) {
-            worlds_.push_back(std::move(w));
-            owner_.push_back(uint32_t(i));
-            continue;
-        }
-        for (mesh4d::World4D& slab : mesh4d::extrudeSlabs(w.mesh, w.motion, times, w.cap_a_real, w.cap_b_real)) {
-            worlds_.push_back(std::move(slab));
-            owner_.push_back(uint32_t(i));
-        }
+        motions_.push_back(cutMotionOf(objects[i].spec, model, scene).motion);
+        if (isSlabbed(objects[i].spec)) continue;
+        objects_[i].worlds.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
+        setTraces(&objects_[i]);
     }
+    planner_ = std::make_unique<SlabPlanner>(scene, objects, mirrors_, model, options_.padded_span);
+    if (!planner_->objects().empty()) buildWindow(first_frame);
+}
+
+SceneTracer::~SceneTracer() = default;
+
+size_t SceneTracer::worldCount() const {
+    size_t n = 0;
+    for (const ObjectTraces& o : objects_) n += o.worlds.size();
+    return n;
+}
+
+void SceneTracer::setTraces(ObjectTraces* o) const {
+    o->traces.clear();
+    o->trace_worlds.clear();
     // An object of several time slabs is traced through one hierarchy over all of them (ray4d.h
     // prepareSlabsTrace); without the hierarchy (the benchmarks' peer) each slab is scanned alone.
-    for (size_t begin = 0, end = 0; begin < worlds_.size(); begin = end) {
-        end = begin + 1;
-        while (end < worlds_.size() && owner_[end] == owner_[begin]) ++end;
-        if (end - begin > 1 && hierarchy) {
-            std::vector<const mesh4d::World4D*> slabs;
-            for (size_t i = begin; i < end; ++i) slabs.push_back(&worlds_[i]);
-            traces_.push_back(mesh4d::prepareSlabsTrace(slabs));
-            // The trace leaves out empty slabs: map its slab numbers back to worlds.
-            std::vector<uint32_t> world_of_slab;
-            for (size_t i = begin; i < end; ++i)
-                if (!worlds_[i].empty()) world_of_slab.push_back(uint32_t(i));
-            trace_worlds_.push_back(std::move(world_of_slab));
-            trace_owner_.push_back(owner_[begin]);
-            continue;
+    if (o->worlds.size() > 1 && options_.hierarchy) {
+        std::vector<const mesh4d::World4D*> slabs;
+        std::vector<uint32_t> world_of_slab;  // the trace leaves out empty slabs: its slab numbers to worlds
+        for (size_t i = 0; i < o->worlds.size(); ++i) {
+            slabs.push_back(&o->worlds[i]);
+            if (!o->worlds[i].empty()) world_of_slab.push_back(uint32_t(i));
         }
-        for (size_t i = begin; i < end; ++i) {
-            traces_.push_back(mesh4d::prepareTrace(worlds_[i], hierarchy));
-            trace_worlds_.push_back({uint32_t(i)});
-            trace_owner_.push_back(owner_[i]);
-        }
+        o->traces.push_back(mesh4d::prepareSlabsTrace(slabs));
+        o->trace_worlds.push_back(std::move(world_of_slab));
+        return;
     }
-    trace_group_end_.resize(traces_.size());
-    for (size_t i = traces_.size(); i-- > 0;)
-        trace_group_end_[i] = i + 1 < traces_.size() && trace_owner_[i + 1] == trace_owner_[i] ? trace_group_end_[i + 1] : i + 1;
+    for (size_t i = 0; i < o->worlds.size(); ++i) {
+        o->traces.push_back(mesh4d::prepareTrace(o->worlds[i], options_.hierarchy));
+        o->trace_worlds.push_back({uint32_t(i)});
+    }
+}
+
+void SceneTracer::buildWindow(long long k) {
+    // Step: the window from k: the longest run of frames whose slabs fit (the callers checked that
+    // frame k alone does); the old window's slabs go first, so that at most one window is held.
+    const long long end = std::max(k, planner_->windowEnd(k, last_, options_.window_slabs));
+    size_t slabs = 0;
+    for (const SlabPlanner::Slabbed& o : planner_->objects()) {
+        ObjectTraces& traces = objects_[o.object];
+        traces = {};
+        const SlabPlanner::Span span = planner_->span(o, k, end);
+        const std::vector<double> times = planner_->samples(o, span, std::numeric_limits<size_t>::max());
+        if (times.size() < 2) {  // the object does not exist in the window
+            mesh4d::World4D empty;
+            empty.motion = o.motion;
+            traces.worlds.push_back(std::move(empty));
+        } else {
+            traces.worlds = mesh4d::extrudeSlabs(o.rest, o.motion, times, span.real_a, span.real_b);
+            slabs += traces.worlds.size();
+        }
+        setTraces(&traces);
+    }
+    window_first_ = k;
+    window_last_ = end;
+    ++slab_counts_.windows;
+    slab_counts_.built += slabs;
+    slab_counts_.most = std::max(slab_counts_.most, slabs);
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
@@ -226,14 +365,14 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     // Objects in scene order; an object's traces (its time slabs, when scanned one by one) latest
     // first: the ray runs back in time, so the first slab it hits holds that object's nearest hit,
     // and the earlier slabs then fail their root box at once.
-    for (size_t begin = 0, end = 0; begin < traces_.size(); begin = end) {
-        end = trace_group_end_[begin];
-        if (skip_mirrors && mirror_of_object_[trace_owner_[begin]] >= 0) continue;
-        for (size_t i = end; i-- > begin;)
-            if (const auto h = mesh4d::intersectWorld(traces_[i], ray, s_max)) {
+    for (size_t object = 0; object < objects_.size(); ++object) {
+        if (skip_mirrors && mirror_of_object_[object] >= 0) continue;
+        const ObjectTraces& o = objects_[object];
+        for (size_t i = o.traces.size(); i-- > 0;)
+            if (const auto h = mesh4d::intersectWorld(o.traces[i], ray, s_max)) {
                 s_max = h->s;
-                best.object = int32_t(trace_owner_[i]);
-                best.world = trace_worlds_[i][h->slab];
+                best.object = int32_t(object);
+                best.world = o.trace_worlds[i][h->slab];
                 best.hit = *h;
             }
     }
@@ -271,7 +410,7 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
             // The hit's own time kept inside its slab, short of its closing key, so that the segment
             // is this slab's (keyframes.h gives a key to the segment it starts); the camera is at
             // rest for these motions.
-            const mesh4d::World4D& slab = worlds_[h.world];
+            const mesh4d::World4D& slab = objects_[size_t(h.object)].worlds[h.world];
             const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));
             d = mesh4d::worldlineDoppler(motion, kind, receiver, s, h.hit.rest_point, emitted_at);
         }
@@ -293,7 +432,8 @@ std::array<double, 3> SceneTracer::shadeReflected(const Hit& h, const mesh4d::Vi
                      reflectDirection(m, camera.velocity));
 }
 
-TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) const {
+TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) {
+    if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) buildWindow(k);
     TracedFrame frame;
     frame.image = RgbImage(width, height);
     frame.object.assign(size_t(width) * size_t(height), -1);
@@ -450,9 +590,11 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
             if (settings.write_png) log << ", " << dir << "/";
             if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
             if (receiver) log << ", " << group.size() << " processes shared the frames";
-            const size_t slabs = size_t(std::count_if(tracer.worlds().begin(), tracer.worlds().end(),
-                                                      [](const mesh4d::World4D& w) { return !mesh4d::isUniform(w.motion); }));
-            if (slabs > 0) log << ", " << slabs << " time slabs";
+            const SceneTracer::SlabCounts& slabs = tracer.slabCounts();
+            if (slabs.windows == 1 && slabs.built > 0) log << ", " << slabs.built << " time slabs";
+            if (slabs.windows > 1)
+                log << ", " << slabs.built << " time slabs in " << slabs.windows << " windows of frames (at most "
+                    << slabs.most << " at once)";
             log << "\n";
         }
     }

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,35 +45,74 @@ struct TracedFrame {
     std::vector<int32_t> reflected;
 };
 
+// Time slabs (mesh4d/extrude.h) of one object whose motion is not uniform held at once, and the
+// prisms over all of them (memory grows with both).
+constexpr size_t kMaxTraceSlabs = 4096;
+constexpr size_t kMaxTraceSlabPrisms = 20000000;
+
+struct TracerOptions {
+    bool hierarchy = true;     // false: every prism tested for every ray (the benchmarks' peer, ray4d.h)
+    // true: a motion that is not uniform is traced over buildWorld's padded span (light-crossing
+    // time over 1 - b), not the span its frames see (worlds.h): the tests' peer of the seen span.
+    bool padded_span = false;
+    size_t window_slabs = kMaxTraceSlabs;  // one object's time slabs held at once (windows, below)
+};
+
+class SlabPlanner;
+
 // The scene's worlds for one model, prepared for tracing frames first..last (global numbers).
-// Worlds are extruded over the span the camera and each mirror image of it can see.
+// Uniform motions: one world each, extruded once over the span the camera and each mirror image
+// of it can see in first..last. Motions that are not uniform: time slabs on the motion's slab grid
+// (extrude.h SlabGrid) over the span a window of frames sees (worlds.h spinSpanSeen, pathSpanSeen),
+// the window the longest run of frames from the first one traced whose slabs fit in
+// options.window_slabs and kMaxTraceSlabPrisms per object; a frame outside it gets a new window
+// from that frame. The grid makes a slab the same in every window that holds it, so each frame's
+// picture is the same whichever windows the frames were traced in (and as one window over a short
+// range). Memory: at most one window's slabs at a time.
 class SceneTracer {
 public:
-    // Preconditions: the scene passed checkSceneForModel for `model`; mirrors from findMirrors.
-    // hierarchy false: every prism is tested for every ray (the benchmarks' peer, ray4d.h).
+    // Preconditions: the scene passed checkSceneForModel for `model` and every frame first..last
+    // fits a window alone (raytrace and figure check it: checkTracedMotions); mirrors from
+    // findMirrors; `objects` may go after the constructor.
     SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects, const std::vector<MirrorPlane>& mirrors,
-                Model model, long long first_frame, long long last_frame, bool hierarchy = true);
+                Model model, long long first_frame, long long last_frame, TracerOptions options = {});
+    ~SceneTracer();
     SceneTracer(const SceneTracer&) = delete;
     SceneTracer& operator=(const SceneTracer&) = delete;
 
-    // Traces global frame k at width x height (rows in parallel with TBB; deterministic). Each row
+    // Traces global frame k (first..last) at width x height (rows in parallel with TBB;
+    // deterministic), building the window of time slabs that holds it first when needed. Each row
     // done is counted in `progress` when given.
-    TracedFrame traceFrame(long long k, int width, int height, TraceProgress* progress = nullptr) const;
+    TracedFrame traceFrame(long long k, int width, int height, TraceProgress* progress = nullptr);
 
     // --shade doppler (off by default): colours shifted by each hit's Doppler factor.
     void setShadeDoppler(bool on) { shade_doppler_ = on; }
 
-    // The traced worlds: one per object, or one per time slab of an object whose motion is not
-    // uniform (owners() gives each world's object).
-    const std::vector<mesh4d::World4D>& worlds() const { return worlds_; }
-    const std::vector<uint32_t>& owners() const { return owner_; }
+    // The traced worlds of the current window: one per object, or one per time slab of an object
+    // whose motion is not uniform.
+    size_t worldCount() const;
+    // Windows built so far, the time slabs built over all of them, the most held at once.
+    struct SlabCounts {
+        size_t windows = 0, built = 0, most = 0;
+    };
+    const SlabCounts& slabCounts() const { return slab_counts_; }
 
 private:
     struct Hit {
         int32_t object = -1;
-        uint32_t world = 0;  // the world (time slab) hit
+        uint32_t world = 0;  // the world (time slab) hit, in its object's worlds
         mesh4d::WorldHit hit;
     };
+    // One object's worlds and their traces: one world, or one per time slab (traced through one
+    // hierarchy over all of them, ray4d.h prepareSlabsTrace; scanned one by one without it).
+    struct ObjectTraces {
+        std::vector<mesh4d::World4D> worlds;
+        std::vector<mesh4d::TraceWorld> traces;
+        std::vector<std::vector<uint32_t>> trace_worlds;  // per trace, the world of each of its slabs
+    };
+    void setTraces(ObjectTraces* o) const;
+    // The window of time slabs that holds frame k.
+    void buildWindow(long long k);
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
     // `receiver`: where the light goes from the hit (the camera or the mirror point), for D, and its
     // velocity (light_factors.h dopplerFactor: nonzero only for finite with a moving camera).
@@ -89,17 +129,17 @@ private:
 
     Scene scene_;
     Model model_;
+    TracerOptions options_;
+    long long first_ = 0, last_ = 0;
+    long long window_first_ = 1, window_last_ = 0;  // the current window of slabs (empty at first)
     std::vector<MirrorPlane> mirrors_;
     std::vector<int32_t> mirror_of_object_;  // index into mirrors_, or -1
     std::vector<std::array<double, 4>> colors_;
     std::vector<mesh4d::Motion> motions_;       // per object
     std::vector<mesh4d::Motion> lab_motions_;   // each object's lab motion (reflections' Doppler)
-    std::vector<mesh4d::World4D> worlds_;       // per object, or per time slab of a motion that is not uniform
-    std::vector<uint32_t> owner_;               // the object of each world
-    std::vector<mesh4d::TraceWorld> traces_;    // per world, or one over all slabs of an object
-    std::vector<uint32_t> trace_owner_;         // the object of each trace
-    std::vector<size_t> trace_group_end_;       // per trace, one past the last trace of its object
-    std::vector<std::vector<uint32_t>> trace_worlds_;  // per trace, the world of each of its slabs
+    std::vector<ObjectTraces> objects_;         // per object
+    std::unique_ptr<SlabPlanner> planner_;      // the objects whose motion is not uniform
+    SlabCounts slab_counts_;
     bool shade_doppler_ = false;
 };
 

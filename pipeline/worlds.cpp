@@ -115,6 +115,73 @@ mesh4d::ProperTimeSpan spinSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::
     return {span.lo - widen, span.hi + widen};
 }
 
+SeenSpan pathSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion, const mesh4d::ViewSurface& first,
+                      const mesh4d::ViewSurface& last, double offset) {
+    const bool lorentz = motion.kinematics == mesh4d::Kinematics::Lorentz;
+    const bool cone = first.kind == mesh4d::ViewKind::PastCone;
+    // Step: the slabs' distance from the history in the lab, and the longest rest edge.
+    const double d = offset / std::sqrt(motion.one_minus_beta2) * (1 + motion.beta);
+    const double slab_shift = cone ? std::sqrt(2.0) * d : d;
+    double e = 0;
+    for (const auto& t : rest.triangles)
+        for (int c = 0; c < 3; ++c) e = std::max(e, mesh4d::norm(rest.positions[t[c]] - rest.positions[t[(c + 1) % 3]]));
+    // The least (or largest) vertex crossing of `view` with its apex time moved by `shift`.
+    auto crossings = [&](mesh4d::ViewSurface view, double shift, bool least) {
+        view.t_c += shift;
+        double s = least ? INFINITY : -INFINITY;
+        for (const Vec3& q : rest.positions) {
+            const double c = mesh4d::crossWorldline(view, motion, q).s;
+            s = least ? std::min(s, c) : std::max(s, c);
+        }
+        return s;
+    };
+    SeenSpan out;
+    const double lo = crossings(first, -slab_shift, true);
+    double hi = crossings(last, slab_shift, false);
+    if (cone && e > 0) {
+        // Step: the apex moved by e W, W the least future vector with W - U(sigma) future causal
+        // for every U(sigma) with sigma in [lo', hi'] (lo' the least vertex crossing of the last
+        // view, hi' the guess): in the own frame (start frame, F_V; the lab for Galilean)
+        // U = (cosh phi, k sinh phi), phi = |a| max(sigma, 0), so in light-cone coordinates
+        // W_+ = e^phi_hi, W_- = e^-phi_lo; then boosted with `velocity` (Lorentz).
+        const double a = lorentz ? mesh4d::norm(motion.acceleration) : 0;
+        const Vec3 k = a > 0 ? motion.acceleration / a : Vec3{0, 0, 0};
+        const double phi_lo = a * std::max(crossings(last, slab_shift, true), 0.0);
+        auto apexShift = [&](double guess) {
+            const double phi_hi = a * std::max(guess, phi_lo / std::max(a, 1e-300));
+            const double w_t = 0.5 * (std::exp(phi_hi) + std::exp(-phi_lo));
+            const Vec3 w_x = 0.5 * (std::exp(phi_hi) - std::exp(-phi_lo)) * k;
+            mesh4d::Event w{w_t, w_x};
+            if (lorentz && motion.beta > 0) {
+                const double g = motion.gamma;
+                const Vec3 u = motion.velocity / motion.beta;
+                w = {g * (w_t + mesh4d::dot(motion.velocity, w_x)),
+                     w_x + (g - 1) * mesh4d::dot(w_x, u) * u + g * w_t * motion.velocity};
+            }
+            return w;
+        };
+        double guess = hi;
+        out.ok = false;
+        for (int round = 0; round < 8 && !out.ok; ++round) {
+            mesh4d::ViewSurface moved = last;
+            const mesh4d::Event w = apexShift(guess);
+            moved.t_c += e * w.t;
+            moved.apex = moved.apex + e * w.x;
+            const double next = crossings(moved, slab_shift, false);
+            if (next <= guess || a == 0) {
+                hi = next;  // without an acceleration W is constant: one round is exact
+                out.ok = true;
+            } else {
+                guess += 2 * (next - guess);  // overshoot; W grows as e^(|a| guess), so this may not close
+            }
+        }
+    }
+    if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi)) out.ok = false;
+    const double widen = 1e-9 * std::max(std::fabs(lo), std::fabs(hi));
+    out.span = {lo - widen, hi + widen};
+    return out;
+}
+
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
                                          long long first_frame, long long last_frame) {
     std::vector<mesh4d::World4D> worlds;

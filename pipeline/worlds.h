@@ -44,6 +44,48 @@ mesh4d::World4D extrudeSeen(const ObjectSpec& spec, const mesh4d::RestMesh& rest
 mesh4d::ProperTimeSpan spinSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion,
                                     const mesh4d::ViewSurface& first, const mesh4d::ViewSurface& last, double offset);
 
+// The object's times s at which views `first` .. `last` (as spinSpanSeen's, the camera at rest) can
+// meet any point of an accelerated or keyframed body (Motion::acceleration or Motion::keyed), or
+// the traced surface of its time slabs, which lies within `offset` (extrude.h slabSpacing's chord,
+// in the object's own frame; at most offset g (1 + b) = d in the lab, b the speed of `velocity`) of
+// the true history. Bounded by the vertices' own worldlines, not the centre's: each rest vertex's
+// crossing (worldline.h crossWorldline) with the first view, moved earlier, and with the last,
+// moved later, as follows. h(s, q) = t_c - t - |x - C| (cone) or t_c - t (hyperplane) is concave in
+// q at a fixed s (t and x are affine in q for these motions) and decreases in s.
+//   lo: a point p = sum l_i q_i of a triangle has h(s, p) >= sum l_i h(s, q_i), so at the least
+//     vertex crossing s_lo every point is still behind the view: no point crosses before any vertex.
+//     A slab point Z within d of a true event E: on the cone, t_E >= t_c - sqrt(2) d - |x_E - C|,
+//     so E is behind the view whose apex time is t_c - sqrt(2) d (t_c - d on a hyperplane): lo is
+//     the least vertex crossing of that view.
+//   hi: on a hyperplane h is affine in q, so no point crosses after every vertex. On a cone, at a
+//     fixed s these bodies are their rest mesh moved rigidly in one inertial frame F(s) whose
+//     simultaneity holds all events at that s (keyframed: F_V, or the lab for Galilean; Born-rigid
+//     acceleration: the momentary rest frame; Galilean: the lab). A point p crossing at sigma has a
+//     vertex q_i of its triangle within e (the longest rest edge), simultaneous with it in
+//     F(sigma), so t'_i = t'_p = t'_c - |x'_p - C'| <= t'_c + e - |x'_i - C'| in F(sigma): q_i's
+//     event at sigma is behind the cone whose apex is moved by e U (U F(sigma)'s 4-velocity), and
+//     so behind the cone whose apex time is t_c + e g_F (1 + b_F) (that apex lies in the future
+//     light cone of the other), b_F the speed of F(sigma) in the lab; q_i crosses that cone at or
+//     after sigma. Cones with apexes A + e U(sigma) for all sigma in [lo', hi'] (lo' the least
+//     vertex crossing of the last view, hi' a guess of the largest point crossing) lie behind the
+//     cone with apex A + e W, W the least vector with W - U(sigma) future causal for all of them:
+//     in the own frame (F_V, the start frame; the lab for Galilean) U = (cosh phi, k sinh phi),
+//     phi = |a| max(sigma, 0) (0 for a keyframed path), so in light-cone coordinates W_+ =
+//     e^phi(hi'), W_- = e^-phi(lo'); boosted with `velocity` for Lorentz. With the slabs' d as
+//     for lo, hi is the largest vertex crossing of the last view with apex A + e W + (sqrt(2) d, 0),
+//     accepted when it is <= hi' (the crossings of a triangle's points form an interval through
+//     its vertices', which cannot jump past hi'); a keyframed path's W is constant (one round).
+//     An acceleration's W grows as e^(|a| hi'): across a body whose crossings spread over
+//     1/|a| or more (the rocket of data/scenes: 2 ls long at 0.5 ls/s^2) no guess closes.
+// Widened by 1e-9 |s| for the crossings' rounding (worldline.h: 1e-14 relative). ok = false when no
+// guess closed in 8 rounds: the caller then keeps the padded span of buildWorld.
+struct SeenSpan {
+    mesh4d::ProperTimeSpan span;
+    bool ok = true;
+};
+SeenSpan pathSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion, const mesh4d::ViewSurface& first,
+                      const mesh4d::ViewSurface& last, double offset);
+
 // buildWorld for every object, in scene order.
 std::vector<mesh4d::World4D> buildWorlds(const std::vector<PreparedObject>& objects, Model model, const Scene& scene,
                                          long long first_frame, long long last_frame);

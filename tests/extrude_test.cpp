@@ -176,3 +176,48 @@ TEST(Extrude, ChunkBoxesAreTheBoxesOfTheirTrianglesEvents) {
         }
     }
 }
+
+// Issue 18: the slab grid (extrude.h SlabGrid) is fixed by the motion alone: the samples of a span
+// are the tau_a, tau_b given and exactly the grid points between them, so the samples of a narrower
+// span are a wider one's inside it, bit for bit; every step is within slabSpacing over its own
+// interval; atOrBefore / atOrAfter bracket a time by neighbouring samples.
+TEST(SlabGrid, SamplesOfAnySpanAreOneGridsPoints) {
+    const RestMesh mesh = testmesh::cylinder(1.0, 0.5, 24);
+    Motion spin = makeMotion(Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0});
+    spin.angular_velocity = {0, 0, 0.8};
+    Motion rocket = makeMotion(Kinematics::Lorentz, 0, {0, 0, 0}, {0.3, 0, 0});
+    rocket.acceleration = {0.2, 0, 0};
+    const double chord = 1e-3;
+    for (const Motion& m : {spin, rocket}) {
+        const SlabGrid grid(mesh, m, chord);
+        const std::vector<double> wide = grid.samples(-3.0, 12.0, 100000);
+        ASSERT_GT(wide.size(), 20u);
+        for (size_t i = 1; i < wide.size(); ++i) {
+            ASSERT_LT(wide[i - 1], wide[i]);
+            // each step within the bound over its own interval; before t0 an acceleration is uniform
+            // motion (straight worldlines, one slab up to s = 0, where the grid begins)
+            if (norm(m.acceleration) > 0 && wide[i] <= 0) continue;
+            EXPECT_LE(wide[i] - wide[i - 1], slabSpacing(mesh, m, wide[i - 1], wide[i], chord) * (1 + 1e-12)) << i;
+        }
+        for (const auto& [lo, hi] : {std::pair{0.37, 4.1}, std::pair{-1.5, 0.25}, std::pair{7.0, 11.9}}) {
+            const std::vector<double> narrow = grid.samples(lo, hi, 100000);
+            ASSERT_GE(narrow.size(), 2u);
+            EXPECT_EQ(narrow.front(), lo);
+            EXPECT_EQ(narrow.back(), hi);
+            std::vector<double> inside;
+            for (double s : wide)
+                if (s > lo && s < hi) inside.push_back(s);
+            EXPECT_EQ(std::vector<double>(narrow.begin() + 1, narrow.end() - 1), inside) << lo << " " << hi;
+            // the bracket of lo: the wide samples just below (a grid point, not the span's start -3,
+            // or none) and above it
+            const auto up = std::upper_bound(wide.begin(), wide.end(), lo);
+            EXPECT_EQ(grid.atOrBefore(lo), up - 1 == wide.begin() ? -INFINITY : *(up - 1));
+            EXPECT_EQ(grid.atOrAfter(lo), *up);
+            EXPECT_EQ(grid.atOrAfter(*up), *up);
+        }
+        EXPECT_TRUE(grid.samples(-3.0, 12.0, 10).empty());  // more than 10 slabs: none
+    }
+    // Uniform motion has no grid points: one slab.
+    const SlabGrid none(mesh, makeMotion(Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0}), chord);
+    EXPECT_EQ(none.samples(-3.0, 12.0, 10), (std::vector<double>{-3.0, 12.0}));
+}

@@ -369,7 +369,7 @@ void crossCheck(const std::string& scene_file, long long stride, long long min_m
             std::cout << "[cross-check] " << modelName(model) << ": refused for this scene, skipped\n";
             continue;
         }
-        const SceneTracer tracer(scene, objects, mirrors, model, 0, frames - 1);
+        SceneTracer tracer(scene, objects, mirrors, model, 0, frames - 1);
         std::vector<mesh4d::World4D> worlds;
         for (const auto& o : objects) worlds.push_back(buildWorld(o, model, scene, 0, frames - 1));
         const MirrorReflections reflections(scene, objects, mirrors, model, 0, frames - 1);
@@ -519,9 +519,9 @@ TEST(RaytraceCrossCheck, RollingWheelThroughTimeSlabsMatchesTheRefinedCut) {
     ASSERT_EQ(objects.size(), 1u);
     const int w = 160, h = 90;
     const long long first = 100, last = 101;
-    const SceneTracer tracer(scene, objects, {}, Model::Relativistic, first, last);
-    std::cout << "[rolling wheel] " << tracer.worlds().size() << " time slabs\n";
-    EXPECT_GT(tracer.worlds().size(), 100u);
+    SceneTracer tracer(scene, objects, {}, Model::Relativistic, first, last);
+    std::cout << "[rolling wheel] " << tracer.worldCount() << " time slabs\n";
+    EXPECT_GT(tracer.worldCount(), 100u);
     const mesh4d::World4D world = buildWorld(objects[0], Model::Relativistic, scene, first, last);
     mesh4d::EventBox box;
     for (const Vec3& p : objects[0].rest.positions) box.addPoint(p);
@@ -637,7 +637,7 @@ TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
         ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
         for (Model model : stage.models) {
             const bool lorentz = model == Model::Relativistic || model == Model::Contracted;
-            const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, 50, 50);
+            SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, 50, 50);
             const TracedFrame frame = tracer.traceFrame(50, 320, 180);
             std::map<int32_t, int> pixels;
             for (size_t i = 0; i < frame.object.size(); ++i) {
@@ -692,7 +692,7 @@ TEST(RaytraceShading, DefaultLightShowsTheFacesOfABoxApart) {
         std::ostringstream log;
         std::string error;
         ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
-        const SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, stage.models[0], 0, 0);
+        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, stage.models[0], 0, 0);
         const TracedFrame frame = tracer.traceFrame(0, 160, 90);
         std::map<std::array<uint8_t, 3>, int> shades;
         for (size_t i = 0; i < frame.object.size(); ++i)
@@ -925,7 +925,7 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsTheUniformModelsAtConstantSpeed) 
         const TracedFrame f = tracer.traceFrame(0, 160, 90);
         image[i] = f.image;
         object[i] = f.object;
-        if (i < 2) worlds[i] = tracer.worlds().size();
+        if (i < 2) worlds[i] = tracer.worldCount();
     }
     EXPECT_GE(worlds[0], 2u);  // the key cuts the keyed history
     EXPECT_EQ(worlds[1], 1u);
@@ -1112,4 +1112,138 @@ TEST(Ray4D, SlabsHierarchyFindsWhatEachSlabsScanFinds) {
             EXPECT_EQ(got->triangle, expected->triangle);
         }
     EXPECT_GT(hits, 150);
+}
+
+namespace {
+
+// A cube of edge 0.3 ls (data/meshes/box.obj scaled) accelerating from rest at t0 = 0 along +x
+// with 0.2 ls/s^2, 6 ls in front of the camera: short beside 1/|a|, so its seen span closes
+// (worlds.h pathSpanSeen).
+std::string writeSmallRocketScene(const std::string& dir) {
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(source("data/meshes/box.obj"), dir + "/box.obj",
+                               std::filesystem::copy_options::overwrite_existing);
+    const std::string path = dir + "/small_rocket.json";
+    std::ofstream(path) << R"({ "camera": {"position": [0, 0, 6], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 20, "instant_delay": 6},
+  "frames": {"start": 0, "end": 16, "fps": 10}, "model": "relativistic",
+  "objects": [{"mesh": "box.obj", "scale": [0.3, 0.3, 0.3], "position": [-1, 0, 0], "t0": 0,
+               "acceleration": [0.2, 0, 0]}] })";
+    return path;
+}
+
+struct TracedRun {
+    std::vector<RgbImage> images;
+    std::vector<std::vector<int32_t>> objects;
+    size_t worlds = 0;  // after the first frame
+    SceneTracer::SlabCounts counts;
+};
+
+// Frames `frames` of `stage` traced by one SceneTracer over first..last with `options`, 160 x 90.
+TracedRun traceRun(const Stage& stage, Model model, long long first, long long last, const std::vector<long long>& frames,
+                   TracerOptions options) {
+    SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last, options);
+    TracedRun run;
+    for (long long k : frames) {
+        const TracedFrame f = tracer.traceFrame(k, 160, 90);
+        if (run.images.empty()) run.worlds = tracer.worldCount();
+        run.images.push_back(f.image);
+        run.objects.push_back(f.object);
+    }
+    run.counts = tracer.slabCounts();
+    return run;
+}
+
+long long coveredPixels(const std::vector<int32_t>& object) {
+    return std::count_if(object.begin(), object.end(), [](int32_t o) { return o >= 0; });
+}
+
+}  // namespace
+
+// Issue 18, item 5: an accelerated and a keyframed body traced over only the span their frames see
+// (worlds.h pathSpanSeen) give the pictures of the padded span (buildWorld: light-crossing time
+// over 1 - b), byte for byte, with far fewer slabs: the slabs lie on the motion's grid (extrude.h
+// SlabGrid), so the seen span's slabs are the padded span's that the frames can reach, and a seen
+// span too narrow would cut the picture (an open end of the history shows the background).
+TEST(RaytraceSpan, SeenSpanTracesWhatThePaddedSpanTraces) {
+    const std::string dir = ::testing::TempDir() + "span_seen_" + std::to_string(::getpid());
+    struct Case {
+        std::string scene;
+        Model model;
+        std::vector<long long> frames;
+        size_t fewer;  // the padded span needs more than this many times the seen span's slabs
+    };
+    const std::vector<Case> cases = {
+        {source("data/scenes/keyed.gltf"), Model::Relativistic, {40, 80, 120}, 2},
+        {source("data/scenes/keyed.gltf"), Model::Finite, {60, 100}, 2},
+        {source("data/scenes/keyed.gltf"), Model::Contracted, {100}, 1},
+        {source("data/scenes/keyed.gltf"), Model::Instant, {100}, 1},
+        {writeSmallRocketScene(dir), Model::Relativistic, {70, 110}, 1},
+        {writeSmallRocketScene(dir), Model::Finite, {110}, 1},
+        {writeSmallRocketScene(dir), Model::Contracted, {110}, 1},
+    };
+    for (const Case& c : cases) {
+        Stage stage;
+        std::string error;
+        ASSERT_TRUE(loadQuietStage(c.scene, &stage, &error, {c.model})) << error;
+        for (long long k : c.frames) {
+            TracerOptions padded;
+            padded.padded_span = true;
+            const TracedRun wide = traceRun(stage, c.model, k, k, {k}, padded);
+            const TracedRun seen = traceRun(stage, c.model, k, k, {k}, {});
+            std::cout << "[seen span] " << c.scene.substr(c.scene.rfind('/') + 1) << " " << modelName(c.model) << " frame "
+                      << k << ": " << seen.worlds << " slabs (padded " << wide.worlds << "), "
+                      << coveredPixels(seen.objects[0]) << " pixels show it\n";
+            EXPECT_GT(coveredPixels(seen.objects[0]), 100) << c.scene << " " << k;
+            EXPECT_LT(c.fewer * seen.worlds, wide.worlds) << c.scene << " " << k;
+            EXPECT_EQ(seen.objects[0], wide.objects[0]) << c.scene << " " << k;
+            EXPECT_TRUE(seen.images[0].rgb == wide.images[0].rgb) << c.scene << " " << k;
+        }
+    }
+    std::filesystem::remove_all(dir);
+}
+
+// Issue 18: a long frame range traced in windows of slabs (SceneTracer: at most window_slabs per
+// object at once, rebuilt as the frames advance) gives each frame the picture of a short range
+// traced in one window, byte for byte; the run below needs several windows.
+TEST(RaytraceSpan, WindowsOfFramesTraceWhatOneWindowTraces) {
+    Stage stage;
+    std::string error;
+    ASSERT_TRUE(loadQuietStage(source("data/scenes/keyed.gltf"), &stage, &error, {Model::Relativistic})) << error;
+    const std::vector<long long> frames{100, 101, 102, 103};
+    const TracedRun one = traceRun(stage, Model::Relativistic, 100, 103, frames, {});
+    TracerOptions narrow;
+    narrow.window_slabs = 500;  // frame 80 alone needs 412
+    const TracedRun windows = traceRun(stage, Model::Relativistic, 90, 130, frames, narrow);
+    std::cout << "[windows] keyed.gltf frames 100..103: one window of " << one.counts.most << " slabs; in a run over 90..130 "
+              << windows.counts.windows << " windows, at most " << windows.counts.most << " slabs at once\n";
+    EXPECT_EQ(one.counts.windows, 1u);
+    EXPECT_GE(windows.counts.windows, 2u);
+    EXPECT_LE(windows.counts.most, 500u);
+    for (size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_GT(coveredPixels(one.objects[i]), 100) << frames[i];
+        EXPECT_EQ(one.objects[i], windows.objects[i]) << frames[i];
+        EXPECT_TRUE(one.images[i].rgb == windows.images[i].rgb) << frames[i];
+    }
+}
+
+// Issue 18: only a frame that alone needs more slabs than one window may hold is refused, with one
+// line naming the field, the count and the frame (exit 2): the rolling wheel at 0.99c (w R = |v|).
+TEST(RaytraceSpan, AFrameThatAloneNeedsTooManySlabsIsRefused) {
+    const std::string dir = ::testing::TempDir() + "span_fast_wheel_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(source("data/meshes/wheel.obj"), dir + "/wheel.obj",
+                               std::filesystem::copy_options::overwrite_existing);
+    std::ofstream(dir + "/wheel.json") << R"({ "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 70},
+  "frames": {"start": 0, "end": 16, "fps": 10}, "model": "relativistic",
+  "objects": [{"mesh": "wheel.obj", "position": [-4.5, 0, 0], "t0": 0, "velocity": [0.99, 0, 0],
+               "angular_velocity": [0, 0, -0.99]}] })";
+    const CommandRun r = run({"raytrace", dir + "/wheel.json", "--out", dir + "/out", "--frames", "100:101", "--size", "8x4"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("wheel.json: objects[0].angular_velocity: the raytracer would need more than 4096 time slabs of 792 "
+                         "prisms for frame 100 alone"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out/relativistic/frame_00100.png"));
+    std::filesystem::remove_all(dir);
 }
