@@ -315,30 +315,34 @@ TEST(Stage, FrameLoopDeliversFramesInOrder) {
 
 // The loop computes the light factors (doppler, proper_time) only when some sink reads them:
 // sinks that all say no get none, on the scene objects and on the mirror reflections alike; one
-// sink that says yes gets them for every object, and so does the sink beside it.
+// sink that says yes gets them for every object, and so does the sink beside it. The default scene
+// and the same seen by a moving camera (pipeline/mirror.h: its reflections are made apart).
 TEST(Stage, LightFactorsOnlyWhenASinkReadsThem) {
-    StageOptions options;
-    options.scene_path = source("data/scenes/flanges.json");  // one mirror: reflections too
-    options.frame_from = 98;
-    options.frame_to = 101;
-    options.quiet = true;
-    Stage stage;
-    std::ostringstream log, progress;
-    std::string error;
-    ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
-    for (Model model : {Model::Relativistic, Model::Finite}) {
-        for (bool second_reads : {false, true}) {
-            RecordingSink a, b;
-            a.reads = false;
-            b.reads = second_reads;
-            OutputBudget budget(0);
-            FrameLoopSettings settings;
-            settings.progress = false;
-            FrameLoopResult result;
-            ASSERT_TRUE(runFrameLoop(stage, model, settings, {&a, &b}, &budget, progress, &result, &error)) << error;
-            for (const RecordingSink* s : {&a, &b}) {
-                EXPECT_GT(s->reflections_seen, 0u);
-                EXPECT_EQ(second_reads ? s->with_factors : s->without_factors, s->non_empty) << second_reads;
+    for (const char* scene : {"data/scenes/flanges.json", "data/fixtures/scene_mirror_camera.json"}) {
+        StageOptions options;
+        options.scene_path = source(scene);  // one mirror: reflections too
+        options.frame_from = 8;
+        options.frame_to = 11;
+        options.quiet = true;
+        Stage stage;
+        std::ostringstream log, progress;
+        std::string error;
+        ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+        for (Model model : {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted}) {
+            for (bool second_reads : {false, true}) {
+                RecordingSink a, b;
+                a.reads = false;
+                b.reads = second_reads;
+                OutputBudget budget(0);
+                FrameLoopSettings settings;
+                settings.progress = false;
+                FrameLoopResult result;
+                ASSERT_TRUE(runFrameLoop(stage, model, settings, {&a, &b}, &budget, progress, &result, &error)) << error;
+                for (const RecordingSink* s : {&a, &b}) {
+                    EXPECT_GT(s->reflections_seen, 0u) << scene << " " << modelName(model);
+                    EXPECT_EQ(second_reads ? s->with_factors : s->without_factors, s->non_empty)
+                        << scene << " " << modelName(model) << " " << second_reads;
+                }
             }
         }
     }
