@@ -53,8 +53,10 @@ bool FrameSink::addEncoded(long long index, const EncodedOutput&, std::vector<st
     return false;
 }
 
-FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize)
-    : dir_(std::move(dir)), extension_(std::move(extension)), write_(write), serialize_(serialize) {}
+FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize,
+                             bool light_factors)
+    : dir_(std::move(dir)), extension_(std::move(extension)), write_(write), serialize_(serialize),
+      light_factors_(light_factors) {}
 
 std::string FrameFileSink::path(long long k) const {
     return (std::filesystem::path(dir_) / (frameName(k) + "." + extension_)).string();

@@ -39,7 +39,9 @@ using FrameSerializer = void (*)(const ExportFrame& frame, std::string* bytes);
 
 class FrameFileSink final : public FrameSink {
 public:
-    FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize);
+    // `light_factors`: whether `write` reads the frames' light factors (FrameSink::readsLightFactors).
+    FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize,
+                  bool light_factors = true);
     bool begin(const SequenceInfo& info, std::string* error) override;
     PendingOutput pending(const ExportFrame& frame) override;
     long long estimate(const ExportFrame& frame) const override { return leastFrameBytes(frame); }
@@ -54,6 +56,7 @@ public:
     bool beginEncoding(const SequenceInfo& info, std::string* error) override;
     void beforeSending(long long index, EncodedOutput* frame) override;
     void dropEncoded(long long first, long long last_excl) override;
+    bool readsLightFactors() const override { return light_factors_; }
     ~FrameFileSink() override;
 
 private:
@@ -63,6 +66,7 @@ private:
     std::string dir_, extension_;
     FrameWriter write_;
     FrameSerializer serialize_;
+    bool light_factors_;
 };
 
 // Each rank of a run whose ranks write frame files (above): from now on an interrupt (SIGINT,

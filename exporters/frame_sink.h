@@ -74,6 +74,10 @@ public:
     // Set before finish(): a sink that writes a file there checks its whole size with `check`
     // before writing any of it (the default writes nothing in finish()).
     virtual void setFinishCheck(OutputCheck /*check*/) {}
+    // Whether this sink reads the frames' light factors (ApparentMesh::doppler and proper_time,
+    // mesh4d/light_factors.h): the loop computes them only when some sink does. The default: yes,
+    // so a sink that does not say stays correct.
+    virtual bool readsLightFactors() const { return true; }
 
     // Frames across processes. On the process that cuts frames without writing: what begin() sets
     // up for prepare() and encode(), nothing written (the default: nothing).

@@ -109,7 +109,7 @@ bool writeObj(const std::string& path, const ExportFrame& frame, std::string* er
 }
 
 std::unique_ptr<FrameSink> objSink(std::string dir) {
-    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj, serializeObj);
+    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj, serializeObj, /*light_factors=*/false);
 }
 
 }  // namespace apparent

@@ -16,7 +16,7 @@ void serializeObj(const ExportFrame& frame, std::string* bytes);
 
 bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error);
 
-// The OBJ sink: DIR/frame_NNNNN.obj per frame (exporters/frame_files.h).
+// The OBJ sink: DIR/frame_NNNNN.obj per frame (exporters/frame_files.h); it reads no light factors.
 std::unique_ptr<FrameSink> objSink(std::string dir);
 
 }  // namespace apparent

@@ -162,6 +162,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         }
 
     // Step: per frame, cut every world with the view surface (refined to the tolerance), then deliver.
+    // The light factors only when a sink reads them (the same sinks on every process of the run,
+    // so every rank or shard computes what the writing one needs).
+    bool light_factors = false;
+    for (const FrameSink* sink : sinks) light_factors = light_factors || sink->readsLightFactors();
     mesh4d::SliceSettings slice_settings;
     slice_settings.tolerance = scene.tolerance;
     slice_settings.max_triangles = size_t(settings.max_frame_triangles);
@@ -217,10 +221,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             mesh4d::SliceSettings own = slice_settings;
             own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
             frame->objects[o] = mesh4d::sliceWorld(world, view, own);
-            mesh4d::addLightFactors(world, view, &frame->objects[o]);
+            if (light_factors) mesh4d::addLightFactors(world, view, &frame->objects[o]);
         });
         // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-        reflections.append(view, slice_settings, &frame->objects, &stage.tolerances);
+        reflections.append(view, slice_settings, &frame->objects, &stage.tolerances, light_factors);
         APPARENT_CHECK(frame->objects.size(), ==, info.objects.size());
     };
     // In parallel: cut every world with the frame's view surface, then each sink's conversion.

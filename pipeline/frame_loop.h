@@ -6,7 +6,9 @@
 // against the sink's least size, and after it against the real size of every completed file.
 // Before the first write, the sinks' estimate of the first batch of frames, scaled to every frame
 // and every model left, is checked against the budget too: a run that would pass it stops with
-// nothing written. Progress (frames done, rate, time left) is shown on a terminal.
+// nothing written. Progress (frames done, rate, time left) is shown on a terminal. The light
+// factors (mesh4d/light_factors.h) are computed only when some sink reads them
+// (FrameSink::readsLightFactors); otherwise every object's doppler and proper_time stay empty.
 #pragma once
 
 #include <iosfwd>

@@ -287,7 +287,8 @@ MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<Prepa
 }
 
 void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
-                               std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances) const {
+                               std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances,
+                               bool light_factors) const {
     // Step: each mirror as the camera sees it in this frame (its own cut, `exists` included):
     // what is seen through it is clipped to these triangles. Slivers give no pyramid.
     APPARENT_CHECK(objects->size(), >=, scene_objects_);  // the frame's scene objects come first
@@ -303,7 +304,7 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         }
     }
     if (camera_motion_.moving()) {
-        appendMoving(view, settings, objects, object_tolerances, seen);
+        appendMoving(view, settings, objects, object_tolerances, seen, light_factors);
         return;
     }
     for (const Target& target : targets_) {
@@ -319,7 +320,7 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
         // The light factors of the path through the mirror: a mirror at rest changes no frequency,
         // so they are those seen by the image of the camera.
-        mesh4d::addLightFactors(target.world, image, &cut);
+        if (light_factors) mesh4d::addLightFactors(target.world, image, &cut);
         objects->push_back(reflectAndClip(cut, m, seen[target.mirror], camera_));
     }
 }
@@ -331,7 +332,8 @@ mesh4d::Event MirrorReflections::cameraInLab(double t_c) const {
 void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                                      std::vector<mesh4d::ApparentMesh>* objects,
                                      const std::vector<double>* object_tolerances,
-                                     const std::vector<std::vector<std::array<Vec3, 3>>>& seen) const {
+                                     const std::vector<std::vector<std::array<Vec3, 3>>>& seen,
+                                     bool light_factors) const {
     const mesh4d::Kinematics kinematics = kinematicsOf(model_);
     const bool cone = view.kind == mesh4d::ViewKind::PastCone;
     // Step (cone models): the camera's lab event at this frame's camera time, and each mirror as
@@ -367,7 +369,7 @@ void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh
             const double off = mesh4d::dot(m.normal, mesh4d::fromCameraFrame(camera_motion_, kinematics, {view.t_c, camera_}).x - m.point);
             const MirrorPlane now{m.object, camera_ - a_n * (off / mesh4d::norm2(a_n)), a_n / mesh4d::norm(a_n)};
             mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, view, own);
-            mesh4d::addLightFactors(target.world, view, &cut);
+            if (light_factors) mesh4d::addLightFactors(target.world, view, &cut);
             objects->push_back(reflectAndClip(cut, now, seen[target.mirror], camera_));
             continue;
         }
@@ -377,9 +379,9 @@ void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh
         own.displacement = target.displacement;
         mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
         const Vec3 v_r = reflectDirection(m, camera_motion_.velocity);
-        cut.doppler.resize(cut.positions.size());
-        cut.proper_time.resize(cut.positions.size());
-        for (size_t i = 0; i < cut.positions.size(); ++i) {
+        cut.doppler.resize(light_factors ? cut.positions.size() : 0);
+        cut.proper_time.resize(light_factors ? cut.positions.size() : 0);
+        for (size_t i = 0; i < cut.doppler.size(); ++i) {
             cut.doppler[i] = mesh4d::dopplerFactor(target.world.motion, image.kind, image.apex, cut.absolutePosition(i), v_r);
             cut.proper_time[i] = mesh4d::properTimeAt(target.world.motion, cut.rest_points[i], cut.absoluteTime(i));
         }

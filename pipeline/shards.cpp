@@ -186,6 +186,7 @@ public:
         return true;
     }
     void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
+    bool readsLightFactors() const override { return glb_.readsLightFactors(); }
 
 private:
     bool write(const std::string& bytes, std::string* error) {

@@ -11,6 +11,9 @@
 #include <sstream>
 
 #include "exporters/frame_sink.h"
+#include "exporters/gltf.h"
+#include "exporters/obj.h"
+#include "exporters/ply.h"
 #include "mesh4d/box.h"
 #include "mesh4d/check.h"
 #include "pipeline/frame_loop.h"
@@ -239,8 +242,18 @@ public:
         order.push_back(frame.index);
         prepared_for_it += static_cast<const Prepared*>(prepared)->index == frame.index;
         triangles += frame.triangleCount();
+        for (size_t i = 0; i < frame.objects.size(); ++i) {
+            const mesh4d::ApparentMesh& o = frame.objects[i];
+            if (o.positions.empty()) continue;
+            ++non_empty;
+            reflections_seen += i >= 4;  // the default scene's 4 objects come first
+            const bool both = o.doppler.size() == o.positions.size() && o.proper_time.size() == o.positions.size();
+            with_factors += both;
+            without_factors += o.doppler.empty() && o.proper_time.empty();
+        }
         return true;
     }
+    bool readsLightFactors() const override { return reads; }
     bool finish(SinkSummary* summary, std::string*) override {
         summary->text = ", recorded";
         ++finished;
@@ -250,7 +263,10 @@ public:
     struct Prepared : PreparedFrame {
         long long index = -1;
     };
+    bool reads = true;  // readsLightFactors()
     size_t objects = 0, triangles = 0;
+    size_t non_empty = 0, reflections_seen = 0;    // objects delivered with points; of them reflections
+    size_t with_factors = 0, without_factors = 0;  // of them with both light factors or neither
     int begun = 0, finished = 0;
     long long prepared_for_it = 0;
     std::vector<long long> order;
@@ -295,6 +311,73 @@ TEST(Stage, FrameLoopDeliversFramesInOrder) {
         if (threads == 1) triangles_one_thread = a.triangles;
         else EXPECT_EQ(a.triangles, triangles_one_thread);
     }
+}
+
+// The loop computes the light factors (doppler, proper_time) only when some sink reads them:
+// sinks that all say no get none, on the scene objects and on the mirror reflections alike; one
+// sink that says yes gets them for every object, and so does the sink beside it. The default scene
+// and the same seen by a moving camera (pipeline/mirror.h: its reflections are made apart).
+TEST(Stage, LightFactorsOnlyWhenASinkReadsThem) {
+    for (const char* scene : {"data/scenes/flanges.json", "data/fixtures/scene_mirror_camera.json"}) {
+        StageOptions options;
+        options.scene_path = source(scene);  // one mirror: reflections too
+        options.frame_from = 8;
+        options.frame_to = 11;
+        options.quiet = true;
+        Stage stage;
+        std::ostringstream log, progress;
+        std::string error;
+        ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+        for (Model model : {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted}) {
+            for (bool second_reads : {false, true}) {
+                RecordingSink a, b;
+                a.reads = false;
+                b.reads = second_reads;
+                OutputBudget budget(0);
+                FrameLoopSettings settings;
+                settings.progress = false;
+                FrameLoopResult result;
+                ASSERT_TRUE(runFrameLoop(stage, model, settings, {&a, &b}, &budget, progress, &result, &error)) << error;
+                for (const RecordingSink* s : {&a, &b}) {
+                    EXPECT_GT(s->reflections_seen, 0u) << scene << " " << modelName(model);
+                    EXPECT_EQ(second_reads ? s->with_factors : s->without_factors, s->non_empty)
+                        << scene << " " << modelName(model) << " " << second_reads;
+                }
+            }
+        }
+    }
+}
+
+// The sinks' answers: the PLY writes doppler and proper_time, the OBJ nothing of them, the .glb
+// only with --attributes doppler / proper_time or --shade doppler.
+TEST(Stage, SinksSayWhetherTheyReadLightFactors) {
+    const fs::path dir = freshDir("reads_factors");
+    EXPECT_TRUE(plySink((dir / "p").string())->readsLightFactors());
+    EXPECT_FALSE(objSink((dir / "o").string())->readsLightFactors());
+    GlbOptions plain;
+    EXPECT_FALSE(GlbSink((dir / "a.glb").string(), plain, false).readsLightFactors());
+    for (int which = 0; which < 3; ++which) {
+        GlbOptions o;
+        (which == 0 ? o.doppler : which == 1 ? o.proper_time : o.shade_doppler) = true;
+        EXPECT_TRUE(GlbSink((dir / "a.glb").string(), o, false).readsLightFactors()) << which;
+    }
+    fs::remove_all(dir);
+}
+
+// A .glb beside the PLY leaves the PLY its light factors; the PLY alone has them too.
+TEST(Stage, PlyKeepsLightFactorsBesideAPlainGlb) {
+    const fs::path dir = freshDir("ply_factors");
+    for (const std::string formats : {"glb,ply", "ply"}) {
+        const fs::path out = dir / formats;
+        const auto r = apparentRun({"render", source("data/scenes/flanges.json"), "--out", out.string(), "--quiet",
+                                    "--model", "relativistic", "--frames", "98:99", "--format", formats});
+        ASSERT_EQ(r.code, 0) << r.err;
+        const std::string bytes = testio::readBytes(out / "relativistic" / "frame_00098.ply");
+        EXPECT_NE(bytes.substr(0, bytes.find("end_header")).find("property double doppler\nproperty double proper_time\n"),
+                  std::string::npos)
+            << formats;
+    }
+    fs::remove_all(dir);
 }
 
 // The budget refuses before writing past the limit and names what would have passed it.
