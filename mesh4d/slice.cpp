@@ -803,6 +803,15 @@ struct FrameBuilder {
     // piece's first level). A piece that passed as a whole (and the mesh's triangles that needed
     // nothing) keeps level 1: its sides' extra points are fanned and, the delay being convex,
     // every triangle inside it is within its own bound.
+    // A piece whose shape fails that rule and whose need is at most kAnisoMaxNeed is filled by
+    // bisection in its form's metric instead (form_bisect.h: the grid would round its stretched
+    // triangles up; the global bisection would pay its bounds and records per piece); its sides
+    // get the counts FormBisection::sideSegments gives (each segment within 3 T / speed by the
+    // form), in the same largest-count-around-each-edge rule, so its neighbours conform. Larger
+    // needs are bisected on: their halves soon get grids, far cheaper per triangle (refine_bench
+    // --count under callgrind: with no limit the plate at T = 1e-4, 1e-5 x size cost about 3
+    // times main's instructions per triangle; with the limit at 32 the plate at 1e-3 x size 1.6
+    // times per triangle; at 8 the sphere at 1e-4 x size lost the gain; docs/ACCURACY.md).
     // The template makes no record per output triangle; where it is not used (a level below
     // kMinLevel, or more triangles than the halves') the bisection goes on to pieces that
     // pass, which adapts more finely (docs/ACCURACY.md: the constants keep every trade ratio
