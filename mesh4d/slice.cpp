@@ -946,7 +946,8 @@ struct FrameBuilder {
         }
         std::vector<std::array<uint32_t, 3>>& local = scratch.local;
         // A piece stretched in its form's metric: the bisection in that metric (form_bisect.h),
-        // unless it would make more than the grid of the largest level (then the grid below).
+        // unless that fails (past cap^2 triangles, or a fan of slivers along a side held to its
+        // points): then the grid below, on the same side counts.
         if (aniso && form) {
             FormBisection& fb = scratch.bisection;
             if (fb.fill(tf, n, size_t(cap) * size_t(cap), local)) {
