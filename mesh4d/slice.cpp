@@ -11,6 +11,7 @@
 
 #include "chord_error.h"
 #include "exact_side.h"
+#include "form_bisect.h"
 #include "robust.h"
 #include "tessellate.h"
 #include "worldline.h"
@@ -111,6 +112,8 @@ struct RefineScratch {
     // form (index, or kUnset), each edge record's segment count and first point, one piece's
     // local triangles and its local-to-global point map.
     std::vector<PieceForm> forms;
+    std::vector<uint8_t> form_aniso;  // per form: filled by FormBisection (form_bisect.h), not a grid
+    FormBisection bisection;
     std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
     std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
     std::vector<std::array<uint32_t, 3>> local;
@@ -122,6 +125,7 @@ struct RefineScratch {
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
                init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
+               form_aniso.capacity() +
                (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity() +
                 coarse.capacity()) *
                    sizeof(uint32_t) +
@@ -689,6 +693,7 @@ struct FrameBuilder {
                     }
                     scratch.form_of[id] = kUnset;
                     scratch.forms.pop_back();
+                    scratch.form_aniso.pop_back();
                 }
                 if (splitLongestPath(id, stack, false) == kSplitOther) stack.push_back(id);
             } else if (split == kSplitOther) {
@@ -808,6 +813,15 @@ struct FrameBuilder {
     // piece's first level). A piece that passed as a whole (and the mesh's triangles that needed
     // nothing) keeps level 1: its sides' extra points are fanned and, the delay being convex,
     // every triangle inside it is within its own bound.
+    // A piece whose shape fails that rule and whose need is at most kAnisoMaxNeed is filled by
+    // bisection in its form's metric instead (form_bisect.h: the grid would round its stretched
+    // triangles up; the global bisection would pay its bounds and records per piece); its sides
+    // get the counts FormBisection::sideSegments gives (each segment within 3 T / speed by the
+    // form), in the same largest-count-around-each-edge rule, so its neighbours conform. Larger
+    // needs are bisected on: their halves soon get grids, far cheaper per triangle (refine_bench
+    // --count under callgrind: with no limit the plate at T = 1e-4, 1e-5 x size cost about 3
+    // times main's instructions per triangle; with the limit at 32 the plate at 1e-3 x size 1.6
+    // times per triangle; at 8 the sphere at 1e-4 x size lost the gain; docs/ACCURACY.md).
     // The template makes no record per output triangle; where it is not used (a level below
     // kMinLevel, or more triangles than the halves') the bisection goes on to pieces that
     // pass, which adapts more finely (docs/ACCURACY.md: the constants keep every trade ratio
@@ -820,6 +834,8 @@ struct FrameBuilder {
     static constexpr double kTemplateShare = 0.5;  // least share of the leaves the templates' triangles must make (refineFrame)
     static constexpr uint32_t kKeptLevel = 2;      // least level of a template the guard keeps whole
     static constexpr double kForceRatio = 2;       // a forced template's triangles over its bisection's expected count, at most
+    static constexpr double kAnisoCost = 2;        // FormBisection's triangles over the form's need (bubbleMax speed / T), about
+    static constexpr double kAnisoMaxNeed = 16;    // the largest need (bubbleMax speed / T) FormBisection fills
     static constexpr uint32_t kNoCap = 1u << 20;   // formLevel without the max_segments cap
 
     // True when the whole-piece form of the piece with corners' shape offsets a, b, c (chord_error.h
@@ -838,11 +854,10 @@ struct FrameBuilder {
     // bubbles' bound over T (at least 1).
     bool forcedTemplatePays(uint32_t id) {
         const uint32_t* v = rt[id].v;
-        const double n = formLevel(scratch.forms[scratch.form_of[id]], kNoCap);
         const double c[3] = {edgeOf(id, 0).c, edgeOf(id, 1).c, edgeOf(id, 2).c};
         const ChordError ce = pointsBound(c, r_term_data[v[0]], r_term_data[v[1]], r_term_data[v[2]]);
         const double expected = std::max(1.0, ce.quadratic / settings.tolerance);
-        return n * n <= kForceRatio * expected;
+        return fillEstimate(scratch.form_of[id], kNoCap) <= kForceRatio * expected;
     }
 
     // The form of piece id (its corners' shape offsets s) when it is finite and (unless `force`:
@@ -854,28 +869,46 @@ struct FrameBuilder {
         form_of[id] = kUnset;
         const PieceForm pf = pieceForm(world.motion, r_now, s);
         if (!pf.finite) return false;
+        const double whole = bubbleMax(pf.c[0], pf.c[1], pf.c[2]);
+        const double need = bound_speed * whole / settings.tolerance;
+        // Its shape in the form's metric: area over bound, against the equilateral's (the
+        // template's triangles are the piece's shape, scaled).
+        const double cuv = 0.5 * (pf.c[0] + pf.c[2] - pf.c[1]);
+        const double area = std::sqrt(std::max(0.0, pf.c[0] * pf.c[2] - cuv * cuv));
+        const bool shaped = area >= kShapeShare * kEquilateral * whole;
+        // A piece the grid would fill with stretched triangles, and that needs at most
+        // kAnisoMaxNeed, is filled by the bisection in the form's metric (form_bisect.h) instead:
+        // about kAnisoCost times its need. (Larger ones are bisected on: their halves soon have
+        // a shape the grid fills at a few tens of instructions per triangle, against the local
+        // bisection's few hundred.)
+        const double xa = std::ceil(std::sqrt(need));
+        const bool aniso = !shaped && need <= kAnisoMaxNeed;
         if (!force) {
-            const double whole = bubbleMax(pf.c[0], pf.c[1], pf.c[2]);
             const double centre = bubbleMax(pf.centre[0], pf.centre[1], pf.centre[2]);
-            {  // the template's triangles against the halves' (above)
-                const double xa = std::sqrt(bound_speed * whole / settings.tolerance);
+            {  // the fill's triangles against the halves' (above)
                 const double xc2 = bound_speed * centre / settings.tolerance;
                 const double infl = whole / centre;
-                const double cost_t = std::ceil(xa) * std::ceil(xa);
+                const double cost_t = aniso ? kAnisoCost * need : xa * xa;
                 const double child = 0.5 * xc2 * (1 + (infl - 1) / 1.4142135623730951);
                 const double cost_b = 2 * std::max(1.0, (std::sqrt(child) + kRounding) * (std::sqrt(child) + kRounding));
                 if (!(cost_t <= cost_b) && !(whole <= kCoarseSlack * centre)) return false;
             }
-            // Its shape in the form's metric: area over bound, against the equilateral's (the
-            // template's triangles are the piece's shape, scaled).
-            const double cuv = 0.5 * (pf.c[0] + pf.c[2] - pf.c[1]);
-            const double area = std::sqrt(std::max(0.0, pf.c[0] * pf.c[2] - cuv * cuv));
-            if (!(area >= kShapeShare * kEquilateral * whole)) return false;
-            if (!(bound_speed * whole >= kMinLevel * kMinLevel * settings.tolerance)) return false;
+            if (!aniso && !shaped) return false;
+            if (!(need >= kMinLevel * kMinLevel)) return false;
         }
         form_of[id] = uint32_t(scratch.forms.size());
         scratch.forms.push_back(pf);
+        scratch.form_aniso.push_back(aniso ? 1 : 0);
         return true;
+    }
+
+    // The triangles the fill of form f is expected to make: n^2 for a grid of level n (at most
+    // cap), kAnisoCost times the form's need for the bisection in its metric.
+    double fillEstimate(uint32_t f, uint32_t cap) const {
+        const PieceForm& pf = scratch.forms[f];
+        if (scratch.form_aniso[f]) return std::max(1.0, kAnisoCost * bound_speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]) / settings.tolerance);
+        const double n = formLevel(pf, cap);
+        return n * n;
     }
 
     // The least level n >= 1 with speed bubbleMax(c) / n^2 <= T, at most `cap`.
@@ -906,7 +939,7 @@ struct FrameBuilder {
     // level N (form: the piece's form, or null for a piece within the bound as a whole) and
     // appends the triangles. base: the output index of the first new point.
     void fillLeaf(uint32_t src, const uint32_t v[3], const uint32_t e[3], uint32_t N, const PieceForm* form,
-                  bool unsplit, size_t base, uint32_t cap) {
+                  bool unsplit, size_t base, uint32_t cap, bool aniso = false) {
         auto outOf = [&](uint32_t g) { return g < r_nv ? vertex_out[g] : uint32_t(base + (g - r_nv)); };
         const uint32_t* count = scratch.edge_count.data();  // segments - 1
         const int n[3] = {int(count[e[0]]) + 1, int(count[e[1]]) + 1, int(count[e[2]]) + 1};
@@ -922,6 +955,34 @@ struct FrameBuilder {
             tf.limit = settings.tolerance / bound_speed;
         }
         std::vector<std::array<uint32_t, 3>>& local = scratch.local;
+        // A piece stretched in its form's metric: the bisection in that metric (form_bisect.h),
+        // unless that fails (past cap^2 triangles, or a fan of slivers along a side held to its
+        // points): then the grid below, on the same side counts.
+        if (aniso && form) {
+            FormBisection& fb = scratch.bisection;
+            if (fb.fill(tf, n, size_t(cap) * size_t(cap), local)) {
+                std::vector<uint32_t>& map = scratch.local_map;
+                map.resize(fb.innerFirst() + fb.params().size());
+                for (int k = 0; k < 3; ++k) map[size_t(k)] = v[k];
+                for (int k = 0; k < 3; ++k) {
+                    if (n[k] == 1) continue;
+                    const uint32_t a = v[k], b = v[kSucc[k]];
+                    const uint32_t first = edgePoints(e[k], a, b, uint32_t(n[k]));
+                    for (int i = 1; i < n[k]; ++i)
+                        map[fb.sideFirst(k) + uint32_t(i - 1)] = first + uint32_t(a < b ? i - 1 : n[k] - i - 1);
+                }
+                const Vec3 p0 = restOfId(v[0]), p1 = restOfId(v[1]), p2 = restOfId(v[2]);
+                uint32_t id = uint32_t(r_nv + r_rest.size());
+                for (size_t j = 0; j < fb.params().size(); ++j) {
+                    const double l1 = fb.params()[j][0], l2 = fb.params()[j][1];
+                    r_rest.push_back(p0 * (1 - l1 - l2) + p1 * l1 + p2 * l2);
+                    map[fb.innerFirst() + j] = id++;
+                }
+                for (const auto& t : local) addOutput(src, {outOf(map[t[0]]), outOf(map[t[1]]), outOf(map[t[2]])});
+                if (unsplit && local.size() > 1) ++out.refined_triangles;
+                return;
+            }
+        }
         int level = int(N);
         for (;;) {
             const TessLayout probe(level, n);
@@ -991,10 +1052,21 @@ struct FrameBuilder {
                 return;
             }
             if (form_of[id] == kUnset) return;
-            const uint32_t n = formLevel(scratch.forms[form_of[id]], cap);
+            const PieceForm& pf = scratch.forms[form_of[id]];
+            const uint32_t n = formLevel(pf, cap);
             // A form asking for more than max_segments segments gets that many: the tolerance is
             // not met there, counted as the depth limit is.
-            if (n == cap && formLevel(scratch.forms[form_of[id]], kNoCap) > cap) r_limited[t.src] = 1;
+            if (n == cap && formLevel(pf, kNoCap) > cap) r_limited[t.src] = 1;
+            if (scratch.form_aniso[form_of[id]] && !out.over_budget) {
+                // The bisection's sides: each cut so that its segments pass alone (form_bisect.h).
+                estimate += fillEstimate(form_of[id], cap);
+                const double limit = settings.tolerance / bound_speed;
+                for (int c = 0; c < 3; ++c) {
+                    const uint32_t k = uint32_t(FormBisection::sideSegments(pf.c[c], limit, int(cap))) - 1;
+                    count[t.edge[c]] = std::max(count[t.edge[c]], k);
+                }
+                return;
+            }
             estimate += double(n) * double(n);
             for (int c = 0; c < 3; ++c) count[t.edge[c]] = std::max(count[t.edge[c]], n - 1);
         };
@@ -1027,7 +1099,8 @@ struct FrameBuilder {
             const bool formed = (t.state == kCoarse || t.state == kFailed) && form_of[id] != kUnset;
             const PieceForm* pf = formed ? &scratch.forms[form_of[id]] : nullptr;
             const uint32_t v[3] = {t.v[0], t.v[1], t.v[2]}, e[3] = {t.edge[0], t.edge[1], t.edge[2]};
-            fillLeaf(t.src, v, e, pf ? formLevel(*pf, cap) : 1, out.over_budget ? nullptr : pf, t.depth == 0, base, cap);
+            const bool aniso = pf && scratch.form_aniso[form_of[id]] && !out.over_budget;
+            fillLeaf(t.src, v, e, pf ? formLevel(*pf, cap) : 1, out.over_budget ? nullptr : pf, t.depth == 0, base, cap, aniso);
         };
         for (uint32_t f = 0; f < r_nt; ++f) {
             if (r_init[f]) {
@@ -1103,6 +1176,7 @@ struct FrameBuilder {
         r_caps = caps;
         r_templates = !caps;
         scratch.forms.clear();
+        scratch.form_aniso.clear();
         scratch.form_of.clear();
         scratch.coarse.clear();
         if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
@@ -1221,7 +1295,7 @@ struct FrameBuilder {
                 const uint32_t cap = uint32_t(std::max(settings.max_segments, 2));
                 double templated = 0;
                 auto share = [&](uint32_t id) {
-                    if (rt[id].state == kCoarse) templated += std::pow(double(formLevel(scratch.forms[scratch.form_of[id]], cap)), 2);
+                    if (rt[id].state == kCoarse) templated += fillEstimate(scratch.form_of[id], cap);
                 };
                 // The records still coarse, in id order (as a pass over all records would meet
                 // them), from the list of those marked: no pass over every record.
@@ -1238,6 +1312,7 @@ struct FrameBuilder {
                     }
                     drain(stack);
                     scratch.forms.clear();
+                    scratch.form_aniso.clear();
                 }
             }
         }
