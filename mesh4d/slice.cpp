@@ -955,6 +955,18 @@ struct FrameBuilder {
             tf.limit = settings.tolerance / bound_speed;
         }
         std::vector<std::array<uint32_t, 3>>& local = scratch.local;
+        // A fill's local points 0..2 are the corners, then each side's n[k] - 1 shared points from
+        // side_first(k): both mapped to the frame's point ids (the sides' points in edge order).
+        auto mapCornersAndSides = [&](std::vector<uint32_t>& map, auto side_first) {
+            for (int k = 0; k < 3; ++k) map[size_t(k)] = v[k];
+            for (int k = 0; k < 3; ++k) {
+                if (n[k] == 1) continue;
+                const uint32_t a = v[k], b = v[kSucc[k]];
+                const uint32_t first = edgePoints(e[k], a, b, uint32_t(n[k]));
+                for (int i = 1; i < n[k]; ++i)
+                    map[side_first(k) + uint32_t(i - 1)] = first + uint32_t(a < b ? i - 1 : n[k] - i - 1);
+            }
+        };
         // A piece stretched in its form's metric: the bisection in that metric (form_bisect.h),
         // unless that fails (past cap^2 triangles, or a fan of slivers along a side held to its
         // points): then the grid below, on the same side counts.
@@ -963,14 +975,7 @@ struct FrameBuilder {
             if (fb.fill(tf, n, size_t(cap) * size_t(cap), local)) {
                 std::vector<uint32_t>& map = scratch.local_map;
                 map.resize(fb.innerFirst() + fb.params().size());
-                for (int k = 0; k < 3; ++k) map[size_t(k)] = v[k];
-                for (int k = 0; k < 3; ++k) {
-                    if (n[k] == 1) continue;
-                    const uint32_t a = v[k], b = v[kSucc[k]];
-                    const uint32_t first = edgePoints(e[k], a, b, uint32_t(n[k]));
-                    for (int i = 1; i < n[k]; ++i)
-                        map[fb.sideFirst(k) + uint32_t(i - 1)] = first + uint32_t(a < b ? i - 1 : n[k] - i - 1);
-                }
+                mapCornersAndSides(map, [&](int k) { return fb.sideFirst(k); });
                 const Vec3 p0 = restOfId(v[0]), p1 = restOfId(v[1]), p2 = restOfId(v[2]);
                 uint32_t id = uint32_t(r_nv + r_rest.size());
                 for (size_t j = 0; j < fb.params().size(); ++j) {
@@ -999,14 +1004,7 @@ struct FrameBuilder {
         // Step: the leaf's points: corners, its sides' shared points, its own inner points.
         std::vector<uint32_t>& map = scratch.local_map;
         map.resize(lay.count());
-        for (int k = 0; k < 3; ++k) map[size_t(k)] = v[k];
-        for (int k = 0; k < 3; ++k) {
-            if (n[k] == 1) continue;
-            const uint32_t a = v[k], b = v[kSucc[k]];
-            const uint32_t first = edgePoints(e[k], a, b, uint32_t(n[k]));
-            for (int i = 1; i < n[k]; ++i)
-                map[lay.sideFirst(k) + uint32_t(i - 1)] = first + uint32_t(a < b ? i - 1 : n[k] - i - 1);
-        }
+        mapCornersAndSides(map, [&](int k) { return lay.sideFirst(k); });
         if (lay.innerCount() > 0) {
             const Vec3 p0 = restOfId(v[0]), p1 = restOfId(v[1]), p2 = restOfId(v[2]);
             uint32_t id = uint32_t(r_nv + r_rest.size());

@@ -27,6 +27,7 @@
 #include "exporters/obj.h"
 #include "exporters/ply.h"
 #include "file_bytes.h"
+#include "file_size_limit.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -206,25 +207,21 @@ TEST(FrameExport, WriteWholeWritesThePiecesInOrder) {
         EXPECT_TRUE(testio::readBytes(file) == expected) << k;
     }
 
-    struct sigaction ignore {}, old_action {};
-    ignore.sa_handler = SIG_IGN;
-    ::sigaction(SIGXFSZ, &ignore, &old_action);
-    rlimit old_limit{};
-    ::getrlimit(RLIMIT_FSIZE, &old_limit);
-    rlimit limit = old_limit;
-    limit.rlim_cur = 3 * 4096;
+    constexpr size_t kLimit = 3 * 4096;
     std::string big = bytes(kDirectLeast + 100), error;
     const iovec one{big.data(), big.size()};
     const int fd = ::open((dir / "limited.bin").c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
     ASSERT_GE(fd, 0);
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
     size_t written = 0;
-    const bool ok = writeWhole(fd, &one, 1, &error, &written);
-    ::setrlimit(RLIMIT_FSIZE, &old_limit);
-    ::sigaction(SIGXFSZ, &old_action, nullptr);
+    bool ok = false;
+    {
+        const testio::FileSizeLimit limit(kLimit);
+        ASSERT_TRUE(limit.ok());
+        ok = writeWhole(fd, &one, 1, &error, &written);
+    }
     ::close(fd);
     EXPECT_FALSE(ok);
     EXPECT_EQ(error, std::strerror(EFBIG));
-    EXPECT_EQ(written, limit.rlim_cur);  // up to the limit, then refused
+    EXPECT_EQ(written, kLimit);  // up to the limit, then refused
     fs::remove_all(dir);
 }

@@ -27,6 +27,7 @@
 #include "pipeline/ply_reader.h"
 #include "pipeline/scene.h"
 #include "file_bytes.h"
+#include "file_size_limit.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -196,17 +197,12 @@ TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
     ASSERT_TRUE(writePly(path, small, &error)) << error;
     const std::string previous = testio::readBytes(path);
 
-    struct sigaction ignore {}, old_action {};
-    ignore.sa_handler = SIG_IGN;
-    ::sigaction(SIGXFSZ, &ignore, &old_action);
-    rlimit old_limit{};
-    ::getrlimit(RLIMIT_FSIZE, &old_limit);
-    rlimit limit = old_limit;
-    limit.rlim_cur = 4096;
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
-    const bool ok = writePly(path, frame, &error);
-    ::setrlimit(RLIMIT_FSIZE, &old_limit);
-    ::sigaction(SIGXFSZ, &old_action, nullptr);
+    bool ok = false;
+    {
+        const testio::FileSizeLimit limit(4096);
+        ASSERT_TRUE(limit.ok());
+        ok = writePly(path, frame, &error);
+    }
 
     EXPECT_FALSE(ok);
     EXPECT_NE(error.find("frame_00000.ply: cannot write (4096 of "), std::string::npos) << error;
