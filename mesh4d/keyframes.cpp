@@ -170,7 +170,12 @@ KeyedLocal keyedLocal(const KeyedMotion& k, double s, const Vec3& q) {
 }
 
 KeyedLocal keyedSegmentLocal(const KeyedMotion& k, size_t j, double s, const Vec3& q) {
-    return keyedSegmentTurned(k, j, s, rotate(k.turns[j == 0 ? 0 : j - 1], q));
+    KeyedLocal l = keyedSegmentTurned(k, j, s, rotate(k.turns[j == 0 ? 0 : j - 1], q));
+    if (k.lorentz) {
+        const double speed = norm(l.dy);
+        l.dtau = std::sqrt(std::max(0.0, (1 - speed) * (1 + speed)));
+    }
+    return l;
 }
 
 KeyedLocal keyedSegmentTurned(const KeyedMotion& k, size_t j, double s, const Vec3& p) {
@@ -191,10 +196,6 @@ KeyedLocal keyedSegmentTurned(const KeyedMotion& k, size_t j, double s, const Ve
     }
     l.y = k.centre[at.key] + k.velocity[at.segment] * ds + turned;
     l.dy = k.velocity[at.segment] + (rate > 0 ? cross(axis, turned) * rate : Vec3{0, 0, 0});
-    if (k.lorentz) {
-        const double speed = norm(l.dy);
-        l.dtau = std::sqrt(std::max(0.0, (1 - speed) * (1 + speed)));
-    }
     return l;
 }
 

@@ -123,8 +123,9 @@ size_t keyedSegment(const KeyedMotion& k, double s);
 // tolerance bound across a key (worldline_bound.h) takes apart.
 KeyedLocal keyedSegmentLocal(const KeyedMotion& k, size_t j, double s, const Vec3& q);
 // keyedSegmentLocal with q already turned by the segment's first key: p = rotate(k.turns[key], q),
-// key = j - 1 (0 for j = 0). The same numbers, bit for bit; for callers that take several segments
-// or times of one point (worldline_bound.cpp) and so turn it once per key.
+// key = j - 1 (0 for j = 0). The same y and dy, bit for bit, but no clock rate (dtau is left 1);
+// for callers that take several segments or times of one point and need only its pose and
+// velocity (the bound of worldline_bound.cpp), so turn it once per key.
 KeyedLocal keyedSegmentTurned(const KeyedMotion& k, size_t j, double s, const Vec3& p);
 
 // q's own clock at s: the integral of d tau above from 0 to s, closed form per segment. O(keys).
