@@ -165,10 +165,11 @@ double segmentLambda(const Motion& m, const ViewSurface& view, const CornerCross
     return dt + (c.rho > 0 ? dot(c.event.x - view.apex, dx) / c.rho : -norm(dx));
 }
 
-// The least Lambda of every segment meeting [s_lo, s_hi] at the three corners.
+// The least of `least` and the Lambda of every segment of `span` at the three corners (a least
+// value does not depend on the order taken, so a grown window adds only its new segments).
 double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossing c[3], TurnedCorners& turned,
-                   const SegmentSpan& span) {
-    double out = INFINITY;
+                   const SegmentSpan& span, double least) {
+    double out = least;
     for (size_t j = span.first; j <= span.last; ++j) {
         const Vec3* p = turned.segment(j);
         for (int i = 0; i < 3; ++i) out = std::min(out, segmentLambda(m, view, c[i], p[i], j));
@@ -176,16 +177,14 @@ double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossin
     return out;
 }
 
-// A keyframed path's rates over the segments of `span` (header): the frame rates (every one the
-// largest over them) and the lab rate (t_s, x_s): per segment the boost of (1, u) exactly plus the
-// turn's part (0, w x R Q q) by its magnitude w rho, so a segment at rest in the lab has |x_s| = 0
-// but for its turn (its .c is not used).
+// A keyframed path's rates over the segments of `span` (header), taken into *f and *first as
+// largest values (so a grown window adds only its new segments): the frame rates and the lab rate
+// (t_s, x_s): per segment the boost of (1, u) exactly plus the turn's part (0, w x R Q q) by its
+// magnitude w rho, so a segment at rest in the lab has |x_s| = 0 but for its turn (its .c is not used).
 void keyedRates(const Motion& m, TurnedCorners& turned, const SegmentSpan& span, FrameRates* f, LabPair* first) {
     const double nu = m.kinematics == Kinematics::Lorentz ? m.beta : 0.0;  // the c part at its worst
     const KeyedMotion& k = *m.keyed;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
-    *f = FrameRates{};
-    *first = LabPair{0, 0, 0};
     for (size_t j = span.first; j <= span.last; ++j) {
         const double rho = turnRho(k, j, turned.segment(j));
         f->takeMax(segmentRates(k, j, rho));
@@ -380,7 +379,7 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
     if (m.keyed) {
         turned.emplace(*m.keyed, c);
         held = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
-        lam_c = keyedLambda(m, view, c, *turned, held);
+        lam_c = keyedLambda(m, view, c, *turned, held, INFINITY);
         if (!(lam_c > 0)) return none;
         keyedRates(m, *turned, held, &keyed_f, &keyed_s1);
     }
@@ -392,8 +391,20 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
         if (m.keyed) {  // every segment the window meets, at every corner (header)
             const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
             if (span.first != held.first || span.last != held.last) {
-                lam_c = keyedLambda(m, view, c, *turned, span);
-                keyedRates(m, *turned, span, &keyed_f, &keyed_s1);
+                // The window only grows (spread doubles past G d): its new segments at each end.
+                const SegmentSpan ends[2] = {{span.first, held.first - 1}, {held.last + 1, span.last}};
+                if (span.first <= held.first && span.last >= held.last) {
+                    for (const SegmentSpan& e : ends)
+                        if (e.first <= e.last && e.last != size_t(-1)) {
+                            lam_c = keyedLambda(m, view, c, *turned, e, lam_c);
+                            keyedRates(m, *turned, e, &keyed_f, &keyed_s1);
+                        }
+                } else {
+                    keyed_f = FrameRates{};
+                    keyed_s1 = LabPair{0, 0, 0};
+                    lam_c = keyedLambda(m, view, c, *turned, span, INFINITY);
+                    keyedRates(m, *turned, span, &keyed_f, &keyed_s1);
+                }
                 held = span;
             }
             if (!(lam_c > 0)) return none;
