@@ -12,10 +12,11 @@ namespace {
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
 // Rodrigues' turn of p about unit axis k by angle a (1 - cos a = 2 sin^2(a/2): no cancellation).
-Vec3 turnAbout(const Vec3& k, double a, const Vec3& p) {
-    const double h = std::sin(0.5 * a);
-    return p * std::cos(a) + cross(k, p) * std::sin(a) + k * (dot(k, p) * 2 * h * h);
+// With the angle's cosine, sine and half-angle sine given (ca, sa, h).
+Vec3 turnWith(const Vec3& k, double ca, double sa, double h, const Vec3& p) {
+    return p * ca + cross(k, p) * sa + k * (dot(k, p) * 2 * h * h);
 }
+Vec3 turnAbout(const Vec3& k, double a, const Vec3& p) { return turnWith(k, std::cos(a), std::sin(a), std::sin(0.5 * a), p); }
 
 // (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as boost.h.
 Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
@@ -144,6 +145,7 @@ std::shared_ptr<const KeyedMotion> makeKeyedMotion(const KeyPath& path, bool lor
     k->velocity.assign(n + 1, -V);
     k->axis.assign(n + 1, Vec3{0, 0, 0});
     k->rate.assign(n + 1, 0.0);
+    k->whole_turn.assign(n + 1, KeyedMotion::WholeTurn{});
     for (size_t j = 1; j < n; ++j) {
         const double ds = k->s[j] - k->s[j - 1];
         k->velocity[j] = (k->centre[j] - k->centre[j - 1]) / ds;
@@ -154,6 +156,8 @@ std::shared_ptr<const KeyedMotion> makeKeyedMotion(const KeyPath& path, bool lor
         if (vn > 0) {
             k->axis[j] = v / vn;
             k->rate[j] = 2 * std::atan2(vn, d.w) / ds;
+            const double a = k->rate[j] * ds;  // as keyedSegmentTurned forms it at s = s[j]
+            k->whole_turn[j] = {std::cos(a), std::sin(a), std::sin(0.5 * a)};
         }
     }
     return k;
@@ -166,19 +170,32 @@ KeyedLocal keyedLocal(const KeyedMotion& k, double s, const Vec3& q) {
 }
 
 KeyedLocal keyedSegmentLocal(const KeyedMotion& k, size_t j, double s, const Vec3& q) {
-    KeyedLocal l;
-    const Where at{j, j == 0 ? 0 : j - 1};
-    const double ds = s - k.s[at.key];
-    const Vec3 p = rotate(k.turns[at.key], q);
-    const double rate = k.rate[at.segment];
-    const Vec3& axis = k.axis[at.segment];
-    const Vec3 turned = rate > 0 ? turnAbout(axis, rate * ds, p) : p;
-    l.y = k.centre[at.key] + k.velocity[at.segment] * ds + turned;
-    l.dy = k.velocity[at.segment] + (rate > 0 ? cross(axis, turned) * rate : Vec3{0, 0, 0});
+    KeyedLocal l = keyedSegmentTurned(k, j, s, rotate(k.turns[j == 0 ? 0 : j - 1], q));
     if (k.lorentz) {
         const double speed = norm(l.dy);
         l.dtau = std::sqrt(std::max(0.0, (1 - speed) * (1 + speed)));
     }
+    return l;
+}
+
+KeyedLocal keyedSegmentTurned(const KeyedMotion& k, size_t j, double s, const Vec3& p) {
+    KeyedLocal l;
+    const Where at{j, j == 0 ? 0 : j - 1};
+    const double ds = s - k.s[at.key];
+    const double rate = k.rate[at.segment];
+    const Vec3& axis = k.axis[at.segment];
+    // The turn by rate ds; none at the segment's first key, the stored whole turn at its last.
+    Vec3 turned = p;
+    if (rate > 0 && ds != 0) {
+        if (j < k.s.size() && s == k.s[j] && j < k.whole_turn.size()) {
+            const KeyedMotion::WholeTurn& w = k.whole_turn[j];
+            turned = turnWith(axis, w.cos, w.sin, w.half_sin, p);
+        } else {
+            turned = turnAbout(axis, rate * ds, p);
+        }
+    }
+    l.y = k.centre[at.key] + k.velocity[at.segment] * ds + turned;
+    l.dy = k.velocity[at.segment] + (rate > 0 ? cross(axis, turned) * rate : Vec3{0, 0, 0});
     return l;
 }
 

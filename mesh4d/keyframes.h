@@ -82,6 +82,13 @@ struct KeyedMotion {
     std::vector<Vec3> velocity;    // per segment (n + 1): dP/ds
     std::vector<Vec3> axis;        // per segment: unit turn axis (zero without a turn)
     std::vector<double> rate;      // per segment: turn rate, rad per unit s (>= 0)
+    // Per segment: the trigonometry of its whole turn, the angle rate[j] (s[j] - s[j - 1]) (0 < j < n;
+    // identity elsewhere), computed once: the pose at a segment's last key (the kink bound of
+    // worldline_bound.h takes it at every key) then costs no sine. Bit-identical to the per-call turn.
+    struct WholeTurn {
+        double cos = 1, sin = 0, half_sin = 0;  // cos a, sin a, sin(a / 2)
+    };
+    std::vector<WholeTurn> whole_turn;
 };
 
 // The path's mean velocity between its first and last key (zero for one key): V above.
@@ -115,6 +122,11 @@ size_t keyedSegment(const KeyedMotion& k, double s);
 // segments i and i + 1 give the same y (the pose at key i) but different dy: the kink that the
 // tolerance bound across a key (worldline_bound.h) takes apart.
 KeyedLocal keyedSegmentLocal(const KeyedMotion& k, size_t j, double s, const Vec3& q);
+// keyedSegmentLocal with q already turned by the segment's first key: p = rotate(k.turns[key], q),
+// key = j - 1 (0 for j = 0). The same y and dy, bit for bit, but no clock rate (dtau is left 1);
+// for callers that take several segments or times of one point and need only its pose and
+// velocity (the bound of worldline_bound.cpp), so turn it once per key.
+KeyedLocal keyedSegmentTurned(const KeyedMotion& k, size_t j, double s, const Vec3& p);
 
 // q's own clock at s: the integral of d tau above from 0 to s, closed form per segment. O(keys).
 double keyedProperTime(const KeyedMotion& k, double s, const Vec3& q);

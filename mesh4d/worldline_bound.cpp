@@ -1,7 +1,11 @@
 #include "worldline_bound.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <optional>
+#include <vector>
 
 #include "keyframes.h"
 
@@ -29,32 +33,56 @@ SegmentSpan segmentsIn(const KeyedMotion& k, double s_lo, double s_hi) {
     return {keyedSegment(k, s_lo), keyedSegment(k, s_hi)};
 }
 
+// A keyframed path's corners turned by each key's pose, p = rotate(turns[key], q) (keyframes.h
+// keyedSegmentTurned): every segment's rates, Lambda and kink start from them, so each is turned
+// once per piece instead of once per use. Lazily per key; a per-thread store stamped per piece.
+class TurnedCorners {
+public:
+    TurnedCorners(const KeyedMotion& k, const CornerCrossing c[3]) : k_(k), c_(c) {
+        thread_local Store store;
+        st_ = &store;
+        if (st_->p.size() < k.s.size()) st_->p.resize(k.s.size()), st_->stamp.resize(k.s.size(), 0);
+        if (++st_->piece == 0) std::fill(st_->stamp.begin(), st_->stamp.end(), 0), st_->piece = 1;
+    }
+    // The corners turned by segment j's first key (key 0 for j = 0).
+    const Vec3* segment(size_t j) {
+        const size_t key = j == 0 ? 0 : j - 1;
+        if (st_->stamp[key] != st_->piece) {
+            for (int i = 0; i < 3; ++i) st_->p[key][i] = rotate(k_.turns[key], c_[i].q);
+            st_->stamp[key] = st_->piece;
+        }
+        return st_->p[key].data();
+    }
+
+private:
+    struct Store {
+        std::vector<std::array<Vec3, 3>> p;
+        std::vector<uint64_t> stamp;
+        uint64_t piece = 0;
+    };
+    const KeyedMotion& k_;
+    const CornerCrossing* c_;
+    Store* st_;
+};
+
 // Segment j of a keyframed path, as a carry in its own frame (the header): Y = P + u s + R(s) Q q.
 // rho: the corners' largest distance from the turn axis after the key's turn (a distance to a line
 // is convex, so no point of the triangle is farther).
-double turnRho(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
-    const size_t key = j == 0 ? 0 : j - 1;
+double turnRho(const KeyedMotion& k, size_t j, const Vec3 p[3]) {
     double rho = 0;
     if (k.rate[j] > 0)
-        for (int i = 0; i < 3; ++i) {
-            const Vec3 p = rotate(k.turns[key], c[i].q);
-            rho = std::max(rho, norm(p - k.axis[j] * dot(k.axis[j], p)));
-        }
+        for (int i = 0; i < 3; ++i) rho = std::max(rho, norm(p[i] - k.axis[j] * dot(k.axis[j], p[i])));
     return rho;
 }
-FrameRates segmentRates(const KeyedMotion& k, size_t j, const CornerCrossing c[3]) {
-    const double w = k.rate[j], rho = turnRho(k, j, c);
+FrameRates segmentRates(const KeyedMotion& k, size_t j, double rho) {
+    const double w = k.rate[j];
     return {1, norm(k.velocity[j]) + w * rho, 0, w * w * rho, 0, 1, 0, w};
 }
 
+// Not for a keyframed path (keyedRates below).
 FrameRates frameRates(const Motion& m, const CornerCrossing c[3], double s_lo, double s_hi) {
     FrameRates r;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
-    if (m.keyed) {
-        const SegmentSpan span = segmentsIn(*m.keyed, s_lo, s_hi);
-        for (size_t j = span.first; j <= span.last; ++j) r.takeMax(segmentRates(*m.keyed, j, c));
-        return r;
-    }
     if (!accelerated(m)) {  // spin
         const double wn = norm(m.angular_velocity);
         double rim = 0, carried = 0;
@@ -125,8 +153,8 @@ namespace {
 Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
 
 // Lambda of segment j's rates at corner c's exact event (the header: its own segment's is c.lambda).
-double segmentLambda(const Motion& m, const ViewSurface& view, const CornerCrossing& c, size_t j) {
-    const KeyedLocal l = keyedSegmentLocal(*m.keyed, j, c.s, c.q);
+double segmentLambda(const Motion& m, const ViewSurface& view, const CornerCrossing& c, const Vec3& p, size_t j) {
+    const KeyedLocal l = keyedSegmentTurned(*m.keyed, j, c.s, p);
     double dt = 1;
     Vec3 dx = l.dy;
     if (m.kinematics == Kinematics::Lorentz) {
@@ -137,34 +165,58 @@ double segmentLambda(const Motion& m, const ViewSurface& view, const CornerCross
     return dt + (c.rho > 0 ? dot(c.event.x - view.apex, dx) / c.rho : -norm(dx));
 }
 
-// The least Lambda of every segment meeting [s_lo, s_hi] at the three corners.
-double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossing c[3], double s_lo, double s_hi) {
-    const SegmentSpan span = segmentsIn(*m.keyed, s_lo, s_hi);
-    double out = INFINITY;
-    for (size_t j = span.first; j <= span.last; ++j)
-        for (int i = 0; i < 3; ++i) out = std::min(out, segmentLambda(m, view, c[i], j));
+// The least of `least` and the Lambda of every segment of `span` at the three corners (a least
+// value does not depend on the order taken, so a grown window adds only its new segments).
+double keyedLambda(const Motion& m, const ViewSurface& view, const CornerCrossing c[3], TurnedCorners& turned,
+                   const SegmentSpan& span, double least) {
+    double out = least;
+    for (size_t j = span.first; j <= span.last; ++j) {
+        const Vec3* p = turned.segment(j);
+        for (int i = 0; i < 3; ++i) out = std::min(out, segmentLambda(m, view, c[i], p[i], j));
+    }
     return out;
 }
 
-// The lab rate (t_s, x_s) of a keyframed path over the segments meeting [s_lo, s_hi] (header): per
-// segment the boost of (1, u) exactly plus the turn's part (0, w x R Q q) by its magnitude w rho,
-// so a segment at rest in the lab has |x_s| = 0 but for its turn.
-LabPair keyedFirstRates(const CornerCrossing c[3], const Motion& m, double s_lo, double s_hi) {
+// A keyframed path's rates over the segments of `span` (header), taken into *f and *first as
+// largest values (so a grown window adds only its new segments): the frame rates and the lab rate
+// (t_s, x_s): per segment the boost of (1, u) exactly plus the turn's part (0, w x R Q q) by its
+// magnitude w rho, so a segment at rest in the lab has |x_s| = 0 but for its turn (its .c is not used).
+void keyedRates(const Motion& m, TurnedCorners& turned, const SegmentSpan& span, FrameRates* f, LabPair* first) {
     const double nu = m.kinematics == Kinematics::Lorentz ? m.beta : 0.0;  // the c part at its worst
     const KeyedMotion& k = *m.keyed;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
-    const SegmentSpan span = segmentsIn(k, s_lo, s_hi);
-    LabPair out{0, 0, 0};
     for (size_t j = span.first; j <= span.last; ++j) {
+        const double rho = turnRho(k, j, turned.segment(j));
+        f->takeMax(segmentRates(k, j, rho));
         const Vec3& u = k.velocity[j];
         const double tt = lorentz ? m.gamma * (1 + dot(m.velocity, u)) : 1.0;
         const double xt = norm(lorentz ? u + stretch(m.velocity, m.gamma, u) + m.velocity * m.gamma : u);
-        const LabPair turn = toLab(m, nu, 0, k.rate[j] * turnRho(k, j, c));
-        out.t = std::max(out.t, tt + turn.t);
-        out.x = std::max(out.x, xt + turn.x);
-        out.c = std::max(out.c, tt + xt + turn.c);
+        const LabPair turn = toLab(m, nu, 0, k.rate[j] * rho);
+        first->t = std::max(first->t, tt + turn.t);
+        first->x = std::max(first->x, xt + turn.x);
+        first->c = std::max(first->c, tt + xt + turn.c);
     }
-    return out;
+}
+
+// The corners' lab events at key i's time s_i, relative to (0, 0) as worldlineEvent gives them
+// (worldline.cpp relativeEvent: the pose y at s_i boosted with V about (t0, X0), or carried), and
+// their rates on the segment after the key (dyb), from one keyedSegmentTurned call per corner.
+void keyEvents(const Motion& m, size_t i, TurnedCorners& turned, Event ev[3], Vec3 dyb[3]) {
+    const KeyedMotion& k = *m.keyed;
+    const double s = k.s[i];
+    const Vec3* p = turned.segment(i + 1);
+    for (int q = 0; q < 3; ++q) {
+        const KeyedLocal l = keyedSegmentTurned(k, i + 1, s, p[q]);
+        dyb[q] = l.dy;
+        if (m.kinematics == Kinematics::Galilean) {
+            ev[q].t = m.t0 + s;
+            ev[q].x = m.origin + l.y;
+        } else {
+            const double g = m.gamma;
+            ev[q].t = m.t0 + g * (s + dot(m.velocity, l.y));
+            ev[q].x = m.origin + (l.y + stretch(m.velocity, g, l.y) + m.velocity * (g * s));
+        }
+    }
 }
 
 // Whether the curve sigma = s_i may meet the triangle (header): the sign of
@@ -199,8 +251,8 @@ bool keyMayCross(const ViewSurface& view, const Event e[3]) {
 // The kink's size per unit length at key i over the triangle (header): j(q) = |c(q)| D(q) at q's
 // event at s_i (ev), exact at the corners, carried over the triangle by its Lipschitz bound. INFINITY
 // when the carried bounds do not close (the triangle may reach the camera or a Lambda 0).
-double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const CornerCrossing c[3],
-               const Event ev[3], double d) {
+double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const Event ev[3],
+               const Vec3 dyb[3], TurnedCorners& turned, double d) {
     const KeyedMotion& k = *m.keyed;
     const bool cone = view.kind == ViewKind::PastCone, lorentz = m.kinematics == Kinematics::Lorentz;
     const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
@@ -208,6 +260,7 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
     const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
     auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
     auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
+    const Vec3* pa = turned.segment(i);
     double rho_min = INFINITY, j_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0, lam_min = INFINITY;
     for (int q = 0; q < 3; ++q) {
         const Event& e = ev[q];
@@ -219,9 +272,9 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
             rho_min = std::min(rho_min, rho);
             n = r / rho;
         }
-        const Vec3 dya = keyedSegmentLocal(k, i, s, c[q].q).dy, dyb = keyedSegmentLocal(k, i + 1, s, c[q].q).dy;
-        const double ta = labT(dya), tb = labT(dyb);
-        const Vec3 xa = labX(dya), xb = labX(dyb);
+        const Vec3 dya = keyedSegmentTurned(k, i, s, pa[q]).dy;
+        const double ta = labT(dya), tb = labT(dyb[q]);
+        const Vec3 xa = labX(dya), xb = labX(dyb[q]);
         const double la = ta + dot(n, xa), lb = tb + dot(n, xb);
         if (!(la > 0) || !(lb > 0)) return INFINITY;
         const double D = norm(xb / lb - xa / la) + shear_speed * std::fabs(tb / lb - ta / la);
@@ -258,8 +311,8 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
 // at their largest, the term is D_hi a b / (a + b), D_hi = the least corner D plus L_D d (D's
 // Lipschitz bound of keyKink above, no n). 0 when the corners do not straddle the plane; INFINITY
 // when the carried bounds do not close.
-double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const CornerCrossing c[3], const Event ev[3],
-                      double d) {
+double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const Event ev[3],
+                      const Vec3 dyb[3], TurnedCorners& turned, double d) {
     const KeyedMotion& k = *m.keyed;
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
     const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
@@ -267,14 +320,15 @@ double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const 
     const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
     auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
     auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
+    const Vec3* pa = turned.segment(i);
     double above = 0, below = 0, D_min = INFINITY, x_max = 0, lam_min = INFINITY;
     for (int q = 0; q < 3; ++q) {
         const double gk = view.t_c - ev[q].t;
         above = std::max(above, gk);
         below = std::max(below, -gk);
-        const Vec3 dya = keyedSegmentLocal(k, i, s, c[q].q).dy, dyb = keyedSegmentLocal(k, i + 1, s, c[q].q).dy;
-        const double ta = labT(dya), tb = labT(dyb);
-        const Vec3 xa = labX(dya), xb = labX(dyb);
+        const Vec3 dya = keyedSegmentTurned(k, i, s, pa[q]).dy;
+        const double ta = labT(dya), tb = labT(dyb[q]);
+        const Vec3 xa = labX(dya), xb = labX(dyb[q]);
         if (!(ta > 0) || !(tb > 0)) return INFINITY;
         D_min = std::min(D_min, norm(xb / tb - xa / ta));  // the shear's part: |t_s / Lambda| = 1 on both sides
         x_max = std::max({x_max, norm(xa), norm(xb)});
@@ -321,12 +375,13 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
     SegmentSpan held{1, 0};
     FrameRates keyed_f;
     LabPair keyed_s1{0, 0, 0};
+    std::optional<TurnedCorners> turned;
     if (m.keyed) {
-        lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
-        if (!(lam_c > 0)) return none;
-        keyed_f = frameRates(m, c, s_lo - spread, s_hi + spread);
-        keyed_s1 = keyedFirstRates(c, m, s_lo - spread, s_hi + spread);  // its .c is not used
+        turned.emplace(*m.keyed, c);
         held = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
+        lam_c = keyedLambda(m, view, c, *turned, held, INFINITY);
+        if (!(lam_c > 0)) return none;
+        keyedRates(m, *turned, held, &keyed_f, &keyed_s1);
     }
     if (!(lam_c > 0)) return none;
     double lam_min = 0.9 * lam_c;
@@ -336,9 +391,20 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
         if (m.keyed) {  // every segment the window meets, at every corner (header)
             const SegmentSpan span = segmentsIn(*m.keyed, s_lo - spread, s_hi + spread);
             if (span.first != held.first || span.last != held.last) {
-                keyed_f = frameRates(m, c, s_lo - spread, s_hi + spread);
-                lam_c = keyedLambda(m, view, c, s_lo - spread, s_hi + spread);
-                keyed_s1 = keyedFirstRates(c, m, s_lo - spread, s_hi + spread);  // its .c is not used
+                // The window only grows (spread doubles past G d): its new segments at each end.
+                const SegmentSpan ends[2] = {{span.first, held.first - 1}, {held.last + 1, span.last}};
+                if (span.first <= held.first && span.last >= held.last) {
+                    for (const SegmentSpan& e : ends)
+                        if (e.first <= e.last && e.last != size_t(-1)) {
+                            lam_c = keyedLambda(m, view, c, *turned, e, lam_c);
+                            keyedRates(m, *turned, e, &keyed_f, &keyed_s1);
+                        }
+                } else {
+                    keyed_f = FrameRates{};
+                    keyed_s1 = LabPair{0, 0, 0};
+                    lam_c = keyedLambda(m, view, c, *turned, span, INFINITY);
+                    keyedRates(m, *turned, span, &keyed_f, &keyed_s1);
+                }
                 held = span;
             }
             if (!(lam_c > 0)) return none;
@@ -382,9 +448,10 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
                 double kinks = 0, plane = 0;
                 for (size_t i = span.first; i < span.last; ++i) {
                     Event ev[3];  // the corners' events at the key's time, shared by the tests below
-                    for (int q = 0; q < 3; ++q) ev[q] = worldlineEvent(m, m.keyed->s[i], c[q].q);
-                    if (!cone) plane += keyKinkOnPlane(m, view, i, c, ev, d);
-                    else if (keyMayCross(view, ev)) kinks += 2 * keyKink(m, view, shear_speed, i, c, ev, d);
+                    Vec3 dyb[3];  // and their rates on the segment after it
+                    keyEvents(m, i, *turned, ev, dyb);
+                    if (!cone) plane += keyKinkOnPlane(m, view, i, ev, dyb, *turned, d);
+                    else if (keyMayCross(view, ev)) kinks += 2 * keyKink(m, view, shear_speed, i, ev, dyb, *turned, d);
                 }
                 const double kink = kinks * std::sqrt(d2 / 3) + plane;
                 out.kink = kink == kink ? kink : INFINITY;

@@ -216,6 +216,49 @@ TEST(Keyframes, ClockOfAMovingTurningPointIsTheIntegral) {
     }
 }
 
+// A segment's motion at its own keys (keyframes.h keyedSegmentLocal): at its first key the pose
+// of that key, at its last (the stored whole turn, KeyedMotion::whole_turn) the pose of the next
+// key, centre P_k plus the key's turn Q_k q, each rotated here by a matrix written out from the
+// quaternion; and the bound's shortcut keyedSegmentTurned (q turned once by the caller) gives
+// the same pose and velocity bit for bit at the keys and between them.
+TEST(Keyframes, SegmentPoseAtItsKeysIsTheKeyPose) {
+    mesh4d::KeyPath path;
+    path.times = {0, 4, 9, 11};
+    path.positions = {{0, 0, 0}, {2, 0, 0}, {2, 2.5, 1}, {1, 3, 1}};
+    const double a1 = 1.2, a2 = 2.6, a3 = 0.4;
+    path.turns = {{1, 0, 0, 0},
+                  {std::cos(a1 / 2), 0, 0, std::sin(a1 / 2)},
+                  {std::cos(a2 / 2), std::sin(a2 / 2) * 0.6, 0, std::sin(a2 / 2) * 0.8},
+                  {std::cos(a3 / 2), 0, std::sin(a3 / 2), 0}};
+    auto matrixTurn = [](const mesh4d::Quat& r, const Vec3& v) {
+        const double w = r.w, x = r.x, y = r.y, z = r.z;
+        return Vec3{(1 - 2 * (y * y + z * z)) * v.x + 2 * (x * y - w * z) * v.y + 2 * (x * z + w * y) * v.z,
+                    2 * (x * y + w * z) * v.x + (1 - 2 * (x * x + z * z)) * v.y + 2 * (y * z - w * x) * v.z,
+                    2 * (x * z - w * y) * v.x + 2 * (y * z + w * x) * v.y + (1 - 2 * (x * x + y * y)) * v.z};
+    };
+    for (bool lorentz : {true, false}) {
+        const Vec3 V = mesh4d::meanVelocity(path);
+        const auto k = mesh4d::makeKeyedMotion(path, lorentz, 1.0, mesh4d::keyedCentreAt(path, 1.0), V);
+        for (const Vec3& q : {Vec3{0.7, -0.4, 0.3}, Vec3{-0.2, 0.5, -0.6}, Vec3{0, 0, 0}}) {
+            for (size_t j = 1; j < k->s.size(); ++j) {
+                for (size_t key : {j - 1, j}) {
+                    const Vec3 want = k->centre[key] + matrixTurn(k->turns[key], q);
+                    const Vec3 got = mesh4d::keyedSegmentLocal(*k, j, k->s[key], q).y;
+                    EXPECT_LT(mesh4d::norm(got - want), 1e-12 * (1 + mesh4d::norm(want))) << lorentz << " " << j << " " << key;
+                }
+                const Vec3 p = mesh4d::rotate(k->turns[j - 1], q);
+                for (double f : {0.0, 0.3, 1.0, 1.7}) {
+                    const double s = f == 1.0 ? k->s[j] : k->s[j - 1] + f * (k->s[j] - k->s[j - 1]);
+                    const mesh4d::KeyedLocal a = mesh4d::keyedSegmentLocal(*k, j, s, q);
+                    const mesh4d::KeyedLocal b = mesh4d::keyedSegmentTurned(*k, j, s, p);
+                    EXPECT_TRUE(a.y.x == b.y.x && a.y.y == b.y.y && a.y.z == b.y.z) << j << " " << f;
+                    EXPECT_TRUE(a.dy.x == b.dy.x && a.dy.y == b.dy.y && a.dy.z == b.dy.z) << j << " " << f;
+                }
+            }
+        }
+    }
+}
+
 // Faster than light anywhere is refused with the time and the speed: the centre's path (every
 // model), and a vertex carried by the turn (the box's corner at rho = 0.707 turning at 3 rad/s).
 // A tolerance for a keyframed object that begins existing within the frames is refused (its clip
