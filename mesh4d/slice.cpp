@@ -845,8 +845,7 @@ struct FrameBuilder {
     // order along the line of sight), so a piece it passes needs no further split.
     bool passesByForm(const Vec3& a, const Vec3& b, const Vec3& c) const {
         const Vec3 s[3] = {a, b, c};
-        const PieceForm pf = pieceForm(world.motion, r_now, s);
-        return pf.finite && bound_speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]) <= settings.tolerance;
+        return pieceFormWithin(world.motion, r_now, s, bound_speed, settings.tolerance);
     }
 
     // Whether piece id's forced template (its form made by coarseForm(id, s, true)) makes at
@@ -1202,11 +1201,15 @@ struct FrameBuilder {
             const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
             const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
             // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
+            // The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
+            // chordErrorFromCorners' bit for bit, from the one spread both tests use.
             const bool displaced = view.sheared() || settings.displacement >= 0;
-            if (!displaced && passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
-            const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
-            if (displaced || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
-                candidates.push_back(uint32_t(f));
+            if (!displaced) {
+                const double d2 = cornerSpread(sc, world.motion);
+                if (passesFromSpread(d2, xc, world.motion, settings.tolerance)) continue;
+                if (!(chordErrorFromSpread(d2, xc, world.motion) > settings.tolerance)) continue;
+            }
+            candidates.push_back(uint32_t(f));
         }
         // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits:
         // ends in id order), when the candidates are enough to pay for the edge records' reset
