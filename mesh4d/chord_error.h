@@ -70,7 +70,7 @@ inline double normMOfEvent(const ViewAnchor& anchor, const Motion& m, const Even
 inline double bubbleMax(double c01, double c12, double c20) {
     // a_k: coefficient of the edge opposite corner k.
     const double a0 = c12, a1 = c20, a2 = c01;
-    double best = 0.25 * std::max({a0, a1, a2});  // edge middles
+    double best = 0.25 * std::max(std::max(a0, a1), a2);  // edge middles (std::max({a0, a1, a2}), NaNs alike)
     const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
     const double den = w0 + w1 + w2;  // = 2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2
     if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);
