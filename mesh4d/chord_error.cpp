@@ -5,19 +5,6 @@
 
 namespace mesh4d {
 
-
-namespace {
-// The corners' shape offsets (into s) and the least |x_i|_M.
-double cornerTerms(const ViewAnchor& anchor, const Motion& m, const Event corner[3], Vec3 s[3]) {
-    double xm_min = INFINITY;
-    for (int i = 0; i < 3; ++i) {
-        s[i] = shapeOfEvent(m, corner[i]);
-        xm_min = std::min(xm_min, normMOfEvent(anchor, m, corner[i]));
-    }
-    return xm_min;
-}
-}  // namespace
-
 ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
                       double tolerance) {
     if (m.beta == 0) return {};
@@ -52,17 +39,12 @@ ChordError displacedChordError(const Motion& m, double speed, const double t_cor
 double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Event corner[3]) {
     if (m.beta == 0) return 0;
     Vec3 s[3];
-    const double xm_min = cornerTerms(anchor, m, corner, s);
-    double d2 = 0;  // d_M^2
+    double xm[3];
     for (int i = 0; i < 3; ++i) {
-        const Vec3 u = s[(i + 1) % 3] - s[i];
-        const double uv = dot(u, m.velocity);
-        d2 = std::max(d2, uv * uv + m.one_minus_beta2 * norm2(u));
+        s[i] = shapeOfEvent(m, corner[i]);
+        xm[i] = normMOfEvent(anchor, m, corner[i]);
     }
-    const double mlow = xm_min - std::sqrt(d2);
-    if (!(mlow > 0)) return INFINITY;
-    const double bound = m.beta * d2 / (6 * m.one_minus_beta2 * mlow);
-    return bound == bound ? bound : INFINITY;
+    return chordErrorFromSpread(cornerSpread(s, m), xm, m);
 }
 
 }  // namespace mesh4d

@@ -70,7 +70,7 @@ inline double normMOfEvent(const ViewAnchor& anchor, const Motion& m, const Even
 inline double bubbleMax(double c01, double c12, double c20) {
     // a_k: coefficient of the edge opposite corner k.
     const double a0 = c12, a1 = c20, a2 = c01;
-    double best = 0.25 * std::max({a0, a1, a2});  // edge middles
+    double best = 0.25 * std::max(std::max(a0, a1), a2);  // edge middles (std::max({a0, a1, a2}), NaNs alike)
     const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
     const double den = w0 + w1 + w2;  // = 2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2
     if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);
@@ -123,15 +123,36 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
 // true only when chordErrorFromCorners <= tolerance holds with m >= |x|_M,min / 2 in place of
 // m (sufficient: d_M^2 <= xm^2 / 4 gives d_M <= xm / 2). s: shape offsets y + v delta of the
 // corners; xm: their |x|_M = S + y.v + delta (chordErrorFromCorners shows both).
-inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion& m, double tolerance) {
-    const double xmin = std::min(xm[0], std::min(xm[1], xm[2]));
+// d_M^2, the square of the longest side in the metric M, of the corners with shape offsets s.
+inline double cornerSpread(const Vec3 s[3], const Motion& m) {
     double d2 = 0;
     for (int i = 0; i < 3; ++i) {
         const Vec3 u = s[(i + 1) % 3] - s[i];
         const double uv = dot(u, m.velocity);
         d2 = std::max(d2, uv * uv + m.one_minus_beta2 * norm2(u));
     }
+    return d2;
+}
+// passesFromCorners with the corners' spread d2 = cornerSpread(s, m) given.
+inline bool passesFromSpread(double d2, const double xm[3], const Motion& m, double tolerance) {
+    const double xmin = std::min(xm[0], std::min(xm[1], xm[2]));
     return xmin > 0 && 4 * d2 <= xmin * xmin && m.beta * d2 <= 3 * m.one_minus_beta2 * tolerance * xmin;
+}
+inline bool passesFromCorners(const Vec3 s[3], const double xm[3], const Motion& m, double tolerance) {
+    return passesFromSpread(cornerSpread(s, m), xm, m, tolerance);
+}
+// chordErrorFromCorners from the corners' terms, for a caller that keeps them per point (the
+// refinement's first pass): d2 = cornerSpread(s, m), xm the corners' |x|_M = normMOfEvent.
+// Bit for bit chordErrorFromCorners of the events the terms were made from (it makes the same
+// terms, the same spread, and calls this).
+inline double chordErrorFromSpread(double d2, const double xm[3], const Motion& m) {
+    if (m.beta == 0) return 0;
+    double xm_min = INFINITY;
+    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, xm[i]);
+    const double mlow = xm_min - std::sqrt(d2);
+    if (!(mlow > 0)) return INFINITY;
+    const double bound = m.beta * d2 / (6 * m.one_minus_beta2 * mlow);
+    return bound == bound ? bound : INFINITY;
 }
 
 // ---- The a-priori bound: the bubbles from the Hessian, no midpoint cut ----
@@ -308,8 +329,10 @@ struct PieceForm {
     double centre[3] = {0, 0, 0};                  // the same with H(x_c) alone
     bool finite = false;                           // false when the piece may reach the camera (m <= 0)
 };
-inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
-    PieceForm r;
+// The candidate forms of pieceForm, in its order: visit(c, v) for each, c its sides' coefficients
+// and v = bubbleMax(c); the scan stops when visit returns true. centre: H(x_c)'s coefficients.
+template <class Visit>
+inline void scanPieceForms(const Motion& m, const Vec3& E, const Vec3 s[3], double centre_c[3], Visit visit) {
     const double k = m.one_minus_beta2;
     const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
     const Vec3 x = E + centre;
@@ -335,11 +358,10 @@ inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
         const double uv = dot(u, m.velocity);
         const double l2 = uv * uv + k * norm2(u);
         const double uMx = uv * xv + k * dot(u, x);
-        r.centre[e] = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
+        centre_c[e] = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
         along2[e] = uMx * uMx / xm2;
         across[e] = std::max(0.0, l2 - along2[e]);
     }
-    double best = INFINITY;
     // (1) The direct form.
     const double m1 = xm - reach;
     if (m1 > 0) {
@@ -354,11 +376,7 @@ inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
             const double fa = 1 + mu, fb = b[3] > 0 ? 1 + 1 / mu : 0;
             double c[3];
             for (int e = 0; e < 3; ++e) c[e] = inv * (fa * across[e] + fb * sin2 * along2[e]);
-            const double v = bubbleMax(c[0], c[1], c[2]);
-            if (v < best) {
-                best = v;
-                for (int e = 0; e < 3; ++e) r.c[e] = c[e];
-            }
+            if (visit(c, bubbleMax(c[0], c[1], c[2]))) return;
             if (b[3] == 0) break;
         }
     }
@@ -368,13 +386,37 @@ inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
     if (mlow > 0) {
         const double K = 2 / 1.7320508075688772 * rM / (k * mlow * mlow);
         double c[3];
-        for (int e = 0; e < 3; ++e) c[e] = r.centre[e] + 0.5 * K * (across[e] + along2[e]);
-        if (bubbleMax(c[0], c[1], c[2]) < best)
-            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
+        for (int e = 0; e < 3; ++e) c[e] = centre_c[e] + 0.5 * K * (across[e] + along2[e]);
+        visit(c, bubbleMax(c[0], c[1], c[2]));
     }
+}
+
+inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
+    PieceForm r;
+    double best = INFINITY;
+    scanPieceForms(m, E, s, r.centre, [&](const double c[3], double v) {
+        if (v < best) {
+            best = v;
+            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
+        }
+        return false;
+    });
     r.finite = r.c[0] == r.c[0] && r.c[1] == r.c[1] && r.c[2] == r.c[2] && r.c[0] < INFINITY &&
                r.c[1] < INFINITY && r.c[2] < INFINITY;
     return r;
+}
+
+// Whether pieceForm(m, E, s) is finite and speed bubbleMax(its c) <= tolerance, without the
+// candidates after the first that passes: the least candidate passes when any does (the product
+// by speed is monotonic), so the answer is pieceForm's whenever its coefficients are numbers.
+inline bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance) {
+    double centre[3];
+    bool within = false;
+    scanPieceForms(m, E, s, centre, [&](const double c[3], double v) {
+        within = c[0] < INFINITY && c[1] < INFINITY && c[2] < INFINITY && speed * v <= tolerance;
+        return within;
+    });
+    return within;
 }
 
 }  // namespace mesh4d

@@ -108,6 +108,7 @@ struct RefineScratch {
     std::vector<uint32_t> members, stack;
     std::vector<Side> side;
     std::vector<uint32_t> vertex_out;
+    std::vector<double> spread;  // per mesh edge: its |u|_M^2 (refineFrame's first pass)
     // The templates (refineFrame without a real cap): the coarse pieces' forms, each record's
     // form (index, or kUnset), each edge record's segment count and first point, one piece's
     // local triangles and its local-to-global point map.
@@ -120,7 +121,7 @@ struct RefineScratch {
 
     size_t bytes() const {
         return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
-               terms.capacity() * sizeof(VTerms) +
+               terms.capacity() * sizeof(VTerms) + spread.capacity() * sizeof(double) +
                cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
@@ -845,8 +846,7 @@ struct FrameBuilder {
     // order along the line of sight), so a piece it passes needs no further split.
     bool passesByForm(const Vec3& a, const Vec3& b, const Vec3& c) const {
         const Vec3 s[3] = {a, b, c};
-        const PieceForm pf = pieceForm(world.motion, r_now, s);
-        return pf.finite && bound_speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]) <= settings.tolerance;
+        return pieceFormWithin(world.motion, r_now, s, bound_speed, settings.tolerance);
     }
 
     // Whether piece id's forced template (its form made by coarseForm(id, s, true)) makes at
@@ -1190,6 +1190,25 @@ struct FrameBuilder {
             r_terms[i].s = shapeOfEvent(world.motion, e);
             r_terms[i].xm = normMOfEvent(anchor, world.motion, e);
         }
+        // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
+        const bool displaced = view.sheared() || settings.displacement >= 0;
+        // The corners' spread (chord_error.h cornerSpread: the largest |u|_M^2 of a triangle's
+        // sides) from each mesh edge's |u|_M^2, made once per edge instead of once per side of
+        // each triangle: |u|_M^2 is even in u (negating u negates its terms exactly), and the
+        // largest of three does not depend on their order, so each triangle's spread is
+        // cornerSpread's bit for bit. (With a cull, per triangle: most edges may be culled.)
+        std::vector<double>& spread = scratch.spread;
+        const bool edge_spread = !displaced && !live;
+        if (edge_spread) {
+            spread.resize(ne);
+            const Vec3 v = world.motion.velocity;
+            const double k = world.motion.one_minus_beta2;
+            for (size_t e = 0; e < ne; ++e) {
+                const Vec3 u = r_terms[world.edges[e].hi].s - r_terms[world.edges[e].lo].s;
+                const double uv = dot(u, v);
+                spread[e] = uv * uv + k * norm2(u);
+            }
+        }
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             const auto& t = world.mesh.triangles[f];
@@ -1199,14 +1218,22 @@ struct FrameBuilder {
                 if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
                 if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
             }
-            const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
-            const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
-            // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
-            const bool displaced = view.sheared() || settings.displacement >= 0;
-            if (!displaced && passesFromCorners(sc, xc, world.motion, settings.tolerance)) continue;
-            const Event corner[3] = {{r_time[t[0]], r_pos[t[0]]}, {r_time[t[1]], r_pos[t[1]]}, {r_time[t[2]], r_pos[t[2]]}};
-            if (displaced || chordErrorFromCorners(anchor, world.motion, corner) > settings.tolerance)
-                candidates.push_back(uint32_t(f));
+            // The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
+            // chordErrorFromCorners' bit for bit, from the one spread both tests use.
+            if (!displaced) {
+                const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
+                double d2;
+                if (edge_spread) {
+                    const auto& te = world.triangle_edges[f];
+                    d2 = std::max(std::max(std::max(0.0, spread[te[0]]), spread[te[1]]), spread[te[2]]);
+                } else {
+                    const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
+                    d2 = cornerSpread(sc, world.motion);
+                }
+                if (passesFromSpread(d2, xc, world.motion, settings.tolerance)) continue;
+                if (!(chordErrorFromSpread(d2, xc, world.motion) > settings.tolerance)) continue;
+            }
+            candidates.push_back(uint32_t(f));
         }
         // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits:
         // ends in id order), when the candidates are enough to pay for the edge records' reset

@@ -888,6 +888,83 @@ TEST(Refine, PieceFormIsTightForSmallPieces) {
     std::printf("whole-piece form over the centroid's, pieces of 1/50 of their distance: at most %.3f\n", worst);
 }
 
+// The refinement's first pass takes each triangle's spread (chord_error.h cornerSpread: its
+// largest side in the metric M, squared) from one |u|_M^2 per mesh edge, made from the edge's lo
+// end to its hi end whatever the triangle's orientation: that is cornerSpread's value bit for bit
+// only because |u|_M^2 is even in u and the largest of three does not depend on their order.
+// Random triangles, every order of their corners and every orientation of their sides.
+TEST(Refine, CornerSpreadFromEdgesIsTheTrianglesBitForBit) {
+    std::mt19937 rng(53);
+    std::uniform_real_distribution<double> u(-1, 1);
+    auto spreadOf = [](const Motion& m, const Vec3& from, const Vec3& to) {
+        const Vec3 d = to - from;
+        const double dv = dot(d, m.velocity);
+        return dv * dv + m.one_minus_beta2 * norm2(d);
+    };
+    const int perm[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+    int checked = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -10 * size}, velocity);
+        Vec3 s[3];
+        for (auto& si : s) si = Vec3{u(rng), u(rng), u(rng)} * size + Vec3{3, -2, 7} * size;
+        for (const auto& p : perm) {
+            const Vec3 sp[3] = {s[p[0]], s[p[1]], s[p[2]]};
+            const double direct = cornerSpread(sp, m);
+            for (int flips = 0; flips < 8; ++flips) {
+                double d2 = 0;
+                for (int e = 0; e < 3; ++e) {
+                    const Vec3 &a = sp[e], &b = sp[(e + 1) % 3];
+                    d2 = std::max(d2, (flips >> e) & 1 ? spreadOf(m, b, a) : spreadOf(m, a, b));
+                }
+                EXPECT_EQ(0, std::memcmp(&d2, &direct, sizeof(double))) << "trial " << trial;
+                ++checked;
+            }
+        }
+    }
+    EXPECT_EQ(checked, 2000 * 6 * 8);
+}
+
+// passesByForm asks pieceFormWithin, which stops at the first candidate form that passes: it must
+// answer as pieceForm does (its least candidate, finite, times the speed within T), also at T
+// equal to that product and one ulp on either side of it. Random pieces near (some reaching the
+// camera: no finite form) and far.
+TEST(Refine, PieceFormWithinIsPieceFormsAnswer) {
+    std::mt19937 rng(59);
+    std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
+    int finite = 0, passed = 0, checked = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
+        const double distance = size * (trial % 3 == 0 ? 0.6 + w(rng) : std::pow(10.0, 0.3 + 2 * w(rng)));
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, velocity);
+        const ViewSurface view{ViewKind::PastCone, distance * (1 + 0.5 * u(rng)), {0, 0, 0}};
+        const Vec3 E = nowBase(view, m);
+        Vec3 s[3];
+        const double piece = size * std::pow(10.0, -2 * w(rng));
+        for (auto& si : s) si = shapeOffset(m, Vec3{u(rng), u(rng), u(rng)} * (0.5 * piece));
+        const PieceForm pf = pieceForm(m, E, s);
+        const double speed = m.beta;
+        const double value = speed * bubbleMax(pf.c[0], pf.c[1], pf.c[2]);
+        finite += pf.finite;
+        const double ladder[6] = {value, std::nextafter(value, 0.0), std::nextafter(value, INFINITY),
+                                  0.5 * value, 2 * value, value * (0.5 + w(rng))};
+        for (double T : ladder) {
+            if (!(T > 0) || !(T < INFINITY)) continue;
+            const bool expected = pf.finite && value <= T;
+            EXPECT_EQ(pieceFormWithin(m, E, s, speed, T), expected) << "trial " << trial << " T " << T;
+            passed += expected;
+            ++checked;
+        }
+    }
+    EXPECT_GT(finite, 2000);
+    EXPECT_GT(passed, 4000);
+    EXPECT_GT(checked, 10000);
+}
+
 // Pieces far from the camera are filled by templates (a level of 2 or more, a form near the
 // centroid's: the flange-like plate 18.675 ls away, whose output differs from bisection alone):
 // the output stays one manifold sheet with one boundary loop (no T-junction opens a crack),
