@@ -211,7 +211,8 @@ bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* wr
 
 namespace {
 
-// writeWhole's page-aligned buffers, kept by the process (one per writer running at once).
+// writeWhole's page-aligned buffers of kDirectChunk + kPage bytes (room for a staging offset
+// below a page, detail::writeWholeStaged), kept by the process (one per writer running at once).
 struct DirectBuffers {
     std::mutex mutex;
     std::vector<void*> free;
@@ -280,6 +281,11 @@ bool writeBuffered(int fd, const iovec* pieces, size_t count, size_t total, std:
 }  // namespace
 
 bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, size_t* written) {
+    return detail::writeWholeStaged(fd, pieces, count, 0, error, written);
+}
+
+bool detail::writeWholeStaged(int fd, const iovec* pieces, size_t count, size_t stage_offset, std::string* error,
+                              size_t* written) {
     size_t ignored = 0;
     if (!written) written = &ignored;
     *written = 0;
@@ -297,13 +303,13 @@ bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, s
             pool.free.pop_back();
         }
     }
-    if (!buffer && ::posix_memalign(&buffer, kPage, kDirectChunk) != 0) buffer = nullptr;
+    if (!buffer && ::posix_memalign(&buffer, kPage, kDirectChunk + kPage) != 0) buffer = nullptr;
     if (!buffer) {
         (void)::fcntl(fd, F_SETFL, flags);
         return writeBuffered(fd, pieces, count, total, error, written);
     }
     // Chunks of kDirectChunk bytes (the last padded with zeros to a whole page, cut off below).
-    char* const stage = static_cast<char*>(buffer);
+    char* const stage = static_cast<char*>(buffer) + stage_offset % kPage;
     bool direct = true, ok = true;
     uint64_t offset = 0;
     size_t fill = 0;

@@ -68,6 +68,14 @@ bool writeAll(int fd, const void* data, size_t n, std::string* error, size_t* wr
 constexpr size_t kDirectLeast = size_t(4) << 20;
 constexpr size_t kDirectChunk = size_t(8) << 20;
 bool writeWhole(int fd, const iovec* pieces, size_t count, std::string* error, size_t* written = nullptr);
+namespace detail {
+// writeWhole with its staging buffer `stage_offset` bytes (below a page) past a page boundary;
+// writeWhole is this with 0. The seam of the fallback's test (tests/atomic_file_test.cpp): a file
+// system that checks O_DIRECT's memory alignment (ext4 on a block device: 512 bytes here) then
+// fails the first direct write with EINVAL, the kernel's own refusal, as where O_DIRECT is refused.
+bool writeWholeStaged(int fd, const iovec* pieces, size_t count, size_t stage_offset, std::string* error,
+                      size_t* written = nullptr);
+}  // namespace detail
 
 // A file for scratch data in `dir` that has no name from the start (O_TMPFILE; where the file
 // system lacks it, created exclusively under a random name and unlinked at once): nothing is left

@@ -17,7 +17,6 @@
 #include <draco/compression/expert_encode.h>
 #include <draco/mesh/mesh.h>
 #include <meshoptimizer.h>
-#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -25,6 +24,7 @@
 
 #include "exporters/atomic_file.h"
 #include "exporters/frame_spill.h"
+#include "exporters/gltf_json.h"
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
 #include "mesh4d/doppler_colour.h"
@@ -454,13 +454,14 @@ struct BinSink {
 
 class GlbBuilder {
 public:
-    tinygltf::Model model;
+    // The JSON records (gltf_json.h), written by SequenceModel::finish.
+    std::vector<gltfjson::Accessor> accessors;
+    std::vector<gltfjson::BufferView> views;
+    std::vector<gltfjson::Mesh> meshes;
+    std::vector<gltfjson::Node> nodes;
+    size_t fallback_size = 0;  // meshopt: the fallback buffer's byteLength (0: no meshopt view)
 
-    GlbBuilder(const GlbOptions& options, BinSink* sink) : options_(options), sink_(sink) {
-        model.asset.version = "2.0";
-        model.asset.generator = "apparent";
-        model.buffers.emplace_back();  // buffer 0 without uri: the GLB BIN chunk (data in the sink)
-    }
+    GlbBuilder(const GlbOptions& options, BinSink* sink) : options_(options), sink_(sink) {}
 
     size_t sinkSize() const { return sink_->size; }
 
@@ -477,54 +478,57 @@ public:
         return d.remote.on ? addView(span, target) : addView(local.data(), local.size() * sizeof(local[0]), target);
     }
 
-    int addAccessor(int view, int component, int type, size_t count, std::vector<double> min_v = {},
-                    std::vector<double> max_v = {}) {
-        tinygltf::Accessor a;
-        a.bufferView = view;
-        a.componentType = component;
-        a.type = type;
+    // A new accessor (`vec3`: VEC3, else SCALAR) at `offset` bytes of `view`; with `lo` and `hi`
+    // its min and max (`n` values each).
+    int addAccessor(int view, int component, bool vec3, size_t count, size_t offset = 0, const double* lo = nullptr,
+                    const double* hi = nullptr, int n = 0) {
+        gltfjson::Accessor& a = accessors.emplace_back();
+        a.view = view;
+        a.component = component;
+        a.vec3 = vec3;
         a.count = count;
-        a.minValues = std::move(min_v);
-        a.maxValues = std::move(max_v);
-        model.accessors.push_back(a);
-        return int(model.accessors.size()) - 1;
+        a.offset = offset;
+        if (lo) {
+            a.bounds = uint8_t(n);
+            std::copy(lo, lo + n, a.min);
+            std::copy(hi, hi + n, a.max);
+        }
+        return int(accessors.size()) - 1;
+    }
+    int addNormalized(int view, int component, bool vec3, size_t count, size_t offset) {
+        const int a = addAccessor(view, component, vec3, count, offset);
+        accessors.back().normalized = true;
+        return a;
     }
 
     // A plain (uncompressed) primitive; `shared_indices` >= 0: that index accessor instead of a new one.
-    tinygltf::Primitive plainPrimitive(const PrimitiveData& d, int shared_indices) {
-        tinygltf::Primitive prim;
-        std::vector<double> lo, hi;
+    gltfjson::Primitive plainPrimitive(const PrimitiveData& d, int shared_indices) {
+        gltfjson::Primitive prim;
+        double lo[3], hi[3];
         if (d.remote.on) {
-            lo.assign(d.remote.lo, d.remote.lo + 3);
-            hi.assign(d.remote.hi, d.remote.hi + 3);
+            std::copy(d.remote.lo, d.remote.lo + 3, lo);
+            std::copy(d.remote.hi, d.remote.hi + 3, hi);
         } else if (d.bounded) {
-            lo.assign(d.lo, d.lo + 3);
-            hi.assign(d.hi, d.hi + 3);
+            std::copy(d.lo, d.lo + 3, lo);
+            std::copy(d.hi, d.hi + 3, hi);
         } else {
-            bounds(d.positions, &lo, &hi);
+            bounds(d.positions, lo, hi);
         }
         const PrimitiveData::Remote& r = d.remote;
-        prim.attributes["POSITION"] = addAccessor(addView(d, d.positions, r.positions, kArray),
-                                                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount(), lo, hi);
-        prim.attributes["NORMAL"] = addAccessor(addView(d, d.normals, r.normals, kArray),
-                                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount());
-        prim.attributes["_EMISSION_TIME"] = addAccessor(addView(d, d.emission, r.emission, kArray),
-                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
-                                                        d.vertexCount());
+        const size_t nv = d.vertexCount();
+        auto& at = prim.attributes;
+        at[gltfjson::kPosition] = addAccessor(addView(d, d.positions, r.positions, kArray), kFloat, true, nv, 0, lo, hi, 3);
+        at[gltfjson::kNormal] = addAccessor(addView(d, d.normals, r.normals, kArray), kFloat, true, nv);
+        at[gltfjson::kEmissionTime] = addAccessor(addView(d, d.emission, r.emission, kArray), kFloat, false, nv);
         if (d.has(d.doppler, r.doppler))
-            prim.attributes["_DOPPLER"] = addAccessor(addView(d, d.doppler, r.doppler, kArray),
-                                                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
+            at[gltfjson::kDoppler] = addAccessor(addView(d, d.doppler, r.doppler, kArray), kFloat, false, nv);
         if (d.has(d.proper_time, r.proper_time))
-            prim.attributes["_PROPER_TIME"] = addAccessor(addView(d, d.proper_time, r.proper_time, kArray),
-                                                          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, d.vertexCount());
+            at[gltfjson::kProperTime] = addAccessor(addView(d, d.proper_time, r.proper_time, kArray), kFloat, false, nv);
         if (d.has(d.colors, r.colors))
-            prim.attributes["COLOR_0"] = addAccessor(addView(d, d.colors, r.colors, kArray),
-                                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, d.vertexCount());
-        prim.indices = shared_indices >= 0
-                           ? shared_indices
-                           : addAccessor(addView(d, d.indices, r.indices, kElements),
-                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, d.indexCount());
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
+            at[gltfjson::kColor0] = addAccessor(addView(d, d.colors, r.colors, kArray), kFloat, true, nv);
+        prim.indices = shared_indices >= 0 ? shared_indices
+                                           : addAccessor(addView(d, d.indices, r.indices, kElements),
+                                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false, d.indexCount());
         return prim;
     }
 
@@ -532,44 +536,32 @@ public:
     // view `vview` (records of `layout`, `stride` bytes each) and normal view `nview` (-1: the
     // normals end each record), its indices the accessor `indices` (made by the caller: new or
     // shared).
-    tinygltf::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, size_t stride, int vview,
+    gltfjson::Primitive meshoptPrimitive(const PrimitiveData& d, const MeshoptLayout& layout, size_t stride, int vview,
                                          int nview, size_t first_vertex, int indices) {
-        tinygltf::Primitive prim;
+        gltfjson::Primitive prim;
         const size_t nv = d.packedVertices(layout.stride);
-        auto attribute = [&](int view, size_t view_stride, size_t offset, int component, int type, bool normalized,
-                             std::vector<double> lo, std::vector<double> hi) {
-            const int a = addAccessor(view, component, type, nv, std::move(lo), std::move(hi));
-            model.accessors[a].byteOffset = first_vertex * view_stride + offset;
-            model.accessors[a].normalized = normalized;
-            return a;
-        };
-        prim.attributes["POSITION"] =
-            attribute(vview, stride, 0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
-                      {double(d.qmin[0]), double(d.qmin[1]), double(d.qmin[2])},
-                      {double(d.qmax[0]), double(d.qmax[1]), double(d.qmax[2])});
-        prim.attributes["NORMAL"] = nview >= 0 ? attribute(nview, kMeshoptNormalStride, 0, TINYGLTF_COMPONENT_TYPE_BYTE,
-                                                           TINYGLTF_TYPE_VEC3, true, {}, {})
-                                               : attribute(vview, stride, layout.stride, TINYGLTF_COMPONENT_TYPE_BYTE,
-                                                           TINYGLTF_TYPE_VEC3, true, {}, {});
-        prim.attributes["_EMISSION_TIME"] =
-            attribute(vview, stride, 8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+        const size_t at0 = first_vertex * stride;
+        auto& at = prim.attributes;
+        const double lo[3] = {double(d.qmin[0]), double(d.qmin[1]), double(d.qmin[2])};
+        const double hi[3] = {double(d.qmax[0]), double(d.qmax[1]), double(d.qmax[2])};
+        at[gltfjson::kPosition] = addAccessor(vview, TINYGLTF_COMPONENT_TYPE_SHORT, true, nv, at0, lo, hi, 3);
+        at[gltfjson::kNormal] =
+            nview >= 0 ? addNormalized(nview, TINYGLTF_COMPONENT_TYPE_BYTE, true, nv, first_vertex * kMeshoptNormalStride)
+                       : addNormalized(vview, TINYGLTF_COMPONENT_TYPE_BYTE, true, nv, at0 + layout.stride);
+        at[gltfjson::kEmissionTime] = addAccessor(vview, kFloat, false, nv, at0 + 8);
         if (layout.doppler >= 0 && d.has(d.doppler, d.remote.doppler))
-            prim.attributes["_DOPPLER"] = attribute(vview, stride, size_t(layout.doppler), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                                    TINYGLTF_TYPE_SCALAR, false, {}, {});
+            at[gltfjson::kDoppler] = addAccessor(vview, kFloat, false, nv, at0 + size_t(layout.doppler));
         if (layout.proper_time >= 0 && d.has(d.proper_time, d.remote.proper_time))
-            prim.attributes["_PROPER_TIME"] = attribute(vview, stride, size_t(layout.proper_time),
-                                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
+            at[gltfjson::kProperTime] = addAccessor(vview, kFloat, false, nv, at0 + size_t(layout.proper_time));
         if (layout.color >= 0 && d.has(d.colors, d.remote.colors))
-            prim.attributes["COLOR_0"] = attribute(vview, stride, size_t(layout.color), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                                                   TINYGLTF_TYPE_VEC3, true, {}, {});
+            at[gltfjson::kColor0] =
+                addNormalized(vview, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true, nv, at0 + size_t(layout.color));
         prim.indices = indices;
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
         return prim;
     }
 
     // A view of the fallback buffer (1, no data) whose EXT_meshopt_compression object points at
-    // `encoded` in the BIN chunk; the extension objects are added to the JSON by meshoptJson().
-    // `octahedral`: the view's data went through the OCTAHEDRAL filter.
+    // `encoded` in the BIN chunk. `octahedral`: the view's data went through the OCTAHEDRAL filter.
     int addMeshoptView(const std::vector<unsigned char>& encoded, size_t count, size_t stride, bool indices,
                        bool octahedral = false) {
         return newMeshoptView(encoded.size(), count, stride, indices, octahedral,
@@ -583,38 +575,23 @@ public:
     template <class Write>
     int newMeshoptView(size_t length, size_t count, size_t stride, bool indices, bool octahedral, const Write& write) {
         if (sink_->size % 4) sink_->pad(4 - sink_->size % 4);
-        MeshoptView mv{sink_->size, length, stride, count, indices, octahedral};
+        gltfjson::BufferView& v = views.emplace_back();
+        v.meshopt = true;
+        v.ext = {sink_->size, length, stride, count, indices, octahedral};
         write();
-        tinygltf::BufferView v;
         v.buffer = 1;
-        v.byteOffset = fallback_size;
-        v.byteLength = count * stride;
-        v.byteStride = indices ? 0 : stride;
+        v.offset = fallback_size;
+        v.length = count * stride;
+        v.stride = indices ? 0 : stride;
         v.target = indices ? kElements : kArray;
-        fallback_size += (v.byteLength + 3) / 4 * 4;
-        model.bufferViews.push_back(v);
-        meshopt_views.emplace_back(int(model.bufferViews.size()) - 1, mv);
-        return int(model.bufferViews.size()) - 1;
-    }
-
-    // Adds the meshopt views' extension objects and the fallback buffer to the JSON `j`.
-    void meshoptJson(nlohmann::json* j) const {
-        if (meshopt_views.empty()) return;
-        for (const auto& [view, mv] : meshopt_views) {
-            nlohmann::json ext = {{"buffer", 0},           {"byteOffset", mv.offset}, {"byteLength", mv.length},
-                                  {"byteStride", mv.stride}, {"count", mv.count},
-                                  {"mode", mv.indices ? "TRIANGLES" : "ATTRIBUTES"}};
-            if (mv.octahedral) ext["filter"] = "OCTAHEDRAL";
-            (*j)["bufferViews"][size_t(view)]["extensions"]["EXT_meshopt_compression"] = ext;
-        }
-        (*j)["buffers"][1] = {{"byteLength", fallback_size},
-                              {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}};
+        fallback_size += (v.length + 3) / 4 * 4;
+        return int(views.size()) - 1;
     }
 
     // A KHR_draco_mesh_compression primitive from its coding (DracoCoded, made by prepare());
     // returns false with the message when Draco failed there. `quantization_error` receives the
     // position error bound.
-    bool dracoPrimitive(const PrimitiveData& d, tinygltf::Primitive* prim, double* quantization_error,
+    bool dracoPrimitive(const PrimitiveData& d, gltfjson::Primitive* prim, double* quantization_error,
                         std::string* error) {
         const DracoCoded& c = d.draco;
         if (!c.error.empty()) {
@@ -623,25 +600,19 @@ public:
         }
         *quantization_error = c.quantization_error;
         const size_t n_points = size_t(c.points);
-        prim->attributes["POSITION"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points,
-                                                   {c.lo[0], c.lo[1], c.lo[2]}, {c.hi[0], c.hi[1], c.hi[2]});
-        prim->attributes["NORMAL"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
-        prim->attributes["_EMISSION_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
-        if (c.ids[3] >= 0) prim->attributes["_DOPPLER"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
-        if (c.ids[4] >= 0)
-            prim->attributes["_PROPER_TIME"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, n_points);
-        if (c.ids[5] >= 0) prim->attributes["COLOR_0"] = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n_points);
-        prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, size_t(c.faces) * 3);
-        prim->mode = TINYGLTF_MODE_TRIANGLES;
-        const int view = d.remote.on ? addView(d.remote.draco, 0) : addView(c.bytes.data(), c.bytes.size(), 0);
-        tinygltf::Value::Object attrs{{"POSITION", tinygltf::Value(c.ids[0])},
-                                      {"NORMAL", tinygltf::Value(c.ids[1])},
-                                      {"_EMISSION_TIME", tinygltf::Value(c.ids[2])}};
-        if (c.ids[3] >= 0) attrs["_DOPPLER"] = tinygltf::Value(c.ids[3]);
-        if (c.ids[4] >= 0) attrs["_PROPER_TIME"] = tinygltf::Value(c.ids[4]);
-        if (c.ids[5] >= 0) attrs["COLOR_0"] = tinygltf::Value(c.ids[5]);
-        prim->extensions["KHR_draco_mesh_compression"] = tinygltf::Value(
-            tinygltf::Value::Object{{"bufferView", tinygltf::Value(view)}, {"attributes", tinygltf::Value(attrs)}});
+        auto& at = prim->attributes;
+        at[gltfjson::kPosition] = addAccessor(-1, kFloat, true, n_points, 0, c.lo, c.hi, 3);
+        at[gltfjson::kNormal] = addAccessor(-1, kFloat, true, n_points);
+        at[gltfjson::kEmissionTime] = addAccessor(-1, kFloat, false, n_points);
+        if (c.ids[3] >= 0) at[gltfjson::kDoppler] = addAccessor(-1, kFloat, false, n_points);
+        if (c.ids[4] >= 0) at[gltfjson::kProperTime] = addAccessor(-1, kFloat, false, n_points);
+        if (c.ids[5] >= 0) at[gltfjson::kColor0] = addAccessor(-1, kFloat, true, n_points);
+        prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false, size_t(c.faces) * 3);
+        prim->draco_view = d.remote.on ? addView(d.remote.draco, 0) : addView(c.bytes.data(), c.bytes.size(), 0);
+        // The Draco ids in DracoCoded's order: POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME, COLOR_0.
+        static constexpr int kOrder[6] = {gltfjson::kPosition, gltfjson::kNormal,     gltfjson::kEmissionTime,
+                                          gltfjson::kDoppler,  gltfjson::kProperTime, gltfjson::kColor0};
+        for (int i = 0; i < 6; ++i) prim->draco_ids[size_t(kOrder[i])] = c.ids[i];
         return true;
     }
 
@@ -650,37 +621,31 @@ private:
     template <class Write>
     int newView(size_t n, int target, const Write& write) {
         if (sink_->size % 4) sink_->pad(4 - sink_->size % 4);
-        tinygltf::BufferView v;
+        gltfjson::BufferView& v = views.emplace_back();
         v.buffer = 0;
-        v.byteOffset = sink_->size;
-        v.byteLength = n;
+        v.offset = sink_->size;
+        v.length = n;
         v.target = target;
         write();
-        model.bufferViews.push_back(v);
-        return int(model.bufferViews.size()) - 1;
+        return int(views.size()) - 1;
     }
 
     static constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
     static constexpr int kElements = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
+    static constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
     GlbOptions options_;
     BinSink* sink_;
-    struct MeshoptView {
-        size_t offset, length, stride, count;
-        bool indices, octahedral;
-    };
-    std::vector<std::pair<int, MeshoptView>> meshopt_views;
-    size_t fallback_size = 0;
 
     // Per coordinate, in vertex order (the same bits as any order but for the sign of a zero).
-    static void bounds(const std::vector<float>& xyz, std::vector<double>* lo, std::vector<double>* hi) {
+    static void bounds(const std::vector<float>& xyz, double* lo, double* hi) {
         double l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t i = 0; i + 3 <= xyz.size(); i += 3)
             for (int c = 0; c < 3; ++c) {
                 l[c] = std::min(l[c], double(xyz[i + size_t(c)]));
                 h[c] = std::max(h[c], double(xyz[i + size_t(c)]));
             }
-        lo->assign(l, l + 3);
-        hi->assign(h, h + 3);
+        std::copy(l, l + 3, lo);
+        std::copy(h, h + 3, hi);
     }
 };
 
@@ -822,8 +787,6 @@ std::vector<double> cameraRotation(const ExportCamera& cam) {
     return {x / len, y / len, z / len, w / len};
 }
 
-tinygltf::Value number(double v) { return tinygltf::Value(v); }
-
 // A frame's meshopt index stream: the objects' vertex-cache-ordered lists, one after another.
 void encodeIndexStream(const std::vector<unsigned int>& all, size_t most_vertices, std::vector<unsigned char>* out) {
     out->resize(meshopt_encodeIndexBufferBound(all.size(), most_vertices));
@@ -952,52 +915,21 @@ std::vector<unsigned char> encodeMorphRecords(const std::vector<unsigned char>& 
 // counts, for the size without Draco.
 struct SequenceModel {
     SequenceModel(const SequenceInfo& info_, const GlbOptions& options, BinSink* sink)
-        : info(info_), b(options, sink), layout(options) {
-        tinygltf::Model& model = b.model;
-    // Step: one material per object.
-    for (const ExportObject& o : info.objects) {
-        tinygltf::Material mat;
-        mat.name = o.name;
-        mat.pbrMetallicRoughness.baseColorFactor = {o.base_color[0], o.base_color[1], o.base_color[2], o.base_color[3]};
-        if (options.shade_doppler) {
-            // COLOR_0 holds the whole shaded colour (glTF multiplies it with the factor): white
-            // here, the plain colour kept in extras for viewers that switch between the two.
-            mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, o.base_color[3]};
-            mat.extras = tinygltf::Value(tinygltf::Value::Object{
-                {"base_color", tinygltf::Value(tinygltf::Value::Array{
-                                   tinygltf::Value(o.base_color[0]), tinygltf::Value(o.base_color[1]),
-                                   tinygltf::Value(o.base_color[2]), tinygltf::Value(o.base_color[3])})}});
-        }
-        mat.pbrMetallicRoughness.metallicFactor = 0.0;
-        mat.pbrMetallicRoughness.roughnessFactor = 0.8;
-        mat.doubleSided = true;  // thin shells such as the flanges are seen from both sides
-        if (o.base_color[3] < 1) mat.alphaMode = "BLEND";  // e.g. a mirror, to show the reflections behind it
-        model.materials.push_back(mat);
-    }
-
+        : info(info_), b(options, sink), layout(options), shade_doppler(options.shade_doppler) {
         // Step: the camera node (node 0); its clip planes are set in finish().
-        scene.name = info.model;
-        tinygltf::Camera cam;
-        cam.type = "perspective";
-        cam.perspective.yfov = info.camera.fov_deg * mesh4d::kPi / 180.0;
-        model.cameras.push_back(cam);
-        tinygltf::Node node;
+        gltfjson::Node& node = b.nodes.emplace_back();
         node.name = "camera";
         node.camera = 0;
-        node.translation = {info.camera.position.x, info.camera.position.y, info.camera.position.z};
-        node.rotation = cameraRotation(info.camera);
-        model.nodes.push_back(node);
-        scene.nodes.push_back(0);
-        if (options.draco) {
-            model.extensionsUsed.push_back("KHR_draco_mesh_compression");
-            model.extensionsRequired.push_back("KHR_draco_mesh_compression");
-        }
-        if (options.meshopt) {
-            for (const char* e : {"EXT_meshopt_compression", "KHR_mesh_quantization"}) {
-                model.extensionsUsed.push_back(e);
-                model.extensionsRequired.push_back(e);
-            }
-        }
+        node.has_translation = node.has_rotation = true;
+        node.translation[0] = info.camera.position.x;
+        node.translation[1] = info.camera.position.y;
+        node.translation[2] = info.camera.position.z;
+        const std::vector<double> q = cameraRotation(info.camera);
+        std::copy(q.begin(), q.end(), node.rotation);
+        scene_nodes.push_back(0);
+        if (options.draco) extensions.push_back("KHR_draco_mesh_compression");
+        if (options.meshopt)
+            for (const char* e : {"EXT_meshopt_compression", "KHR_mesh_quantization"}) extensions.push_back(e);
         compression = options.draco ? Compression::draco : options.meshopt ? Compression::meshopt : Compression::none;
         previous.resize(info.objects.size());
     }
@@ -1010,7 +942,7 @@ struct SequenceModel {
     // `meshopt`: the frame's encoded vertex stream (with meshopt compression).
     bool addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3], double scale,
                   const MeshoptFrame* meshopt, GlbStats* stats, std::string* error) {
-        tinygltf::Node node;
+        gltfjson::Node node;
         if (previous.size() < f.objects.size()) previous.resize(f.objects.size());
         node.name = frameName(f.index);
         // Step: the objects' groups in order: -1 (the frame node) first, then mirrors as they appear.
@@ -1034,7 +966,7 @@ struct SequenceModel {
         if (compression == Compression::meshopt && meshopt) {
             std::string target_error;
             if (morphTarget(f, data, scale, *meshopt, shared, groups, &target_error)) {
-                morph_nodes.push_back({b.model.nodes.size(), run.targets, runs.size() - 1});
+                morph_nodes.push_back({b.nodes.size(), run.targets, runs.size() - 1});
                 node.mesh = run.mesh;
                 return endFrame(f, &node, origin, scale);
             }
@@ -1086,22 +1018,20 @@ struct SequenceModel {
                 }
                 for (size_t o = 0; o < f.objects.size(); ++o)
                     if (!f.objects[o].triangles.empty() && shared[o] < 0) {
-                        const int a = b.addAccessor(iview,
-                                                    size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
-                                                              : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                                    TINYGLTF_TYPE_SCALAR, data[o].orderedCount());
-                        b.model.accessors[a].byteOffset = first[o] * size;
-                        meshopt_indices[o] = a;
+                        meshopt_indices[o] = b.addAccessor(iview,
+                                                           size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
+                                                                     : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                                           false, data[o].orderedCount(), first[o] * size);
                     }
             }
         }
         std::vector<bool> shown(f.objects.size(), false);
         for (const int group : groups) {
-            tinygltf::Mesh mesh;
+            gltfjson::Mesh mesh;
             mesh.name = group < 0 ? node.name : reflectionName(node.name, mirrorName(group));
             for (size_t o = 0; o < f.objects.size(); ++o) {
                 if (f.objects[o].triangles.empty() || groupOf(o) != group) continue;
-                tinygltf::Primitive prim;
+                gltfjson::Primitive prim;
                 Previous& prev = previous[o];
                 if (compression == Compression::draco) {
                     double qerr = 0;
@@ -1119,13 +1049,13 @@ struct SequenceModel {
                 if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o], borrow_indices);
                 shown[o] = true;
                 prim.material = o < info.objects.size() ? int(o) : -1;
-                mesh.primitives.push_back(prim);
+                mesh.primitives.push_back(std::move(prim));
             }
-            b.model.meshes.push_back(mesh);
+            b.meshes.push_back(std::move(mesh));
             if (group < 0)
-                node.mesh = int(b.model.meshes.size()) - 1;
+                node.mesh = int(b.meshes.size()) - 1;
             else
-                reflections.push_back({frames, mirrorName(group), int(b.model.meshes.size()) - 1});
+                reflections.push_back({frames, mirrorName(group), int(b.meshes.size()) - 1});
         }
         // Sharing is between consecutive frames: an object not shown forgets its index list.
         for (size_t o = 0; o < f.objects.size(); ++o)
@@ -1138,15 +1068,19 @@ struct SequenceModel {
     }
 
     // The frame node's transform, its scale channel's value and the frame's extras (any frame).
-    bool endFrame(const ExportFrame& f, tinygltf::Node* node, const double* origin, double scale) {
+    bool endFrame(const ExportFrame& f, gltfjson::Node* node, const double* origin, double scale) {
         // Reflections are relative to the same origin: their child nodes need no transform.
-        if (origin) node->translation = {origin[0], origin[1], origin[2]};
+        if (origin) {
+            node->has_translation = true;
+            std::copy(origin, origin + 3, node->translation);
+        }
         const double s = frames == 0 ? scale : 0.0;
-        node->scale = {s, s, s};
+        node->has_scale = true;
+        node->scale[0] = node->scale[1] = node->scale[2] = s;
         frame_scales.push_back(float(scale));
-        b.model.nodes.push_back(*node);
-        scene.nodes.push_back(int(b.model.nodes.size()) - 1);
-        frame_times.push_back(tinygltf::Value(f.t_c));
+        b.nodes.push_back(std::move(*node));
+        scene_nodes.push_back(int(b.nodes.size()) - 1);
+        frame_times.push_back(f.t_c);
         if (frames == 0) first_frame = f.index;
         ++frames;
         return true;
@@ -1227,24 +1161,18 @@ struct SequenceModel {
             view = b.addMeshoptView(encodeMorphRecords(rec, run.count), run.count, kMorphStride, false);
         }
         // Per primitive the target's three accessors.
-        tinygltf::Mesh& mesh = b.model.meshes[size_t(run.mesh)];
+        gltfjson::Mesh& mesh = b.meshes[size_t(run.mesh)];
+        const double lo_d[3] = {double(lo[0]), double(lo[1]), double(lo[2])};
+        const double hi_d[3] = {double(hi[0]), double(hi[1]), double(hi[2])};
         for (size_t j = 0; j < objects.size(); ++j) {
             const size_t nv = data[objects[j]].packedVertices(12);
-            auto attribute = [&](size_t offset, int component, int type, bool normalized, std::vector<double> min_v,
-                                 std::vector<double> max_v) {
-                const int a = b.addAccessor(view, component, type, nv, std::move(min_v), std::move(max_v));
-                b.model.accessors[size_t(a)].byteOffset = first[j] * kMorphStride + offset;
-                b.model.accessors[size_t(a)].normalized = normalized;
-                return a;
-            };
+            const size_t at = first[j] * kMorphStride;
             // POSITION's bounds (required) are the whole frame's: a bound of every primitive's.
-            std::map<std::string, int> target;
-            target["POSITION"] = attribute(0, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, false,
-                                           {double(lo[0]), double(lo[1]), double(lo[2])},
-                                           {double(hi[0]), double(hi[1]), double(hi[2])});
-            target["_EMISSION_TIME"] = attribute(8, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, false, {}, {});
-            target["NORMAL"] = attribute(12, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_TYPE_VEC3, true, {}, {});
-            mesh.primitives[j].targets.push_back(target);
+            std::array<int, gltfjson::kAttributes>& target = mesh.primitives[j].targets.emplace_back();
+            target.fill(-1);
+            target[gltfjson::kPosition] = b.addAccessor(view, TINYGLTF_COMPONENT_TYPE_SHORT, true, nv, at, lo_d, hi_d, 3);
+            target[gltfjson::kEmissionTime] = b.addAccessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, false, nv, at + 8);
+            target[gltfjson::kNormal] = b.addNormalized(view, TINYGLTF_COMPONENT_TYPE_BYTE, true, nv, at + 12);
         }
         // The frame is now the run's reference for the next one.
         size_t v = 0;
@@ -1275,12 +1203,9 @@ struct SequenceModel {
     // Step: what needs the whole sequence: the camera's clip planes, the animation (at most 3 keys
     // per channel), the scene extras. Returns the JSON chunk's text.
     std::string finish(double far) {
-        tinygltf::Model& model = b.model;
         // Clip planes in light-seconds: 1e-3 of, and 10 times, the farthest apparent point's
-        // distance (tinygltf always writes zfar, and the validator requires zfar > znear).
+        // distance (the validator requires zfar > znear).
         far = far > 0 ? far : 1.0;
-        model.cameras[0].perspective.znear = 1e-3 * far;
-        model.cameras[0].perspective.zfar = 10 * far;
 
         // STEP scale channels, at most 3 keys each so the file grows linearly with the frame
         // count: scale 0 until k/fps, 1 during frame k, 0 from (k+1)/fps on. The last frame keeps
@@ -1289,14 +1214,13 @@ struct SequenceModel {
         // All key times in one view, the distinct scale sequences (a handful: frame scales repeat)
         // in another, each channel's accessors pointing into them.
         const size_t n = frames;
-        tinygltf::Animation anim;
-        anim.name = "frames";
         std::vector<float> all_times, all_scales;
         std::vector<std::pair<size_t, size_t>> time_keys(n);  // offset (floats) and count per frame
         std::vector<size_t> scale_key(n);                   // offset (floats) of the frame's scales
         std::map<std::vector<float>, size_t> distinct;
+        std::vector<float> scales;
         for (size_t k = 0; k < n; ++k) {
-            std::vector<float> scales;
+            scales.clear();
             time_keys[k] = {all_times.size(), 0};
             auto key = [&](size_t i, float v) {
                 all_times.push_back(float(double(i) / info.fps));
@@ -1317,82 +1241,247 @@ struct SequenceModel {
         const int times_view = b.addView(all_times.data(), all_times.size() * 4, 0);
         const int scales_view = b.addView(all_scales.data(), all_scales.size() * 4, 0);
         std::map<size_t, int> scale_accessors;  // by offset
+        std::vector<std::pair<int, int>> samplers(n);  // per frame, its input and output accessors
         for (size_t k = 0; k < n; ++k) {
             const auto [offset, count] = time_keys[k];
-            const int in_acc = b.addAccessor(times_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, count,
-                                             {double(all_times[offset])}, {double(all_times[offset + count - 1])});
-            b.model.accessors[in_acc].byteOffset = 4 * offset;
+            const double lo = all_times[offset], hi = all_times[offset + count - 1];
+            samplers[k].first =
+                b.addAccessor(times_view, TINYGLTF_COMPONENT_TYPE_FLOAT, false, count, 4 * offset, &lo, &hi, 1);
             auto sa = scale_accessors.find(scale_key[k]);
-            if (sa == scale_accessors.end()) {
-                const int a = b.addAccessor(scales_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, count);
-                b.model.accessors[a].byteOffset = 4 * scale_key[k];
-                sa = scale_accessors.emplace(scale_key[k], a).first;
-            }
-            const int out_acc = sa->second;
-            tinygltf::AnimationSampler sampler;
-            sampler.input = in_acc;
-            sampler.output = out_acc;
-            sampler.interpolation = "STEP";
-            anim.samplers.push_back(sampler);
-            tinygltf::AnimationChannel c;
-            c.sampler = int(k);
-            c.target_node = int(1 + k);
-            c.target_path = "scale";
-            anim.channels.push_back(c);
+            if (sa == scale_accessors.end())
+                sa = scale_accessors
+                         .emplace(scale_key[k], b.addAccessor(scales_view, TINYGLTF_COMPONENT_TYPE_FLOAT, true, count,
+                                                              4 * scale_key[k]))
+                         .first;
+            samplers[k].second = sa->second;
         }
-        model.animations.push_back(anim);
 
         // Step: the reflections' nodes, children of their frame nodes (so shown and hidden with them).
         for (const Reflection& r : reflections) {
-            tinygltf::Node child;
-            child.name = reflectionName(model.nodes[1 + r.frame].name, r.mirror);
+            gltfjson::Node child;
+            child.name = reflectionName(b.nodes[1 + r.frame].name, r.mirror);
             child.mesh = r.mesh;
-            child.extras = tinygltf::Value(tinygltf::Value::Object{{"mirror", tinygltf::Value(r.mirror)}});
-            model.nodes.push_back(child);
-            model.nodes[1 + r.frame].children.push_back(int(model.nodes.size()) - 1);
+            child.has_mirror = true;
+            child.mirror = r.mirror;
+            b.nodes.push_back(std::move(child));
+            b.nodes[1 + r.frame].children.push_back(int(b.nodes.size()) - 1);
         }
-
-        // Scene extras: what was computed, in which units, at which camera times.
-        tinygltf::Value::Array object_names;
-        for (const auto& o : info.objects) object_names.push_back(tinygltf::Value(o.name));
-        tinygltf::Value::Object extras{{"model", tinygltf::Value(info.model)},
-                                       {"tolerance", number(info.tolerance)},
-                                       {"units", tinygltf::Value(std::string("light-seconds, seconds, c = 1"))},
-                                       {"fps", number(info.fps)},
-                                       {"first_frame", tinygltf::Value(int(first_frame))},
-                                       {"frame_times", tinygltf::Value(frame_times)},
-                                       {"objects", tinygltf::Value(object_names)},
-                                       {"scene_file", tinygltf::Value(info.scene_path)}};
-        scene.extras = tinygltf::Value(extras);
-        model.scenes.push_back(scene);
-        model.defaultScene = 0;
-
-        // The JSON by tinygltf (a GLB with an empty BIN chunk), with buffer 0's byteLength set to
-        // the streamed size: the only field tinygltf cannot know.
-        tinygltf::TinyGLTF writer;
-        std::ostringstream glb;
-        writer.WriteGltfSceneToStream(&model, glb, /*prettyPrint=*/false, /*writeBinary=*/true);
-        const std::string bytes = glb.str();
-        uint32_t json_len = 0;
-        std::memcpy(&json_len, bytes.data() + 12, 4);
-        nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_len));
-        j["buffers"][0]["byteLength"] = b.sinkSize();
-        b.meshoptJson(&j);
         // The target frames' weights: the first `place` of the run's targets at 1 (cumulative
         // differences), written as integers.
         for (const MorphNode& m : morph_nodes) {
-            nlohmann::json w = nlohmann::json::array();
-            for (size_t t = 0; t < runs[m.run]; ++t) w.push_back(t < m.place ? 1 : 0);
-            j["nodes"][m.node]["weights"] = w;
+            std::vector<int>& w = b.nodes[m.node].weights;
+            w.assign(runs[m.run], 0);
+            std::fill(w.begin(), w.begin() + std::ptrdiff_t(m.place), 1);
         }
-        return j.dump();
+
+        // The JSON, its keys in byte order at every level (gltf_json.h).
+        gltfjson::Text t;
+        t.out.reserve(256 * (b.accessors.size() + b.views.size() + b.nodes.size()) + 1024);
+        auto array = [&t](const char* key, const auto& records) {
+            if (records.empty()) return;
+            t.key(key);
+            t.open('[');
+            for (const auto& r : records) gltfjson::write(&t, r);
+            t.close(']');
+        };
+        auto strings = [&t](const char* key, const std::vector<std::string>& list) {
+            if (list.empty()) return;
+            t.key(key);
+            t.open('[');
+            for (const std::string& s : list) t.value(s);
+            t.close(']');
+        };
+        auto numbers = [&t](const char* key, const double* v, size_t count) {
+            t.key(key);
+            t.open('[');
+            for (size_t i = 0; i < count; ++i) t.value(v[i]);
+            t.close(']');
+        };
+        t.open('{');
+        array("accessors", b.accessors);
+        // One animation "frames" of STEP scale channels.
+        t.key("animations");
+        t.open('[');
+        t.open('{');
+        t.key("channels");
+        t.open('[');
+        for (size_t k = 0; k < n; ++k) {
+            t.open('{');
+            t.key("sampler");
+            t.value(uint64_t(k));
+            t.key("target");
+            t.open('{');
+            t.key("node");
+            t.value(uint64_t(1 + k));
+            t.key("path");
+            t.value("scale");
+            t.close('}');
+            t.close('}');
+        }
+        t.close(']');
+        t.key("name");
+        t.value("frames");
+        t.key("samplers");
+        t.open('[');
+        for (const auto& [input, output] : samplers) {
+            t.open('{');
+            t.key("input");
+            t.value(input);
+            t.key("interpolation");
+            t.value("STEP");
+            t.key("output");
+            t.value(output);
+            t.close('}');
+        }
+        t.close(']');
+        t.close('}');
+        t.close(']');
+        t.key("asset");
+        t.open('{');
+        t.key("generator");
+        t.value("apparent");
+        t.key("version");
+        t.value("2.0");
+        t.close('}');
+        array("bufferViews", b.views);
+        // Buffer 0: the GLB BIN chunk (its size: what the sink received); with meshopt buffer 1,
+        // the fallback buffer without data.
+        t.key("buffers");
+        t.open('[');
+        t.open('{');
+        t.key("byteLength");
+        t.value(uint64_t(b.sinkSize()));
+        t.close('}');
+        if (std::any_of(b.views.begin(), b.views.end(), [](const gltfjson::BufferView& v) { return v.meshopt; })) {
+            t.open('{');
+            t.key("byteLength");
+            t.value(uint64_t(b.fallback_size));
+            t.key("extensions");
+            t.open('{');
+            t.key("EXT_meshopt_compression");
+            t.open('{');
+            t.key("fallback");
+            t.value(true);
+            t.close('}');
+            t.close('}');
+            t.close('}');
+        }
+        t.close(']');
+        t.key("cameras");
+        t.open('[');
+        t.open('{');
+        t.key("perspective");
+        t.open('{');
+        const double yfov = info.camera.fov_deg * mesh4d::kPi / 180.0;
+        if (yfov > 0) {
+            t.key("yfov");
+            t.value(yfov);
+        }
+        t.key("zfar");
+        t.value(10 * far);
+        t.key("znear");
+        t.value(1e-3 * far);
+        t.close('}');
+        t.key("type");
+        t.value("perspective");
+        t.close('}');
+        t.close(']');
+        strings("extensionsRequired", extensions);
+        strings("extensionsUsed", extensions);
+        // One material per object: a thin shell seen from both sides (the flanges), blended
+        // when not opaque (e.g. a mirror, to show the reflections behind it). With --shade
+        // doppler COLOR_0 holds the whole shaded colour (glTF multiplies it with the factor): a
+        // white factor, the plain colour kept in extras for viewers that switch between the two.
+        if (!info.objects.empty()) {
+            t.key("materials");
+            t.open('[');
+            for (const ExportObject& o : info.objects) {
+                t.open('{');
+                if (o.base_color[3] < 1) {
+                    t.key("alphaMode");
+                    t.value("BLEND");
+                }
+                t.key("doubleSided");
+                t.value(true);
+                const double plain[4] = {o.base_color[0], o.base_color[1], o.base_color[2], o.base_color[3]};
+                const double white[4] = {1.0, 1.0, 1.0, o.base_color[3]};
+                if (shade_doppler) {
+                    t.key("extras");
+                    t.open('{');
+                    numbers("base_color", plain, 4);
+                    t.close('}');
+                }
+                if (!o.name.empty()) {
+                    t.key("name");
+                    t.value(o.name);
+                }
+                t.key("pbrMetallicRoughness");
+                t.open('{');
+                const double* factor = shade_doppler ? white : plain;
+                // glTF's default factor (1, 1, 1, 1) is left out.
+                if (std::any_of(factor, factor + 4, [](double c) { return !(std::fabs(c - 1.0) < 1e-12); }))
+                    numbers("baseColorFactor", factor, 4);
+                t.key("metallicFactor");
+                t.value(0.0);
+                t.key("roughnessFactor");
+                t.value(0.8);
+                t.close('}');
+                t.close('}');
+            }
+            t.close(']');
+        }
+        array("meshes", b.meshes);
+        array("nodes", b.nodes);
+        t.key("scene");
+        t.value(0);
+        // Scene extras: what was computed, in which units, at which camera times.
+        t.key("scenes");
+        t.open('[');
+        t.open('{');
+        t.key("extras");
+        t.open('{');
+        t.key("first_frame");
+        t.value(int64_t(int(first_frame)));
+        t.key("fps");
+        t.value(info.fps);
+        t.key("frame_times");
+        t.open('[');
+        for (const double time : frame_times) t.value(time);
+        t.close(']');
+        t.key("model");
+        t.value(info.model);
+        t.key("objects");
+        t.open('[');
+        for (const ExportObject& o : info.objects) t.value(o.name);
+        t.close(']');
+        t.key("scene_file");
+        t.value(info.scene_path);
+        t.key("tolerance");
+        t.value(info.tolerance);
+        t.key("units");
+        t.value("light-seconds, seconds, c = 1");
+        t.close('}');
+        if (!info.model.empty()) {
+            t.key("name");
+            t.value(info.model);
+        }
+        t.key("nodes");
+        t.open('[');
+        for (const int node : scene_nodes) t.value(node);
+        t.close(']');
+        t.close('}');
+        t.close(']');
+        t.close('}');
+        return std::move(t.out);
     }
 
     const SequenceInfo& info;
     GlbBuilder b;
     MeshoptLayout layout;  // with meshopt: the vertex record
-    tinygltf::Scene scene;
-    tinygltf::Value::Array frame_times;
+    bool shade_doppler = false;
+    std::vector<std::string> extensions;  // used and required
+    std::vector<int> scene_nodes;
+    std::vector<double> frame_times;
     std::vector<float> frame_scales;  // per frame, its node's scale while shown
     long long first_frame = 0;
     size_t frames = 0;
