@@ -28,9 +28,9 @@
 //               (0, w x R u) <= (0, |w|)   (the curvature |w|^2 rho and the spread of the
 //               velocity across the triangle, |w| l, of the brief);
 //               Galilean carry: (1, w x Y + v) <= (1, max_i maxGalileanSpeed(q_i)), the rest as above;
-//       Born-rigid acceleration on a hyperplane (on the cone, relativistic: the closed forms of
-//               "A Born-rigid acceleration on the cone" below instead) (xi = 1/|a| + q.k in [xi_lo,
-//               xi_hi] from the corners, s in a window
+//       Born-rigid acceleration (relativistic on the cone: the closed forms of "A Born-rigid
+//               acceleration on the cone" below instead) (xi = 1/|a| + q.k in [xi_lo, xi_hi] from
+//               the corners, s in a window
 //               [s_lo, s_hi], S = max(s_hi, 0), ch = cosh(|a| S), sh = sinh(|a| S)):
 //               (T, Y)_s = xi |a| (cosh, k sinh) <= xi_hi |a| (ch, sh), (T, Y)_ss = xi |a|^2 (sinh,
 //               k cosh) <= xi_hi |a|^2 (sh, ch) (the proper acceleration 1/xi), (T, Y)_q = ((k.u)
