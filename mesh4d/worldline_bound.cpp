@@ -344,6 +344,79 @@ double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const 
     return term == term ? term : INFINITY;
 }
 
+// The Born-rigid acceleration seen on a past cone, relativistic (header, "A Born-rigid acceleration
+// on the cone"): everything in the start frame, where the worldlines are hyperbolae about one
+// event, then the second derivative boosted into the lab. No bootstrap: sigma's Lipschitz bound
+// G, the distance rho and Lambda-hat follow from the corners without a guess.
+PieceBound rigidBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3],
+                      double d) {
+    const PieceBound none;
+    const double a = norm(m.acceleration);
+    const Vec3 k = m.acceleration / a;
+    const double g = m.gamma;
+    const Vec3& V = m.velocity;
+    // Start-frame event of a lab event, about (t0, X0) (the inverse of worldline.cpp's boost).
+    auto startFrame = [&](double t, const Vec3& x, double* T) {
+        const double dt = t - m.t0;
+        const Vec3 dx = x - m.origin;
+        *T = g * (dt - dot(V, dx));
+        return dx + stretch(V, g, dx) - V * (g * dt);
+    };
+    double Tc;
+    const Vec3 P = startFrame(view.t_c, view.apex, &Tc);
+    double xi_lo = INFINITY, rho_c = INFINITY, lhat_c = INFINITY, s_lo = INFINITY, s_hi = -INFINITY;
+    for (int i = 0; i < 3; ++i) {
+        double T;
+        const Vec3 r = startFrame(c[i].event.t, c[i].event.x, &T) - P;
+        const double rho = norm(r);
+        if (!(rho > 0)) return none;
+        xi_lo = std::min(xi_lo, horizonDistance(m, c[i].q));
+        rho_c = std::min(rho_c, rho);
+        const double s = c[i].s;
+        lhat_c = std::min(lhat_c, s > 0 ? std::cosh(a * s) + dot(k, r) / rho * std::sinh(a * s) : 1.0);
+        s_lo = std::min(s_lo, s);
+        s_hi = std::max(s_hi, s);
+    }
+    if (!(xi_lo > 0) || !(lhat_c > 0)) return none;
+    // sigma is Lipschitz with G = 1 / (xi a) after t0 (|c| = Lambda-hat) and 1 before: its window.
+    const double G = std::max(1.0, 1 / (xi_lo * a));
+    const double w_lo = s_lo - G * d, w_hi = s_hi + G * d;
+    const double S = std::max(w_hi, 0.0);
+    const double sh = std::sinh(a * S), ch = std::cosh(a * S), e = std::exp(a * S);
+    // rho and Lambda-hat over the triangle from a bound xdot on |x.| (Gronwall along a segment from a
+    // corner: Lambda-hat' >= -Lambda-hat / xi - sh |x.| / rho); false when they do not close.
+    double rho_min = 0, lhat = 0;
+    auto carry = [&](double xdot) {
+        rho_min = (rho_c - xdot * d) * (1 - 1e-9);
+        if (!(rho_min > 0)) return false;  // the triangle may reach the camera (a smaller one may not)
+        const double C = sh * xdot / rho_min * xi_lo;  // C / kappa, kappa = 1 / xi_lo
+        lhat = (lhat_c + C) * std::exp(-d / xi_lo) - C;
+        return lhat > 0;
+    };
+    // |x.| <= e^(a S) everywhere, and <= 1 + (e^(a S) - 1) / Lambda-hat: first the one, then the other
+    // with the Lambda-hat it gave; when the first does not close, the second with a guess
+    // Lambda-hat >= lhat_c / 2, accepted when the carry returns more (the bootstrap of the header).
+    double xdot = e;
+    if (carry(xdot)) {
+        xdot = std::min(e, 1 + (e - 1) / lhat);
+        if (!carry(xdot)) return none;
+    } else {
+        const double guess = 0.5 * lhat_c;
+        xdot = std::min(e, 1 + (e - 1) / guess);
+        if (!carry(xdot) || !(lhat > guess)) return none;
+    }
+    const double Pr = xdot * xdot / rho_min;  // P / rho
+    double X = 0, T = 0;  // |x..| and |t..| per |u|^2 in the start frame
+    if (w_hi > 0) X = (1 / xi_lo + sh * Pr) / lhat, T = (1 / xi_lo + ch * Pr) / lhat;
+    if (w_lo <= 0) T = std::max(T, Pr);  // at rest before t0: x.. = 0, t.. = -P / rho
+    // Into the lab: x.. = X k boosted plus g V t.., t.. boosted.
+    const double kx = norm(k + stretch(V, g, k));
+    const double K = X * kx + g * norm(V) * T + shear_speed * g * (T + std::fabs(dot(V, k)) * X);
+    PieceBound out;
+    out.K = K == K ? K : INFINITY;
+    return out;
+}
+
 }  // namespace
 
 PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_speed, const CornerCrossing c[3]) {
@@ -360,6 +433,7 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
         s_hi = std::max(s_hi, c[i].s);
     }
     if (!(lam_c > 0) || (cone && !(rho_c > 0))) return none;
+    if (cone && accelerated(m) && m.kinematics == Kinematics::Lorentz) return rigidBound(m, view, shear_speed, c, d);
     if (m.keyed && !(std::isfinite(s_lo) && std::isfinite(s_hi))) return none;  // no window of segments
     const bool windowed = accelerated(m) || m.keyed;
     // v.n at the corners (the Doppler factor of the boost, header): the guess nu starts a hundredth

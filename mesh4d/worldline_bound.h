@@ -28,7 +28,9 @@
 //               (0, w x R u) <= (0, |w|)   (the curvature |w|^2 rho and the spread of the
 //               velocity across the triangle, |w| l, of the brief);
 //               Galilean carry: (1, w x Y + v) <= (1, max_i maxGalileanSpeed(q_i)), the rest as above;
-//       Born-rigid acceleration (xi = 1/|a| + q.k in [xi_lo, xi_hi] from the corners, s in a window
+//       Born-rigid acceleration (relativistic on the cone: the closed forms of "A Born-rigid
+//               acceleration on the cone" below instead) (xi = 1/|a| + q.k in [xi_lo, xi_hi] from
+//               the corners, s in a window
 //               [s_lo, s_hi], S = max(s_hi, 0), ch = cosh(|a| S), sh = sinh(|a| S)):
 //               (T, Y)_s = xi |a| (cosh, k sinh) <= xi_hi |a| (ch, sh), (T, Y)_ss = xi |a|^2 (sinh,
 //               k cosh) <= xi_hi |a|^2 (sh, ch) (the proper acceleration 1/xi), (T, Y)_q = ((k.u)
@@ -62,6 +64,36 @@
 //     S2 = (c_ss G^2 + 2 c_sq G + L_F^2 / rho_min) / Lambda_min bounding |sigma''| (a hyperplane:
 //     (t_ss G^2 + 2 t_sq G) / Lambda_min), all per |u|^2. (shear: the finite model's moving camera,
 //     lightcone.h; the callers refuse it for these motions, so it is 0 in practice.)
+// A Born-rigid acceleration on the cone (relativistic). The worst-case rates above lose the
+// hyperbolae's structure (a factor of about e^(3 |a| s) / Lambda-hat^2); in the start frame (the
+// corners' events and the camera's boosted back about (t0, X0)) the terms close by themselves.
+// After t0, with xi = 1/|a| + q.k, ch, sh of |a| s, mu = k.n, all per |u| = 1:
+//   - E_s = xi |a| (ch, k sh), E_ss = xi |a|^2 (sh, k ch), E_q u = ((k.u) sh, u + k (k.u)(ch - 1)),
+//     E_sq u = ((k.u) / xi) E_s; so Lambda = xi |a| Lh, Lh = ch + mu sh (the Doppler part), and
+//     (t_sq + n.x_sq) u = (k.u) Lambda / xi.
+//   - c = t_q + x_q^T n = n + k (sh + mu (ch - 1)) has |c|^2 = (mu ch + sh)^2 + 1 - mu^2 = Lh^2, so
+//     |sigma'| = |c.u| / Lambda <= 1 / (xi |a|) exactly (the proper time xi |a| s is 1-Lipschitz in
+//     q); before t0 (at rest in the start frame) Lambda = 1, c = n, |sigma'| <= 1. So sigma moves at
+//     most G = max(1, 1 / (xi_lo |a|)) per unit length: the window is the corners' s -+ G d.
+//   - putting Lambda sigma'' into x.. and t.., the mixed terms cancel (E_sq is along E_s) and
+//     ch Lh - sh (sh + mu ch) = 1, sh Lh - ch (sh + mu ch) = -mu leave
+//         x.. = k (xi |a|^2 sigma'^2 - sh P / rho) / Lh,   t.. = -(mu xi |a|^2 sigma'^2 + ch P / rho) / Lh,
+//     with xi |a|^2 sigma'^2 <= 1 / xi; before t0, x.. = 0 and t.. = -P / rho.
+//   - x. = u - k ((k.u)(ch - 1) + (n.u) sh) / Lh (the same substitution), so
+//     |x.| <= min(e^(|a| s), 1 + (e^(|a| s) - 1) / Lh) (the first: |x_q u| <= ch, |x_s sigma'| <= sh),
+//     P <= |x.|^2, and rho >= min_i rho_i - |x.| d.
+//   - Lh' = |a| sigma' (sh + mu ch) + sh mu', |sh + mu ch| <= Lh (Lh^2 - (sh + mu ch)^2 = 1 - mu^2),
+//     |mu'| <= |x.| / rho: Lh' >= -Lh / xi_lo - C, C = sh |x.| / rho_min, so along a segment of
+//     length d from a corner Lh >= (min_i Lh_i + C xi_lo) e^(-d / xi_lo) - C xi_lo (Gronwall; Lh is 1
+//     before t0 and continuous at t0). |x.| is taken first as e^(|a| S) (no Lh needed), then by its
+//     Lh form with the Lh that gave; when the first does not close, with a guess Lh >= min_i Lh_i / 2
+//     accepted when the carry returns more (the bootstrap argument of Lambda above).
+//   - with S the window's end (ch, sh, e^(|a| S) at their largest there) the start frame's
+//     |x..| <= X = (1 / xi_lo + sh P / rho_min) / Lh_min, |t..| <= T = (1 / xi_lo + ch P / rho_min) / Lh_min
+//     (P / rho_min alone for T before t0, X = 0), and into the lab (x.. along k before the boost)
+//     K = X |k + (g - 1)(k.v^)v^| + g b T (+ |shear| g (T + |v.k| X)).
+// No guessed Lambda_min, no worst-case Doppler factor: what is loose is |x.| and Lh taken at their
+// worst over the piece, which a sub-piece's own bound shortens.
 // The use: for the linear interpolant L of F on a triangle with exact corners, and any point
 // p = sum l_i q_i, Taylor's theorem with integral remainder from p to each corner gives
 // |F(p) - L(p)| <= (K / 2) sum_i l_i |q_i - p|^2 = (K / 2) sum_{i<j} l_i l_j |q_i - q_j|^2 <= K d^2 / 6.

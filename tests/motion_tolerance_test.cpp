@@ -16,6 +16,7 @@
 #include "mesh4d/keyframes.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/slice.h"
+#include "mesh4d/worldline_bound.h"
 #include "mesh4d/worldline.h"
 #include "test_meshes.h"
 
@@ -523,6 +524,112 @@ TEST(MotionTolerance, TwoKeysAtConstantSpeedMatchUniformMotion) {
                         gap / settings.tolerance, ok.triangles.size(), ou.triangles.size());
         }
     }
+}
+
+// ---- Born-rigid acceleration on the cone (worldline_bound.h, "A Born-rigid acceleration on the cone") ----
+
+// The rocket of data/scenes/rocket.json (box.obj scaled 2 x 0.5 x 0.5 at X0 = (-3, 0, 0), a = 0.5 along x
+// from t0 = 0, camera at (0, 0, 6)) launched from a frame moving at V: its Motion and its true worldlines,
+// the start-frame hyperbolas of `accelerated` carried into the lab by the boost matrix.
+struct Rocket {
+    mesh4d::RestMesh mesh;
+    mesh4d::Motion motion;
+    Worldline exact;
+    double size;
+};
+Rocket rocket(const Vec3& V) {
+    Rocket r;
+    r.mesh = box(0.5);
+    for (Vec3& p : r.mesh.positions) p = {p.x * 2, p.y * 0.5, p.z * 0.5};
+    r.size = std::sqrt(4 + 0.25 + 0.25);
+    const Vec3 X0{-3, 0, 0};
+    r.motion = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, X0, V);
+    r.motion.acceleration = {0.5, 0, 0};
+    const auto back = boostMatrix(V * -1.0);
+    const Worldline start = accelerated(0.5, {0, 0, 0});
+    r.exact = [=](double s, const Vec3& q) {
+        const Event e = start(s, q);
+        const Event l = apply(back, e.t, e.x);
+        return Event{l.t, X0 + l.x};
+    };
+    return r;
+}
+
+// The rocket at rest before launch (the shipped scene) and launched from a frame moving at
+// (0.3, 0.4, 0), at frames before, while and after it passes the camera: two-sided error <= T at T = 1e-2,
+// 1e-3 and 1e-4 of its size, sampled both ways against the exact surface; the closed box stays closed. The
+// bound is tight enough that the largest error over the frames is at least half of T (0.87 to 0.94 when
+// written; docs/ACCURACY.md "Non-uniform motion").
+TEST(MotionTolerance, RocketSceneWithinTheTolerance) {
+    plane = false;
+    for (const Vec3& V : {Vec3{0, 0, 0}, Vec3{0.3, 0.4, 0}}) {
+        const Rocket r = rocket(V);
+        const mesh4d::World4D world = mesh4d::extrude(r.mesh, r.motion, -1e3, 1e3, false, false);
+        for (double rel : {1e-2, 1e-3, 1e-4}) {
+            double worst = 0;  // err / T over the frames, as `apparent trade` takes it
+            for (double t_c : {4.0, 8.0, 12.0, 16.0}) {
+                mesh4d::ViewSurface view;
+                view.t_c = t_c;
+                view.apex = {0, 0, 6};
+                const Sampled v = sample(r.mesh, mesh4d::sliceWorld(world, view), r.exact, t_c, view.apex);
+                mesh4d::SliceSettings settings;
+                settings.tolerance = rel * r.size;
+                const mesh4d::ApparentMesh out = mesh4d::sliceWorld(world, view, settings);
+                const Sampled s = sample(r.mesh, out, r.exact, t_c, view.apex);
+                const double err = std::max(s.output_to_exact, s.exact_to_output);
+                EXPECT_LE(err, settings.tolerance + 1e-11) << "V.x " << V.x << " t_c " << t_c << " T = " << rel;
+                EXPECT_EQ(out.limited_triangles, 0u);
+                EXPECT_FALSE(out.over_budget);
+                expectClosed(out);
+                worst = std::max(worst, err / settings.tolerance);
+                std::printf("[ tolerance ] rocket, V = (%.1f, %.1f, 0) t_c = %4.1f T = %g x size: err/T %.3f (vertex mode %.3g), "
+                            "12 -> %zu triangles\n",
+                            V.x, V.y, t_c, rel, err / settings.tolerance,
+                            std::max(v.output_to_exact, v.exact_to_output) / settings.tolerance, out.triangles.size());
+            }
+            EXPECT_GE(worst, 0.5) << "V.x " << V.x << " T = " << rel;
+        }
+    }
+}
+
+// The bound's K against the map's second derivative measured along lines: small rest triangles of the
+// launched rocket, the exact apparent point by bisection at the centroid and a step +-h along each side's
+// direction (central second difference, within about 1e-6 of the derivative here); |F..| <= K on every
+// line (the header's closed forms in the start frame, boosted); K finite at sides 0.1 ls (a larger piece
+// may have none: it is split). Prints the largest |F..| / K.
+TEST(MotionTolerance, RigidBoundAboveSecondDerivative) {
+    plane = false;
+    const Rocket r = rocket({0.3, 0.4, 0});
+    double tight = 0;
+    for (double t_c : {5.0, 8.0, 11.0, 14.0, 17.0})
+        for (const Vec3& q0 : {Vec3{-1, -0.25, 0.25}, Vec3{1, 0.25, -0.25}, Vec3{0, 0.25, 0.25}, Vec3{0.5, -0.25, 0}})
+            for (double side : {0.4, 0.1}) {
+                mesh4d::ViewSurface view;
+                view.t_c = t_c;
+                view.apex = {0, 0, 6};
+                const Vec3 q[3] = {q0, q0 + Vec3{side, 0, 0}, q0 + Vec3{0.3 * side, 0.6 * side, -0.7 * side}};
+                mesh4d::CornerCrossing c[3];
+                for (int i = 0; i < 3; ++i) {
+                    bool ok = false;
+                    c[i] = mesh4d::cornerCrossing(view, r.motion, q[i], &ok);
+                    ASSERT_TRUE(ok);
+                }
+                const double K = mesh4d::pieceBound(r.motion, view, 0, c).K;
+                if (!std::isfinite(K)) {  // no bound closes on a large piece: refinement splits it
+                    EXPECT_GT(side, 0.1) << "t_c " << t_c << " q0.x " << q0.x;
+                    continue;
+                }
+                const Vec3 mid = (q[0] + q[1] + q[2]) / 3.0;
+                const double h = 1e-3 * side;
+                for (int i = 0; i < 3; ++i) {
+                    const Vec3 u = (q[(i + 1) % 3] - q[i]) / mesh4d::norm(q[(i + 1) % 3] - q[i]);
+                    const Vec3 fdd = (exactPoint(r.exact, t_c, view.apex, mid + u * h) - exactPoint(r.exact, t_c, view.apex, mid) * 2.0 +
+                                      exactPoint(r.exact, t_c, view.apex, mid - u * h)) / (h * h);
+                    EXPECT_LE(mesh4d::norm(fdd), K + 1e-6) << "t_c " << t_c << " side " << side;
+                    tight = std::max(tight, mesh4d::norm(fdd) / K);
+                }
+            }
+    std::printf("[ tolerance ] launched rocket: largest |F..| / K on the sampled lines %.3f\n", tight);
 }
 
 // ---- The measure of `apparent trade` on motions beyond uniform (mesh4d/measure.h) ----
