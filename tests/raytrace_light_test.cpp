@@ -37,12 +37,12 @@ int linearToSrgb8(double c) {
     return int(std::lround(255 * (c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055)));
 }
 
-// The camera-frame direction k in which a camera at the lab origin at t = 0, moving at v, sees
+// The camera-frame direction k in which a camera at the lab origin, moving at v, sees
 // light that reached it along the lab direction d (from the camera towards the source), and back.
 // relativistic: aberration, k = (d + (g - 1)(d.n) n + g v) / (g (1 + d.v)), n = v/|v|;
 // finite (light at c in the lab, Galilean camera frame): k along d + v; contracted (the camera's
-// hyperplane t' = 0, the lab seen through the boost at one camera time): k along
-// d + (1/g - 1)(d.n) n; instant (x' = x - v t at t = 0): k = d.
+// hyperplane t' = t_c, the lab seen through the boost at one camera time): k along
+// d + (1/g - 1)(d.n) n; instant (the hyperplane t = t_c, where x' = x - v t_c is a shift): k = d.
 Vec3 seenDirection(Model model, const Vec3& v, const Vec3& d) {
     const double b = mesh4d::norm(v);
     if (b == 0 || model == Model::Instant) return d;
@@ -92,15 +92,19 @@ const char* kFaces[6][4] = {{"0.5 -0.5 -0.5", "0.5 0.5 -0.5", "0.5 0.5 0.5", "0.
 const Vec3 kCentre{0, 0, -5};
 
 // A unit cube at rest in the lab at kCentre, rotated, its six faces separate objects, seen by a
-// camera at the lab origin at t = 0 (frame 0) moving at `velocity`, looking along `forward`.
-std::string writeScene(const std::filesystem::path& dir, const Vec3& velocity, const Vec3& forward, double fov_deg,
-                       const std::string& light) {
+// camera moving at `velocity`, looking along `forward`, at its frame 0 (camera time kTime), which
+// it spends at the lab origin when it starts from `position`.
+constexpr double kTime = 2;
+std::string writeScene(const std::filesystem::path& dir, const Vec3& position, const Vec3& velocity,
+                       const Vec3& forward, double fov_deg, const std::string& light) {
     std::filesystem::create_directories(dir);
     std::ostringstream scene;
     scene.precision(17);
-    scene << R"({ "camera": {"position": [0, 0, 0], "look_at": [)" << forward.x << ", " << forward.y << ", " << forward.z
+    scene << R"({ "camera": {"position": [)" << position.x << ", " << position.y << ", " << position.z
+          << R"(], "look_at": [)" << position.x + forward.x << ", " << position.y + forward.y << ", " << position.z + forward.z
           << R"(], "up": [0, 1, 0], "fov_deg": )" << fov_deg << R"(, "velocity": [)" << velocity.x << ", " << velocity.y
-          << ", " << velocity.z << "]},\n  " << light << R"( "frames": {"start": 0, "end": 0.1, "fps": 10}, "objects": [)";
+          << ", " << velocity.z << "]},\n  " << light << R"( "frames": {"start": )" << kTime << R"(, "end": )" << kTime + 0.1
+          << R"(, "fps": 10}, "objects": [)";
     for (int f = 0; f < 6; ++f) {
         std::ofstream obj(dir / ("face" + std::to_string(f) + ".obj"));
         for (const char* v : kFaces[f]) obj << "v " << v << "\n";
@@ -133,10 +137,15 @@ std::map<int32_t, std::array<double, 3>> checkEveryPixel(Model model, const Vec3
     }
     const double fov = 2.4 * widest * 180 / mesh4d::kPi;
     const int size = 160;
+    // The camera's lab event at camera time kTime is (g kTime, position + g v kTime) under Lorentz
+    // kinematics (its clock runs slow), (kTime, position + v kTime) under Galilean: at the origin.
+    const double b = mesh4d::norm(velocity);
+    const bool lorentz = model == Model::Relativistic || model == Model::Contracted;
+    const double g = lorentz ? 1 / std::sqrt(1 - b * b) : 1;
     Stage stage;
     std::string error;
     std::map<int32_t, std::array<double, 3>> means;
-    if (!loadQuietStage(writeScene(dir, velocity, forward, fov, light.json), &stage, &error, {model})) {
+    if (!loadQuietStage(writeScene(dir, -g * kTime * velocity, velocity, forward, fov, light.json), &stage, &error, {model})) {
         ADD_FAILURE() << error;
         return means;
     }
