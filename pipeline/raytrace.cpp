@@ -89,6 +89,53 @@ bool isSlabbed(const ObjectSpec& spec) {
     return mesh4d::norm(spec.angular_velocity) != 0 || mesh4d::norm(spec.acceleration) != 0 || spec.keys;
 }
 
+// The hit's normal and point in the lab, where the scene's light is at rest (scene.h LightSpec):
+// Lambert's law is stated in the light's frame, so the shade of a face does not depend on how the
+// camera moves, only where the face appears does.
+//
+// The hit is traced in a frame F: the camera's rest frame for relativistic, contracted and instant
+// with a moving camera (camera_frame.h), the lab for finite (its cut is made there, physics.h
+// viewAt) and for every model with a camera at rest. Where F is the lab nothing is mapped, so those
+// pictures keep their bytes. Otherwise, term by term:
+// - the point: the hit event e_F in the lab, e_L = fromCameraFrame(e_F); a point light at rest at
+//   P_L has, in the lab, always been at P_L, so the light reaching the hit left it along
+//   l_L = (P_L - x_L) / |P_L - x_L| (in F the light moves, and this is the direction to its
+//   retarded event seen from the hit, aberrated into F);
+// - a directional light (and the default pair, scene.h): l_L = direction, as given (in F it is
+//   aberrated as a star's direction is, README "A moving camera");
+// - the normal: the hit's prism lies in a 3-flat {E : N . E = const} of spacetime. Its F form is
+//   N_F = (-(n_F . w), n_F): n_F = lab_normal (ray4d.h: the spatial part of the flat's normal,
+//   turned so that N_F . D_F < 0 for the ray's 4D direction D_F) annihilates the triangle's
+//   tangents (0, a) at one F instant, and the time part makes N_F . (1, w) = 0 for the
+//   worldlines of the rest points, all of F velocity w (a moving camera only with uniform
+//   motions, physics.h checkObjectMotion). Lab differences map to F differences by the linear
+//   M = toCameraFrameDifference, so N_F . (M E_L) = N_L . E_L with N_L's component mu equal to
+//   N_F . (M e_mu) for the lab unit vectors e_t, e_x, e_y, e_z. The spatial part of N_L
+//   annihilates the triangle's tangents at one lab instant: the lab normal n_L, normalised; it
+//   keeps its side, N_L . D_L = N_F . D_F < 0. Under a boost this undoes the contraction
+//   (an object at rest in the lab gets its rest normal back); under the Galilean map M keeps
+//   spatial vectors, n_L = n_F, and only the point moves (x_L = x_F + v t).
+struct LabShading {
+    Vec3 normal;  // unit, towards the side the ray arrives from
+    Vec3 point;   // the hit's lab position
+};
+
+LabShading labShading(const mesh4d::WorldHit& hit, const mesh4d::Motion& traced_motion,
+                      const mesh4d::CameraMotion& camera, Model model) {
+    if (!camera.moving() || model == Model::Finite) return {hit.lab_normal, hit.event.x};
+    const mesh4d::Kinematics kinematics = kinematicsOf(model);
+    const Vec3& n = hit.lab_normal;
+    const std::array<double, 4> normal_f{-mesh4d::dot(n, traced_motion.velocity), n.x, n.y, n.z};
+    const mesh4d::Event units[4] = {{1, {0, 0, 0}}, {0, {1, 0, 0}}, {0, {0, 1, 0}}, {0, {0, 0, 1}}};
+    std::array<double, 4> normal_l{};
+    for (size_t mu = 0; mu < 4; ++mu) {
+        const mesh4d::Event m = mesh4d::toCameraFrameDifference(camera, kinematics, units[mu]);
+        normal_l[mu] = normal_f[0] * m.t + normal_f[1] * m.x.x + normal_f[2] * m.x.y + normal_f[3] * m.x.z;
+    }
+    const Vec3 spatial{normal_l[1], normal_l[2], normal_l[3]};
+    return {spatial / mesh4d::norm(spatial), mesh4d::fromCameraFrame(camera, kinematics, hit.event).x};
+}
+
 }  // namespace
 
 // The objects of a scene whose motion is not uniform, for one model: the span of their time a
@@ -389,12 +436,14 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
                                              const Vec3& receiver_velocity) const {
     // Lambert: base * (ambient + (1 - ambient) max(0, n . l)), summed over the lights with their
     // weights (the default key light, scene.h), n already turned towards the side
-    // the ray arrives from (the surfaces are two-sided, as in the exported glTF).
-    const Vec3 n = h.hit.lab_normal;
+    // the ray arrives from (the surfaces are two-sided, as in the exported glTF). In the lab, where
+    // the light is at rest (labShading: the hit's normal and point taken there).
+    const LabShading lab = labShading(h.hit, motions_[size_t(h.object)], cameraMotionOf(scene_), model_);
+    const Vec3 n = lab.normal;
     const LightSpec& light = scene_.light;
     Vec3 l = light.direction;
     if (light.kind == LightSpec::Kind::Point) {
-        const Vec3 to_light = light.position - h.hit.event.x;
+        const Vec3 to_light = light.position - lab.point;
         const double len = mesh4d::norm(to_light);
         l = len > 0 ? to_light / len : Vec3{0, 0, 0};
     }

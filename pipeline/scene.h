@@ -33,7 +33,10 @@ struct CameraSpec {
     mesh4d::Vec3 velocity{0, 0, 0};
 };
 
-// The light that shades the raytracer's pictures, at rest in the lab (README "Scene format").
+// The light that shades the raytracer's pictures, at rest in the lab (README "Scene format"):
+// position and directions are lab coordinates, and every hit is shaded in the lab (its normal and
+// point taken there, pipeline/raytrace.cpp labShading), so with a moving camera (camera.velocity)
+// a face at rest in the lab keeps the shade a camera at rest sees; only where it appears changes.
 struct LightSpec {
     enum class Kind { Directional, Point } kind = Kind::Directional;
     mesh4d::Vec3 position;              // Point: lab position
