@@ -24,6 +24,8 @@
 #include "quiet_stage.h"
 #include "slab_rays.h"
 
+#include "temp_dir.h"
+
 using apparent::Model;
 using mesh4d::Vec3;
 using testkeys::Channel;
@@ -62,7 +64,7 @@ Cut cutAll(const std::string& scene, Model model) {
     return c;
 }
 
-std::string dir() { return ::testing::TempDir(); }
+std::string dir() { return testio::processTempDir(); }
 
 Channel translationKeys(const std::vector<float>& times, const std::vector<Vec3>& points) {
     Channel ch;

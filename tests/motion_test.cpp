@@ -20,6 +20,8 @@
 #include "pipeline/raytrace.h"
 #include "pipeline/worlds.h"
 
+#include "temp_dir.h"
+
 using mesh4d::Event;
 using mesh4d::Motion;
 using mesh4d::Vec3;
@@ -284,7 +286,7 @@ TEST(Motion, ExistenceCapClipsOnTheTrueWorldlines) {
 // The stage refuses what a spin cannot be: a vertex at or above c (file, field, speed), a tolerance
 // other than vertex mode, a moving camera, a spinning mirror; the raytracer refuses spin.
 TEST(Motion, StageRefusalsNameFileFieldAndSpeed) {
-    const std::string dir = ::testing::TempDir();
+    const std::string dir = testio::processTempDir();
     auto write = [&](const std::string& name, const std::string& body) {
         const std::string path = dir + "/" + name;
         FILE* f = std::fopen(path.c_str(), "w");
@@ -510,7 +512,7 @@ TEST(Motion, AcceleratedFromAMovingStartAgainstAnIndependentBoost) {
 // An accelerated body through the stage: refusals (behind the horizon, with a spin, rapidity past
 // the limit) and a rendered cut whose every vertex lies on the cone and on its own hyperbola.
 TEST(Motion, AcceleratedBodyThroughTheStage) {
-    const std::string dir = ::testing::TempDir();
+    const std::string dir = testio::processTempDir();
     auto write = [&](const std::string& name, const std::string& body) {
         const std::string path = dir + "/" + name;
         FILE* f = std::fopen(path.c_str(), "w");

@@ -33,6 +33,8 @@
 #include "test_meshes.h"
 #include "quiet_stage.h"
 
+#include "temp_dir.h"
+
 using namespace apparent;
 using mesh4d::Vec3;
 
@@ -910,7 +912,7 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsTheUniformModelsAtConstantSpeed) 
         for (double c : {x0.x + v.x * t, x0.y + v.y * t, x0.z + v.z * t}) ch.values.push_back(float(c));
     keyed.channels.push_back(ch);
     uniform.object_extras = {{"t0", 0}, {"velocity", {v.x, v.y, v.z}}};
-    const std::string dir = ::testing::TempDir();
+    const std::string dir = testio::processTempDir();
     RgbImage image[3];
     std::vector<int32_t> object[3];
     size_t worlds[2] = {0, 0};
@@ -1015,7 +1017,7 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsItsSegmentsVelocitys) {
     keyed.channels.push_back(ch);
     Stage stage;
     std::string error;
-    ASSERT_TRUE(loadQuietStage(keyed.write(::testing::TempDir(), "doppler_segments"), &stage, &error)) << error;
+    ASSERT_TRUE(loadQuietStage(keyed.write(testio::processTempDir(), "doppler_segments"), &stage, &error)) << error;
     const DopplerRatios r = dopplerRatios(stage, 160, 90, 60, [&](const Vec3& d) -> std::optional<double> {
         return std::sqrt(1 - mesh4d::dot(u, u)) / (1 + mesh4d::dot(u, d));
     });
@@ -1038,7 +1040,7 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsItsSegmentsVelocitys) {
 // out) on channels of at least 100 levels, where the 8-bit rounding of the two pictures stays
 // within 3% (at 60 levels it reaches about 4%).
 TEST(RaytraceShading, DopplerOfASpinningDiskIsItsRimVelocitys) {
-    const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "doppler_spin";
+    const std::filesystem::path dir = std::filesystem::path(testio::processTempDir()) / "doppler_spin";
     std::filesystem::create_directories(dir);
     const int n = 64;
     {

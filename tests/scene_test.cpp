@@ -6,6 +6,8 @@
 
 #include "pipeline/scene.h"
 
+#include "temp_dir.h"
+
 using namespace apparent;
 
 namespace {
@@ -122,7 +124,7 @@ TEST(Scene, GltfSceneErrorsNameTheNode) {
 // Speeds stated exactly: direction with gamma or rapidity; velocity is derived, and mixing the
 // two forms is refused.
 TEST(Scene, ExactSpeedAsGammaOrRapidity) {
-    const std::string dir = ::testing::TempDir();
+    const std::string dir = testio::processTempDir();
     auto write = [&](const std::string& name, const std::string& text) {
         std::ofstream(dir + name) << text;
         return dir + name;
