@@ -57,7 +57,7 @@ mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& res
     // its gamma is gamma_V before t0, then gamma_V sqrt(1 - B^2) cosh(|a| s + atanh B) (B = V.k):
     // it falls, if at all, only back to gamma_V before it rises, so the fastest is at an end of the
     // span. That pad is capped at kPadReach / |a| of the object's time (worldline events stay below
-    // e^kPadReach / |a|, their squares finite); the span proven sound (pathSpanSeen with no slabs,
+    // e^kPadReach / |a|, their squares finite); the span proven sound (pathSpanSeen,
     // mesh4d/latest_crossing.h for Born-rigid bodies) is held whatever the pad.
     const double a = mesh4d::norm(motion.acceleration);
     double speed_cap = INFINITY;
@@ -67,7 +67,9 @@ mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& res
         b = std::min(b, 1 - 1e-9);
         one_minus_b2 = (1 - b) * (1 + b);
         speed_cap = kPadReach / a;
-        const SeenSpan proven = pathSpanSeen(rest, motion, first, last, 0);
+        // (An offset of 1e-3 diag, as the raytracer's slabs: it widens the span by a few of it and
+        // ends the refinement within 4e-3 diag of the latest crossing, not at its split budget.)
+        const SeenSpan proven = pathSpanSeen(rest, motion, first, last, 1e-3 * diag);
         if (proven.ok) sound = proven.span;
     }
     const double rounding = 1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
