@@ -1,7 +1,8 @@
 // The span of an accelerated body's time that the raytracer extrudes (pipeline/worlds.h
 // pathSpanSeen, mesh4d/latest_crossing.h), checked against crossings found independently: the
-// rocket of data/scenes/rocket.json (a Born-rigid box 2 ls long at 0.5 ls/s^2, whose late frames
-// see interior points of its faces emit after every vertex) and a tumbling torus with a boost.
+// rocket of data/scenes/rocket.json (a Born-rigid box 2 ls long at 0.5 ls/s^2, whose frames
+// see interior points of its faces emit after every vertex) and a turned torus, boosted and
+// accelerated obliquely.
 // Crossings come from mesh4d/measure.h crossingBySearch (its own bisection on the true worldline),
 // their object time s from the test's inverse of the motion.
 #include <gtest/gtest.h>
@@ -72,7 +73,7 @@ Body rocketBody(const Stage& stage) {
 
 // A torus (R 0.6, r 0.25) turned about two axes, boosted and accelerated obliquely: a body
 // whose start frame is not the lab's and whose acceleration is along no axis.
-Body tumblingTorus() {
+Body turnedTorus() {
     Body b;
     b.rest = testmesh::torus(16, 8, 0.6, 0.25);
     const double c1 = std::cos(0.7), s1 = std::sin(0.7), c2 = std::cos(-0.4), s2 = std::sin(-0.4);
@@ -124,7 +125,7 @@ TEST(LatestCrossing, CrossingsOfTwoPointsDifferByAtMostTheirLightTime) {
     Stage stage;
     std::string error;
     ASSERT_TRUE(loadQuietStage(source("data/scenes/rocket.json"), &stage, &error)) << error;
-    const Body rocket = rocketBody(stage), torus = tumblingTorus();
+    const Body rocket = rocketBody(stage), torus = turnedTorus();
     std::mt19937 rng(18);
     for (const Body* body : {&rocket, &torus}) {
         const std::vector<Vec3> points = trianglePoints(body->rest, 6);
@@ -161,7 +162,7 @@ TEST(LatestCrossing, BoundsTheCrossingOfEveryPointOfTheTriangles) {
     Stage stage;
     std::string error;
     ASSERT_TRUE(loadQuietStage(source("data/scenes/rocket.json"), &stage, &error)) << error;
-    const Body rocket = rocketBody(stage), torus = tumblingTorus();
+    const Body rocket = rocketBody(stage), torus = turnedTorus();
     struct Case {
         const Body* body;
         mesh4d::ViewSurface view;
@@ -195,7 +196,7 @@ TEST(LatestCrossing, BoundsTheCrossingOfEveryPointOfTheTriangles) {
 // pathSpanSeen as the raytracer calls it (the rocket in the frame of the cut, the slabs' offset
 // 1e-3 of its diagonal) holds the object time of every sampled point's emission seen by the
 // window's first and last frames, for one-frame and four-frame windows across the range and at
-// the late frames 150..153.
+// the late frames 150..153; so does buildWorld's padded span.
 TEST(RaytraceSpan, RocketSeenSpanHoldsEverySampledEmission) {
     Stage stage;
     std::string error;
@@ -219,6 +220,10 @@ TEST(RaytraceSpan, RocketSeenSpanHoldsEverySampledEmission) {
         EXPECT_LE(seen.span.lo, lo) << first;
         EXPECT_GE(seen.span.hi, hi) << last;
         EXPECT_LT(seen.span.hi - hi, 0.05) << last;  // tight: a slab or two at these times
+        // buildWorld's padded span (render's, and the raytracer's fallback) holds them too.
+        const mesh4d::World4D padded = buildWorld(stage.objects[0], Model::Relativistic, stage.scene, first, last);
+        EXPECT_LE(padded.tau_a, lo) << first;
+        EXPECT_GE(padded.tau_b, hi) << last;
     }
 }
 
