@@ -158,8 +158,8 @@ public:
     };
 
     SlabPlanner(const Scene& scene, const std::vector<PreparedObject>& objects, const std::vector<MirrorPlane>& mirrors,
-                Model model, bool padded)
-        : scene_(scene), mirrors_(mirrors), model_(model), padded_(padded) {
+                Model model, bool padded, double margin = 0)
+        : scene_(scene), mirrors_(mirrors), model_(model), padded_(padded), margin_(margin) {
         for (size_t i = 0; i < objects.size(); ++i) {
             if (!isSlabbed(objects[i].spec)) continue;
             Slabbed o;
@@ -197,8 +197,8 @@ public:
                     padded = padded || !path.ok;
                     seen = path.span;
                 }
-                lo = std::min(lo, seen.lo);
-                hi = std::max(hi, seen.hi);
+                lo = std::min(lo, seen.lo - margin_);
+                hi = std::max(hi, seen.hi + margin_);
             }
         }
         if (padded) {  // the peer, or a seen span that did not close: buildWorld's padded span
@@ -269,6 +269,7 @@ private:
     std::vector<MirrorPlane> mirrors_;
     Model model_;
     bool padded_;
+    double margin_;  // TracerOptions::span_margin
     std::vector<Slabbed> slabbed_;
 };
 
@@ -345,7 +346,8 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
         objects_[i].worlds.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
         setTraces(&objects_[i]);
     }
-    planner_ = std::make_unique<SlabPlanner>(scene, objects, mirrors_, model, options_.padded_span);
+    planner_ = std::make_unique<SlabPlanner>(scene, objects, mirrors_, model, options_.padded_span,
+                                            options_.span_margin);
     if (!planner_->objects().empty()) buildWindow(first_frame);
 }
 

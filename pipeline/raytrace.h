@@ -55,6 +55,9 @@ struct TracerOptions {
     // true: a motion that is not uniform is traced over buildWorld's padded span (light-crossing
     // time over 1 - b), not the span its frames see (worlds.h): the tests' peer of the seen span.
     bool padded_span = false;
+    // The seen span of such a motion widened by this much of the object's time on both sides
+    // (negative: narrowed), before its ends go out to the slab grid: the tests' generous peer.
+    double span_margin = 0;
     size_t window_slabs = kMaxTraceSlabs;  // one object's time slabs held at once (windows, below)
 };
 

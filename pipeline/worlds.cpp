@@ -7,6 +7,7 @@
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
 #include "mesh4d/keyframes.h"
+#include "mesh4d/latest_crossing.h"
 #include "mesh4d/worldline.h"
 
 namespace apparent {
@@ -14,6 +15,15 @@ namespace apparent {
 using mesh4d::Vec3;
 
 namespace {
+
+// pathSpanSeen's refinement of an accelerated body's latest crossing (mesh4d/latest_crossing.h):
+// it stops within kLatestTolerance x the slabs' offset (in the body's time) of the latest crossing
+// computed, or after kLatestMaxSplits splits (the bound is sound either way; a looser one costs
+// slabs, at most a few at the spacing of the slab grid).
+constexpr double kLatestTolerance = 4;
+constexpr size_t kLatestMaxSplits = 4096;
+// buildWorld's pad of an accelerated body is at most kPadReach / |a| of its time: e^64 = 6e27.
+constexpr double kPadReach = 64;
 
 // The rest mesh `*mesh` in the frame of the cut, rotated in place where that needs it (as
 // restInCameraFrame, without the copy).
@@ -42,9 +52,29 @@ mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& res
         b = std::min(b, 1 - 1e-9);  // the stage refused faster (finite, relativistic); instant has no limit
         one_minus_b2 = (1 - b) * (1 + b);
     }
-    const double pad = diag * (1 + b) / one_minus_b2 +
-                       1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
-    const double open_a = seen.lo - pad, open_b = seen.hi + pad;
+    // An acceleration: b is the fastest speed over the seen span. At one s every point moves with
+    // the origin's lab velocity (Born-rigid: the momentary rest frame's; Galilean: the carry's), and
+    // its gamma is gamma_V before t0, then gamma_V sqrt(1 - B^2) cosh(|a| s + atanh B) (B = V.k):
+    // it falls, if at all, only back to gamma_V before it rises, so the fastest is at an end of the
+    // span. That pad is capped at kPadReach / |a| of the object's time (worldline events stay below
+    // e^kPadReach / |a|, their squares finite); the span proven sound (pathSpanSeen,
+    // mesh4d/latest_crossing.h for Born-rigid bodies) is held whatever the pad.
+    const double a = mesh4d::norm(motion.acceleration);
+    double speed_cap = INFINITY;
+    mesh4d::ProperTimeSpan sound = seen;
+    if (a > 0 && std::isfinite(seen.lo) && std::isfinite(seen.hi)) {
+        for (double at : {seen.lo, seen.hi}) b = std::max(b, mesh4d::norm(mesh4d::worldlineVelocity(motion, at, Vec3{0, 0, 0})));
+        b = std::min(b, 1 - 1e-9);
+        one_minus_b2 = (1 - b) * (1 + b);
+        speed_cap = kPadReach / a;
+        // (An offset of 1e-3 diag, as the raytracer's slabs: it widens the span by a few of it and
+        // ends the refinement within 4e-3 diag of the latest crossing, not at its split budget.)
+        const SeenSpan proven = pathSpanSeen(rest, motion, first, last, 1e-3 * diag);
+        if (proven.ok) sound = proven.span;
+    }
+    const double rounding = 1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
+    const double pad = std::min(diag * (1 + b) / one_minus_b2, speed_cap) + rounding;
+    const double open_a = std::min(seen.lo - pad, sound.lo - rounding), open_b = std::max(seen.hi + pad, sound.hi + rounding);
     // Step: clip the span to the object's existence; only those ends are real caps.
     const bool cap_a_real = s.exists_from > open_a;
     const bool cap_b_real = s.exists_to < open_b;
@@ -119,13 +149,14 @@ SeenSpan pathSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion
                       const mesh4d::ViewSurface& last, double offset) {
     const bool lorentz = motion.kinematics == mesh4d::Kinematics::Lorentz;
     const bool cone = first.kind == mesh4d::ViewKind::PastCone;
+    const bool accelerated = mesh4d::norm(motion.acceleration) > 0;
     // Step: the slabs' distance from the history in the lab, and the longest rest edge.
     const double d = offset / std::sqrt(motion.one_minus_beta2) * (1 + motion.beta);
     const double slab_shift = cone ? std::sqrt(2.0) * d : d;
     double e = 0;
     for (const auto& t : rest.triangles)
         for (int c = 0; c < 3; ++c) e = std::max(e, mesh4d::norm(rest.positions[t[c]] - rest.positions[t[(c + 1) % 3]]));
-    // The least (or largest) vertex crossing of `view` with its apex time moved by `shift`.
+    // The largest vertex crossing of `view` with its apex time moved by `shift`, or the least.
     auto crossings = [&](mesh4d::ViewSurface view, double shift, bool least) {
         view.t_c += shift;
         double s = least ? INFINITY : -INFINITY;
@@ -138,43 +169,26 @@ SeenSpan pathSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion
     SeenSpan out;
     const double lo = crossings(first, -slab_shift, true);
     double hi = crossings(last, slab_shift, false);
-    if (cone && e > 0) {
-        // Step: the apex moved by e W, W the least future vector with W - U(sigma) future causal
-        // for every U(sigma) with sigma in [lo', hi'] (lo' the least vertex crossing of the last
-        // view, hi' the guess): in the own frame (start frame, F_V; the lab for Galilean)
-        // U = (cosh phi, k sinh phi), phi = |a| max(sigma, 0), so in light-cone coordinates
-        // W_+ = e^phi_hi, W_- = e^-phi_lo; then boosted with `velocity` (Lorentz).
-        const double a = lorentz ? mesh4d::norm(motion.acceleration) : 0;
-        const Vec3 k = a > 0 ? motion.acceleration / a : Vec3{0, 0, 0};
-        const double phi_lo = a * std::max(crossings(last, slab_shift, true), 0.0);
-        auto apexShift = [&](double guess) {
-            const double phi_hi = a * std::max(guess, phi_lo / std::max(a, 1e-300));
-            const double w_t = 0.5 * (std::exp(phi_hi) + std::exp(-phi_lo));
-            const Vec3 w_x = 0.5 * (std::exp(phi_hi) - std::exp(-phi_lo)) * k;
-            mesh4d::Event w{w_t, w_x};
-            if (lorentz && motion.beta > 0) {
-                const double g = motion.gamma;
-                const Vec3 u = motion.velocity / motion.beta;
-                w = {g * (w_t + mesh4d::dot(motion.velocity, w_x)),
-                     w_x + (g - 1) * mesh4d::dot(w_x, u) * u + g * w_t * motion.velocity};
-            }
-            return w;
-        };
-        double guess = hi;
-        out.ok = false;
-        for (int round = 0; round < 8 && !out.ok; ++round) {
-            mesh4d::ViewSurface moved = last;
-            const mesh4d::Event w = apexShift(guess);
-            moved.t_c += e * w.t;
-            moved.apex = moved.apex + e * w.x;
-            const double next = crossings(moved, slab_shift, false);
-            if (next <= guess || a == 0) {
-                hi = next;  // without an acceleration W is constant: one round is exact
-                out.ok = true;
-            } else {
-                guess += 2 * (next - guess);  // overshoot; W grows as e^(|a| guess), so this may not close
-            }
-        }
+    if (cone && lorentz && accelerated) {
+        // Step: Born-rigid acceleration, the latest crossing of any point of the triangles, bounded
+        // in the body's own (Rindler) time and refined to within kLatestTolerance offsets
+        // (mesh4d/latest_crossing.h).
+        mesh4d::ViewSurface moved = last;
+        moved.t_c += slab_shift;
+        const mesh4d::LatestCrossing latest = mesh4d::latestCrossing(rest, motion, moved, kLatestTolerance * offset,
+                                                                     kLatestMaxSplits);
+        out.ok = latest.ok;
+        hi = std::max(hi, latest.bound);
+    } else if (cone && e > 0) {
+        // Step: a keyframed path (F_V) or a Galilean carry (the lab): F(s) is one frame for every
+        // s, so the vertex within e of a point crosses the view whose apex is moved by e U, U that
+        // frame's 4-velocity (boosted with `velocity` for Lorentz), at or after the point.
+        mesh4d::Event w{1, {0, 0, 0}};
+        if (lorentz && motion.beta > 0) w = {motion.gamma, motion.gamma * motion.velocity};
+        mesh4d::ViewSurface moved = last;
+        moved.t_c += e * w.t;
+        moved.apex = moved.apex + e * w.x;
+        hi = crossings(moved, slab_shift, false);
     }
     if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi)) out.ok = false;
     const double widen = 1e-9 * std::max(std::fabs(lo), std::fabs(hi));

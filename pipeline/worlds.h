@@ -15,7 +15,9 @@ namespace apparent {
 
 // The 4D history of one object for `model`, extruded over the proper-time span that frames
 // [first_frame, last_frame] (global numbers, both included) can see from the scene's camera,
-// padded by the object's light-crossing time; only ends of the object's existence are real caps.
+// padded by the object's light-crossing time over 1 - b (b its speed; for an acceleration the
+// fastest over the span, the pad at most 64 / |a|, and the span never short of the one
+// pathSpanSeen proves); only ends of the object's existence are real caps.
 // Empty (motion set, no tetrahedra) when the object does not exist within that span. In the frame
 // the cut is made in (physics.h cutMotionOf: the camera's, or the lab for finite).
 mesh4d::World4D buildWorld(const PreparedObject& object, Model model, const Scene& scene, long long first_frame,
@@ -57,28 +59,27 @@ mesh4d::ProperTimeSpan spinSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::
 //     A slab point Z within d of a true event E: on the cone, t_E >= t_c - sqrt(2) d - |x_E - C|,
 //     so E is behind the view whose apex time is t_c - sqrt(2) d (t_c - d on a hyperplane): lo is
 //     the least vertex crossing of that view.
-//   hi: on a hyperplane h is affine in q, so no point crosses after every vertex. On a cone, at a
-//     fixed s these bodies are their rest mesh moved rigidly in one inertial frame F(s) whose
-//     simultaneity holds all events at that s (keyframed: F_V, or the lab for Galilean; Born-rigid
-//     acceleration: the momentary rest frame; Galilean: the lab). A point p crossing at sigma has a
-//     vertex q_i of its triangle within e (the longest rest edge), simultaneous with it in
-//     F(sigma), so t'_i = t'_p = t'_c - |x'_p - C'| <= t'_c + e - |x'_i - C'| in F(sigma): q_i's
-//     event at sigma is behind the cone whose apex is moved by e U (U F(sigma)'s 4-velocity), and
-//     so behind the cone whose apex time is t_c + e g_F (1 + b_F) (that apex lies in the future
-//     light cone of the other), b_F the speed of F(sigma) in the lab; q_i crosses that cone at or
-//     after sigma. Cones with apexes A + e U(sigma) for all sigma in [lo', hi'] (lo' the least
-//     vertex crossing of the last view, hi' a guess of the largest point crossing) lie behind the
-//     cone with apex A + e W, W the least vector with W - U(sigma) future causal for all of them:
-//     in the own frame (F_V, the start frame; the lab for Galilean) U = (cosh phi, k sinh phi),
-//     phi = |a| max(sigma, 0) (0 for a keyframed path), so in light-cone coordinates W_+ =
-//     e^phi(hi'), W_- = e^-phi(lo'); boosted with `velocity` for Lorentz. With the slabs' d as
-//     for lo, hi is the largest vertex crossing of the last view with apex A + e W + (sqrt(2) d, 0),
-//     accepted when it is <= hi' (the crossings of a triangle's points form an interval through
-//     its vertices', which cannot jump past hi'); a keyframed path's W is constant (one round).
-//     An acceleration's W grows as e^(|a| hi'): across a body whose crossings spread over
-//     1/|a| or more (the rocket of data/scenes: 2 ls long at 0.5 ls/s^2) no guess closes.
-// Widened by 1e-9 |s| for the crossings' rounding (worldline.h: 1e-14 relative). ok = false when no
-// guess closed in 8 rounds: the caller then keeps the padded span of buildWorld.
+//   hi: on a hyperplane h is affine in q, so no point crosses after every vertex. On a cone, with
+//     the slabs' d as for lo (the last view's apex time moved by sqrt(2) d):
+//     - Born-rigid acceleration (relativistic): mesh4d/latest_crossing.h. The body's own time s is
+//       a static (Rindler) time, in which light crosses rest distance at coordinate speed
+//       min(1, |a| xi) (xi = 1/|a| + q.k), so two points' crossings differ by at most their
+//       distance over that speed: a triangle's points cross at most r / min(1, |a| xi_min) after
+//       its latest vertex (r: every point within r of a vertex), a bound refined by branch and
+//       bound on sub-triangles to within kLatestTolerance (4) offsets of a crossing computed
+//       (worlds.cpp; at most 4096 splits). The rocket of data/scenes (2 ls long at 0.5 ls/s^2,
+//       tests/raytrace_span_test.cpp): hi at most 0.012 s of its time past the latest emission of
+//       its sampled points over frames 0-159, where interior points emit up to 0.009 s after
+//       every vertex (frame 80).
+//     - Keyframed path or Galilean carry (finite): at a fixed s the body is its rest mesh moved
+//       rigidly in one inertial frame F (F_V; the lab) whose simultaneity holds all events at that
+//       s. A point p crossing at sigma has a vertex q_i of its triangle within e (the longest rest
+//       edge), simultaneous with it in F, so t'_i = t'_p = t'_c - |x'_p - C'| <= t'_c + e -
+//       |x'_i - C'|: q_i's event at sigma is behind the cone whose apex is moved by e U (U F's
+//       4-velocity, boosted with `velocity` for Lorentz), and q_i crosses that cone at or after
+//       sigma: hi is the largest vertex crossing of the moved cone.
+// Widened by 1e-9 |s| for the crossings' rounding (worldline.h: 1e-14 relative). ok = false only for
+// NaN or infinite crossings: the caller then keeps the padded span of buildWorld.
 struct SeenSpan {
     mesh4d::ProperTimeSpan span;
     bool ok = true;

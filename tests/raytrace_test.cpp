@@ -31,6 +31,7 @@
 #include "pipeline/worlds.h"
 #include "keyed_gltf.h"
 #include "test_meshes.h"
+#include "mesh_caster.h"
 #include "quiet_stage.h"
 
 #include "temp_dir.h"
@@ -260,87 +261,7 @@ TEST(RaytraceScene, BadLightAndMirrorFields) {
     std::filesystem::remove_all(dir);
 }
 
-namespace {
-
-// A plain 3D ray caster over triangles with object ids: the triangles are binned by their
-// screen-space bounding boxes into 8 x 8 pixel tiles, then every pixel ray is tested (Moeller-
-// Trumbore) against its tile's triangles; the nearest hit wins.
-class MeshCaster {
-public:
-    MeshCaster(const CameraSpec& cam, int width, int height) : cam_(cam), w_(width), h_(height) {
-        const Vec3 f0 = cam.look_at - cam.position;
-        f_ = f0 / mesh4d::norm(f0);
-        const Vec3 r0 = mesh4d::cross(f_, cam.up);
-        r_ = r0 / mesh4d::norm(r0);
-        u_ = mesh4d::cross(r_, f_);
-        half_h_ = std::tan(cam.fov_deg * 3.14159265358979323846 / 360);
-        half_w_ = half_h_ * width / height;
-        tiles_x_ = (w_ + 7) / 8;
-        tiles_y_ = (h_ + 7) / 8;
-        tiles_.assign(size_t(tiles_x_ * tiles_y_), {});
-    }
-
-    void add(const Vec3& a, const Vec3& b, const Vec3& c, int32_t id) {
-        const size_t index = tris_.size();
-        tris_.push_back({a, b, c, id});
-        // Screen bounds; a triangle reaching behind the camera covers every tile.
-        double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-        bool behind = false;
-        for (const Vec3& p : {a, b, c}) {
-            const Vec3 d = p - cam_.position;
-            const double z = mesh4d::dot(d, f_);
-            if (!(z > 1e-9)) { behind = true; break; }
-            const double sx = (mesh4d::dot(d, r_) / z / half_w_ + 1) * 0.5 * w_;
-            const double sy = (1 - mesh4d::dot(d, u_) / z / half_h_) * 0.5 * h_;
-            x0 = std::min(x0, sx); x1 = std::max(x1, sx); y0 = std::min(y0, sy); y1 = std::max(y1, sy);
-        }
-        int tx0 = 0, tx1 = tiles_x_ - 1, ty0 = 0, ty1 = tiles_y_ - 1;
-        if (!behind) {
-            tx0 = std::max(0, int(std::floor(x0 - 1)) / 8); tx1 = std::min(tiles_x_ - 1, int(std::floor(x1 + 1)) / 8);
-            ty0 = std::max(0, int(std::floor(y0 - 1)) / 8); ty1 = std::min(tiles_y_ - 1, int(std::floor(y1 + 1)) / 8);
-            if (x1 < -1 || y1 < -1) return;
-        }
-        for (int ty = ty0; ty <= ty1; ++ty)
-            for (int tx = tx0; tx <= tx1; ++tx) tiles_[size_t(ty * tiles_x_ + tx)].push_back(index);
-    }
-
-    int32_t cast(int px, int py) const {
-        const Vec3 d = pixelDirection(cam_, w_, h_, px, py);
-        double best = INFINITY;
-        int32_t id = -1;
-        for (size_t i : tiles_[size_t((py / 8) * tiles_x_ + px / 8)]) {
-            const Tri& t = tris_[i];
-            const Vec3 e1 = t.b - t.a, e2 = t.c - t.a;
-            const Vec3 p = mesh4d::cross(d, e2);
-            const double det = mesh4d::dot(e1, p);
-            if (det == 0) continue;
-            const Vec3 s = cam_.position - t.a;
-            const double bu = mesh4d::dot(s, p) / det;
-            if (bu < 0 || bu > 1) continue;
-            const Vec3 q = mesh4d::cross(s, e1);
-            const double bv = mesh4d::dot(d, q) / det;
-            if (bv < 0 || bu + bv > 1) continue;
-            const double dist = mesh4d::dot(e2, q) / det;
-            if (dist > 0 && dist < best) { best = dist; id = t.id; }
-        }
-        return id;
-    }
-
-private:
-    struct Tri {
-        Vec3 a, b, c;
-        int32_t id;
-    };
-    CameraSpec cam_;
-    int w_, h_;
-    Vec3 f_, r_, u_;
-    double half_w_ = 1, half_h_ = 1;
-    int tiles_x_ = 1, tiles_y_ = 1;
-    std::vector<Tri> tris_;
-    std::vector<std::vector<size_t>> tiles_;
-};
-
-}  // namespace
+using testcast::MeshCaster;
 
 // The cross-check of issue #7 on one scene with one mirror, every model, every `stride`-th frame
 // at 240 x 135: the object each pixel shows first, by the 4D raytracer and by a 3D ray cast over
