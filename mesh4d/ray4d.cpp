@@ -196,7 +196,11 @@ TraceWorld prepareSlabsTrace(const std::vector<const World4D*>& slabs) {
     trace.world = slabs.front();
     trace.velocity = slabs.front()->motion.velocity;
     trace.split_time = true;
+    size_t prisms = 0;
+    for (const World4D* w : slabs) prisms += w->empty() ? 0 : w->mesh.triangles.size();
+    trace.prisms.reserve(prisms);
     std::vector<EventBox> boxes;
+    boxes.reserve(prisms);
     for (const World4D* w : slabs) {
         if (w->empty()) continue;
         trace.slabs.push_back(w);

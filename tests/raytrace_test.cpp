@@ -1226,6 +1226,46 @@ TEST(RaytraceSpan, WindowsOfFramesTraceWhatOneWindowTraces) {
     }
 }
 
+// Issue 18: a window keeps the slabs it shares with the last one (SceneTracer TraceChunk): frames
+// traced one window after another extrude each slab of their range once, exactly the slabs one
+// window over the range extrudes, and give its pictures byte for byte. Backwards the same, but
+// for the first window (the constructor's, at the range's start), whose slabs the window of the
+// last frame drops.
+TEST(RaytraceSpan, AWindowExtrudesOnlyTheSlabsTheLastOneDidNotHold) {
+    Stage stage;
+    std::string error;
+    ASSERT_TRUE(loadQuietStage(source("data/scenes/keyed.gltf"), &stage, &error, {Model::Relativistic})) << error;
+    const std::vector<long long> frames{100, 102, 104, 106, 108, 110};
+    const TracedRun one = traceRun(stage, Model::Relativistic, 100, 110, frames, {});
+    TracerOptions narrow;
+    narrow.window_slabs = 420;  // frames 100..110 need 492: windows of a few frames
+    const size_t first_window = SceneTracer(stage.scene, stage.objects, stage.mirrors, Model::Relativistic, 100, 110, narrow)
+                                    .slabCounts()
+                                    .built;
+    for (bool backwards : {false, true}) {
+        std::vector<long long> order = frames;
+        if (backwards) std::reverse(order.begin(), order.end());
+        const TracedRun windows = traceRun(stage, Model::Relativistic, 100, 110, order, narrow);
+        std::cout << "[window reuse] keyed.gltf frames 100..110" << (backwards ? " backwards" : "") << ": "
+                  << windows.counts.windows << " windows extruded " << windows.counts.built << " slabs; one window "
+                  << one.counts.built << "\n";
+        EXPECT_GE(windows.counts.windows, 3u);
+        EXPECT_LE(windows.counts.most, 420u);
+        if (backwards) {  // without reuse: a window of 400 slabs or more per frame
+            EXPECT_GE(windows.counts.built, one.counts.built);
+            EXPECT_LE(windows.counts.built, one.counts.built + first_window);
+        } else {
+            EXPECT_EQ(windows.counts.built, one.counts.built);
+        }
+        for (size_t i = 0; i < order.size(); ++i) {
+            const size_t j = size_t(order[i] - 100) / 2;
+            EXPECT_GT(coveredPixels(windows.objects[i]), 100) << order[i];
+            EXPECT_EQ(one.objects[j], windows.objects[i]) << order[i];
+            EXPECT_TRUE(one.images[j].rgb == windows.images[i].rgb) << order[i];
+        }
+    }
+}
+
 // Issue 18: only a frame that alone needs more slabs than one window may hold is refused, with one
 // line naming the field, the count and the frame (exit 2): the rolling wheel at 0.99c (w R = |v|).
 TEST(RaytraceSpan, AFrameThatAloneNeedsTooManySlabsIsRefused) {
