@@ -301,6 +301,18 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
     }
     planner_ = std::make_unique<SlabPlanner>(scene, objects, mirrors_, model, options_.padded_span);
     if (!planner_->objects().empty()) buildWindow(first_frame);
+    listTraces();
+}
+
+void SceneTracer::listTraces() {
+    trace_refs_.clear();
+    for (size_t object = 0; object < objects_.size(); ++object) {
+        const ObjectTraces& o = objects_[object];
+        for (size_t c = o.chunks.size(); c-- > 0;)
+            for (size_t i = o.chunks[c]->traces.size(); i-- > 0;)
+                trace_refs_.push_back({&o.chunks[c]->traces[i], &o.chunks[c]->trace_worlds[i], int32_t(object),
+                                       mirror_of_object_[object] >= 0});
+    }
 }
 
 SceneTracer::~SceneTracer() = default;
@@ -428,18 +440,13 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
     // Objects in scene order; an object's chunks and traces (its time slabs, when scanned one by
     // one) latest first: the ray runs back in time, so the first slab it hits holds that object's
     // nearest hit, and the earlier slabs then fail their root box at once.
-    for (size_t object = 0; object < objects_.size(); ++object) {
-        if (skip_mirrors && mirror_of_object_[object] >= 0) continue;
-        const ObjectTraces& o = objects_[object];
-        for (size_t c = o.chunks.size(); c-- > 0;) {
-            const TraceChunk& chunk = *o.chunks[c];
-            for (size_t i = chunk.traces.size(); i-- > 0;)
-                if (const auto h = mesh4d::intersectWorld(chunk.traces[i], ray, s_max)) {
-                    s_max = h->s;
-                    best.object = int32_t(object);
-                    best.world = chunk.trace_worlds[i][h->slab];
-                    best.hit = *h;
-                }
+    for (const TraceRef& r : trace_refs_) {
+        if (skip_mirrors && r.mirror) continue;
+        if (const auto h = mesh4d::intersectWorld(*r.trace, ray, s_max)) {
+            s_max = h->s;
+            best.object = r.object;
+            best.world = (*r.worlds)[h->slab];
+            best.hit = *h;
         }
     }
     return best;
@@ -499,7 +506,10 @@ std::array<double, 3> SceneTracer::shadeReflected(const Hit& h, const mesh4d::Vi
 }
 
 TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) {
-    if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) buildWindow(k);
+    if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) {
+        buildWindow(k);
+        listTraces();
+    }
     TracedFrame frame;
     frame.image = RgbImage(width, height);
     frame.object.assign(size_t(width) * size_t(height), -1);
