@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "worldline.h"
+
 namespace mesh4d {
 
 namespace {
@@ -180,6 +182,7 @@ void buildHierarchy(TraceWorld* trace, const std::vector<EventBox>& boxes) {
 TraceWorld prepareTrace(const World4D& world, bool hierarchy) {
     TraceWorld trace;
     trace.world = &world;
+    trace.flat_prisms = isUniform(world.motion);
     if (world.empty()) return trace;
     trace.prisms.reserve(world.mesh.triangles.size());
     trace.velocity = hierarchy ? world.motion.velocity : Vec3{0, 0, 0};
@@ -196,7 +199,12 @@ TraceWorld prepareSlabsTrace(const std::vector<const World4D*>& slabs) {
     trace.world = slabs.front();
     trace.velocity = slabs.front()->motion.velocity;
     trace.split_time = true;
+    trace.flat_prisms = isUniform(slabs.front()->motion);
+    size_t prisms = 0;
+    for (const World4D* w : slabs) prisms += w->empty() ? 0 : w->mesh.triangles.size();
+    trace.prisms.reserve(prisms);
     std::vector<EventBox> boxes;
+    boxes.reserve(prisms);
     for (const World4D* w : slabs) {
         if (w->empty()) continue;
         trace.slabs.push_back(w);
@@ -260,17 +268,26 @@ std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray
     };
     auto testPrism = [&](size_t f) {
         const TraceWorld::Prism& p = trace.prisms[f];
-        // Step: cheap rejection: where the ray meets the prism's 3-flat must be ahead, nearer than
-        // the best hit so far and inside the prism's bounds (slack of 1e-9 of the box and the
-        // position, far above the rounding of s, far below any pixel).
-        const double nd = dot4(p.normal, d);
-        if (nd == 0) return;
-        const double s_flat = (p.offset - dot4(p.normal, o)) / nd;
-        const double slack_s = 1e-9 * (std::fabs(s_flat) + 1);
-        if (!(s_flat > -slack_s && s_flat < best.s + slack_s)) return;
-        const Event at = ray.at(s_flat);
-        const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
-        if (!p.box.contains(at, slack)) return;
+        if (trace.flat_prisms) {
+            // Step: cheap rejection: where the ray meets the prism's 3-flat must be ahead, nearer
+            // than the best hit so far and inside the prism's bounds (slack of 1e-9 of the box and
+            // the position, far above the rounding of s, far below any pixel).
+            const double nd = dot4(p.normal, d);
+            if (nd == 0) return;
+            const double s_flat = (p.offset - dot4(p.normal, o)) / nd;
+            const double slack_s = 1e-9 * (std::fabs(s_flat) + 1);
+            if (!(s_flat > -slack_s && s_flat < best.s + slack_s)) return;
+            const Event at = ray.at(s_flat);
+            const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
+            if (!p.box.contains(at, slack)) return;
+        } else {
+            // Step: a twisted prism (flat_prisms): the ray must pass through its box ahead of the
+            // origin and nearer than the best hit so far (slack as above).
+            const double slack =
+                1e-9 * (p.box.diagonal() + (p.box.t_hi - p.box.t_lo) + norm(ray.origin.x) + std::fabs(ray.origin.t) + 1);
+            double s_lo = -slack, s_hi = best.s + slack * (1 + std::fabs(best.s));
+            if (!slab(p.box, slack, o, d, &s_lo, &s_hi)) return;
+        }
         // Step: the prism's world (its slab) and triangle there.
         uint32_t slab = 0, triangle = uint32_t(f);
         if constexpr (kSlabs) {

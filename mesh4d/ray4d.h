@@ -87,6 +87,11 @@ struct TraceWorld {
     std::vector<const World4D*> slabs;
     std::vector<uint32_t> slab_first;    // per slab its first prism: prism p of slab k is its triangle p - slab_first[k]
     bool split_time = false;             // the hierarchy may split along t (only with slabs)
+    // Each prism's three tetrahedra lie in its one 3-flat (`normal`, `offset`): true for uniform
+    // motion, where the prism is the affine image of triangle x interval. A slab of a spin or a
+    // keyframed turn twists its lateral quads (extrude.h slabSpacing), so its tetrahedra lie in
+    // three 3-flats: a ray is then kept or dropped by the prism's box along it, not by the flat.
+    bool flat_prisms = true;
 };
 constexpr uint32_t kLeafPrisms = 4;
 

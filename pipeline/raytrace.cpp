@@ -343,87 +343,160 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
         lab_motions_.push_back(motionOf(objects[i].spec, model));
         motions_.push_back(cutMotionOf(objects[i].spec, model, scene).motion);
         if (isSlabbed(objects[i].spec)) continue;
-        objects_[i].worlds.push_back(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame));
-        setTraces(&objects_[i]);
+        objects_[i].chunks = {
+            makeChunk({std::make_shared<const mesh4d::World4D>(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame))},
+                      false)};
     }
     planner_ = std::make_unique<SlabPlanner>(scene, objects, mirrors_, model, options_.padded_span,
                                             options_.span_margin);
     if (!planner_->objects().empty()) buildWindow(first_frame);
+    listTraces();
+}
+
+void SceneTracer::listTraces() {
+    trace_refs_.clear();
+    for (size_t object = 0; object < objects_.size(); ++object) {
+        const ObjectTraces& o = objects_[object];
+        for (size_t c = o.chunks.size(); c-- > 0;)
+            for (size_t i = o.chunks[c]->traces.size(); i-- > 0;)
+                trace_refs_.push_back({&o.chunks[c]->traces[i], &o.chunks[c]->trace_worlds[i], int32_t(object),
+                                       mirror_of_object_[object] >= 0});
+    }
 }
 
 SceneTracer::~SceneTracer() = default;
 
 size_t SceneTracer::worldCount() const {
     size_t n = 0;
-    for (const ObjectTraces& o : objects_) n += o.worlds.size();
+    for (const ObjectTraces& o : objects_)
+        for (const auto& c : o.chunks) n += c->worlds.size();
     return n;
 }
 
-void SceneTracer::setTraces(ObjectTraces* o) const {
-    o->traces.clear();
-    o->trace_worlds.clear();
-    // An object of several time slabs is traced through one hierarchy over all of them (ray4d.h
+std::shared_ptr<const SceneTracer::TraceChunk> SceneTracer::makeChunk(
+    std::vector<std::shared_ptr<const mesh4d::World4D>> worlds, bool slabs) const {
+    auto chunk = std::make_shared<TraceChunk>();
+    chunk->worlds = std::move(worlds);
+    // Several time slabs are traced through one hierarchy over all of them (ray4d.h
     // prepareSlabsTrace); without the hierarchy (the benchmarks' peer) each slab is scanned alone.
-    if (o->worlds.size() > 1 && options_.hierarchy) {
-        std::vector<const mesh4d::World4D*> slabs;
-        std::vector<uint32_t> world_of_slab;  // the trace leaves out empty slabs: its slab numbers to worlds
-        for (size_t i = 0; i < o->worlds.size(); ++i) {
-            slabs.push_back(&o->worlds[i]);
-            if (!o->worlds[i].empty()) world_of_slab.push_back(uint32_t(i));
+    if (slabs && chunk->worlds.size() > 1 && options_.hierarchy) {
+        std::vector<const mesh4d::World4D*> all;
+        std::vector<const mesh4d::World4D*> world_of_slab;  // the trace leaves out empty slabs: its slab numbers to worlds
+        for (const auto& w : chunk->worlds) {
+            all.push_back(w.get());
+            if (!w->empty()) world_of_slab.push_back(w.get());
         }
-        o->traces.push_back(mesh4d::prepareSlabsTrace(slabs));
-        o->trace_worlds.push_back(std::move(world_of_slab));
-        return;
+        chunk->traces.push_back(mesh4d::prepareSlabsTrace(all));
+        chunk->trace_worlds.push_back(std::move(world_of_slab));
+        return chunk;
     }
-    for (size_t i = 0; i < o->worlds.size(); ++i) {
-        o->traces.push_back(mesh4d::prepareTrace(o->worlds[i], options_.hierarchy));
-        o->trace_worlds.push_back({uint32_t(i)});
+    for (const auto& w : chunk->worlds) {
+        chunk->traces.push_back(mesh4d::prepareTrace(*w, options_.hierarchy));
+        chunk->trace_worlds.push_back({w.get()});
     }
+    return chunk;
 }
+
+namespace {
+
+// Prisms of one hierarchy over consecutive time slabs (TraceChunk): enough that a ray crossing
+// thousands of slabs meets few chunks' roots, few enough that the chunk a window cuts and
+// rebuilds costs little beside the window. At most kChunkSlabs slabs. Measured on the rolling
+// wheel (792 prisms a slab, docs/PERFORMANCE.md): 2^16 (82 slabs) to 2^18 prisms trace a frame
+// about as fast, and faster than one hierarchy over the window's 2587 slabs (which is also slower
+// to build); 2^13 slower.
+constexpr size_t kChunkPrisms = size_t(1) << 16;
+constexpr size_t kChunkSlabs = 256;
+
+}  // namespace
 
 void SceneTracer::buildWindow(long long k) {
     // Step: the window from k: the longest run of frames whose slabs fit (the callers checked that
-    // frame k alone does); the old window's slabs go first, so that at most one window is held.
+    // frame k alone does).
     const long long end = std::max(k, planner_->windowEnd(k, last_, options_.window_slabs));
-    size_t slabs = 0;
+    size_t slabs = 0, built = 0;
     for (const SlabPlanner::Slabbed& o : planner_->objects()) {
         ObjectTraces& traces = objects_[o.object];
-        traces = {};
         const SlabPlanner::Span span = planner_->span(o, k, end);
         const std::vector<double> times = planner_->samples(o, span, std::numeric_limits<size_t>::max());
         if (times.size() < 2) {  // the object does not exist in the window
-            mesh4d::World4D empty;
-            empty.motion = o.motion;
-            traces.worlds.push_back(std::move(empty));
-        } else {
-            traces.worlds = mesh4d::extrudeSlabs(o.rest, o.motion, times, span.real_a, span.real_b);
-            slabs += traces.worlds.size();
+            auto empty = std::make_shared<mesh4d::World4D>();
+            empty->motion = o.motion;
+            traces.chunks = {makeChunk({std::move(empty)}, false)};
+            continue;
         }
-        setTraces(&traces);
+        const size_t n = times.size() - 1;
+        slabs += n;
+        // Step: the last window's slabs that this one has (the same times and caps: the grid makes
+        // them the same slabs), and its chunks made only of them, at their places among the n.
+        auto wanted = [&](const mesh4d::World4D& w, size_t i) {
+            return w.tau_a == times[i] && w.tau_b == times[i + 1] && w.cap_a_real == (span.real_a && i == 0) &&
+                   w.cap_b_real == (span.real_b && i + 1 == n);
+        };
+        std::vector<std::shared_ptr<const mesh4d::World4D>> slab(n);
+        std::vector<std::shared_ptr<const TraceChunk>> kept(n);  // by the place of its first slab
+        for (const auto& chunk : traces.chunks) {
+            bool whole = true;
+            for (const auto& w : chunk->worlds) {
+                const size_t i = size_t(std::lower_bound(times.begin(), times.end() - 1, w->tau_a) - times.begin());
+                if (i < n && wanted(*w, i)) slab[i] = w;
+                else whole = false;
+            }
+            if (whole) kept[size_t(std::lower_bound(times.begin(), times.end() - 1, chunk->worlds.front()->tau_a) - times.begin())] = chunk;
+        }
+        // Step: the rest of the last window goes before anything new is built.
+        traces.chunks.clear();
+        // Step: the new slabs, in runs of consecutive places.
+        for (size_t i = 0; i < n;) {
+            if (slab[i]) {
+                ++i;
+                continue;
+            }
+            size_t j = i;
+            while (j < n && !slab[j]) ++j;
+            const std::vector<double> run(times.begin() + long(i), times.begin() + long(j) + 1);
+            std::vector<mesh4d::World4D> made =
+                mesh4d::extrudeSlabs(o.rest, o.motion, run, span.real_a && i == 0, span.real_b && j == n);
+            for (size_t m = 0; m < made.size(); ++m) slab[i + m] = std::make_shared<const mesh4d::World4D>(std::move(made[m]));
+            built += j - i;
+            i = j;
+        }
+        // Step: the chunks: the kept ones, and the places between them cut into new chunks of at
+        // most kChunkPrisms prisms (kChunkSlabs slabs).
+        const size_t per_chunk =
+            std::clamp<size_t>(kChunkPrisms / std::max<size_t>(1, o.rest.triangles.size()), 1, kChunkSlabs);
+        for (size_t i = 0; i < n;) {
+            if (kept[i]) {
+                traces.chunks.push_back(std::move(kept[i]));
+                i += traces.chunks.back()->worlds.size();
+                continue;
+            }
+            std::vector<std::shared_ptr<const mesh4d::World4D>> worlds;
+            for (; i < n && !kept[i] && worlds.size() < per_chunk; ++i) worlds.push_back(slab[i]);
+            traces.chunks.push_back(makeChunk(std::move(worlds), true));
+        }
     }
     window_first_ = k;
     window_last_ = end;
     ++slab_counts_.windows;
-    slab_counts_.built += slabs;
+    slab_counts_.built += built;
     slab_counts_.most = std::max(slab_counts_.most, slabs);
 }
 
 SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
     Hit best;
     double s_max = INFINITY;
-    // Objects in scene order; an object's traces (its time slabs, when scanned one by one) latest
-    // first: the ray runs back in time, so the first slab it hits holds that object's nearest hit,
-    // and the earlier slabs then fail their root box at once.
-    for (size_t object = 0; object < objects_.size(); ++object) {
-        if (skip_mirrors && mirror_of_object_[object] >= 0) continue;
-        const ObjectTraces& o = objects_[object];
-        for (size_t i = o.traces.size(); i-- > 0;)
-            if (const auto h = mesh4d::intersectWorld(o.traces[i], ray, s_max)) {
-                s_max = h->s;
-                best.object = int32_t(object);
-                best.world = o.trace_worlds[i][h->slab];
-                best.hit = *h;
-            }
+    // Objects in scene order; an object's chunks and traces (its time slabs, when scanned one by
+    // one) latest first: the ray runs back in time, so the first slab it hits holds that object's
+    // nearest hit, and the earlier slabs then fail their root box at once.
+    for (const TraceRef& r : trace_refs_) {
+        if (skip_mirrors && r.mirror) continue;
+        if (const auto h = mesh4d::intersectWorld(*r.trace, ray, s_max)) {
+            s_max = h->s;
+            best.object = r.object;
+            best.world = (*r.worlds)[h->slab];
+            best.hit = *h;
+        }
     }
     return best;
 }
@@ -461,7 +534,7 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
             // The hit's own time kept inside its slab, short of its closing key, so that the segment
             // is this slab's (keyframes.h gives a key to the segment it starts); the camera is at
             // rest for these motions.
-            const mesh4d::World4D& slab = objects_[size_t(h.object)].worlds[h.world];
+            const mesh4d::World4D& slab = *h.world;
             const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));
             d = mesh4d::worldlineDoppler(motion, kind, receiver, s, h.hit.rest_point, emitted_at);
         }
@@ -484,7 +557,10 @@ std::array<double, 3> SceneTracer::shadeReflected(const Hit& h, const mesh4d::Vi
 }
 
 TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) {
-    if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) buildWindow(k);
+    if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) {
+        buildWindow(k);
+        listTraces();
+    }
     TracedFrame frame;
     frame.image = RgbImage(width, height);
     frame.object.assign(size_t(width) * size_t(height), -1);

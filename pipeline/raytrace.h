@@ -71,7 +71,10 @@ class SlabPlanner;
 // options.window_slabs and kMaxTraceSlabPrisms per object; a frame outside it gets a new window
 // from that frame. The grid makes a slab the same in every window that holds it, so each frame's
 // picture is the same whichever windows the frames were traced in (and as one window over a short
-// range). Memory: at most one window's slabs at a time.
+// range). A new window keeps the slabs it shares with the last one, and their hierarchies in
+// chunks of consecutive slabs (TraceChunk), extruding only its new slabs and building the
+// hierarchies only of its new chunks and of a kept chunk's remainder. Memory: at most one
+// window's slabs at a time (those of the last window it does not hold go first).
 class SceneTracer {
 public:
     // Preconditions: the scene passed checkSceneForModel for `model` and every frame first..last
@@ -94,7 +97,8 @@ public:
     // The traced worlds of the current window: one per object, or one per time slab of an object
     // whose motion is not uniform.
     size_t worldCount() const;
-    // Windows built so far, the time slabs built over all of them, the most held at once.
+    // Windows built so far, the time slabs extruded for them (a slab a window shares with the last
+    // one is not extruded again), the most one window holds.
     struct SlabCounts {
         size_t windows = 0, built = 0, most = 0;
     };
@@ -103,17 +107,35 @@ public:
 private:
     struct Hit {
         int32_t object = -1;
-        uint32_t world = 0;  // the world (time slab) hit, in its object's worlds
+        const mesh4d::World4D* world = nullptr;  // the world (time slab) hit
         mesh4d::WorldHit hit;
     };
-    // One object's worlds and their traces: one world, or one per time slab (traced through one
-    // hierarchy over all of them, ray4d.h prepareSlabsTrace; scanned one by one without it).
-    struct ObjectTraces {
-        std::vector<mesh4d::World4D> worlds;
-        std::vector<mesh4d::TraceWorld> traces;
-        std::vector<std::vector<uint32_t>> trace_worlds;  // per trace, the world of each of its slabs
+    // A run of an object's worlds consecutive in time and their traces: one world, or time slabs
+    // traced through one hierarchy (ray4d.h prepareSlabsTrace; each scanned alone without it). A
+    // window of frames keeps the chunks of the last window that it holds whole, so their slabs and
+    // hierarchies are built once; a chunk shares the slabs it has with one it was cut from.
+    struct TraceChunk {
+        std::vector<std::shared_ptr<const mesh4d::World4D>> worlds;  // in time order
+        std::vector<mesh4d::TraceWorld> traces;                      // they point into the worlds
+        std::vector<std::vector<const mesh4d::World4D*>> trace_worlds;  // per trace, the world of each of its slabs
     };
-    void setTraces(ObjectTraces* o) const;
+    // One object's chunks, in time order.
+    struct ObjectTraces {
+        std::vector<std::shared_ptr<const TraceChunk>> chunks;
+    };
+    // Every trace of every object in the order nearest() searches them (objects in scene order,
+    // an object's latest first), one flat list as on 648c0a5: the loops over objects, chunks and
+    // traces were 5 % of a uniform frame's instructions (callgrind, raytrace_bench BM_TraceFrame/1/0).
+    struct TraceRef {
+        const mesh4d::TraceWorld* trace = nullptr;
+        const std::vector<const mesh4d::World4D*>* worlds = nullptr;  // its slabs' worlds
+        int32_t object = -1;
+        bool mirror = false;  // the object is a mirror
+    };
+    void listTraces();
+    // The chunk of `worlds` (consecutive in time; slabs: the object's motion is not uniform).
+    std::shared_ptr<const TraceChunk> makeChunk(std::vector<std::shared_ptr<const mesh4d::World4D>> worlds,
+                                                bool slabs) const;
     // The window of time slabs that holds frame k.
     void buildWindow(long long k);
     Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
@@ -141,6 +163,7 @@ private:
     std::vector<mesh4d::Motion> motions_;       // per object
     std::vector<mesh4d::Motion> lab_motions_;   // each object's lab motion (reflections' Doppler)
     std::vector<ObjectTraces> objects_;         // per object
+    std::vector<TraceRef> trace_refs_;          // listTraces
     std::unique_ptr<SlabPlanner> planner_;      // the objects whose motion is not uniform
     SlabCounts slab_counts_;
     bool shade_doppler_ = false;

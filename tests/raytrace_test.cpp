@@ -1037,6 +1037,52 @@ TEST(Ray4D, SlabsHierarchyFindsWhatEachSlabsScanFinds) {
     EXPECT_GT(hits, 150);
 }
 
+// A slab of a spin twists its prisms: their tetrahedra lie in three 3-flats (ray4d.h
+// flat_prisms), so no prism-level flat may drop a ray. With coarse slabs (0.5 rad a slab) the
+// hierarchy over the slabs and each slab's linear scan find the nearest hit over every
+// tetrahedron of every slab tested one by one (intersectTet alone): the same ray parameter.
+TEST(Ray4D, TwistedPrismsOfSpinSlabsLoseNoHit) {
+    const mesh4d::RestMesh mesh = testmesh::cylinder(1, 0.3, 24);
+    mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0});
+    m.angular_velocity = {0, 0, -0.6};
+    std::vector<double> samples;
+    for (int k = 0; k <= 30; ++k) samples.push_back(-12 + 0.8 * k);
+    const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(mesh, m, samples, false, false);
+    std::vector<const mesh4d::World4D*> pointers;
+    std::vector<mesh4d::TraceWorld> scans;
+    for (const auto& w : slabs) {
+        pointers.push_back(&w);
+        scans.push_back(mesh4d::prepareTrace(w, false));
+    }
+    const mesh4d::TraceWorld joint = mesh4d::prepareSlabsTrace(pointers);
+    EXPECT_FALSE(joint.flat_prisms);
+    int hits = 0;
+    for (int iy = -20; iy <= 20; ++iy)
+        for (int ix = -40; ix <= 40; ++ix) {
+            mesh4d::Ray4D ray;
+            ray.origin = {6, {0, 0, 6}};
+            const Vec3 d{0.02 * ix, 0.02 * iy, -1};
+            ray.direction = d / mesh4d::norm(d);
+            double nearest = INFINITY;
+            for (const auto& w : slabs)
+                for (size_t t = 0; t < w.tetCount(); ++t) {
+                    const auto tet = w.tet(t);
+                    const std::array<mesh4d::Event, 4> v{w.events[tet[0]], w.events[tet[1]], w.events[tet[2]], w.events[tet[3]]};
+                    if (const auto h = mesh4d::intersectTet(ray, v, nearest)) nearest = h->s;
+                }
+            double scanned = INFINITY;
+            for (const auto& scan : scans)
+                if (const auto h = mesh4d::intersectWorld(scan, ray, scanned)) scanned = h->s;
+            const auto got = mesh4d::intersectWorld(joint, ray, INFINITY);
+            ASSERT_EQ(got.has_value(), nearest < INFINITY) << ix << " " << iy;
+            EXPECT_EQ(scanned, nearest) << ix << " " << iy;
+            if (!got) continue;
+            ++hits;
+            EXPECT_EQ(got->s, nearest) << ix << " " << iy;
+        }
+    EXPECT_GT(hits, 150);
+}
+
 namespace {
 
 // A cube of edge 0.3 ls (data/meshes/box.obj scaled) accelerating from rest at t0 = 0 along +x
@@ -1146,6 +1192,46 @@ TEST(RaytraceSpan, WindowsOfFramesTraceWhatOneWindowTraces) {
         EXPECT_GT(coveredPixels(one.objects[i]), 100) << frames[i];
         EXPECT_EQ(one.objects[i], windows.objects[i]) << frames[i];
         EXPECT_TRUE(one.images[i].rgb == windows.images[i].rgb) << frames[i];
+    }
+}
+
+// Issue 18: a window keeps the slabs it shares with the last one (SceneTracer TraceChunk): frames
+// traced one window after another extrude each slab of their range once, exactly the slabs one
+// window over the range extrudes, and give its pictures byte for byte. Backwards the same, but
+// for the first window (the constructor's, at the range's start), whose slabs the window of the
+// last frame drops.
+TEST(RaytraceSpan, AWindowExtrudesOnlyTheSlabsTheLastOneDidNotHold) {
+    Stage stage;
+    std::string error;
+    ASSERT_TRUE(loadQuietStage(source("data/scenes/keyed.gltf"), &stage, &error, {Model::Relativistic})) << error;
+    const std::vector<long long> frames{100, 102, 104, 106, 108, 110};
+    const TracedRun one = traceRun(stage, Model::Relativistic, 100, 110, frames, {});
+    TracerOptions narrow;
+    narrow.window_slabs = 420;  // frames 100..110 need 492: windows of a few frames
+    const size_t first_window = SceneTracer(stage.scene, stage.objects, stage.mirrors, Model::Relativistic, 100, 110, narrow)
+                                    .slabCounts()
+                                    .built;
+    for (bool backwards : {false, true}) {
+        std::vector<long long> order = frames;
+        if (backwards) std::reverse(order.begin(), order.end());
+        const TracedRun windows = traceRun(stage, Model::Relativistic, 100, 110, order, narrow);
+        std::cout << "[window reuse] keyed.gltf frames 100..110" << (backwards ? " backwards" : "") << ": "
+                  << windows.counts.windows << " windows extruded " << windows.counts.built << " slabs; one window "
+                  << one.counts.built << "\n";
+        EXPECT_GE(windows.counts.windows, 3u);
+        EXPECT_LE(windows.counts.most, 420u);
+        if (backwards) {  // without reuse: a window of 400 slabs or more per frame
+            EXPECT_GE(windows.counts.built, one.counts.built);
+            EXPECT_LE(windows.counts.built, one.counts.built + first_window);
+        } else {
+            EXPECT_EQ(windows.counts.built, one.counts.built);
+        }
+        for (size_t i = 0; i < order.size(); ++i) {
+            const size_t j = size_t(order[i] - 100) / 2;
+            EXPECT_GT(coveredPixels(windows.objects[i]), 100) << order[i];
+            EXPECT_EQ(one.objects[j], windows.objects[i]) << order[i];
+            EXPECT_TRUE(one.images[j].rgb == windows.images[i].rgb) << order[i];
+        }
     }
 }
 
