@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesh4d/event.h"
+#include "mesh4d/slice.h"
 #include "pipeline/raytrace.h"
 #include "pipeline/scene.h"
 
@@ -92,5 +93,43 @@ private:
     std::vector<Tri> tris_;
     std::vector<std::vector<size_t>> tiles_;
 };
+
+// A cut's apparent mesh cast as one object, id 0: the object id per pixel, row by row (-1 where
+// nothing is hit).
+inline std::vector<int32_t> castCut(const CameraSpec& cam, int w, int h, const mesh4d::ApparentMesh& cut) {
+    MeshCaster caster(cam, w, h);
+    for (const auto& t : cut.triangles)
+        caster.add(cut.absolutePosition(t[0]), cut.absolutePosition(t[1]), cut.absolutePosition(t[2]), 0);
+    std::vector<int32_t> image(size_t(w) * size_t(h));
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px) image[size_t(py * w + px)] = caster.cast(px, py);
+    return image;
+}
+
+// Two object-id pictures of one size compared: `shown` pixels show an object in either, `differ`
+// show different ones, and `far` of those have neither picture's object within one pixel in the
+// other picture (a difference of more than an edge's rasterization).
+struct ImageDifference {
+    long long shown = 0, differ = 0, far = 0;
+};
+inline ImageDifference compareObjectImages(const std::vector<int32_t>& a, const std::vector<int32_t>& b, int w, int h) {
+    auto near = [&](const std::vector<int32_t>& image, int px, int py, int32_t value) {
+        for (int y = std::max(0, py - 1); y <= std::min(h - 1, py + 1); ++y)
+            for (int x = std::max(0, px - 1); x <= std::min(w - 1, px + 1); ++x)
+                if (image[size_t(y * w + x)] == value) return true;
+        return false;
+    };
+    ImageDifference d;
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px) {
+            const int32_t va = a[size_t(py * w + px)], vb = b[size_t(py * w + px)];
+            if (va < 0 && vb < 0) continue;
+            ++d.shown;
+            if (va == vb) continue;
+            ++d.differ;
+            d.far += !near(b, px, py, va) || !near(a, px, py, vb);
+        }
+    return d;
+}
 
 }  // namespace testcast

@@ -20,6 +20,7 @@
 #include "mesh4d/angles.h"
 #include "pipeline/raytrace.h"
 #include "quiet_stage.h"
+#include "srgb.h"
 
 using namespace apparent;
 using mesh4d::Vec3;
@@ -28,14 +29,8 @@ namespace {
 
 Vec3 unit(const Vec3& v) { return v / mesh4d::norm(v); }
 
-double srgbToLinear(int v) {
-    const double s = v / 255.0;
-    return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
-}
-int linearToSrgb8(double c) {
-    c = std::clamp(c, 0.0, 1.0);
-    return int(std::lround(255 * (c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055)));
-}
+using testio::linearToSrgb8;
+using testio::srgbToLinear;
 
 // The camera-frame direction k in which a camera at the lab origin, moving at v, sees
 // light that reached it along the lab direction d (from the camera towards the source), and back.

@@ -301,33 +301,14 @@ TEST(RaytraceSpan, RocketAtLateFramesMatchesTheRefinedCut) {
         mesh4d::SliceSettings slice;
         slice.tolerance = 1e-3 * box.diagonal();
         const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(world, viewForFrame(scene, Model::Relativistic, k), slice);
-        testcast::MeshCaster caster(scene.camera, w, h);
-        for (const auto& t : cut.triangles)
-            caster.add(cut.absolutePosition(t[0]), cut.absolutePosition(t[1]), cut.absolutePosition(t[2]), 0);
-        std::vector<int32_t> cast(size_t(w * h));
-        for (int py = 0; py < h; ++py)
-            for (int px = 0; px < w; ++px) cast[size_t(py * w + px)] = caster.cast(px, py);
-        auto near = [&](const std::vector<int32_t>& image, int px, int py, int32_t value) {
-            for (int y = std::max(0, py - 1); y <= std::min(h - 1, py + 1); ++y)
-                for (int x = std::max(0, px - 1); x <= std::min(w - 1, px + 1); ++x)
-                    if (image[size_t(y * w + x)] == value) return true;
-            return false;
-        };
+        const std::vector<int32_t> cast = testcast::castCut(scene.camera, w, h, cut);
         for (const double margin : {0.0, -0.2}) {
             TracerOptions options;
             options.span_margin = margin;
             SceneTracer tracer(scene, stage.objects, stage.mirrors, Model::Relativistic, k, k, options);
             const std::vector<int32_t> traced = tracer.traceFrame(k, w, h).object;
-            long long shown = 0, differ = 0, far = 0;
-            for (int py = 0; py < h; ++py)
-                for (int px = 0; px < w; ++px) {
-                    const int32_t a = traced[size_t(py * w + px)], b = cast[size_t(py * w + px)];
-                    if (a < 0 && b < 0) continue;
-                    ++shown;
-                    if (a == b) continue;
-                    ++differ;
-                    far += !near(cast, px, py, a) || !near(traced, px, py, b);
-                }
+            const testcast::ImageDifference d = testcast::compareObjectImages(traced, cast, w, h);
+            const long long shown = d.shown, differ = d.differ, far = d.far;
             std::cout << "[rocket cut] frame " << k << ", span margin " << margin << " s: " << shown << " pixels show it, "
                       << differ << " differ, " << far << " of them by more than a pixel\n";
             EXPECT_GT(shown, 1000) << k;

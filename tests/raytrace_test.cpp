@@ -35,6 +35,7 @@
 #include "quiet_stage.h"
 
 #include "temp_dir.h"
+#include "srgb.h"
 
 using namespace apparent;
 using mesh4d::Vec3;
@@ -455,29 +456,9 @@ TEST(RaytraceCrossCheck, RollingWheelThroughTimeSlabsMatchesTheRefinedCut) {
             mesh4d::SliceSettings slice;
             slice.tolerance = tolerance;
             const mesh4d::ApparentMesh cut = mesh4d::sliceWorld(world, view, slice);
-            MeshCaster caster(scene.camera, w, h);
-            for (const auto& t : cut.triangles)
-                caster.add(absolutePoint(cut, t[0]), absolutePoint(cut, t[1]), absolutePoint(cut, t[2]), 0);
-            std::vector<int32_t> cast(size_t(w * h));
-            for (int py = 0; py < h; ++py)
-                for (int px = 0; px < w; ++px) cast[size_t(py * w + px)] = caster.cast(px, py);
-            // Whether `image` shows `value` within one pixel of (px, py).
-            auto near = [&](const std::vector<int32_t>& image, int px, int py, int32_t value) {
-                for (int y = std::max(0, py - 1); y <= std::min(h - 1, py + 1); ++y)
-                    for (int x = std::max(0, px - 1); x <= std::min(w - 1, px + 1); ++x)
-                        if (image[size_t(y * w + x)] == value) return true;
-                return false;
-            };
-            long long covered = 0, differ = 0, far = 0;
-            for (int py = 0; py < h; ++py)
-                for (int px = 0; px < w; ++px) {
-                    const int32_t a = traced.object[size_t(py * w + px)], b = cast[size_t(py * w + px)];
-                    if (a < 0 && b < 0) continue;
-                    ++covered;
-                    if (a == b) continue;
-                    ++differ;
-                    far += !near(cast, px, py, a) || !near(traced.object, px, py, b);
-                }
+            const std::vector<int32_t> cast = testcast::castCut(scene.camera, w, h, cut);
+            const testcast::ImageDifference d = testcast::compareObjectImages(traced.object, cast, w, h);
+            const long long covered = d.shown, differ = d.differ, far = d.far;
             std::cout << "[rolling wheel] frame " << k << ", cut with T = " << tolerance << " ls: " << covered
                       << " pixels show the wheel, " << differ << " differ, " << far << " of them by more than a pixel\n";
             EXPECT_GT(covered, 1500) << k;
@@ -492,15 +473,8 @@ TEST(RaytraceCrossCheck, RollingWheelThroughTimeSlabsMatchesTheRefinedCut) {
 
 namespace {
 
-// Linear value of an 8-bit sRGB level (IEC 61966-2-1), and back, independent of raytrace.cpp.
-double srgbToLinear(uint8_t v) {
-    const double s = v / 255.0;
-    return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
-}
-int linearToSrgb8(double c) {
-    c = std::clamp(c, 0.0, 1.0);
-    return int(std::lround(255 * (c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055)));
-}
+using testio::linearToSrgb8;
+using testio::srgbToLinear;
 
 // Writes a unit cube whose six faces are separate objects (one quad each), rotated by
 // `rotation_deg`, at [0, 0, -5] at t = 0 moving at 0.9c along x, lit by a distant light.
