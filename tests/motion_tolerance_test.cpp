@@ -413,8 +413,9 @@ struct KeyedCase {
 
 // keyed_cubic.gltf's path (data/scenes/make_keyed_gltf.py): the corner as a glTF CUBICSPLINE
 // (Hermite, tangents per second scaled by the interval) through (-4, -1, -6), (0, -1, -6), (0, 2, -6)
-// at t = 0, 8, 16 s, sampled here at `steps` equal sub-steps per interval into linear keys (as the
-// reader samples it); the quarter turn about y linear in time between the three keys.
+// at t = 0, 8, 16 s, sampled here at `steps` equal sub-steps per interval into linear keys (the
+// reader also takes equal sub-steps, as many as its chord error needs); the quarter turn about y
+// linear in time between the three keys.
 TestPath cubicCorner(int steps) {
     const double times[3] = {0, 8, 16};
     const Vec3 X[3] = {{-4, -1, -6}, {0, -1, -6}, {0, 2, -6}};
