@@ -248,9 +248,11 @@ bool keyMayCross(const ViewSurface& view, const Event e[3]) {
     return true;
 }
 
-// The kink's size per unit length at key i over the triangle (header): j(q) = |c(q)| D(q) at q's
-// event at s_i (ev), exact at the corners, carried over the triangle by its Lipschitz bound. INFINITY
-// when the carried bounds do not close (the triangle may reach the camera or a Lambda 0).
+// The kink term of key i over the triangle on the cone (header), light-seconds: the lesser of
+// m_i j_i d / sqrt(3) (j(q) = |c(q)| D(q) at q's event at s_i (ev), exact at the corners, carried over
+// the triangle by its Lipschitz bound) and the crossing-weighted D_hi (3 a b / (a + b) + 2 eps + 2 e)
+// (a, b the corners' largest g_i and -g_i, e = g^2 d^2 / (2 rho_lo), eps = e / 3). INFINITY when the
+// carried bounds do not close (the triangle may reach the camera or a Lambda 0).
 double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const Event ev[3],
                const Vec3 dyb[3], TurnedCorners& turned, double d) {
     const KeyedMotion& k = *m.keyed;
@@ -261,7 +263,8 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
     auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
     auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
     const Vec3* pa = turned.segment(i);
-    double rho_min = INFINITY, j_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0, lam_min = INFINITY;
+    double rho_min = INFINITY, j_min = INFINITY, D_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0,
+           lam_min = INFINITY, above = 0, below = 0;
     for (int q = 0; q < 3; ++q) {
         const Event& e = ev[q];
         Vec3 n{0, 0, 0};
@@ -271,6 +274,9 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
             if (!(rho > 0)) return INFINITY;
             rho_min = std::min(rho_min, rho);
             n = r / rho;
+            const double gk = view.t_c - e.t - rho;  // g_i at the corner (exact)
+            above = std::max(above, gk);
+            below = std::max(below, -gk);
         }
         const Vec3 dya = keyedSegmentTurned(k, i, s, pa[q]).dy;
         const double ta = labT(dya), tb = labT(dyb[q]);
@@ -282,6 +288,7 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
         // (Lorentz; its n-part is n itself for the carry), g V on a hyperplane (0 for the carry).
         const Vec3 cv = cone ? V * g + n + V * (g * g / (g + 1) * dot(V, n)) : V * g;
         j_min = std::min(j_min, norm(cv) * D);
+        D_min = std::min(D_min, D);
         D_max = std::max(D_max, D);
         c_max = std::max(c_max, norm(cv));
         x_max = std::max({x_max, norm(xa), norm(xb)});
@@ -303,7 +310,15 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
                        shear_speed * 2 * (g * b * w / lam_lo + Tm * L_lam / (lam_lo * lam_lo));
     const double L_c = g * dn;
     const double j = j_min + (L_c * (D_max + L_D * d) + (c_max + L_c * d) * L_D) * d;
-    return j == j ? j : INFINITY;
+    const double by_length = 2 * j * d / std::sqrt(3.0);
+    // Weighted by where the lines from a point to the corners can cross Gamma_i (header): g_i is
+    // concave with curvature at most g^2 / rho_lo, so each crossing's remainder is at most
+    // D (|g_i(corner)| + e) and g_i within eps above its affine interpolant.
+    const double e = cone ? g * g * d * d / (2 * rho_lo) : 0.0;
+    const double straddle = above + below > 0 ? above * below / (above + below) : 0.0;
+    const double by_crossing = (D_min + L_D * d) * (3 * straddle + 2 * e / 3 + 2 * e);
+    const double term = std::min(by_length, by_crossing);
+    return term == term ? term : INFINITY;
 }
 
 // The kink term of key i over the triangle on a hyperplane (header, "On a hyperplane"): with
@@ -525,9 +540,9 @@ PieceBound pieceBound(const Motion& m, const ViewSurface& view, double shear_spe
                     Vec3 dyb[3];  // and their rates on the segment after it
                     keyEvents(m, i, *turned, ev, dyb);
                     if (!cone) plane += keyKinkOnPlane(m, view, i, ev, dyb, *turned, d);
-                    else if (keyMayCross(view, ev)) kinks += 2 * keyKink(m, view, shear_speed, i, ev, dyb, *turned, d);
+                    else if (keyMayCross(view, ev)) kinks += keyKink(m, view, shear_speed, i, ev, dyb, *turned, d);
                 }
-                const double kink = kinks * std::sqrt(d2 / 3) + plane;
+                const double kink = kinks + plane;
                 out.kink = kink == kink ? kink : INFINITY;
             }
             return out;

@@ -141,8 +141,31 @@
 // t_c - t = |x - C| squares to a quadratic: a line meets Gamma_i at most m_i = 2 times (once on a
 // hyperplane, t_c - t linear; a line lying in Gamma_i kinks only at its ends). With
 // sum_l l_l |q_l - p| <= sqrt(sum_l l_l |q_l - p|^2) <= d / sqrt(3):
-//     |F(p) - L(p)| <= K d^2 / 6 + (sum_i m_i j_i) d / sqrt(3),
-// the sum over the keys in the window whose curve may meet the triangle. The kink term is linear in d: a piece that
+//     |F(p) - L(p)| <= K d^2 / 6 + sum_i min(m_i j_i d / sqrt(3), W_i),
+// the sum over the keys in the window whose curve may meet the triangle, W_i the same key's term
+// weighted by where the lines can cross it (cheaper for a key whose curve passes near a corner or
+// outside most of the triangle: a sampled cubic path's many keys), term by term:
+//   - g_i(q) = g(s_i, q) is concave with grad g_i = -c (c = t_q + n.x_q, as above) and its second
+//     derivative along a unit direction in [-H, 0], H = g^2 / rho_lo (|x_q| <= g, rho >= rho_lo =
+//     the corners' least rho at s_i minus g d); so g_i lies between its affine interpolant A on the
+//     corners and A + eps, eps = H d^2 / 6 (Taylor from p to the corners, as for K).
+//   - a crossing y on the segment from p to corner q_l leaves the remainder |[grad F] (q_l - y)| =
+//     D(y) |c(y).(q_l - y)|, and along that segment h = g_i from y (h(0) = 0, h(1) = g_l = g_i(q_l))
+//     gives c(y).(q_l - y) = -h'(0) in [-g_l - e, -g_l]: at most D_hi (|g_l| + e), e = H d^2 / 2,
+//     D_hi = min_k D(q_k) + L_D d (keyKink's Lipschitz carry of D).
+//   - only sign changes of g_i kink the map, and {g_i > 0} meets a segment in an interval: from p
+//     with g_i(p) > 0 one crossing to each corner with g_l <= 0, none to the others; from p with
+//     g_i(p) <= 0 one to each corner with g_l > 0 and none or two to the others, two only if h
+//     rises above 0, which A + eps (largest at the segment's ends) rules out when A(p) <= -eps and
+//     g_l <= -eps.
+//   - with P = sum_{g_l > 0} l_l g_l <= lambda a, N = sum_{g_l <= 0} l_l |g_l| <= (1 - lambda) b
+//     (a, b the corners' largest g_l and -g_l, lambda the positive corners' weight) and A(p) = P - N:
+//     g_i(p) > 0 gives N < P + eps and the cost N + e; g_i(p) <= 0 gives P <= N and the cost
+//     P + 2 eps + 2 e when A(p) <= -eps, P + 2 N + 2 e <= 3 P + 2 eps + 2 e otherwise. With
+//     min(P, N) <= min(lambda a, (1 - lambda) b) <= a b / (a + b):
+//         W_i = D_hi (3 a b / (a + b) + 2 eps + 2 e)   (the weights l_l summed against the crossings).
+//     For a curve across the middle (a = b = |c| d / 2) that is 0.75 D |c| d against the length
+//     term's 1.15; it vanishes as a key's curve approaches a corner (a or b -> 0) but for e. The kink term is linear in d: a piece that
 // straddles a key passes once it is about T / (m j) wide, so refinement concentrates where the
 // emission time crosses a key, and a sampled CUBICSPLINE path (many keys, each with a small jump)
 // pays for the sum of its small jumps, about its velocity change over the window, not for the count.
@@ -192,7 +215,7 @@ struct CornerCrossing {
 CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Vec3& q, bool* ok);
 
 // The bound of one rest triangle: K above (per |u|^2) and, for a keyframed path, the kink term
-// over the keys its emission times may cross (light-seconds; on the cone sum_i m_i j_i d / sqrt(3),
+// over the keys its emission times may cross (light-seconds; on the cone sum_i min(m_i j_i d / sqrt(3), W_i),
 // on a hyperplane the straddle term above; 0 for the other motions), so that
 // |F - L| <= K d^2 / 6 + kink on the triangle, d its longest side.
 struct PieceBound {

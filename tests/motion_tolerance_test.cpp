@@ -411,6 +411,29 @@ struct KeyedCase {
     std::vector<double> t_c;  // frames where the emission times cross a key over the body
 };
 
+// keyed_cubic.gltf's path (data/scenes/make_keyed_gltf.py): the corner as a glTF CUBICSPLINE
+// (Hermite, tangents per second scaled by the interval) through (-4, -1, -6), (0, -1, -6), (0, 2, -6)
+// at t = 0, 8, 16 s, sampled here at `steps` equal sub-steps per interval into linear keys (the
+// reader also takes equal sub-steps, as many as its chord error needs); the quarter turn about y
+// linear in time between the three keys.
+TestPath cubicCorner(int steps) {
+    const double times[3] = {0, 8, 16};
+    const Vec3 X[3] = {{-4, -1, -6}, {0, -1, -6}, {0, 2, -6}};
+    const Vec3 m[3] = {{0.5, 0, 0}, {0.25, 0.19, 0}, {0, 0.375, 0}};
+    const double angle[3] = {0, M_PI / 4, M_PI / 2};
+    TestPath p;
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < steps + (j == 1 ? 1 : 0); ++i) {
+            const double f = double(i) / steps, d = times[j + 1] - times[j];
+            const double h00 = 2 * f * f * f - 3 * f * f + 1, h10 = f * f * f - 2 * f * f + f;
+            const double h01 = -2 * f * f * f + 3 * f * f, h11 = f * f * f - f * f;
+            p.t.push_back(times[j] + d * f);
+            p.X.push_back(X[j] * h00 + m[j] * (d * h10) + X[j + 1] * h01 + m[j + 1] * (d * h11));
+            p.angle.push_back(angle[j] + (angle[j + 1] - angle[j]) * f);
+        }
+    return p;
+}
+
 std::vector<KeyedCase> keyedCases() {
     // keyed.gltf's path without its turn: 0.8c along +x, a corner at t = 5 s, 0.6c along +y.
     const TestPath corner{{0, 5, 10}, {{-4, -1, -6}, {0, -1, -6}, {0, 2, -6}}, {0, 0, 0}};
@@ -421,7 +444,8 @@ std::vector<KeyedCase> keyedCases() {
             {"corner, contracted", corner, true, true, {5.0}},
             {"turn key, relativistic", turn, true, false, {9.0}},
             {"turn key, finite", turn, false, false, {9.0}},
-            {"turn key, contracted", turn, true, true, {4.0}}};
+            {"turn key, contracted", turn, true, true, {4.0}},
+            {"cubic corner, relativistic", cubicCorner(32), true, false, {11.0, 14.0}}};
 }
 
 }  // namespace
