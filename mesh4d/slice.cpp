@@ -567,17 +567,10 @@ struct FrameBuilder {
     // each (a, b, o) becomes A = (a, m, o), kept in its record (slot c + 2 stays in place), and
     // B = (m, b, o), appended. The halves' slots on the edge form two new cycles, on two new edge
     // records; each triangle's new inner edge (m, o) gets its own record.
-    void splitEdge(uint32_t id, int c, std::vector<uint32_t>& stack) {
+    // members: the edge's cycle from slot c of id (the walk that chose the edge collected it).
+    void splitEdge(uint32_t id, int c, const std::vector<uint32_t>& members, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
         const uint32_t lo = std::min(rt[id].v[c], rt[id].v[kSucc[c]]);
-        std::vector<uint32_t>& members = scratch_members;
-        members.clear();
-        const uint32_t start = slotOf(id, c);
-        uint32_t p = start;
-        do {
-            members.push_back(p);
-            p = nextOf(p);
-        } while (p != start);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
         r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
         r_edge_data = r_edges.data();
@@ -757,22 +750,26 @@ struct FrameBuilder {
             const int c = longestSlot(t);
             const uint32_t start = slotOf(t, c);
             uint32_t other = kUnset;
-            for (uint32_t p = nextOf(start); p != start; p = nextOf(p))
+            // The edge's cycle, collected as it is walked: when the edge is halved, splitEdge
+            // needs it all.
+            std::vector<uint32_t>& members = scratch_members;
+            members.clear();
+            members.push_back(start);
+            for (uint32_t p = nextOf(start); p != start; p = nextOf(p)) {
                 if (longestSlot(slotTri(p)) != int(slotSide(p))) {
                     other = slotTri(p);
                     break;
                 }
+                members.push_back(p);
+            }
             if (other == kUnset) {
-                if (guard && r_templates) {
-                    uint32_t p = start;
-                    do {
+                if (guard && r_templates)
+                    for (uint32_t p : members) {
                         const uint32_t u = slotTri(p);
                         if (rt[u].state == kCoarse && formLevel(scratch.forms[scratch.form_of[u]], kNoCap) >= kKeptLevel)
                             return kSplitBlocked;
-                        p = nextOf(p);
-                    } while (p != start);
-                }
-                splitEdge(t, c, stack);
+                    }
+                splitEdge(t, c, members, stack);
                 return t == id ? kSplitOwn : kSplitOther;
             }
             t = other;
