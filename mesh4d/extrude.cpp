@@ -17,9 +17,9 @@ namespace mesh4d {
 namespace {
 
 // extrude, with the mesh copied into the world from `mesh`, or moved from `*take` when given
-// (then `mesh` is `*take`).
+// (then `mesh` is `*take`); without `edge_tables`, edges, triangle_edges and slot_next stay empty.
 World4D extrudeMesh(const RestMesh& mesh, RestMesh* take, const Motion& motion, double tau_a, double tau_b,
-                    bool cap_a_real, bool cap_b_real) {
+                    bool cap_a_real, bool cap_b_real, bool edge_tables = true) {
     World4D world;
     world.motion = motion;
     world.tau_a = tau_a;
@@ -35,77 +35,82 @@ World4D extrudeMesh(const RestMesh& mesh, RestMesh* take, const Motion& motion, 
     const size_t nf = mesh.triangles.size();
     const size_t slots = 3 * nf;
     world.vertex_used.assign(nv, 0);
-    std::vector<uint32_t> offset(nv + 1, 0);
-    for (const auto& tri : mesh.triangles)
-        for (int c = 0; c < 3; ++c) {
-            world.vertex_used[tri[c]] = 1;
-            ++offset[std::min(tri[c], tri[(c + 1) % 3]) + 1];
-        }
-    for (size_t v = 0; v < nv; ++v) offset[v + 1] += offset[v];
-    std::vector<uint64_t> by_lo(slots);  // (hi << 32) | slot, grouped by lo
-    {
-        std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
-        for (size_t f = 0; f < nf; ++f)
+    if (!edge_tables) {  // slabs for tracing (extrudeSlabs): the used vertices only
+        for (const auto& tri : mesh.triangles)
+            for (uint32_t v : tri) world.vertex_used[v] = 1;
+    } else {
+        std::vector<uint32_t> offset(nv + 1, 0);
+        for (const auto& tri : mesh.triangles)
             for (int c = 0; c < 3; ++c) {
-                uint32_t a = mesh.triangles[f][c], b = mesh.triangles[f][(c + 1) % 3];
-                if (a > b) std::swap(a, b);
-                by_lo[fill[a]++] = (uint64_t(b) << 32) | uint32_t(3 * f + c);
+                world.vertex_used[tri[c]] = 1;
+                ++offset[std::min(tri[c], tri[(c + 1) % 3]) + 1];
             }
-    }
-    // Each group of equal (lo, hi), its slots in triangle order: the first slot stands for the
-    // edge (stored in triangle_edges until numbered), and the cycle of slot_next links the slots
-    // of non-degenerate triangles (World4D::slot_next).
-    world.triangle_edges.resize(nf);
-    auto first_slot = [&](uint32_t slot) -> uint32_t& { return world.triangle_edges[slot / 3][slot % 3]; };
-    world.slot_next.resize(slots);
-    auto degenerate = [&](uint32_t slot) {
-        const auto& t = mesh.triangles[slot / 3];
-        return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
-    };
-    size_t edge_count = 0;  // one per group of equal (lo, hi)
-    for (size_t v = 0; v < nv; ++v) {
-        uint64_t* g = by_lo.data() + offset[v];
-        uint64_t* const g_end = by_lo.data() + offset[v + 1];
-        std::sort(g, g_end);
-        while (g < g_end) {
-            uint64_t* e = g;
-            while (e < g_end && (*e >> 32) == (*g >> 32)) ++e;
-            const uint32_t first = uint32_t(*g);
-            uint32_t cycle_first = UINT32_MAX, cycle_last = UINT32_MAX;
-            for (uint64_t* it = g; it < e; ++it) {
-                const uint32_t slot = uint32_t(*it);
-                first_slot(slot) = first;
-                world.slot_next[slot] = slot;
-                if (degenerate(slot)) continue;
-                if (cycle_first == UINT32_MAX) cycle_first = slot;
-                else world.slot_next[cycle_last] = slot;
-                cycle_last = slot;
-            }
-            if (cycle_last != UINT32_MAX) world.slot_next[cycle_last] = cycle_first;
-            ++edge_count;
-            g = e;
+        for (size_t v = 0; v < nv; ++v) offset[v + 1] += offset[v];
+        std::vector<uint64_t> by_lo(slots);  // (hi << 32) | slot, grouped by lo
+        {
+            std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
+            for (size_t f = 0; f < nf; ++f)
+                for (int c = 0; c < 3; ++c) {
+                    uint32_t a = mesh.triangles[f][c], b = mesh.triangles[f][(c + 1) % 3];
+                    if (a > b) std::swap(a, b);
+                    by_lo[fill[a]++] = (uint64_t(b) << 32) | uint32_t(3 * f + c);
+                }
         }
-    }
-    std::vector<uint64_t>().swap(by_lo);
-    std::vector<uint32_t>().swap(offset);
-    // The scratch's pages go back to the system (glibc keeps a freed block of this size in its
-    // heap, resident, and the events below do not fit into it): at 1M triangles the resident
-    // peak of a load fell from 111 to 98 MB (docs/PERFORMANCE.md). The edges' array is reserved
-    // at its size, so it is not grown by copies that leave holes of their own.
-#ifdef __GLIBC__
-    if (slots >= (size_t(1) << 20)) malloc_trim(0);  // 8 MB of scratch and more
-#endif
-    world.edges.reserve(edge_count);
-    // Numbering in slot order: a slot's first slot is never after it, so it is numbered already.
-    for (uint32_t slot = 0; slot < slots; ++slot) {
-        if (first_slot(slot) == slot) {
+        // Each group of equal (lo, hi), its slots in triangle order: the first slot stands for the
+        // edge (stored in triangle_edges until numbered), and the cycle of slot_next links the slots
+        // of non-degenerate triangles (World4D::slot_next).
+        world.triangle_edges.resize(nf);
+        auto first_slot = [&](uint32_t slot) -> uint32_t& { return world.triangle_edges[slot / 3][slot % 3]; };
+        world.slot_next.resize(slots);
+        auto degenerate = [&](uint32_t slot) {
             const auto& t = mesh.triangles[slot / 3];
-            uint32_t a = t[slot % 3], b = t[(slot % 3 + 1) % 3];
-            if (a > b) std::swap(a, b);
-            first_slot(slot) = uint32_t(world.edges.size());
-            world.edges.push_back({a, b});
-        } else {
-            first_slot(slot) = first_slot(first_slot(slot));
+            return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
+        };
+        size_t edge_count = 0;  // one per group of equal (lo, hi)
+        for (size_t v = 0; v < nv; ++v) {
+            uint64_t* g = by_lo.data() + offset[v];
+            uint64_t* const g_end = by_lo.data() + offset[v + 1];
+            std::sort(g, g_end);
+            while (g < g_end) {
+                uint64_t* e = g;
+                while (e < g_end && (*e >> 32) == (*g >> 32)) ++e;
+                const uint32_t first = uint32_t(*g);
+                uint32_t cycle_first = UINT32_MAX, cycle_last = UINT32_MAX;
+                for (uint64_t* it = g; it < e; ++it) {
+                    const uint32_t slot = uint32_t(*it);
+                    first_slot(slot) = first;
+                    world.slot_next[slot] = slot;
+                    if (degenerate(slot)) continue;
+                    if (cycle_first == UINT32_MAX) cycle_first = slot;
+                    else world.slot_next[cycle_last] = slot;
+                    cycle_last = slot;
+                }
+                if (cycle_last != UINT32_MAX) world.slot_next[cycle_last] = cycle_first;
+                ++edge_count;
+                g = e;
+            }
+        }
+        std::vector<uint64_t>().swap(by_lo);
+        std::vector<uint32_t>().swap(offset);
+        // The scratch's pages go back to the system (glibc keeps a freed block of this size in its
+        // heap, resident, and the events below do not fit into it): at 1M triangles the resident
+        // peak of a load fell from 111 to 98 MB (docs/PERFORMANCE.md). The edges' array is reserved
+        // at its size, so it is not grown by copies that leave holes of their own.
+    #ifdef __GLIBC__
+        if (slots >= (size_t(1) << 20)) malloc_trim(0);  // 8 MB of scratch and more
+    #endif
+        world.edges.reserve(edge_count);
+        // Numbering in slot order: a slot's first slot is never after it, so it is numbered already.
+        for (uint32_t slot = 0; slot < slots; ++slot) {
+            if (first_slot(slot) == slot) {
+                const auto& t = mesh.triangles[slot / 3];
+                uint32_t a = t[slot % 3], b = t[(slot % 3 + 1) % 3];
+                if (a > b) std::swap(a, b);
+                first_slot(slot) = uint32_t(world.edges.size());
+                world.edges.push_back({a, b});
+            } else {
+                first_slot(slot) = first_slot(first_slot(slot));
+            }
         }
     }
 
@@ -383,7 +388,8 @@ std::vector<World4D> extrudeSlabs(const RestMesh& mesh, const Motion& motion, co
     const size_t count = samples.size() - 1;
     slabs.reserve(count);
     for (size_t k = 0; k < count; ++k)
-        slabs.push_back(extrude(mesh, motion, samples[k], samples[k + 1], cap_a_real && k == 0, cap_b_real && k + 1 == count));
+        slabs.push_back(extrudeMesh(mesh, nullptr, motion, samples[k], samples[k + 1], cap_a_real && k == 0,
+                                    cap_b_real && k + 1 == count, false));
     return slabs;
 }
 

@@ -179,8 +179,10 @@ std::vector<double> slabSamples(const RestMesh& mesh, const Motion& motion, doub
                                 size_t max_slabs);
 
 // The history between consecutive samples, one World4D per slab; only the first slab's cap a and
-// the last's cap b can be real. Each slab holds its own copy of the mesh: memory grows with the
-// number of slabs (callers bound it).
+// the last's cap b can be real. The slabs are for tracing (ray4d.h prepareSlabsTrace), which reads
+// the mesh, events and spans only: their edges, triangle_edges and slot_next are left empty (not
+// built: 36 bytes a triangle a slab, docs/PERFORMANCE.md section 6). Each
+// slab holds its own copy of the mesh: memory grows with the number of slabs (callers bound it).
 std::vector<World4D> extrudeSlabs(const RestMesh& mesh, const Motion& motion, const std::vector<double>& samples,
                                   bool cap_a_real, bool cap_b_real);
 

@@ -155,14 +155,28 @@ void addPrisms(TraceWorld* trace, const World4D& world, std::vector<EventBox>* b
         const std::array<Event, 4> v{world.events[t[0]], world.events[t[1]], world.events[t[2]], world.events[t[3]]};
         p.normal = flatNormal(v);
         p.offset = dot4(p.normal, toVec4(v[0]));
-        // Step: bounds of the prism's six events, in the lab and co-moving.
+        // Step: bounds of the prism's six events, in the lab and co-moving, and across the 3-flat.
         EventBox co;
+        double across_lo = p.offset, across_hi = p.offset, reach = 0;
         for (uint32_t vi : world.mesh.triangles[f])
             for (uint32_t cap = 0; cap < 2; ++cap) {
                 const Event& e = world.events[2 * vi + cap];
                 p.box.add(e);
                 co.add({e.t, comoving(e, trace->velocity)});
+                const double across = dot4(p.normal, toVec4(e));
+                across_lo = std::min(across_lo, across);
+                across_hi = std::max(across_hi, across);
+                reach = std::max(reach, std::fabs(e.t) + norm(e.x));
             }
+        // Step: widen the thick flat by far more than the rounding of normal . V and the hits'
+        // barycentric slack (kBaryEps of an edge), far less than any pixel.
+        const double widen = 1e-8 * (std::fabs(p.normal[0]) + std::fabs(p.normal[1]) + std::fabs(p.normal[2]) +
+                                     std::fabs(p.normal[3])) *
+                             (p.box.diagonal() + (p.box.t_hi - p.box.t_lo) + reach + 1);
+        p.below = float(across_lo - widen - p.offset);
+        if (double(p.below) > across_lo - widen - p.offset) p.below = std::nextafter(p.below, -INFINITY);
+        p.above = float(across_hi + widen - p.offset);
+        if (double(p.above) < across_hi + widen - p.offset) p.above = std::nextafter(p.above, INFINITY);
         trace->prisms.push_back(p);
         if (boxes) boxes->push_back(co);
     }
@@ -260,6 +274,7 @@ template <bool kSlabs>
 std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray, double s_max) {
     const Vec4 d = rayDirection(ray);
     const Vec4 o = toVec4(ray.origin);
+    const double o_abs = std::fabs(o[0]) + std::fabs(o[1]) + std::fabs(o[2]) + std::fabs(o[3]) + 1;
     NearestSoFar best;
     best.s = s_max;
     auto finish = [&]() -> std::optional<WorldHit> {
@@ -281,11 +296,24 @@ std::optional<WorldHit> intersectTrace(const TraceWorld& trace, const Ray4D& ray
             const double slack = 1e-9 * (p.box.diagonal() + norm(at.x) + (p.box.t_hi - p.box.t_lo) + std::fabs(at.t));
             if (!p.box.contains(at, slack)) return;
         } else {
-            // Step: a twisted prism (flat_prisms): the ray must pass through its box ahead of the
-            // origin and nearer than the best hit so far (slack as above).
+            // Step: a twisted prism (flat_prisms false): the ray must pass through its thick flat
+            // and its box at once, ahead of the origin and nearer than the best hit so far (slack as
+            // above; across the flat, 1e-9 of |normal|_1 |o|_1 more for the rounding of normal . o).
             const double slack =
                 1e-9 * (p.box.diagonal() + (p.box.t_hi - p.box.t_lo) + norm(ray.origin.x) + std::fabs(ray.origin.t) + 1);
             double s_lo = -slack, s_hi = best.s + slack * (1 + std::fabs(best.s));
+            const double nd = dot4(p.normal, d), no = dot4(p.normal, o);
+            const double across = 1e-9 * o_abs *
+                                  (std::fabs(p.normal[0]) + std::fabs(p.normal[1]) + std::fabs(p.normal[2]) + std::fabs(p.normal[3]));
+            const double lo = (p.offset - no) + (double(p.below) - across), hi = (p.offset - no) + (double(p.above) + across);
+            if (nd == 0) {
+                if (lo > 0 || hi < 0) return;
+            } else {
+                const double a = lo / nd, b = hi / nd;
+                s_lo = std::max(s_lo, std::min(a, b));
+                s_hi = std::min(s_hi, std::max(a, b));
+                if (s_lo > s_hi) return;
+            }
             if (!slab(p.box, slack, o, d, &s_lo, &s_hi)) return;
         }
         // Step: the prism's world (its slab) and triangle there.

@@ -68,7 +68,12 @@ struct TraceWorld {
     const World4D* world = nullptr;
     struct Prism {
         std::array<double, 4> normal{};  // 4D normal of the prism's 3-flat
-        double offset = 0;               // normal . V for every event V of the prism
+        double offset = 0;               // normal . V for every event V of the prism (flat_prisms)
+        // normal . V over the prism's six events lies in [offset + below, offset + above], widened
+        // by 1e-8 of |normal|_1 (box diagonal + duration + largest |V| + 1): a twisted prism's
+        // thickness across its first tetrahedron's 3-flat. Floats rounded outwards (8 bytes a prism,
+        // not 16: a window of the rolling wheel holds 3.2 million prisms).
+        float below = 0, above = 0;
         EventBox box;                    // 4D bounds of the prism's six events
     };
     std::vector<Prism> prisms;           // one per input triangle
@@ -90,7 +95,9 @@ struct TraceWorld {
     // Each prism's three tetrahedra lie in its one 3-flat (`normal`, `offset`): true for uniform
     // motion, where the prism is the affine image of triangle x interval. A slab of a spin or a
     // keyframed turn twists its lateral quads (extrude.h slabSpacing), so its tetrahedra lie in
-    // three 3-flats: a ray is then kept or dropped by the prism's box along it, not by the flat.
+    // three 3-flats, all inside the convex hull of its six events: a ray is then kept only where it
+    // passes through both the prism's box and the thick flat offset + below <= normal . V <= offset + above
+    // ahead of the origin and nearer than the best hit so far (both hold the hull, so no hit is lost).
     bool flat_prisms = true;
 };
 constexpr uint32_t kLeafPrisms = 4;

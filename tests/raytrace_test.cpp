@@ -1057,6 +1057,45 @@ TEST(Ray4D, TwistedPrismsOfSpinSlabsLoseNoHit) {
     EXPECT_GT(hits, 150);
 }
 
+// The thick flat of a twisted prism (ray4d.h Prism offset + below, offset + above) holds every event of its
+// three tetrahedra, N . V summed here in long double: the rejection by it cannot drop a hit. The
+// slabs of a fast spin cut coarsely are twisted well beyond the widening, so the test has teeth.
+TEST(Ray4D, TwistedPrismsThickFlatHoldsTheirTetrahedra) {
+    const mesh4d::RestMesh mesh = testmesh::cylinder(1, 0.3, 24);
+    mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0});
+    m.angular_velocity = {0, 0, -0.6};
+    const std::vector<double> samples{-12, -11.2, -10.4, -9.6};
+    const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(mesh, m, samples, false, false);
+    std::vector<const mesh4d::World4D*> pointers;
+    for (const auto& w : slabs) pointers.push_back(&w);
+    const mesh4d::TraceWorld trace = mesh4d::prepareSlabsTrace(pointers);
+    ASSERT_FALSE(trace.flat_prisms);
+    ASSERT_EQ(trace.prisms.size(), 3 * mesh.triangles.size());
+    long double thickest = 0;
+    for (size_t k = 0; k < slabs.size(); ++k)
+        for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+            const mesh4d::TraceWorld::Prism& p = trace.prisms[trace.slab_first[k] + f];
+            const long double len = std::sqrt((long double)p.normal[0] * p.normal[0] + (long double)p.normal[1] * p.normal[1] +
+                                              (long double)p.normal[2] * p.normal[2] + (long double)p.normal[3] * p.normal[3]);
+            ASSERT_GT(len, 0);
+            long double lo = INFINITY, hi = -INFINITY;
+            for (size_t j = 0; j < 3; ++j)
+                for (uint32_t e : slabs[k].tet(3 * f + j)) {
+                    const mesh4d::Event& v = slabs[k].events[e];
+                    const long double across = (long double)p.normal[0] * v.t + (long double)p.normal[1] * v.x.x +
+                                               (long double)p.normal[2] * v.x.y + (long double)p.normal[3] * v.x.z;
+                    EXPECT_GE(across, (long double)p.offset + p.below) << k << " " << f;
+                    EXPECT_LE(across, (long double)p.offset + p.above) << k << " " << f;
+                    lo = std::min(lo, across);
+                    hi = std::max(hi, across);
+                }
+            thickest = std::max(thickest, (hi - lo) / len);
+        }
+    // The slabs turn 0.48 rad each about the cylinder's axis: events leave the first flat by a
+    // good fraction of the radius (1), not by rounding.
+    EXPECT_GT(thickest, 1e-3L);
+}
+
 namespace {
 
 // A cube of edge 0.3 ls (data/meshes/box.obj scaled) accelerating from rest at t0 = 0 along +x
