@@ -30,7 +30,6 @@ namespace {
 Vec3 unit(const Vec3& v) { return v / mesh4d::norm(v); }
 
 using testio::linearToSrgb8;
-using testio::srgbToLinear;
 
 // The camera-frame direction k in which a camera at the lab origin, moving at v, sees
 // light that reached it along the lab direction d (from the camera towards the source), and back.
@@ -178,9 +177,7 @@ std::map<int32_t, std::array<double, 3>> checkEveryPixel(Model model, const Vec3
             const uint8_t* p = frame.image.rgb.data() + 3 * i;
             for (size_t c = 0; c < 3; ++c) {
                 const double expect = color[c] * lambert;
-                // One 8-bit level of quantisation, or 1% of the linear value.
-                const bool ok = std::abs(int(p[c]) - linearToSrgb8(expect)) <= 1 ||
-                                std::fabs(srgbToLinear(p[c]) - expect) <= 0.01 * expect;
+                const bool ok = testio::levelShows(p[c], expect);
                 if (!ok && wrong++ < 3)
                     ADD_FAILURE() << what << " face " << o << " pixel (" << px << ", " << py << ") channel " << c << ": "
                                   << int(p[c]) << " != " << linearToSrgb8(expect);

@@ -555,9 +555,7 @@ TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
                 const uint8_t* p = frame.image.rgb.data() + 3 * i;
                 for (size_t c = 0; c < 3; ++c) {
                     const double expect = color[c] * lambert;
-                    // One 8-bit level of quantisation, or 1% of the linear value.
-                    const bool ok = std::abs(int(p[c]) - linearToSrgb8(expect)) <= 1 ||
-                                    std::fabs(srgbToLinear(p[c]) - expect) <= 0.01 * expect;
+                    const bool ok = testio::levelShows(p[c], expect);
                     ASSERT_TRUE(ok) << modelName(model) << " rotation " << rotation << " face " << o << " pixel (" << i % 320
                                     << ", " << i / 320 << ") channel " << c << ": " << int(p[c]) << " != "
                                     << linearToSrgb8(expect);
@@ -968,23 +966,43 @@ TEST(RaytraceShading, DopplerOfASpinningDiskIsItsRimVelocitys) {
     EXPECT_LE(worst, 0.03);
 }
 
-// One hierarchy over the time slabs of a history (ray4d.h prepareSlabsTrace, splitting along time
-// too) finds the hit the slabs' own linear scans find, nearest over all: the same ray parameter,
-// slab and triangle, for rays across a rolling cylinder (b = 0.6, w R = b) cut into 60 slabs.
-TEST(Ray4D, SlabsHierarchyFindsWhatEachSlabsScanFinds) {
+namespace {
+
+// A rolling cylinder (radius 1, height 0.3, 24 sides; b = 0.6 along x, w R = b, Lorentz) cut into
+// `count` time slabs of `step` seconds from s = -12: the slabs, each slab's own linear scan, and
+// one hierarchy over all of them (ray4d.h prepareSlabsTrace).
+struct RollingSlabs {
+    std::vector<mesh4d::World4D> slabs;
+    std::vector<mesh4d::TraceWorld> scans;
+    mesh4d::TraceWorld joint;
+};
+RollingSlabs rollingCylinderSlabs(int count, double step) {
     const mesh4d::RestMesh mesh = testmesh::cylinder(1, 0.3, 24);
     mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0});
     m.angular_velocity = {0, 0, -0.6};
     std::vector<double> samples;
-    for (int k = 0; k <= 60; ++k) samples.push_back(-12 + 0.2 * k);
-    const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(mesh, m, samples, false, false);
+    for (int k = 0; k <= count; ++k) samples.push_back(-12 + step * k);
+    RollingSlabs r;
+    r.slabs = mesh4d::extrudeSlabs(mesh, m, samples, false, false);
     std::vector<const mesh4d::World4D*> pointers;
-    std::vector<mesh4d::TraceWorld> scans;
-    for (const auto& w : slabs) {
+    for (const auto& w : r.slabs) {
         pointers.push_back(&w);
-        scans.push_back(mesh4d::prepareTrace(w, false));
+        r.scans.push_back(mesh4d::prepareTrace(w, false));
     }
-    const mesh4d::TraceWorld joint = mesh4d::prepareSlabsTrace(pointers);
+    r.joint = mesh4d::prepareSlabsTrace(pointers);
+    return r;
+}
+
+}  // namespace
+
+// One hierarchy over the time slabs of a history (ray4d.h prepareSlabsTrace, splitting along time
+// too) finds the hit the slabs' own linear scans find, nearest over all: the same ray parameter,
+// slab and triangle, for rays across a rolling cylinder (b = 0.6, w R = b) cut into 60 slabs.
+TEST(Ray4D, SlabsHierarchyFindsWhatEachSlabsScanFinds) {
+    const RollingSlabs rolling = rollingCylinderSlabs(60, 0.2);
+    const std::vector<mesh4d::World4D>& slabs = rolling.slabs;
+    const std::vector<mesh4d::TraceWorld>& scans = rolling.scans;
+    const mesh4d::TraceWorld& joint = rolling.joint;
     ASSERT_EQ(joint.slabs.size(), slabs.size());
     int hits = 0;
     for (int iy = -20; iy <= 20; ++iy)
@@ -1016,19 +1034,10 @@ TEST(Ray4D, SlabsHierarchyFindsWhatEachSlabsScanFinds) {
 // hierarchy over the slabs and each slab's linear scan find the nearest hit over every
 // tetrahedron of every slab tested one by one (intersectTet alone): the same ray parameter.
 TEST(Ray4D, TwistedPrismsOfSpinSlabsLoseNoHit) {
-    const mesh4d::RestMesh mesh = testmesh::cylinder(1, 0.3, 24);
-    mesh4d::Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 0, {0, 0, 0}, {0.6, 0, 0});
-    m.angular_velocity = {0, 0, -0.6};
-    std::vector<double> samples;
-    for (int k = 0; k <= 30; ++k) samples.push_back(-12 + 0.8 * k);
-    const std::vector<mesh4d::World4D> slabs = mesh4d::extrudeSlabs(mesh, m, samples, false, false);
-    std::vector<const mesh4d::World4D*> pointers;
-    std::vector<mesh4d::TraceWorld> scans;
-    for (const auto& w : slabs) {
-        pointers.push_back(&w);
-        scans.push_back(mesh4d::prepareTrace(w, false));
-    }
-    const mesh4d::TraceWorld joint = mesh4d::prepareSlabsTrace(pointers);
+    const RollingSlabs rolling = rollingCylinderSlabs(30, 0.8);
+    const std::vector<mesh4d::World4D>& slabs = rolling.slabs;
+    const std::vector<mesh4d::TraceWorld>& scans = rolling.scans;
+    const mesh4d::TraceWorld& joint = rolling.joint;
     EXPECT_FALSE(joint.flat_prisms);
     int hits = 0;
     for (int iy = -20; iy <= 20; ++iy)
