@@ -248,6 +248,19 @@ bool keyMayCross(const ViewSurface& view, const Event e[3]) {
     return true;
 }
 
+// The lab rates (dt/ds, dx/ds) of a key segment's velocity dY in the key frame F_V, for the two
+// kink terms below: boosted with `velocity` (Lorentz), as they are for the Galilean carry.
+struct KeyLab {
+    bool lorentz;
+    double g, b;
+    Vec3 V;
+    explicit KeyLab(const Motion& m)
+        : lorentz(m.kinematics == Kinematics::Lorentz), g(lorentz ? m.gamma : 1.0), b(lorentz ? m.beta : 0.0),
+          V(lorentz ? m.velocity : Vec3{0, 0, 0}) {}
+    double t(const Vec3& dY) const { return lorentz ? g * (1 + dot(V, dY)) : 1.0; }
+    Vec3 x(const Vec3& dY) const { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; }
+};
+
 // The kink term of key i over the triangle on the cone (header), light-seconds: the lesser of
 // m_i j_i d / sqrt(3) (j(q) = |c(q)| D(q) at q's event at s_i (ev), exact at the corners, carried over
 // the triangle by its Lipschitz bound) and the crossing-weighted D_hi (3 a b / (a + b) + 2 eps + 2 e)
@@ -256,12 +269,11 @@ bool keyMayCross(const ViewSurface& view, const Event e[3]) {
 double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, size_t i, const Event ev[3],
                const Vec3 dyb[3], TurnedCorners& turned, double d) {
     const KeyedMotion& k = *m.keyed;
-    const bool cone = view.kind == ViewKind::PastCone, lorentz = m.kinematics == Kinematics::Lorentz;
-    const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
-    const Vec3 V = lorentz ? m.velocity : Vec3{0, 0, 0};
+    const bool cone = view.kind == ViewKind::PastCone;
+    const KeyLab lab(m);
+    const double g = lab.g, b = lab.b;
+    const Vec3 V = lab.V;
     const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
-    auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
-    auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
     const Vec3* pa = turned.segment(i);
     double rho_min = INFINITY, j_min = INFINITY, D_min = INFINITY, D_max = 0, c_max = 0, x_max = 0, t_max = 0,
            lam_min = INFINITY, above = 0, below = 0;
@@ -279,8 +291,8 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
             below = std::max(below, -gk);
         }
         const Vec3 dya = keyedSegmentTurned(k, i, s, pa[q]).dy;
-        const double ta = labT(dya), tb = labT(dyb[q]);
-        const Vec3 xa = labX(dya), xb = labX(dyb[q]);
+        const double ta = lab.t(dya), tb = lab.t(dyb[q]);
+        const Vec3 xa = lab.x(dya), xb = lab.x(dyb[q]);
         const double la = ta + dot(n, xa), lb = tb + dot(n, xb);
         if (!(la > 0) || !(lb > 0)) return INFINITY;
         const double D = norm(xb / lb - xa / la) + shear_speed * std::fabs(tb / lb - ta / la);
@@ -329,12 +341,9 @@ double keyKink(const Motion& m, const ViewSurface& view, double shear_speed, siz
 double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const Event ev[3],
                       const Vec3 dyb[3], TurnedCorners& turned, double d) {
     const KeyedMotion& k = *m.keyed;
-    const bool lorentz = m.kinematics == Kinematics::Lorentz;
-    const double g = lorentz ? m.gamma : 1.0, b = lorentz ? m.beta : 0.0;
-    const Vec3 V = lorentz ? m.velocity : Vec3{0, 0, 0};
+    const KeyLab lab(m);
+    const double g = lab.g, b = lab.b;
     const double s = k.s[i], w = std::max(k.rate[i], k.rate[i + 1]);
-    auto labT = [&](const Vec3& dY) { return lorentz ? g * (1 + dot(V, dY)) : 1.0; };
-    auto labX = [&](const Vec3& dY) { return lorentz ? dY + stretch(V, g, dY) + V * g : dY; };
     const Vec3* pa = turned.segment(i);
     double above = 0, below = 0, D_min = INFINITY, x_max = 0, lam_min = INFINITY;
     for (int q = 0; q < 3; ++q) {
@@ -342,8 +351,8 @@ double keyKinkOnPlane(const Motion& m, const ViewSurface& view, size_t i, const 
         above = std::max(above, gk);
         below = std::max(below, -gk);
         const Vec3 dya = keyedSegmentTurned(k, i, s, pa[q]).dy;
-        const double ta = labT(dya), tb = labT(dyb[q]);
-        const Vec3 xa = labX(dya), xb = labX(dyb[q]);
+        const double ta = lab.t(dya), tb = lab.t(dyb[q]);
+        const Vec3 xa = lab.x(dya), xb = lab.x(dyb[q]);
         if (!(ta > 0) || !(tb > 0)) return INFINITY;
         D_min = std::min(D_min, norm(xb / tb - xa / ta));  // the shear's part: |t_s / Lambda| = 1 on both sides
         x_max = std::max({x_max, norm(xa), norm(xb)});
