@@ -524,16 +524,17 @@ struct FrameBuilder {
 
     // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
     // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
-    const REdge& edgeOf(uint32_t id, int c) {
+    // (The look-up inline, the bound made out of line: the hot loops stay small.)
+    [[gnu::always_inline]] const REdge& edgeOf(uint32_t id, int c) {
         REdge& e = r_edge_data[rt[id].edge[c]];
-        if (e.len != e.len) {
-            const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
-            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
-            e.len = eb.length;
-            e.c = eb.c;
-            e.xm_mid = eb.xm_mid;
-        }
+        if (e.len != e.len) makeEdge(e, rt[id].v[c], rt[id].v[kSucc[c]]);
         return e;
+    }
+    [[gnu::noinline]] void makeEdge(REdge& e, uint32_t a, uint32_t b) const {
+        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
+        e.len = eb.length;
+        e.c = eb.c;
+        e.xm_mid = eb.xm_mid;
     }
 
     // The midpoint vertex of slot c of triangle id (made once per edge, when the edge is split).
@@ -548,10 +549,11 @@ struct FrameBuilder {
         return r_edges[rec].mid = newVertex(rest, lo, hi, xm);
     }
 
-    // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
-    // in the edge's cycle.
+    // Moves slot `from` of a triangle being split (its record made) to slot `to` of its half:
+    // same edge, same place in the edge's cycle. The common edge, on two triangles, is a 2-cycle:
+    // the slot after `from` is the one before it, found without a walk.
     void moveSlot(uint32_t from, uint32_t to) {
-        const uint32_t nx = nextOf(from);
+        const uint32_t nx = rt[slotTri(from)].next[slotSide(from)];
         RTri& t = rt[slotTri(to)];
         if (nx == from) {
             t.next[slotSide(to)] = to;
@@ -559,7 +561,7 @@ struct FrameBuilder {
         }
         t.next[slotSide(to)] = nx;
         uint32_t p = nx;
-        while (nextOf(p) != from) p = nextOf(p);
+        for (uint32_t q = nextOf(p); q != from; q = nextOf(p)) p = q;
         setNext(p, to);
     }
 
@@ -567,14 +569,15 @@ struct FrameBuilder {
     // each (a, b, o) becomes A = (a, m, o), kept in its record (slot c + 2 stays in place), and
     // B = (m, b, o), appended. The halves' slots on the edge form two new cycles, on two new edge
     // records; each triangle's new inner edge (m, o) gets its own record.
-    // members: the edge's cycle from slot c of id (the walk that chose the edge collected it).
-    void splitEdge(uint32_t id, int c, const std::vector<uint32_t>& members, std::vector<uint32_t>& stack) {
+    // members: the edge's cycle from slot c of id, n slots (the walk that chose the edge collected
+    // it; their records are made).
+    void splitEdge(uint32_t id, int c, const uint32_t* members, uint32_t n, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
         const uint32_t lo = std::min(rt[id].v[c], rt[id].v[kSucc[c]]);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-        r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
+        r_edges.resize(r_edges.size() + 2 + n, REdge{kUnset, NAN, NAN, NAN});
         r_edge_data = r_edges.data();
-        reserveTris(members.size());
+        reserveTris(n);
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
             if (first == kUnset) first = slot;
@@ -582,10 +585,10 @@ struct FrameBuilder {
             prev = slot;
         };
         uint32_t inner = hi_rec + 1;
-        for (uint32_t q : members) {
+        for (uint32_t k = 0; k < n; ++k) {
+            const uint32_t q = members[k];
             const uint32_t u = slotTri(q);
             const int cu = int(slotSide(q)), c1 = kSucc[cu], c2 = kSucc[c1];
-            ensureBase(u);
             RTri& A = rt[u];
             const uint32_t a = A.v[cu], b = A.v[c1], o = A.v[c2];
             const uint32_t B = uint32_t(r_tri_size++);
@@ -661,37 +664,40 @@ struct FrameBuilder {
                 rt[id].state = kFailed;
                 if (rt[id].longest < 0) rt[id].longest = int16_t(longestOf(v, e));
             }
-            if (rt[id].depth >= r_max_depth) {
-                r_limited[rt[id].src] = 1;
-                continue;
-            }
-            if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
-                out.over_budget = true;
-                stack.clear();
-                return;
-            }
-            const int split = splitLongestPath(id, stack);
-            if (split == kSplitBlocked) {
-                // The split would halve a piece a template fills: this piece is filled by its own
-                // template instead (any level its form asks for), so the template stays whole,
-                // unless that template would make more than kForceRatio times the triangles its
-                // bisection is expected to (then the split is made: the template's halves are
-                // judged again).
-                const uint32_t* v = rt[id].v;
-                const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
-                if (coarseForm(id, s, true)) {
-                    if (forcedTemplatePays(id)) {
-                        rt[id].state = kCoarse;
-                        scratch.coarse.push_back(id);
-                        continue;
-                    }
-                    scratch.form_of[id] = kUnset;
-                    scratch.forms.pop_back();
-                    scratch.form_aniso.pop_back();
+            // A split of a coarser neighbour first (kSplitOther) leaves id as it was (its edges are
+            // shorter than the edge halved): id is judged again at once, as if pushed back and popped.
+            for (bool again = true; again;) {
+                if (rt[id].depth >= r_max_depth) {
+                    r_limited[rt[id].src] = 1;
+                    break;
                 }
-                if (splitLongestPath(id, stack, false) == kSplitOther) stack.push_back(id);
-            } else if (split == kSplitOther) {
-                stack.push_back(id);  // a coarser neighbour went first
+                if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
+                    out.over_budget = true;
+                    stack.clear();
+                    return;
+                }
+                const int split = splitLongestPath(id, stack);
+                again = split == kSplitOther;
+                if (split == kSplitBlocked) {
+                    // The split would halve a piece a template fills: this piece is filled by its
+                    // own template instead (any level its form asks for), so the template stays
+                    // whole, unless that template would make more than kForceRatio times the
+                    // triangles its bisection is expected to (then the split is made: the
+                    // template's halves are judged again).
+                    const uint32_t* v = rt[id].v;
+                    const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
+                    if (coarseForm(id, s, true)) {
+                        if (forcedTemplatePays(id)) {
+                            rt[id].state = kCoarse;
+                            scratch.coarse.push_back(id);
+                            break;
+                        }
+                        scratch.form_of[id] = kUnset;
+                        scratch.forms.pop_back();
+                        scratch.form_aniso.pop_back();
+                    }
+                    again = splitLongestPath(id, stack, false) == kSplitOther;
+                }
             }
         }
     }
@@ -724,9 +730,12 @@ struct FrameBuilder {
         }
         return best;
     }
-    int longestSlot(uint32_t id) {
+    [[gnu::always_inline]] int longestSlot(uint32_t id) {
         ensureBase(id);
         if (rt[id].longest >= 0) return rt[id].longest;
+        return findLongest(id);
+    }
+    [[gnu::noinline]] int findLongest(uint32_t id) {
         const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
         const int best = longestOf(rt[id].v, e);
         rt[id].longest = int16_t(best);
@@ -744,35 +753,52 @@ struct FrameBuilder {
     // With `guard` (templates on), a split that would halve a piece marked kCoarse whose level
     // is kKeptLevel or more is not made: kSplitBlocked (the caller templates id instead).
     static constexpr int kSplitOther = 0, kSplitOwn = 1, kSplitBlocked = 2;
-    int splitLongestPath(uint32_t id, std::vector<uint32_t>& stack, bool guard = true) {
+    // The edge's cycle is collected as it is walked (splitEdge needs it all): an edge on one or
+    // two triangles (every edge of a closed manifold mesh and of its pieces) in a local pair, a
+    // longer cycle in scratch_members. Every record the walk passes is made (longestSlot).
+    [[gnu::noinline]] int splitLongestPath(uint32_t id, std::vector<uint32_t>& stack, bool guard = true) {
         uint32_t t = id;
         for (;;) {
             const int c = longestSlot(t);
             const uint32_t start = slotOf(t, c);
-            uint32_t other = kUnset;
-            // The edge's cycle, collected as it is walked: when the edge is halved, splitEdge
-            // needs it all.
-            std::vector<uint32_t>& members = scratch_members;
-            members.clear();
-            members.push_back(start);
-            for (uint32_t p = nextOf(start); p != start; p = nextOf(p)) {
-                if (longestSlot(slotTri(p)) != int(slotSide(p))) {
-                    other = slotTri(p);
-                    break;
+            uint32_t pair[2] = {start, rt[t].next[c]};
+            const uint32_t* members = pair;
+            uint32_t n = 1;
+            if (pair[1] != start) {
+                const uint32_t p = pair[1], q = slotTri(p);
+                if (longestSlot(q) != int(slotSide(p))) {
+                    t = q;
+                    continue;
                 }
-                members.push_back(p);
-            }
-            if (other == kUnset) {
-                if (guard && r_templates)
-                    for (uint32_t p : members) {
-                        const uint32_t u = slotTri(p);
-                        if (rt[u].state == kCoarse && formLevel(scratch.forms[scratch.form_of[u]], kNoCap) >= kKeptLevel)
-                            return kSplitBlocked;
+                n = 2;
+                const uint32_t after = rt[q].next[slotSide(p)];
+                if (after != start) {
+                    std::vector<uint32_t>& more = scratch_members;
+                    more.assign(pair, pair + 2);
+                    uint32_t other = kUnset;
+                    for (uint32_t r = after; r != start; r = nextOf(r)) {
+                        if (longestSlot(slotTri(r)) != int(slotSide(r))) {
+                            other = slotTri(r);
+                            break;
+                        }
+                        more.push_back(r);
                     }
-                splitEdge(t, c, members, stack);
-                return t == id ? kSplitOwn : kSplitOther;
+                    if (other != kUnset) {
+                        t = other;
+                        continue;
+                    }
+                    members = more.data();
+                    n = uint32_t(more.size());
+                }
             }
-            t = other;
+            if (guard && r_templates)
+                for (uint32_t k = 0; k < n; ++k) {
+                    const uint32_t u = slotTri(members[k]);
+                    if (rt[u].state == kCoarse && formLevel(scratch.forms[scratch.form_of[u]], kNoCap) >= kKeptLevel)
+                        return kSplitBlocked;
+                }
+            splitEdge(t, c, members, n, stack);
+            return t == id ? kSplitOwn : kSplitOther;
         }
     }
 
