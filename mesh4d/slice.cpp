@@ -69,15 +69,15 @@ struct REdge {
 // Triangles of the refinement, the leaves only: ids below r_nt are the mesh's triangles (records
 // made when first touched), later ids pieces made by splits. A split keeps one half in the
 // record it halves (the one with the slot that does not move) and appends the other. Each slot c
-// is the edge from v[c] to v[c + 1]; the slots on one edge form a cycle (next), as
-// World4D::slot_next does for the mesh, so that an edge is split in every triangle that has it:
-// no T-junctions, however the splits go.
+// is the edge from v[c] to v[c + 1]; the slots on one edge form a cycle (the next slot of each,
+// kept apart from the records in an array indexed by the slot itself), as World4D::slot_next
+// does for the mesh, so that an edge is split in every triangle that has it: no T-junctions,
+// however the splits go.
 // kCoarse: its bound fails, but its whole-piece form (chord_error.h pieceForm) is tight enough
 // that a template fills it (tessellate.h) instead of further bisection.
 enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3 };
 struct RTri {
     uint32_t v[3];
-    uint32_t next[3];  // next slot (3 id + c) on the same edge; itself on a boundary edge
     uint32_t edge[3];  // the edge record of each slot
     uint32_t src;      // the mesh triangle it lies on
     uint8_t depth;     // bisections since the mesh triangle (at most 2 log2(max_segments) <= 60)
@@ -85,7 +85,8 @@ struct RTri {
     int16_t longest;   // the slot of its longest edge once known, else -1
 };
 // A slot (triangle record, side) as one number: id << 2 | side (the mesh's World4D::slot_next
-// counts 3 id + side; meshSlot converts). At most 2^30 records.
+// counts 3 id + side; meshSlot converts). At most 2^30 records. The slot after slot p on its
+// edge is next[p] (4 entries per record, the fourth unused); itself on a boundary edge.
 inline uint32_t slotOf(uint32_t id, int side) { return id << 2 | uint32_t(side); }
 inline uint32_t slotTri(uint32_t slot) { return slot >> 2; }
 inline uint32_t slotSide(uint32_t slot) { return slot & 3; }
@@ -104,6 +105,7 @@ struct RefineScratch {
     std::vector<uint8_t> init, limited;
     std::vector<REdge> edges;
     std::unique_ptr<RTri[]> tri;
+    std::unique_ptr<uint32_t[]> next;  // 4 per record (slotOf)
     size_t tri_cap = 0;
     std::vector<uint32_t> members, stack;
     std::vector<Side> side;
@@ -123,7 +125,7 @@ struct RefineScratch {
         return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
                terms.capacity() * sizeof(VTerms) + spread.capacity() * sizeof(double) +
                cap.capacity() * sizeof(Event) +
-               edges.capacity() * sizeof(REdge) + tri_cap * sizeof(RTri) +
+               edges.capacity() * sizeof(REdge) + tri_cap * (sizeof(RTri) + 4 * sizeof(uint32_t)) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
                init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
                form_aniso.capacity() +
@@ -160,7 +162,8 @@ struct FrameBuilder {
           side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
           r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), scratch_members(scratch.members),
           r_edges(scratch.edges),
-          r_tri(scratch.tri), r_tri_cap(scratch.tri_cap), r_init(scratch.init), r_limited(scratch.limited) {
+          r_tri(scratch.tri), r_next(scratch.next), rn(scratch.next.get()), r_tri_cap(scratch.tri_cap),
+          r_init(scratch.init), r_limited(scratch.limited) {
         for (auto* a : {&r_pos, &r_rest}) a->clear();
         r_time.clear();
         r_terms.clear();
@@ -452,6 +455,8 @@ struct FrameBuilder {
     // records are made).
     std::unique_ptr<RTri[]>& r_tri;
     RTri* rt = nullptr;  // r_tri.get(), kept in step by reserveTris
+    std::unique_ptr<uint32_t[]>& r_next;  // each slot's next slot on its edge (slotOf)
+    uint32_t* rn;                         // r_next.get(), kept in step by reserveTris
     size_t& r_tri_cap;
     size_t r_tri_size = 0;
     std::vector<uint8_t>& r_init;
@@ -469,9 +474,15 @@ struct FrameBuilder {
         if (r_tri_size + n <= r_tri_cap) return;
         const size_t cap = std::max(r_tri_size + n, 2 * r_tri_cap);
         std::unique_ptr<RTri[]> grown(new RTri[cap]);
-        if (r_tri_size > 0) std::memcpy(static_cast<void*>(grown.get()), r_tri.get(), r_tri_size * sizeof(RTri));
+        std::unique_ptr<uint32_t[]> grown_next(new uint32_t[4 * cap]);
+        if (r_tri_size > 0) {
+            std::memcpy(static_cast<void*>(grown.get()), r_tri.get(), r_tri_size * sizeof(RTri));
+            std::memcpy(grown_next.get(), r_next.get(), 4 * r_tri_size * sizeof(uint32_t));
+        }
         r_tri = std::move(grown);
         rt = r_tri.get();
+        r_next = std::move(grown_next);
+        rn = r_next.get();
         r_tri_cap = cap;
     }
 
@@ -481,7 +492,7 @@ struct FrameBuilder {
         RTri& t = rt[id];
         for (int c = 0; c < 3; ++c) {
             t.v[c] = world.mesh.triangles[id][c];
-            t.next[c] = meshSlot(world.slot_next[3 * id + c]);
+            rn[slotOf(id, c)] = meshSlot(world.slot_next[3 * id + c]);
             t.edge[c] = world.triangle_edges[id][c];
         }
         t.src = id;
@@ -493,11 +504,11 @@ struct FrameBuilder {
     uint32_t nextOf(uint32_t p) const {
         const uint32_t id = slotTri(p);
         if (id < r_nt && !r_init_data[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
-        return rt[id].next[slotSide(p)];
+        return rn[p];
     }
     void setNext(uint32_t p, uint32_t to) {
         ensureBase(slotTri(p));
-        rt[slotTri(p)].next[slotSide(p)] = to;
+        rn[p] = to;
     }
 
     // A split's point: its terms now, its exact image in the batch after the last split.
@@ -524,16 +535,17 @@ struct FrameBuilder {
 
     // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
     // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
-    const REdge& edgeOf(uint32_t id, int c) {
+    // (The look-up inline, the bound made out of line: the hot loops stay small.)
+    [[gnu::always_inline]] const REdge& edgeOf(uint32_t id, int c) {
         REdge& e = r_edge_data[rt[id].edge[c]];
-        if (e.len != e.len) {
-            const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
-            const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
-            e.len = eb.length;
-            e.c = eb.c;
-            e.xm_mid = eb.xm_mid;
-        }
+        if (e.len != e.len) makeEdge(e, rt[id].v[c], rt[id].v[kSucc[c]]);
         return e;
+    }
+    [[gnu::noinline]] void makeEdge(REdge& e, uint32_t a, uint32_t b) const {
+        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
+        e.len = eb.length;
+        e.c = eb.c;
+        e.xm_mid = eb.xm_mid;
     }
 
     // The midpoint vertex of slot c of triangle id (made once per edge, when the edge is split).
@@ -548,18 +560,18 @@ struct FrameBuilder {
         return r_edges[rec].mid = newVertex(rest, lo, hi, xm);
     }
 
-    // Moves slot `from` of a triangle being split to slot `to` of its half: same edge, same place
-    // in the edge's cycle.
+    // Moves slot `from` of a triangle being split (its record made) to slot `to` of its half:
+    // same edge, same place in the edge's cycle. The common edge, on two triangles, is a 2-cycle:
+    // the slot after `from` is the one before it, found without a walk.
     void moveSlot(uint32_t from, uint32_t to) {
-        const uint32_t nx = nextOf(from);
-        RTri& t = rt[slotTri(to)];
+        const uint32_t nx = rn[from];
         if (nx == from) {
-            t.next[slotSide(to)] = to;
+            rn[to] = to;
             return;
         }
-        t.next[slotSide(to)] = nx;
+        rn[to] = nx;
         uint32_t p = nx;
-        while (nextOf(p) != from) p = nextOf(p);
+        for (uint32_t q = nextOf(p); q != from; q = nextOf(p)) p = q;
         setNext(p, to);
     }
 
@@ -567,25 +579,26 @@ struct FrameBuilder {
     // each (a, b, o) becomes A = (a, m, o), kept in its record (slot c + 2 stays in place), and
     // B = (m, b, o), appended. The halves' slots on the edge form two new cycles, on two new edge
     // records; each triangle's new inner edge (m, o) gets its own record.
-    // members: the edge's cycle from slot c of id (the walk that chose the edge collected it).
-    void splitEdge(uint32_t id, int c, const std::vector<uint32_t>& members, std::vector<uint32_t>& stack) {
+    // members: the edge's cycle from slot c of id, n slots (the walk that chose the edge collected
+    // it; their records are made).
+    void splitEdge(uint32_t id, int c, const uint32_t* members, uint32_t n, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
         const uint32_t lo = std::min(rt[id].v[c], rt[id].v[kSucc[c]]);
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-        r_edges.resize(r_edges.size() + 2 + members.size(), REdge{kUnset, NAN, NAN, NAN});
+        r_edges.resize(r_edges.size() + 2 + n, REdge{kUnset, NAN, NAN, NAN});
         r_edge_data = r_edges.data();
-        reserveTris(members.size());
+        reserveTris(n);
         uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
         auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
             if (first == kUnset) first = slot;
-            else rt[slotTri(prev)].next[slotSide(prev)] = slot;
+            else rn[prev] = slot;
             prev = slot;
         };
         uint32_t inner = hi_rec + 1;
-        for (uint32_t q : members) {
+        for (uint32_t k = 0; k < n; ++k) {
+            const uint32_t q = members[k];
             const uint32_t u = slotTri(q);
             const int cu = int(slotSide(q)), c1 = kSucc[cu], c2 = kSucc[c1];
-            ensureBase(u);
             RTri& A = rt[u];
             const uint32_t a = A.v[cu], b = A.v[c1], o = A.v[c2];
             const uint32_t B = uint32_t(r_tri_size++);
@@ -593,11 +606,11 @@ struct FrameBuilder {
             if (A.depth == 0) ++out.refined_triangles;
             const uint8_t depth = uint8_t(A.depth + 1);
             RTri& Bt = rt[B];
-            Bt = RTri{{m, b, o}, {kUnset, kUnset, slotOf(u, c1)}, {b_half, A.edge[c1], inner}, A.src, depth,
-                      kUnknown, -1};
+            Bt = RTri{{m, b, o}, {b_half, A.edge[c1], inner}, A.src, depth, kUnknown, -1};
+            rn[slotOf(B, 2)] = slotOf(u, c1);
             moveSlot(slotOf(u, c1), slotOf(B, 1));  // the side b -> o goes to B
             A.v[c1] = m;
-            A.next[c1] = slotOf(B, 2);
+            rn[slotOf(u, c1)] = slotOf(B, 2);
             A.edge[cu] = a_half;
             A.edge[c1] = inner;
             A.depth = depth;
@@ -615,8 +628,8 @@ struct FrameBuilder {
             stack.push_back(B);
             stack.push_back(u);
         }
-        rt[slotTri(lo_prev)].next[slotSide(lo_prev)] = lo_first;  // close the two cycles
-        rt[slotTri(hi_prev)].next[slotSide(hi_prev)] = hi_first;
+        rn[lo_prev] = lo_first;  // close the two cycles
+        rn[hi_prev] = hi_first;
     }
 
     // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
@@ -661,37 +674,40 @@ struct FrameBuilder {
                 rt[id].state = kFailed;
                 if (rt[id].longest < 0) rt[id].longest = int16_t(longestOf(v, e));
             }
-            if (rt[id].depth >= r_max_depth) {
-                r_limited[rt[id].src] = 1;
-                continue;
-            }
-            if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
-                out.over_budget = true;
-                stack.clear();
-                return;
-            }
-            const int split = splitLongestPath(id, stack);
-            if (split == kSplitBlocked) {
-                // The split would halve a piece a template fills: this piece is filled by its own
-                // template instead (any level its form asks for), so the template stays whole,
-                // unless that template would make more than kForceRatio times the triangles its
-                // bisection is expected to (then the split is made: the template's halves are
-                // judged again).
-                const uint32_t* v = rt[id].v;
-                const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
-                if (coarseForm(id, s, true)) {
-                    if (forcedTemplatePays(id)) {
-                        rt[id].state = kCoarse;
-                        scratch.coarse.push_back(id);
-                        continue;
-                    }
-                    scratch.form_of[id] = kUnset;
-                    scratch.forms.pop_back();
-                    scratch.form_aniso.pop_back();
+            // A split of a coarser neighbour first (kSplitOther) leaves id as it was (its edges are
+            // shorter than the edge halved): id is judged again at once, as if pushed back and popped.
+            for (bool again = true; again;) {
+                if (rt[id].depth >= r_max_depth) {
+                    r_limited[rt[id].src] = 1;
+                    break;
                 }
-                if (splitLongestPath(id, stack, false) == kSplitOther) stack.push_back(id);
-            } else if (split == kSplitOther) {
-                stack.push_back(id);  // a coarser neighbour went first
+                if (settings.max_triangles > 0 && r_leaves >= settings.max_triangles) {
+                    out.over_budget = true;
+                    stack.clear();
+                    return;
+                }
+                const int split = splitLongestPath(id, stack);
+                again = split == kSplitOther;
+                if (split == kSplitBlocked) {
+                    // The split would halve a piece a template fills: this piece is filled by its
+                    // own template instead (any level its form asks for), so the template stays
+                    // whole, unless that template would make more than kForceRatio times the
+                    // triangles its bisection is expected to (then the split is made: the
+                    // template's halves are judged again).
+                    const uint32_t* v = rt[id].v;
+                    const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
+                    if (coarseForm(id, s, true)) {
+                        if (forcedTemplatePays(id)) {
+                            rt[id].state = kCoarse;
+                            scratch.coarse.push_back(id);
+                            break;
+                        }
+                        scratch.form_of[id] = kUnset;
+                        scratch.forms.pop_back();
+                        scratch.form_aniso.pop_back();
+                    }
+                    again = splitLongestPath(id, stack, false) == kSplitOther;
+                }
             }
         }
     }
@@ -724,9 +740,12 @@ struct FrameBuilder {
         }
         return best;
     }
-    int longestSlot(uint32_t id) {
+    [[gnu::always_inline]] int longestSlot(uint32_t id) {
         ensureBase(id);
         if (rt[id].longest >= 0) return rt[id].longest;
+        return findLongest(id);
+    }
+    [[gnu::noinline]] int findLongest(uint32_t id) {
         const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
         const int best = longestOf(rt[id].v, e);
         rt[id].longest = int16_t(best);
@@ -744,35 +763,52 @@ struct FrameBuilder {
     // With `guard` (templates on), a split that would halve a piece marked kCoarse whose level
     // is kKeptLevel or more is not made: kSplitBlocked (the caller templates id instead).
     static constexpr int kSplitOther = 0, kSplitOwn = 1, kSplitBlocked = 2;
-    int splitLongestPath(uint32_t id, std::vector<uint32_t>& stack, bool guard = true) {
+    // The edge's cycle is collected as it is walked (splitEdge needs it all): an edge on one or
+    // two triangles (every edge of a closed manifold mesh and of its pieces) in a local pair, a
+    // longer cycle in scratch_members. Every record the walk passes is made (longestSlot).
+    [[gnu::noinline]] int splitLongestPath(uint32_t id, std::vector<uint32_t>& stack, bool guard = true) {
         uint32_t t = id;
         for (;;) {
             const int c = longestSlot(t);
             const uint32_t start = slotOf(t, c);
-            uint32_t other = kUnset;
-            // The edge's cycle, collected as it is walked: when the edge is halved, splitEdge
-            // needs it all.
-            std::vector<uint32_t>& members = scratch_members;
-            members.clear();
-            members.push_back(start);
-            for (uint32_t p = nextOf(start); p != start; p = nextOf(p)) {
-                if (longestSlot(slotTri(p)) != int(slotSide(p))) {
-                    other = slotTri(p);
-                    break;
+            uint32_t pair[2] = {start, rn[start]};
+            const uint32_t* members = pair;
+            uint32_t n = 1;
+            if (pair[1] != start) {
+                const uint32_t p = pair[1], q = slotTri(p);
+                if (longestSlot(q) != int(slotSide(p))) {
+                    t = q;
+                    continue;
                 }
-                members.push_back(p);
-            }
-            if (other == kUnset) {
-                if (guard && r_templates)
-                    for (uint32_t p : members) {
-                        const uint32_t u = slotTri(p);
-                        if (rt[u].state == kCoarse && formLevel(scratch.forms[scratch.form_of[u]], kNoCap) >= kKeptLevel)
-                            return kSplitBlocked;
+                n = 2;
+                const uint32_t after = rn[p];
+                if (after != start) {
+                    std::vector<uint32_t>& more = scratch_members;
+                    more.assign(pair, pair + 2);
+                    uint32_t other = kUnset;
+                    for (uint32_t r = after; r != start; r = nextOf(r)) {
+                        if (longestSlot(slotTri(r)) != int(slotSide(r))) {
+                            other = slotTri(r);
+                            break;
+                        }
+                        more.push_back(r);
                     }
-                splitEdge(t, c, members, stack);
-                return t == id ? kSplitOwn : kSplitOther;
+                    if (other != kUnset) {
+                        t = other;
+                        continue;
+                    }
+                    members = more.data();
+                    n = uint32_t(more.size());
+                }
             }
-            t = other;
+            if (guard && r_templates)
+                for (uint32_t k = 0; k < n; ++k) {
+                    const uint32_t u = slotTri(members[k]);
+                    if (rt[u].state == kCoarse && formLevel(scratch.forms[scratch.form_of[u]], kNoCap) >= kKeptLevel)
+                        return kSplitBlocked;
+                }
+            splitEdge(t, c, members, n, stack);
+            return t == id ? kSplitOwn : kSplitOther;
         }
     }
 

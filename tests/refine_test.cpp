@@ -487,6 +487,69 @@ TEST(Refine, RefinedSphereStaysClosedGenusZero) {
     }
 }
 
+// The bisection halves an edge in every triangle around it, whatever their number: three fins
+// sharing one spine (an edge on three triangles, walked as a cycle of three slots) and their
+// outer sides (edges on one triangle) near the camera. Conforming means, counted on the output's
+// vertex ids: every output edge is on one, two or three triangles; those on three lie on the
+// spine and join end to end from one spine end to the other (each spine point inside it is on
+// exactly two of them); those on one lie on a fin's outer sides (rest points on the segment
+// between the rest corners). A T-junction would leave an edge on one triangle inside a fin or on
+// the spine.
+TEST(Refine, EdgeOnThreeTrianglesIsHalvedInAll) {
+    RestMesh fins;
+    fins.positions = {{-0.5, 0, 0}, {0.5, 0, 0}, {0.1, 0.7, 0}, {-0.2, -0.35, 0.6}, {0.15, -0.35, -0.6}};
+    fins.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+    const World4D w = extrude(fins, makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -2}, {0.9, 0, 0}), -100, 100, false, false);
+    SliceSettings s;
+    s.max_segments = 4096;
+    s.tolerance = 1e-3 * restSize(fins);
+    const ApparentMesh out = sliceWorld(w, {ViewKind::PastCone, 2.0, {0, 0, 0}}, s);
+    ASSERT_GT(out.triangles.size(), 30u);
+    // Whether rest point p lies on the segment from a to b (to rounding).
+    auto onSegment = [](const Vec3& p, const Vec3& a, const Vec3& b) {
+        const Vec3 u = b - a;
+        const double t = dot(p - a, u) / dot(u, u);
+        return t >= -1e-12 && t <= 1 + 1e-12 && norm(p - (a + u * t)) <= 1e-12 * norm(u);
+    };
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (const auto& t : out.triangles)
+        for (int c = 0; c < 3; ++c) ++uses[{std::min(t[c], t[(c + 1) % 3]), std::max(t[c], t[(c + 1) % 3])}];
+    const Vec3 a = fins.positions[0], b = fins.positions[1];
+    std::map<uint32_t, int> spine_ends;  // spine edges at each output vertex
+    size_t spine_edges = 0;
+    for (const auto& [e, n] : uses) {
+        const Vec3 p = out.rest_points[e.first], q = out.rest_points[e.second];
+        ASSERT_GE(n, 1);
+        ASSERT_LE(n, 3);
+        if (n == 3) {
+            EXPECT_TRUE(onSegment(p, a, b) && onSegment(q, a, b));
+            ++spine_edges;
+            ++spine_ends[e.first];
+            ++spine_ends[e.second];
+        } else if (n == 1) {
+            bool outer = false;
+            for (uint32_t o : {2u, 3u, 4u}) {
+                const Vec3 c = fins.positions[o];
+                outer |= (onSegment(p, a, c) && onSegment(q, a, c)) || (onSegment(p, b, c) && onSegment(q, b, c));
+            }
+            EXPECT_TRUE(outer) << "an edge on one triangle inside a fin or on the spine: a T-junction";
+        }
+    }
+    EXPECT_GT(spine_edges, 1u) << "the spine was not halved";
+    size_t ends = 0;
+    for (const auto& [v, n] : spine_ends) {
+        const Vec3 p = out.rest_points[v];
+        if (p == a || p == b) {
+            EXPECT_EQ(n, 1);
+            ++ends;
+        } else {
+            EXPECT_EQ(n, 2);
+        }
+    }
+    EXPECT_EQ(ends, 2u);
+    EXPECT_LE(measure::twoSided(w, {ViewKind::PastCone, 2.0, {0, 0, 0}}, out, 8), s.tolerance);
+}
+
 // A budget stops a refinement that would be too large (a tolerance far too fine for the scene):
 // the output stays within it (plus the few pieces clipping adds) and says so.
 TEST(Refine, TriangleBudgetStopsTheRefinement) {
