@@ -117,6 +117,7 @@ struct RefineScratch {
     FormBisection bisection;
     std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
     std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
+    std::vector<uint32_t> candidates, failing;  // refineFrame's first pass: triangles its corners' bound fails, and its a-priori bound
     std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
@@ -128,7 +129,7 @@ struct RefineScratch {
                init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
                form_aniso.capacity() +
                (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity() +
-                coarse.capacity()) *
+                coarse.capacity() + candidates.capacity() + failing.capacity()) *
                    sizeof(uint32_t) +
                local.capacity() * sizeof(std::array<uint32_t, 3>);
     }
@@ -1018,7 +1019,8 @@ struct FrameBuilder {
                     r_rest.push_back(p0 * (1 - l1 - l2) + p1 * l1 + p2 * l2);
                     map[fb.innerFirst() + j] = id++;
                 }
-                for (const auto& t : local) addOutput(src, {outOf(map[t[0]]), outOf(map[t[1]]), outOf(map[t[2]])});
+                for (uint32_t& g : map) g = outOf(g);  // each point's output id once, not once per triangle on it
+                for (const auto& t : local) addOutput(src, {map[t[0]], map[t[1]], map[t[2]]});
                 if (unsplit && local.size() > 1) ++out.refined_triangles;
                 return;
             }
@@ -1053,7 +1055,8 @@ struct FrameBuilder {
             }
             for (uint32_t p = lay.innerFirst(); p < lay.count(); ++p) map[p] = id++;
         }
-        for (const auto& t : local) addOutput(src, {outOf(map[t[0]]), outOf(map[t[1]]), outOf(map[t[2]])});
+        for (uint32_t& g : map) g = outOf(g);  // each point's output id once, not once per triangle on it
+        for (const auto& t : local) addOutput(src, {map[t[0]], map[t[1]], map[t[2]]});
         if (unsplit && local.size() > 1) ++out.refined_triangles;
     }
 
@@ -1216,7 +1219,10 @@ struct FrameBuilder {
 
         // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
         // refinement; the others get the a-priori bound (chordErrorOfBubbles).
-        std::vector<uint32_t> candidates, failing;
+        std::vector<uint32_t>& candidates = scratch.candidates;
+        std::vector<uint32_t>& failing = scratch.failing;
+        candidates.clear();
+        failing.clear();
         double expected_pieces = 0;
         r_now = nowBase(view, world.motion);
         r_terms.resize(r_nv);  // the bound's terms, once per vertex
@@ -1316,15 +1322,22 @@ struct FrameBuilder {
             for (size_t f = 0; f < r_nt; ++f) out.source_triangles[f] = uint32_t(f);
             return;
         }
+        // Room for the pieces and points the refinement is expected to make (growth would copy them).
+        // At most a million: reserving is only a saving, never a bound (max_triangles is). The
+        // output's points first, so that the visible vertices copied in below land in room that
+        // already holds the new points (else each frame allocates and copies them twice).
+        size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
+        if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
+        if (!caps && !failing.empty()) {
+            out.positions.reserve(r_nv + expect);
+            out.emission_times.reserve(r_nv + expect);
+            out.rest_points.reserve(r_nv + expect);
+        }
         if (!caps) classifyVertices(live);  // visible vertices first, in input order
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
             if (!keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
-            // Room for the pieces and points the refinement is expected to make (growth would copy them).
-            // At most a million: reserving is only a saving, never a bound (max_triangles is).
-            size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
-            if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
             reserveTris(r_nt + expect);  // records made on first touch (ensureBase)
             r_tri_size = r_nt;
             r_edges.reserve(ne + 2 * expect);
