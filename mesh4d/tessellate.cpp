@@ -1,6 +1,7 @@
 #include "tessellate.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "chord_error.h"
 
@@ -195,36 +196,65 @@ bool TessLayout::tessellate(const TessForm* form, std::vector<std::array<uint32_
     auto innerKey = [&](size_t b) { return b == 0 ? inner[ni - 1].key - 3 : inner[b - 1].key; };  // b - 1: inner index
     size_t a = 0, b = 0;  // b counts inner advances: the current inner point is inner[(b + ni - 1) % ni]
     const size_t inner_steps = ni == 1 ? 0 : ni;
-    while (a < no || b < inner_steps) {
-        const LoopPoint& oa = outer[a % no];
-        const LoopPoint& ib = inner[(b + ni - 1) % ni];
-        bool take_outer = b == inner_steps || (a < no && outerKey(a + 1) <= innerKey(b + 1));
-        if (form && a < no && b < inner_steps) {
-            // Both may advance: the shorter diagonal in the form's metric (the smaller triangle),
-            // unless that triangle would turn over (a side point beyond the inner side's line).
-            const LoopPoint& on = outer[(a + 1) % no];
-            const LoopPoint& in = inner[b % ni];
-            auto dist = [&](const LoopPoint& p, const LoopPoint& r) {
-                const double du = r.l1 - p.l1, dv = r.l2 - p.l2;
-                return du * du * form->cu + dv * dv * form->cv + 2 * du * dv * form->cuv;
-            };
-            auto turns = [&](const LoopPoint& p, const LoopPoint& q, const LoopPoint& r) {
-                return (q.l1 - p.l1) * (r.l2 - p.l2) - (q.l2 - p.l2) * (r.l1 - p.l1) > 0;
-            };
-            const bool outer_ok = turns(oa, on, ib), inner_ok = turns(oa, in, ib);
-            if (outer_ok && inner_ok) take_outer = dist(on, ib) <= dist(oa, in);
-            else if (outer_ok != inner_ok) take_outer = outer_ok;
+    if (!form) {
+        while (a < no || b < inner_steps) {
+            const LoopPoint& oa = outer[a % no];
+            const LoopPoint& ib = inner[(b + ni - 1) % ni];
+            if (b == inner_steps || (a < no && outerKey(a + 1) <= innerKey(b + 1))) {
+                out.push_back({oa.id, outer[(a + 1) % no].id, ib.id});
+                ++a;
+            } else {
+                out.push_back({oa.id, inner[b % ni].id, ib.id});
+                ++b;
+            }
         }
-        if (take_outer) {
-            const LoopPoint& on = outer[(a + 1) % no];
-            if (!passes(oa, on, ib)) return false;
-            out.push_back({oa.id, on.id, ib.id});
-            ++a;
-        } else {
-            const LoopPoint& in = inner[b % ni];
-            if (!passes(oa, in, ib)) return false;
-            out.push_back({oa.id, in.id, ib.id});
-            ++b;
+    } else {
+        // Each step's triangle (oa, next, ib) is checked on its three sides' values c(d) (as
+        // passes, in the same order): the side (ib, oa) is the diagonal the previous step made,
+        // and the new diagonal is the one the choice measured, so each value is computed once.
+        // (A side's value is the same bits either way round: negating both differences is exact.)
+        auto q = [&](const LoopPoint& p, const LoopPoint& r) {
+            const double du = r.l1 - p.l1, dv = r.l2 - p.l2;
+            return du * du * form->cu + dv * dv * form->cv + 2 * du * dv * form->cuv;
+        };
+        auto turns = [&](const LoopPoint& p, const LoopPoint& u, const LoopPoint& r) {
+            return (u.l1 - p.l1) * (r.l2 - p.l2) - (u.l2 - p.l2) * (r.l1 - p.l1) > 0;
+        };
+        double diag = std::max(0.0, q(inner[(ni - 1) % ni], outer[0]));  // c(ib - oa), the current diagonal
+        while (a < no || b < inner_steps) {
+            const LoopPoint& oa = outer[a % no];
+            const LoopPoint& ib = inner[(b + ni - 1) % ni];
+            bool take_outer = b == inner_steps || (a < no && outerKey(a + 1) <= innerKey(b + 1));
+            double d_outer = NAN, d_inner = NAN;  // c(on - ib) and c(in - oa) when measured
+            if (a < no && b < inner_steps) {
+                // Both may advance: the shorter diagonal in the form's metric (the smaller triangle),
+                // unless that triangle would turn over (a side point beyond the inner side's line).
+                const LoopPoint& on = outer[(a + 1) % no];
+                const LoopPoint& in = inner[b % ni];
+                const bool outer_ok = turns(oa, on, ib), inner_ok = turns(oa, in, ib);
+                if (outer_ok && inner_ok) {
+                    d_outer = q(on, ib);
+                    d_inner = q(oa, in);
+                    take_outer = d_outer <= d_inner;
+                } else if (outer_ok != inner_ok) {
+                    take_outer = outer_ok;
+                }
+            }
+            if (take_outer) {
+                const LoopPoint& on = outer[(a + 1) % no];
+                const double next = std::max(0.0, d_outer == d_outer ? d_outer : q(on, ib));
+                if (!(bubbleMax(std::max(0.0, q(oa, on)), next, diag) <= form->limit)) return false;
+                out.push_back({oa.id, on.id, ib.id});
+                diag = next;
+                ++a;
+            } else {
+                const LoopPoint& in = inner[b % ni];
+                const double next = std::max(0.0, d_inner == d_inner ? d_inner : q(oa, in));
+                if (!(bubbleMax(next, std::max(0.0, q(in, ib)), diag) <= form->limit)) return false;
+                out.push_back({oa.id, in.id, ib.id});
+                diag = next;
+                ++b;
+            }
         }
     }
     // Step: the inner grid (every grid coordinate >= 1: rows j = 1 .. N - 3 hold its triangles),

@@ -1116,6 +1116,45 @@ TEST(Refine, FormMetricBisectionStaysClosedAndWithinTolerance) {
     }
 }
 
+// The far plate of docs/ACCURACY.md (4 triangles, 2 x 4 ls, 18.675 ls away, 0.866c, finite light
+// speed), where the form is nearly uniform and a mesh triangle's level is decided at once
+// (slice.cpp halvesEstimate): at the error uniform subdivision of level k measures over a
+// sequence (the largest over its frames, as `apparent trade` measures it), the adaptive output
+// is within it in every frame and has no more triangles in all than the uniform one (the issue's
+// 1.0x on the plate). The frames lie before, at and after its crossing, the ones where the
+// halves' first estimate halved its triangles down to pieces bisected to the end (t_c = 17, 19)
+// included.
+TEST(Refine, FarPlateNoMoreTrianglesThanUniformAtEqualError) {
+    RestMesh plate;
+    plate.positions = {{-1, -2, 0}, {1, -2, 0}, {1, 2, 0}, {-1, 2, 0}, {0, 0, 0}};
+    plate.triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+    const Motion m = makeMotion(Kinematics::Galilean, -8.675, {0, 0, -18.675}, {0.866, 0, 0});
+    const World4D w = extrude(plate, m, -100, 100, false, false);
+    const double frames[] = {3.0, 10.0, 17.0, 19.0};
+    for (int level : {1, 2, 3, 4}) {
+        const World4D wu = extrude(subdivideUniform(plate, level), m, -100, 100, false, false);
+        double error = 0;
+        size_t uniform = 0, adaptive = 0;
+        for (double t_c : frames) {
+            const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
+            const ApparentMesh u = sliceWorld(wu, view, {});
+            error = std::max(error, measure::twoSided(wu, view, u));
+            uniform += u.triangles.size();
+        }
+        SliceSettings s;
+        s.tolerance = error;
+        for (double t_c : frames) {
+            const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
+            const ApparentMesh a = sliceWorld(w, view, s);
+            EXPECT_LE(measure::twoSided(w, view, a, 6), error) << "level " << level << ", t_c = " << t_c;
+            adaptive += a.triangles.size();
+        }
+        EXPECT_LE(adaptive, uniform) << "level " << level;
+        std::printf("level %d: uniform %zu triangles, error %.3g; adaptive %zu (%.2fx)\n", level, uniform, error, adaptive,
+                    double(adaptive) / double(uniform));
+    }
+}
+
 // The bisection's output near the camera, byte for byte: the box passing 2 ls from the camera
 // and the 320-face sphere passing 4 ls away at 0.9c, seen at closest approach and cut at
 // T = 1e-4 x size (benchmarks/refine_bench.cpp's scenes). The FNV-1a of every output array and
