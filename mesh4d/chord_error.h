@@ -251,8 +251,10 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
         r.c = INFINITY;
         r.length = half_h + kThird * l / k;  // m floored at l
     }
-    if (!(r.c == r.c)) r.c = INFINITY;
-    if (!(r.length == r.length)) r.length = 0;
+    // A NaN c becomes INFINITY, a NaN length 0 (min and max return their first operand for a NaN;
+    // the length is a sum of terms >= 0, so max(0, length) changes nothing else).
+    r.c = std::min(double(INFINITY), r.c);
+    r.length = std::max(0.0, r.length);
     return r;
 }
 
@@ -276,8 +278,7 @@ inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double
     // The sides' squared M-lengths (c[e]'s side: corners e, e + 1) give r_M (thirdOrderTerm).
     const double side2[3] = {normM2(m, p1.s - p0.s), normM2(m, p2.s - p1.s), normM2(m, p0.s - p2.s)};
     const double R = thirdOrderTerm(m, side2, std::min(std::min(p0.xm, p1.xm), p2.xm));
-    r.bound = speed * (Q + R);
-    if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
+    r.bound = std::min(double(INFINITY), speed * (Q + R));  // NaN from a degenerate input: INFINITY, never accepted
     return r;
 }
 inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],
