@@ -189,6 +189,30 @@ inline double normMOfShape(const Motion& m, const Vec3& E, const Vec3& s) {
     const double xv = dot(x, m.velocity);
     return std::sqrt(xv * xv + m.one_minus_beta2 * norm2(x));
 }
+// |u|_M^2 = (u.v)^2 + (1 - b^2) |u|^2 (the same bits for u and -u).
+inline double normM2(const Motion& m, const Vec3& u) {
+    const double uv = dot(u, m.velocity);
+    return uv * uv + m.one_minus_beta2 * norm2(u);
+}
+
+// The third-order term R of the bound (top of this file) from the squared M-lengths side2[e] of
+// the triangle's three sides and the least |x_i|_M of its corners, without the centroid: by the
+// median formula (an identity of any inner product, so of M's) the M-distance from the centroid
+// to corner i, opposite side j k, is
+//     |s_i - centre|_M^2 = (2 l_ij^2 + 2 l_ik^2 - l_jk^2) / 9 = (2 S - 3 l_jk^2) / 9,   S = sum l^2,
+// so 9 r_M^2 = 2 S - 3 min_e l_e^2 exactly, and with r3 = 3 r_M,
+//     m = min_i |x_i|_M - (2/3) r3,     R = 8 r_M^3 / (9 sqrt 3 (1 - b^2) m^2) = 8 r3 (r3^2) / (243 sqrt 3 (1 - b^2) m^2).
+// Rounding: 2 S - 3 min lies in [S, 2 S] (min <= S / 3), no cancellation: a few ulps relative, as
+// the products after it; the sides' own rounding is that of the shape offsets' differences, as
+// before (a few ulps of the object's size).
+inline double thirdOrderTerm(const Motion& m, const double side2[3], double xm_min) {
+    constexpr double kR = 8 / (243 * 1.7320508075688772);  // 8 / (243 sqrt 3)
+    const double S = side2[0] + side2[1] + side2[2];
+    const double q9 = 2 * S - 3 * std::min(std::min(side2[0], side2[1]), side2[2]);  // 9 r_M^2
+    const double r3 = std::sqrt(q9);                                                 // 3 r_M
+    const double mlow = xm_min - (2.0 / 3.0) * r3;
+    return mlow > 0 ? kR * r3 * q9 / (m.one_minus_beta2 * mlow * mlow) : INFINITY;
+}
 
 // The edge a -> b's coefficient bound c (above; INFINITY when the edge may reach the camera,
 // m_e <= 0) and its length in the map's metric for longest-edge bisection: h(1/2) / 2 plus the
@@ -227,8 +251,10 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
         r.c = INFINITY;
         r.length = half_h + kThird * l / k;  // m floored at l
     }
-    if (!(r.c == r.c)) r.c = INFINITY;
-    if (!(r.length == r.length)) r.length = 0;
+    // A NaN c becomes INFINITY, a NaN length 0 (min and max return their first operand for a NaN;
+    // the length is a sum of terms >= 0, so max(0, length) changes nothing else).
+    r.c = std::min(double(INFINITY), r.c);
+    r.length = std::max(0.0, r.length);
     return r;
 }
 
@@ -249,24 +275,10 @@ inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double
         r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
         return r;
     }
-    // The shape offsets' centroid, the M-radius r_M and the least |x_i|_M.
-    const PointTerms* p[3] = {&p0, &p1, &p2};
-    double xm_min = INFINITY;
-    for (int i = 0; i < 3; ++i) xm_min = std::min(xm_min, p[i]->xm);
-    const Vec3 centre = (p0.s + p1.s + p2.s) / 3.0;
-    // The largest |s_i - centre|_M: one square root of the largest square (sqrt is monotonic and
-    // correctly rounded, so this is the largest of the three roots, bit for bit).
-    double q = 0;
-    for (int i = 0; i < 3; ++i) {
-        const Vec3 u = p[i]->s - centre;
-        const double uv = dot(u, m.velocity);
-        q = std::max(q, uv * uv + m.one_minus_beta2 * norm2(u));
-    }
-    const double rM = std::sqrt(q);
-    const double mlow = xm_min - 2 * rM;
-    const double R = mlow > 0 ? 8 * rM * rM * rM / (9 * std::sqrt(3.0) * m.one_minus_beta2 * mlow * mlow) : INFINITY;
-    r.bound = speed * (Q + R);
-    if (!(r.bound == r.bound)) r.bound = INFINITY;  // NaN from a degenerate input: never accepted
+    // The sides' squared M-lengths (c[e]'s side: corners e, e + 1) give r_M (thirdOrderTerm).
+    const double side2[3] = {normM2(m, p1.s - p0.s), normM2(m, p2.s - p1.s), normM2(m, p0.s - p2.s)};
+    const double R = thirdOrderTerm(m, side2, std::min(std::min(p0.xm, p1.xm), p2.xm));
+    r.bound = std::min(double(INFINITY), speed * (Q + R));  // NaN from a degenerate input: INFINITY, never accepted
     return r;
 }
 inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],

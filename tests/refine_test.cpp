@@ -373,6 +373,60 @@ TEST(Refine, AprioriBoundHoldsWithoutMidpointCuts) {
     EXPECT_GT(tight_triangles, 100);
 }
 
+// The third-order term from the sides (chord_error.h thirdOrderTerm: 9 r_M^2 = 2 S - 3 min l^2, the
+// median formula) against the definition: r_M the largest M-distance from the centroid to a
+// corner, made here from the centroid itself in long double, m = min |x_i|_M - 2 r_M, R = 8 r_M^3 /
+// (9 sqrt 3 (1 - b^2) m^2); on random triangles, speeds and directions, from needles to fat ones,
+// and near the camera (m <= 0: INFINITY both ways).
+TEST(Refine, ThirdOrderTermFromSidesIsTheCentroidRadius) {
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int finite = 0, infinite = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        const double beta = 0.99 * (u(rng) + 1) / 2;
+        Vec3 dir{u(rng), u(rng), u(rng)};
+        dir = dir / norm(dir);
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, 0}, dir * beta);
+        const Vec3 E{3 * u(rng), 3 * u(rng), 3 * u(rng) - 4};
+        const double size = std::pow(10.0, 2 * u(rng) - 1);
+        Vec3 s[3];
+        for (auto& p : s) p = Vec3{u(rng), u(rng), u(rng) * (trial % 3 == 0 ? 1e-3 : 1)} * size;
+        PointTerms t[3];
+        double side2[3];
+        for (int i = 0; i < 3; ++i) t[i] = {s[i], normMOfShape(m, E, s[i])};
+        for (int e = 0; e < 3; ++e) side2[e] = normM2(m, s[(e + 1) % 3] - s[e]);
+        const double xm_min = std::min({t[0].xm, t[1].xm, t[2].xm});
+        // The definition, in long double from the centroid.
+        using LD = long double;
+        const LD k = m.one_minus_beta2;
+        LD c[3] = {0, 0, 0}, q = 0;
+        for (const Vec3& p : s) {
+            c[0] += LD(p.x) / 3;
+            c[1] += LD(p.y) / 3;
+            c[2] += LD(p.z) / 3;
+        }
+        for (const Vec3& p : s) {
+            const LD d[3] = {p.x - c[0], p.y - c[1], p.z - c[2]};
+            const LD dv = d[0] * m.velocity.x + d[1] * m.velocity.y + d[2] * m.velocity.z;
+            q = std::max(q, dv * dv + k * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+        }
+        const LD rM = std::sqrt(q), mlow = LD(xm_min) - 2 * rM;
+        const double R = thirdOrderTerm(m, side2, xm_min);
+        if (mlow <= 0) {
+            ++infinite;
+            EXPECT_EQ(R, INFINITY) << "trial " << trial;
+            continue;
+        }
+        const LD expected = 8 * rM * rM * rM / (9 * std::sqrt(LD(3)) * k * mlow * mlow);
+        // Rounding: m's, relative, is that of the difference min |x_i|_M - 2 r_M.
+        const double slack = 1e-13 * (1 + double(LD(xm_min) / mlow));
+        ++finite;
+        EXPECT_NEAR(R, double(expected), slack * double(expected)) << "trial " << trial;
+    }
+    EXPECT_GT(finite, 500);
+    EXPECT_GT(infinite, 50);
+}
+
 namespace {
 // The trade scenes of docs/ACCURACY.md, built in code: the box passing 2 ls from the camera and the
 // 320-face sphere passing 4 ls away, both at 0.9c, relativistic, seen at closest approach.
