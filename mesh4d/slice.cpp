@@ -1359,17 +1359,9 @@ struct FrameBuilder {
             return;
         }
         // Room for the pieces and points the refinement is expected to make (growth would copy them).
-        // At most a million: reserving is only a saving, never a bound (max_triangles is). The
-        // output's points first, so that the visible vertices copied in below land in room that
-        // already holds the new points (else each frame allocates and copies them twice).
+        // At most a million: reserving is only a saving, never a bound (max_triangles is).
         size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
         if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
-        if (!caps && !failing.empty()) {
-            out.positions.reserve(r_nv + expect);
-            out.emission_times.reserve(r_nv + expect);
-            out.rest_points.reserve(r_nv + expect);
-        }
-        if (!caps) classifyVertices(live);  // visible vertices first, in input order
 
         // Step: split until every piece passes.
         if (!failing.empty()) {
@@ -1380,11 +1372,13 @@ struct FrameBuilder {
             for (auto* v : {&r_pos, &r_rest}) v->reserve(v->size() + expect);
             r_terms.reserve(r_terms.size() + expect);
             r_time.reserve(r_time.size() + expect);
-            out.positions.reserve(out.positions.size() + expect);
-            out.emission_times.reserve(out.emission_times.size() + expect);
-            out.rest_points.reserve(out.rest_points.size() + expect);
-            out.triangles.reserve(out.triangles.size() + expect);
-            out.source_triangles.reserve(out.source_triangles.size() + expect);
+            if (caps) {  // the clipped leaves emit their points and triangles one by one (emitLeaf)
+                out.positions.reserve(out.positions.size() + expect);
+                out.emission_times.reserve(out.emission_times.size() + expect);
+                out.rest_points.reserve(out.rest_points.size() + expect);
+                out.triangles.reserve(out.triangles.size() + expect);
+                out.source_triangles.reserve(out.source_triangles.size() + expect);
+            }
             r_init.assign(r_nt, 0);
             r_init_data = r_init.data();
             r_edge_data = r_edges.data();
@@ -1424,6 +1418,18 @@ struct FrameBuilder {
                     scratch.form_aniso.clear();
                 }
             }
+        }
+        // Step (no real cap): the output's points, once the splits are done: the visible vertices
+        // (classifyVertices, in input order), then the points the splits (and the templates) made,
+        // in room for all of them made once. Without templates the room is exact: each output
+        // array is allocated once per frame and its points copied once.
+        if (!caps) {
+            const bool filling = r_templates && !failing.empty() && !out.over_budget && !scratch.forms.empty();
+            const size_t points = r_nv + (filling ? std::max(r_rest.size(), expect) : r_rest.size());
+            out.positions.reserve(points);
+            out.emission_times.reserve(points);
+            out.rest_points.reserve(points);
+            classifyVertices(live);
         }
         // Step (no real cap): the leaves filled by their templates.
         // (Without a coarse piece every leaf is its own output triangle: emitted below as they are.)
