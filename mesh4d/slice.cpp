@@ -75,7 +75,10 @@ struct REdge {
 // however the splits go.
 // kCoarse: its bound fails, but its whole-piece form (chord_error.h pieceForm) is tight enough
 // that a template fills it (tessellate.h) instead of further bisection.
-enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3 };
+// kBoundFailed: a mesh triangle as the mesh has it whose bound and whole-piece form refineFrame's
+// first pass found to fail (the drain's verdict on it, from the same terms, bit for bit): the
+// drain goes on from its coarseForm test without judging it again.
+enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3, kBoundFailed = 4 };
 struct RTri {
     uint32_t v[3];
     uint32_t edge[3];  // the edge record of each slot
@@ -120,11 +123,12 @@ struct RefineScratch {
     std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
     std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
     std::vector<uint32_t> candidates, failing;  // refineFrame's first pass: triangles its corners' bound fails, and its a-priori bound
+    std::vector<double> quadratic;              // per mesh triangle in `failing`: its bound's quadratic part (kBoundFailed)
     std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
         return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
-               terms.capacity() * sizeof(VTerms) + spread.capacity() * sizeof(double) +
+               terms.capacity() * sizeof(VTerms) + (spread.capacity() + quadratic.capacity()) * sizeof(double) +
                cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * (sizeof(RTri) + 4 * sizeof(uint32_t)) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
@@ -196,9 +200,6 @@ struct FrameBuilder {
     }
     ChordError pointsBound(const double c[3], const VTerms& a, const VTerms& b, const VTerms& d) const {
         return chordErrorOfPoints(world.motion, bound_speed, c, a, b, d, settings.tolerance);
-    }
-    ChordError pieceBound(const double c[3], const Vec3 s[3], const double xm[3]) const {
-        return chordErrorOfBubbles(world.motion, bound_speed, c, s, xm, settings.tolerance);
     }
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
@@ -648,25 +649,31 @@ struct FrameBuilder {
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
             if (state == kPassed || state == kCoarse) continue;
-            if (state == kUnknown) {
+            if (state == kUnknown || state == kBoundFailed) {
                 const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
-                const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_term_data[v[0]], &k1 = r_term_data[v[1]], &k2 = r_term_data[v[2]];
-                const ChordError ce = pointsBound(c, k0, k1, k2);
-                if (ce.bound <= settings.tolerance) {
-                    rt[id].state = kPassed;
-                    continue;
-                }
-                // The bubbles pass but the third-order term does not: the whole-piece form (tighter
-                // near the camera, chord_error.h pieceForm) may pass the piece as it is.
-                if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
-                    rt[id].state = kPassed;
-                    continue;
+                double quadratic;
+                if (state == kBoundFailed) {
+                    quadratic = scratch.quadratic[id];
+                } else {
+                    const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
+                    const ChordError ce = pointsBound(c, k0, k1, k2);
+                    if (ce.bound <= settings.tolerance) {
+                        rt[id].state = kPassed;
+                        continue;
+                    }
+                    // The bubbles pass but the third-order term does not: the whole-piece form (tighter
+                    // near the camera, chord_error.h pieceForm) may pass the piece as it is.
+                    if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
+                        rt[id].state = kPassed;
+                        continue;
+                    }
+                    quadratic = ce.quadratic;
                 }
                 // (The form is worth making only for a piece that needs a level of kMinLevel or
                 // more: its bubbles alone say about how much.)
-                if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
+                if (r_templates && quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
                     coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                     rt[id].state = kCoarse;
                     scratch.coarse.push_back(id);
@@ -1318,8 +1325,7 @@ struct FrameBuilder {
         const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
         if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
         for (uint32_t f : candidates) {
-            double c[3], xc[3];
-            Vec3 sc[3];
+            double c[3];
             for (int k = 0; k < 3; ++k) {
                 const uint32_t e = world.triangle_edges[f][k];
                 const Edge& ed = world.edges[e];
@@ -1335,15 +1341,18 @@ struct FrameBuilder {
                 } else {
                     c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
                 }
-                const uint32_t v = world.mesh.triangles[f][k];
-                sc[k] = r_terms[v].s;
-                xc[k] = r_terms[v].xm;
             }
-            const ChordError ce = pieceBound(c, sc, xc);
+            // The corners' terms in place (the drain's pointsBound on the same record: the same bits).
+            const auto& t = world.mesh.triangles[f];
+            const VTerms &k0 = r_terms[t[0]], &k1 = r_terms[t[1]], &k2 = r_terms[t[2]];
+            const ChordError ce = pointsBound(c, k0, k1, k2);
             const double bound = ce.bound;
             if (bound > settings.tolerance &&
-                !(ce.quadratic <= settings.tolerance && passesByForm(sc[0], sc[1], sc[2]))) {
+                !(ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s))) {
+                // (Room for every mesh triangle's, made when the first one fails: set for the failing only.)
+                if (failing.empty() && scratch.quadratic.size() < r_nt) scratch.quadratic.resize(r_nt);
                 failing.push_back(f);
+                scratch.quadratic[f] = ce.quadratic;
                 // About bound / T pieces once halved down to T (the error falls about as the area).
                 expected_pieces += std::min(bound / settings.tolerance, 1e6);
             }
@@ -1394,6 +1403,10 @@ struct FrameBuilder {
             std::vector<uint32_t>& stack = scratch.stack;
             for (uint32_t f : failing) {
                 ensureBase(f);
+                // Still as the mesh has it (only a split changes a record's corners, and it
+                // deepens it; a neighbour's split may have made the record): the first pass's
+                // verdict stands, from the same terms and edge records (edgeOf: the same bits).
+                if (rt[f].depth == 0 && rt[f].state == kUnknown) rt[f].state = kBoundFailed;
                 stack.push_back(f);
                 drain(stack);
             }
