@@ -1324,27 +1324,31 @@ struct FrameBuilder {
         // (a large mesh with a few candidates computes their edges per triangle instead).
         const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
         if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
+        REdge* const kept = keep_edges ? r_edges.data() : nullptr;
+        const VTerms* const terms = r_terms.data();
         for (uint32_t f : candidates) {
+            const auto& te = world.triangle_edges[f];
             double c[3];
             for (int k = 0; k < 3; ++k) {
-                const uint32_t e = world.triangle_edges[f][k];
-                const Edge& ed = world.edges[e];
-                if (keep_edges) {
-                    REdge& re = r_edges[e];
+                const uint32_t e = te[k];
+                if (kept) {
+                    REdge& re = kept[e];
                     if (re.len != re.len) {
-                        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]);
+                        const Edge& ed = world.edges[e];
+                        const EdgeBubble eb = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]);
                         re.len = eb.length;
                         re.c = eb.c;
                         re.xm_mid = eb.xm_mid;
                     }
                     c[k] = re.c;
                 } else {
-                    c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                    const Edge& ed = world.edges[e];
+                    c[k] = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]).c;
                 }
             }
             // The corners' terms in place (the drain's pointsBound on the same record: the same bits).
             const auto& t = world.mesh.triangles[f];
-            const VTerms &k0 = r_terms[t[0]], &k1 = r_terms[t[1]], &k2 = r_terms[t[2]];
+            const VTerms &k0 = terms[t[0]], &k1 = terms[t[1]], &k2 = terms[t[2]];
             const ChordError ce = pointsBound(c, k0, k1, k2);
             const double bound = ce.bound;
             if (bound > settings.tolerance &&
