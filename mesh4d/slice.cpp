@@ -1293,9 +1293,16 @@ struct FrameBuilder {
                 spread[e] = uv * uv + k * norm2(u);
             }
         }
+        // (The arrays and the tolerance read through locals: the compiler cannot tell that
+        // `candidates`'s stores leave them alone, and would load them again per triangle.)
+        const std::array<uint32_t, 3>* const tris = world.mesh.triangles.data();
+        const std::array<uint32_t, 3>* const tri_edges = world.triangle_edges.data();
+        const VTerms* const corner_terms = r_terms.data();
+        const double* const spreads = spread.data();
+        const double tolerance = settings.tolerance;
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
-            const auto& t = world.mesh.triangles[f];
+            const auto& t = tris[f];
             if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
             if (caps) {
                 const Side s0 = side[t[0]];
@@ -1305,17 +1312,17 @@ struct FrameBuilder {
             // The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
             // chordErrorFromCorners' bit for bit, from the one spread both tests use.
             if (!displaced) {
-                const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
+                const double xc[3] = {corner_terms[t[0]].xm, corner_terms[t[1]].xm, corner_terms[t[2]].xm};
                 double d2;
                 if (edge_spread) {
-                    const auto& te = world.triangle_edges[f];
-                    d2 = std::max(std::max(std::max(0.0, spread[te[0]]), spread[te[1]]), spread[te[2]]);
+                    const auto& te = tri_edges[f];
+                    d2 = std::max(std::max(std::max(0.0, spreads[te[0]]), spreads[te[1]]), spreads[te[2]]);
                 } else {
                     const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
                     d2 = cornerSpread(sc, world.motion);
                 }
-                if (passesFromSpread(d2, xc, world.motion, settings.tolerance)) continue;
-                if (!(chordErrorFromSpread(d2, xc, world.motion) > settings.tolerance)) continue;
+                if (passesFromSpread(d2, xc, world.motion, tolerance)) continue;
+                if (!(chordErrorFromSpread(d2, xc, world.motion) > tolerance)) continue;
             }
             candidates.push_back(uint32_t(f));
         }
