@@ -75,7 +75,10 @@ struct REdge {
 // however the splits go.
 // kCoarse: its bound fails, but its whole-piece form (chord_error.h pieceForm) is tight enough
 // that a template fills it (tessellate.h) instead of further bisection.
-enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3 };
+// kBoundFailed: a mesh triangle as the mesh has it whose bound and whole-piece form refineFrame's
+// first pass found to fail (the drain's verdict on it, from the same terms, bit for bit): the
+// drain goes on from its coarseForm test without judging it again.
+enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3, kBoundFailed = 4 };
 struct RTri {
     uint32_t v[3];
     uint32_t edge[3];  // the edge record of each slot
@@ -120,11 +123,12 @@ struct RefineScratch {
     std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
     std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
     std::vector<uint32_t> candidates, failing;  // refineFrame's first pass: triangles its corners' bound fails, and its a-priori bound
+    std::vector<double> quadratic;              // per mesh triangle in `failing`: its bound's quadratic part (kBoundFailed)
     std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
         return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
-               terms.capacity() * sizeof(VTerms) + spread.capacity() * sizeof(double) +
+               terms.capacity() * sizeof(VTerms) + (spread.capacity() + quadratic.capacity()) * sizeof(double) +
                cap.capacity() * sizeof(Event) +
                edges.capacity() * sizeof(REdge) + tri_cap * (sizeof(RTri) + 4 * sizeof(uint32_t)) +
                (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
@@ -196,9 +200,6 @@ struct FrameBuilder {
     }
     ChordError pointsBound(const double c[3], const VTerms& a, const VTerms& b, const VTerms& d) const {
         return chordErrorOfPoints(world.motion, bound_speed, c, a, b, d, settings.tolerance);
-    }
-    ChordError pieceBound(const double c[3], const Vec3 s[3], const double xm[3]) const {
-        return chordErrorOfBubbles(world.motion, bound_speed, c, s, xm, settings.tolerance);
     }
 
     void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
@@ -648,25 +649,31 @@ struct FrameBuilder {
             // A piece back on the stack unchanged (its record is reset when it is halved) keeps
             // its verdict: its bound is not evaluated again.
             if (state == kPassed || state == kCoarse) continue;
-            if (state == kUnknown) {
+            if (state == kUnknown || state == kBoundFailed) {
                 const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
                 const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
-                const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
                 const VTerms &k0 = r_term_data[v[0]], &k1 = r_term_data[v[1]], &k2 = r_term_data[v[2]];
-                const ChordError ce = pointsBound(c, k0, k1, k2);
-                if (ce.bound <= settings.tolerance) {
-                    rt[id].state = kPassed;
-                    continue;
-                }
-                // The bubbles pass but the third-order term does not: the whole-piece form (tighter
-                // near the camera, chord_error.h pieceForm) may pass the piece as it is.
-                if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
-                    rt[id].state = kPassed;
-                    continue;
+                double quadratic;
+                if (state == kBoundFailed) {
+                    quadratic = scratch.quadratic[id];
+                } else {
+                    const double c[3] = {e[0]->c, e[1]->c, e[2]->c};
+                    const ChordError ce = pointsBound(c, k0, k1, k2);
+                    if (ce.bound <= settings.tolerance) {
+                        rt[id].state = kPassed;
+                        continue;
+                    }
+                    // The bubbles pass but the third-order term does not: the whole-piece form (tighter
+                    // near the camera, chord_error.h pieceForm) may pass the piece as it is.
+                    if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
+                        rt[id].state = kPassed;
+                        continue;
+                    }
+                    quadratic = ce.quadratic;
                 }
                 // (The form is worth making only for a piece that needs a level of kMinLevel or
                 // more: its bubbles alone say about how much.)
-                if (r_templates && ce.quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
+                if (r_templates && quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
                     coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                     rt[id].state = kCoarse;
                     scratch.coarse.push_back(id);
@@ -1286,9 +1293,16 @@ struct FrameBuilder {
                 spread[e] = uv * uv + k * norm2(u);
             }
         }
+        // (The arrays and the tolerance read through locals: the compiler cannot tell that
+        // `candidates`'s stores leave them alone, and would load them again per triangle.)
+        const std::array<uint32_t, 3>* const tris = world.mesh.triangles.data();
+        const std::array<uint32_t, 3>* const tri_edges = world.triangle_edges.data();
+        const VTerms* const corner_terms = r_terms.data();
+        const double* const spreads = spread.data();
+        const double tolerance = settings.tolerance;
         for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
-            const auto& t = world.mesh.triangles[f];
+            const auto& t = tris[f];
             if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
             if (caps) {
                 const Side s0 = side[t[0]];
@@ -1298,17 +1312,17 @@ struct FrameBuilder {
             // The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
             // chordErrorFromCorners' bit for bit, from the one spread both tests use.
             if (!displaced) {
-                const double xc[3] = {r_terms[t[0]].xm, r_terms[t[1]].xm, r_terms[t[2]].xm};
+                const double xc[3] = {corner_terms[t[0]].xm, corner_terms[t[1]].xm, corner_terms[t[2]].xm};
                 double d2;
                 if (edge_spread) {
-                    const auto& te = world.triangle_edges[f];
-                    d2 = std::max(std::max(std::max(0.0, spread[te[0]]), spread[te[1]]), spread[te[2]]);
+                    const auto& te = tri_edges[f];
+                    d2 = std::max(std::max(std::max(0.0, spreads[te[0]]), spreads[te[1]]), spreads[te[2]]);
                 } else {
                     const Vec3 sc[3] = {r_terms[t[0]].s, r_terms[t[1]].s, r_terms[t[2]].s};
                     d2 = cornerSpread(sc, world.motion);
                 }
-                if (passesFromSpread(d2, xc, world.motion, settings.tolerance)) continue;
-                if (!(chordErrorFromSpread(d2, xc, world.motion) > settings.tolerance)) continue;
+                if (passesFromSpread(d2, xc, world.motion, tolerance)) continue;
+                if (!(chordErrorFromSpread(d2, xc, world.motion) > tolerance)) continue;
             }
             candidates.push_back(uint32_t(f));
         }
@@ -1317,33 +1331,39 @@ struct FrameBuilder {
         // (a large mesh with a few candidates computes their edges per triangle instead).
         const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
         if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
+        REdge* const kept = keep_edges ? r_edges.data() : nullptr;
+        const VTerms* const terms = r_terms.data();
         for (uint32_t f : candidates) {
-            double c[3], xc[3];
-            Vec3 sc[3];
+            const auto& te = world.triangle_edges[f];
+            double c[3];
             for (int k = 0; k < 3; ++k) {
-                const uint32_t e = world.triangle_edges[f][k];
-                const Edge& ed = world.edges[e];
-                if (keep_edges) {
-                    REdge& re = r_edges[e];
+                const uint32_t e = te[k];
+                if (kept) {
+                    REdge& re = kept[e];
                     if (re.len != re.len) {
-                        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]);
+                        const Edge& ed = world.edges[e];
+                        const EdgeBubble eb = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]);
                         re.len = eb.length;
                         re.c = eb.c;
                         re.xm_mid = eb.xm_mid;
                     }
                     c[k] = re.c;
                 } else {
-                    c[k] = edgeBubble(world.motion, r_now, r_terms[ed.lo], r_terms[ed.hi]).c;
+                    const Edge& ed = world.edges[e];
+                    c[k] = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]).c;
                 }
-                const uint32_t v = world.mesh.triangles[f][k];
-                sc[k] = r_terms[v].s;
-                xc[k] = r_terms[v].xm;
             }
-            const ChordError ce = pieceBound(c, sc, xc);
+            // The corners' terms in place (the drain's pointsBound on the same record: the same bits).
+            const auto& t = world.mesh.triangles[f];
+            const VTerms &k0 = terms[t[0]], &k1 = terms[t[1]], &k2 = terms[t[2]];
+            const ChordError ce = pointsBound(c, k0, k1, k2);
             const double bound = ce.bound;
             if (bound > settings.tolerance &&
-                !(ce.quadratic <= settings.tolerance && passesByForm(sc[0], sc[1], sc[2]))) {
+                !(ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s))) {
+                // (Room for every mesh triangle's, made when the first one fails: set for the failing only.)
+                if (failing.empty() && scratch.quadratic.size() < r_nt) scratch.quadratic.resize(r_nt);
                 failing.push_back(f);
+                scratch.quadratic[f] = ce.quadratic;
                 // About bound / T pieces once halved down to T (the error falls about as the area).
                 expected_pieces += std::min(bound / settings.tolerance, 1e6);
             }
@@ -1388,6 +1408,10 @@ struct FrameBuilder {
             std::vector<uint32_t>& stack = scratch.stack;
             for (uint32_t f : failing) {
                 ensureBase(f);
+                // Still as the mesh has it (only a split changes a record's corners, and it
+                // deepens it; a neighbour's split may have made the record): the first pass's
+                // verdict stands, from the same terms and edge records (edgeOf: the same bits).
+                if (rt[f].depth == 0 && rt[f].state == kUnknown) rt[f].state = kBoundFailed;
                 stack.push_back(f);
                 drain(stack);
             }
