@@ -21,6 +21,7 @@
 //             which the refinement fills with templates (mesh4d/tessellate.h).
 //
 // Instruction counts (repeatable on a shared machine, unlike times): `refine_bench --count SCENE K`
+// (SCENE: 0 or box, 1 or sphere320, 2 or plate)
 // makes one tolerance cut and one vertex cut of the matching uniform mesh, each in its own function
 // (countTolerance, countVertex), and prints both output sizes; run it under
 //   valgrind --tool=callgrind --toggle-collect='*countTolerance*' build/benchmarks/refine_bench --count 0 4
@@ -181,7 +182,15 @@ uint64_t outputHash(const mesh4d::ApparentMesh& m) {
 int main(int argc, char** argv) {
     const bool warm = argc == 4 && std::string(argv[1]) == "--count-warm";
     if (argc == 4 && (std::string(argv[1]) == "--count" || warm)) {
-        const Scene sc = sceneOf(std::atoi(argv[2]));
+        // SCENE: 0 or box, 1 or sphere320, 2 or plate (anything else is refused: atoi would read
+        // a name as 0, the box).
+        const std::string name = argv[2];
+        const long index = name == "0" || name == "box" ? 0 : name == "1" || name == "sphere320" ? 1 : name == "2" || name == "plate" ? 2 : -1;
+        if (index < 0) {
+            std::fprintf(stderr, "refine_bench: SCENE '%s': not a scene (0 or box, 1 or sphere320, 2 or plate)\n", argv[2]);
+            return 2;
+        }
+        const Scene sc = sceneOf(index);
         const mesh4d::World4D w = mesh4d::extrude(sc.mesh, sc.motion, -100, 100, false, false);
         mesh4d::SliceSettings tol;
         tol.max_segments = 4096;
