@@ -1269,10 +1269,16 @@ struct FrameBuilder {
         double expected_pieces = 0;
         r_now = nowBase(view, world.motion);
         r_terms.resize(r_nv);  // the bound's terms, once per vertex
+        // The least |x|_M of all vertices and whether any is NaN (the whole mesh's test below).
+        double xm_least = INFINITY;
+        bool xm_nan = false;
         for (size_t i = 0; i < r_nv; ++i) {
             const Event e{r_time[i], r_pos[i]};
             r_terms[i].s = shapeOfEvent(world.motion, e);
-            r_terms[i].xm = normMOfEvent(anchor, world.motion, e);
+            const double xm = normMOfEvent(anchor, world.motion, e);
+            r_terms[i].xm = xm;
+            xm_least = std::min(xm_least, xm);
+            xm_nan |= xm != xm;
         }
         // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
         const bool displaced = view.sheared() || settings.displacement >= 0;
@@ -1283,15 +1289,28 @@ struct FrameBuilder {
         // cornerSpread's bit for bit. (With a cull, per triangle: most edges may be culled.)
         std::vector<double>& spread = scratch.spread;
         const bool edge_spread = !displaced && !live;
+        // Every triangle passes when the whole mesh does: its largest spread D with the least
+        // |x|_M of all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at
+        // most D (both the same std::max chain from 0 over the same spreads, which skips a NaN)
+        // and its xmin at least X (no xm is NaN), and passesFromSpread is monotone in both as
+        // rounded: 4 d2 is exact, fl(xmin xmin) and fl(beta d2) grow with their operand, and
+        // 3 (1 - beta^2) T >= 0 is one rounded factor of xmin. So the verdict is the triangles'
+        // own (no candidates), without the pass over the triangles.
+        bool whole_passes = false;
         if (edge_spread) {
             spread.resize(ne);
             const Vec3 v = world.motion.velocity;
             const double k = world.motion.one_minus_beta2;
+            double d2_most = 0;
             for (size_t e = 0; e < ne; ++e) {
                 const Vec3 u = r_terms[world.edges[e].hi].s - r_terms[world.edges[e].lo].s;
                 const double uv = dot(u, v);
-                spread[e] = uv * uv + k * norm2(u);
+                const double d2 = uv * uv + k * norm2(u);
+                spread[e] = d2;
+                d2_most = std::max(d2_most, d2);
             }
+            const double xm_all[3] = {xm_least, xm_least, xm_least};
+            whole_passes = !caps && !xm_nan && passesFromSpread(d2_most, xm_all, world.motion, settings.tolerance);
         }
         // (The arrays and the tolerance read through locals: the compiler cannot tell that
         // `candidates`'s stores leave them alone, and would load them again per triangle.)
@@ -1300,7 +1319,7 @@ struct FrameBuilder {
         const VTerms* const corner_terms = r_terms.data();
         const double* const spreads = spread.data();
         const double tolerance = settings.tolerance;
-        for (size_t f = 0; f < r_nt; ++f) {
+        for (size_t f = whole_passes ? r_nt : 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             const auto& t = tris[f];
             if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
@@ -1493,7 +1512,7 @@ struct FrameBuilder {
             for (size_t id = r_nt; id < r_tri_size; ++id) leaf(rt[id].src, rt[id].v);
             return;
         }
-        for (size_t f = 0; f < r_nt; ++f) {
+        for (size_t f = whole_passes ? r_nt : 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
                 const auto& t = world.mesh.triangles[f];
