@@ -1269,16 +1269,10 @@ struct FrameBuilder {
         double expected_pieces = 0;
         r_now = nowBase(view, world.motion);
         r_terms.resize(r_nv);  // the bound's terms, once per vertex
-        // The least |x|_M of all vertices and whether any is NaN (the whole mesh's test below).
-        double xm_least = INFINITY;
-        bool xm_nan = false;
         for (size_t i = 0; i < r_nv; ++i) {
             const Event e{r_time[i], r_pos[i]};
             r_terms[i].s = shapeOfEvent(world.motion, e);
-            const double xm = normMOfEvent(anchor, world.motion, e);
-            r_terms[i].xm = xm;
-            xm_least = std::min(xm_least, xm);
-            xm_nan |= xm != xm;
+            r_terms[i].xm = normMOfEvent(anchor, world.motion, e);
         }
         // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
         const bool displaced = view.sheared() || settings.displacement >= 0;
@@ -1293,11 +1287,21 @@ struct FrameBuilder {
         // |x|_M of all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at
         // most D (both the same std::max chain from 0 over the same spreads, which skips a NaN)
         // and its xmin at least X (no xm is NaN), and passesFromSpread is monotone in both as
-        // rounded: 4 d2 is exact, fl(xmin xmin) and fl(beta d2) grow with their operand, and
-        // 3 (1 - beta^2) T >= 0 is one rounded factor of xmin. So the verdict is the triangles'
-        // own (no candidates), without the pass over the triangles.
+        // rounded (chord_error.h): fl(4 d2), fl(xmin xmin) and fl(beta d2) grow with their
+        // operand, and fl(3 (1 - beta^2) T) >= 0 is one factor of xmin. So the verdict is the
+        // triangles' own (no candidates), without the pass over the triangles (with real caps
+        // that pass also counts the clipped triangles: it is made then).
         bool whole_passes = false;
         if (edge_spread) {
+            // The least |x|_M of all vertices, and their sum: NaN when one is (an infinity of
+            // each sign makes NaN too, and the pass below is only skipped then). (Its own loop:
+            // the terms' loop above stays vectorised.)
+            double xm_least = INFINITY, xm_sum = 0;
+            for (size_t i = 0; i < r_nv; ++i) {
+                const double xm = r_terms[i].xm;
+                xm_least = std::min(xm_least, xm);
+                xm_sum += xm;
+            }
             spread.resize(ne);
             const Vec3 v = world.motion.velocity;
             const double k = world.motion.one_minus_beta2;
@@ -1310,7 +1314,7 @@ struct FrameBuilder {
                 d2_most = std::max(d2_most, d2);
             }
             const double xm_all[3] = {xm_least, xm_least, xm_least};
-            whole_passes = !caps && !xm_nan && passesFromSpread(d2_most, xm_all, world.motion, settings.tolerance);
+            whole_passes = !caps && xm_sum == xm_sum && passesFromSpread(d2_most, xm_all, world.motion, settings.tolerance);
         }
         // (The arrays and the tolerance read through locals: the compiler cannot tell that
         // `candidates`'s stores leave them alone, and would load them again per triangle.)
