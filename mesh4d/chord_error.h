@@ -133,7 +133,11 @@ inline double cornerSpread(const Vec3 s[3], const Motion& m) {
     }
     return d2;
 }
-// passesFromCorners with the corners' spread d2 = cornerSpread(s, m) given.
+// passesFromCorners with the corners' spread d2 = cornerSpread(s, m) given. Monotone as rounded:
+// true at (d2, xm) stays true at any smaller d2 and larger xm (fl(4 d2), fl(xmin xmin) and
+// fl(beta d2) grow with their operand; fl(3 (1 - beta^2) T) >= 0 multiplies xmin), so true at the
+// largest spread of a mesh with the least xm of all its corners is true for each of its triangles
+// (slice.cpp refineFrame skips its pass over the triangles then).
 inline bool passesFromSpread(double d2, const double xm[3], const Motion& m, double tolerance) {
     const double xmin = std::min(xm[0], std::min(xm[1], xm[2]));
     return xmin > 0 && 4 * d2 <= xmin * xmin && m.beta * d2 <= 3 * m.one_minus_beta2 * tolerance * xmin;

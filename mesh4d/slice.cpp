@@ -1283,15 +1283,38 @@ struct FrameBuilder {
         // cornerSpread's bit for bit. (With a cull, per triangle: most edges may be culled.)
         std::vector<double>& spread = scratch.spread;
         const bool edge_spread = !displaced && !live;
+        // Every triangle passes when the whole mesh does: its largest spread D with the least
+        // |x|_M of all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at
+        // most D (both the same std::max chain from 0 over the same spreads, which skips a NaN)
+        // and its xmin at least X (no xm is NaN), and passesFromSpread is monotone in both as
+        // rounded (chord_error.h): fl(4 d2), fl(xmin xmin) and fl(beta d2) grow with their
+        // operand, and fl(3 (1 - beta^2) T) >= 0 is one factor of xmin. So the verdict is the
+        // triangles' own (no candidates), without the pass over the triangles (with real caps
+        // that pass also counts the clipped triangles: it is made then).
+        bool whole_passes = false;
         if (edge_spread) {
+            // The least |x|_M of all vertices, and their sum: NaN when one is (an infinity of
+            // each sign makes NaN too, and the pass below is only skipped then). (Its own loop:
+            // the terms' loop above stays vectorised.)
+            double xm_least = INFINITY, xm_sum = 0;
+            for (size_t i = 0; i < r_nv; ++i) {
+                const double xm = r_terms[i].xm;
+                xm_least = std::min(xm_least, xm);
+                xm_sum += xm;
+            }
             spread.resize(ne);
             const Vec3 v = world.motion.velocity;
             const double k = world.motion.one_minus_beta2;
+            double d2_most = 0;
             for (size_t e = 0; e < ne; ++e) {
                 const Vec3 u = r_terms[world.edges[e].hi].s - r_terms[world.edges[e].lo].s;
                 const double uv = dot(u, v);
-                spread[e] = uv * uv + k * norm2(u);
+                const double d2 = uv * uv + k * norm2(u);
+                spread[e] = d2;
+                d2_most = std::max(d2_most, d2);
             }
+            const double xm_all[3] = {xm_least, xm_least, xm_least};
+            whole_passes = !caps && xm_sum == xm_sum && passesFromSpread(d2_most, xm_all, world.motion, settings.tolerance);
         }
         // (The arrays and the tolerance read through locals: the compiler cannot tell that
         // `candidates`'s stores leave them alone, and would load them again per triangle.)
@@ -1300,7 +1323,7 @@ struct FrameBuilder {
         const VTerms* const corner_terms = r_terms.data();
         const double* const spreads = spread.data();
         const double tolerance = settings.tolerance;
-        for (size_t f = 0; f < r_nt; ++f) {
+        for (size_t f = whole_passes ? r_nt : 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             const auto& t = tris[f];
             if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;  // no area: dropped at output, never split
@@ -1493,7 +1516,7 @@ struct FrameBuilder {
             for (size_t id = r_nt; id < r_tri_size; ++id) leaf(rt[id].src, rt[id].v);
             return;
         }
-        for (size_t f = 0; f < r_nt; ++f) {
+        for (size_t f = whole_passes ? r_nt : 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
                 const auto& t = world.mesh.triangles[f];

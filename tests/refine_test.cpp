@@ -1268,3 +1268,74 @@ TEST(Refine, NearCameraBisectionBytesPinned) {
         EXPECT_EQ(fnv(m), c.hash) << "distance " << c.distance << ": the refined output's bytes changed";
     }
 }
+
+// refineFrame skips its pass over the triangles when the whole mesh passes the corners' bound:
+// the largest spread D of all edges with the least |x|_M X of all vertices. That is the
+// triangles' own verdict only because passesFromSpread, as rounded, is monotone: true at
+// (D, {X, X, X}) must give true at every d2 <= D and corners xm >= X. Random D and X at
+// tolerances on both sides of the bound's two conditions' edges (one ulp either side), checked
+// at d2 = D, one ulp below and random below, with corners at X, one ulp above and random above.
+TEST(Refine, WholeMeshCornersPassImpliesEveryTrianglesPass) {
+    std::mt19937 rng(71);
+    std::uniform_real_distribution<double> w(0, 1);
+    int whole_passed = 0, whole_failed = 0, checked = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -10 * size}, velocity);
+        const double X = size * std::pow(10.0, 3 * w(rng));
+        // D at or near X^2 / 4 (the first condition's edge) or well inside it.
+        const double D = trial % 2 ? 0.25 * X * X * (1 - 1e-12 * w(rng)) : 0.25 * X * X * w(rng);
+        // T at the second condition's edge beta D / (3 (1 - beta^2) X), moved by 0 or 1 ulp.
+        double T = m.beta * D / (3 * m.one_minus_beta2 * X);
+        if (trial % 3 == 1) T = std::nextafter(T, INFINITY);
+        if (trial % 3 == 2) T = std::nextafter(T, 0.0);
+        const double whole[3] = {X, X, X};
+        if (!passesFromSpread(D, whole, m, T)) {
+            ++whole_failed;
+            continue;
+        }
+        ++whole_passed;
+        const double d2s[3] = {D, std::nextafter(D, 0.0), D * w(rng)};
+        for (double d2 : d2s) {
+            for (int c = 0; c < 3; ++c) {
+                double xm[3];
+                for (double& x : xm) x = c == 0 ? X : c == 1 ? std::nextafter(X, INFINITY) : X * (1 + w(rng));
+                xm[trial % 3] = X;  // one corner at the least
+                EXPECT_TRUE(passesFromSpread(d2, xm, m, T)) << "trial " << trial;
+                ++checked;
+            }
+        }
+    }
+    EXPECT_GT(whole_passed, 500);
+    EXPECT_GT(whole_failed, 500);
+    EXPECT_EQ(checked, 9 * whole_passed);
+}
+
+// A frame where nothing needs refining is vertex mode's output bit for bit, whether the whole
+// mesh passes the corners' bound at once (40 to 8 radii) or only triangle by triangle (6 and 5
+// radii, where the largest spread with the nearest corner fails): a 320-triangle sphere at 0.9c,
+// T = 0.005 (1/400 of its diameter).
+TEST(Refine, NothingToRefineIsVertexModesOutputBitForBit) {
+    const RestMesh sphere = testmesh::icosphere(2, 1.0);
+    SliceSettings s;
+    s.tolerance = 0.005;
+    int unrefined = 0;
+    for (double distance : {40.0, 20.0, 10.0, 8.0, 6.0, 5.0}) {
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, {0.9, 0, 0});
+        const World4D w = extrude(sphere, m, -1000, 1000, false, false);
+        const ViewSurface view{ViewKind::PastCone, distance, {0, 0, 0}};
+        const ApparentMesh tol = sliceWorld(w, view, s);
+        if (tol.triangles.size() != sphere.triangles.size()) continue;
+        ++unrefined;
+        const ApparentMesh vtx = sliceWorld(w, view, SliceSettings{});
+        ASSERT_EQ(tol.positions.size(), vtx.positions.size());
+        EXPECT_EQ(0, std::memcmp(tol.positions.data(), vtx.positions.data(), vtx.positions.size() * sizeof(Vec3)));
+        EXPECT_EQ(0, std::memcmp(tol.emission_times.data(), vtx.emission_times.data(),
+                                 vtx.emission_times.size() * sizeof(double)));
+        EXPECT_EQ(tol.triangles, vtx.triangles);
+        EXPECT_EQ(tol.source_triangles, vtx.source_triangles);
+    }
+    EXPECT_EQ(unrefined, 6);
+}
