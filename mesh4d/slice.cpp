@@ -1516,7 +1516,7 @@ struct FrameBuilder {
             for (size_t id = r_nt; id < r_tri_size; ++id) leaf(rt[id].src, rt[id].v);
             return;
         }
-        for (size_t f = whole_passes ? r_nt : 0; f < r_nt; ++f) {
+        for (size_t f = 0; f < r_nt; ++f) {
             if (!isLive(f)) continue;
             if (r_init.empty() || !r_init[f]) {
                 const auto& t = world.mesh.triangles[f];
