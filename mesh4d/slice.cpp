@@ -544,7 +544,9 @@ struct FrameBuilder {
         return e;
     }
     [[gnu::noinline]] void makeEdge(REdge& e, uint32_t a, uint32_t b) const {
-        const EdgeBubble eb = edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]);
+        storeEdge(e, edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]));
+    }
+    static void storeEdge(REdge& e, const EdgeBubble& eb) {
         e.len = eb.length;
         e.c = eb.c;
         e.xm_mid = eb.xm_mid;
@@ -946,8 +948,7 @@ struct FrameBuilder {
                 if (infl <= kNearlyUniform && rt[id].depth == 0) {
                     cost_b = halvesEstimate(pf, bound_speed / settings.tolerance, infl);
                 } else {
-                    const double child = 0.5 * xc2 * (1 + (infl - 1) / 1.4142135623730951);
-                    cost_b = 2 * std::max(1.0, (std::sqrt(child) + kRounding) * (std::sqrt(child) + kRounding));
+                    cost_b = 2 * halfCost(0.5 * xc2 * halfGrowth(infl));
                 }
                 if (!(cost_t <= cost_b) && !(whole <= kCoarseSlack * centre)) return false;
             }
@@ -972,13 +973,17 @@ struct FrameBuilder {
         if (q[2] > q[k]) k = 2;
         const double qc = q[k], qa = q[kSucc[k]], qb = q[kSucc[kSucc[k]]];  // sides k + 1, k + 2
         const double med = std::max(0.0, 0.25 * (2 * qa + 2 * qb - qc));
-        const double grow = 1 + (infl - 1) / 1.4142135623730951;
+        const double grow = halfGrowth(infl);
         double cost = 0;
-        for (const double other : {qb, qa}) {
-            const double child = per * bubbleMax(0.25 * qc, med, other) * grow;
-            cost += std::max(1.0, (std::sqrt(child) + kRounding) * (std::sqrt(child) + kRounding));
-        }
+        for (const double other : {qb, qa}) cost += halfCost(per * bubbleMax(0.25 * qc, med, other) * grow);
         return cost;
+    }
+    // A half's excess of A over the centroid's form: the piece's (infl - 1) shrunk by sqrt 2.
+    static double halfGrowth(double infl) { return 1 + (infl - 1) / 1.4142135623730951; }
+    // The triangles a half of need `child` is expected to make: its level rounded up by kRounding
+    // on average, squared; at least one.
+    static double halfCost(double child) {
+        return std::max(1.0, (std::sqrt(child) + kRounding) * (std::sqrt(child) + kRounding));
     }
 
     // The triangles the fill of form f is expected to make: n^2 for a grid of level n (at most
@@ -1365,10 +1370,7 @@ struct FrameBuilder {
                     REdge& re = kept[e];
                     if (re.len != re.len) {
                         const Edge& ed = world.edges[e];
-                        const EdgeBubble eb = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]);
-                        re.len = eb.length;
-                        re.c = eb.c;
-                        re.xm_mid = eb.xm_mid;
+                        storeEdge(re, edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]));
                     }
                     c[k] = re.c;
                 } else {
@@ -1470,8 +1472,9 @@ struct FrameBuilder {
         // (classifyVertices, in input order), then the points the splits (and the templates) made,
         // in room for all of them made once. Without templates the room is exact: each output
         // array is allocated once per frame and its points copied once.
+        // Templates fill the leaves when the splits left coarse pieces (no real cap: r_templates).
+        const bool filling = r_templates && !failing.empty() && !out.over_budget && !scratch.forms.empty();
         if (!caps) {
-            const bool filling = r_templates && !failing.empty() && !out.over_budget && !scratch.forms.empty();
             const size_t points = r_nv + (filling ? std::max(r_rest.size(), expect) : r_rest.size());
             out.positions.reserve(points);
             out.emission_times.reserve(points);
@@ -1480,8 +1483,7 @@ struct FrameBuilder {
         }
         // Step (no real cap): the leaves filled by their templates.
         // (Without a coarse piece every leaf is its own output triangle: emitted below as they are.)
-        const bool templated =
-            r_templates && !failing.empty() && !out.over_budget && !scratch.forms.empty() && templateLeaves();
+        const bool templated = filling && templateLeaves();
         if (!failing.empty()) {
             for (uint8_t l : r_limited) out.limited_triangles += l;
             // Step: the exact images of the new points (splits' and templates'), in one batch.

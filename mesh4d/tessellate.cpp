@@ -127,12 +127,14 @@ bool TessLayout::tessellate(const TessForm* form, std::vector<std::array<uint32_
         return true;
     }
     // Step: the stitched ring, every triangle checked against the form.
+    // c(d) of the side p -> r in the form's metric (form set), before flooring at 0.
+    auto sideValue = [&](const LoopPoint& p, const LoopPoint& r) {
+        const double du = r.l1 - p.l1, dv = r.l2 - p.l2;
+        return du * du * form->cu + dv * dv * form->cv + 2 * du * dv * form->cuv;
+    };
     auto passes = [&](const LoopPoint& a, const LoopPoint& b, const LoopPoint& c) {
         if (!form) return true;
-        auto q = [&](const LoopPoint& p, const LoopPoint& r) {
-            const double du = r.l1 - p.l1, dv = r.l2 - p.l2;
-            return std::max(0.0, du * du * form->cu + dv * dv * form->cv + 2 * du * dv * form->cuv);
-        };
+        auto q = [&](const LoopPoint& p, const LoopPoint& r) { return std::max(0.0, sideValue(p, r)); };
         return bubbleMax(q(a, b), q(b, c), q(c, a)) <= form->limit;
     };
     // Ears: at a corner whose two sides have inner points, when the ear's chord (from 1/n[k-1] of
@@ -213,10 +215,7 @@ bool TessLayout::tessellate(const TessForm* form, std::vector<std::array<uint32_
         // passes, in the same order): the side (ib, oa) is the diagonal the previous step made,
         // and the new diagonal is the one the choice measured, so each value is computed once.
         // (A side's value is the same bits either way round: negating both differences is exact.)
-        auto q = [&](const LoopPoint& p, const LoopPoint& r) {
-            const double du = r.l1 - p.l1, dv = r.l2 - p.l2;
-            return du * du * form->cu + dv * dv * form->cv + 2 * du * dv * form->cuv;
-        };
+        const auto& q = sideValue;
         auto turns = [&](const LoopPoint& p, const LoopPoint& u, const LoopPoint& r) {
             return (u.l1 - p.l1) * (r.l2 - p.l2) - (u.l2 - p.l2) * (r.l1 - p.l1) > 0;
         };
