@@ -285,6 +285,23 @@ inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double
     r.bound = std::min(double(INFINITY), speed * (Q + R));  // NaN from a degenerate input: INFINITY, never accepted
     return r;
 }
+// chordErrorOfPoints from the sides' squared M-lengths side2 (side2[e] of side e, corners e,
+// e + 1: normM2 of either direction, the same bits) and xm_min, the least of the corners' |x|_M,
+// for a caller that has them already (the refinement's first pass keeps |u|_M^2 per mesh edge,
+// slice.cpp refineFrame): bit for bit chordErrorOfPoints's bound of the same triangle.
+inline ChordError chordErrorOfSides(const Motion& m, double speed, const double c[3], const double side2[3],
+                                    double xm_min, double tolerance = INFINITY) {
+    ChordError r;
+    if (speed == 0) return r;
+    const double Q = bubbleMax(c[0], c[1], c[2]);
+    r.quadratic = speed * Q;
+    if (!(r.quadratic <= tolerance)) {
+        r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
+        return r;
+    }
+    r.bound = std::min(double(INFINITY), speed * (Q + thirdOrderTerm(m, side2, xm_min)));
+    return r;
+}
 inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],
                                       const double xm[3], double tolerance = INFINITY) {
     return chordErrorOfPoints(m, speed, c, PointTerms{s[0], xm[0]}, PointTerms{s[1], xm[1]}, PointTerms{s[2], xm[2]},

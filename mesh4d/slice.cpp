@@ -1378,10 +1378,19 @@ struct FrameBuilder {
                     c[k] = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]).c;
                 }
             }
-            // The corners' terms in place (the drain's pointsBound on the same record: the same bits).
+            // The corners' terms in place (the drain's pointsBound on the same record: the same
+            // bits); the sides' |u|_M^2 are the edges' spreads when made (normM2 of the side
+            // either way round: the same bits, chord_error.h chordErrorOfSides).
             const auto& t = world.mesh.triangles[f];
             const VTerms &k0 = terms[t[0]], &k1 = terms[t[1]], &k2 = terms[t[2]];
-            const ChordError ce = pointsBound(c, k0, k1, k2);
+            ChordError ce;
+            if (edge_spread) {
+                const double side2[3] = {spreads[te[0]], spreads[te[1]], spreads[te[2]]};
+                ce = chordErrorOfSides(world.motion, bound_speed, c, side2, std::min(std::min(k0.xm, k1.xm), k2.xm),
+                                       settings.tolerance);
+            } else {
+                ce = pointsBound(c, k0, k1, k2);
+            }
             const double bound = ce.bound;
             if (bound > settings.tolerance &&
                 !(ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s))) {
