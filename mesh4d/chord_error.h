@@ -285,12 +285,14 @@ inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double
     r.bound = std::min(double(INFINITY), speed * (Q + R));  // NaN from a degenerate input: INFINITY, never accepted
     return r;
 }
-// chordErrorOfPoints from the sides' squared M-lengths side2 (side2[e] of side e, corners e,
-// e + 1: normM2 of either direction, the same bits) and xm_min, the least of the corners' |x|_M,
-// for a caller that has them already (the refinement's first pass keeps |u|_M^2 per mesh edge,
-// slice.cpp refineFrame): bit for bit chordErrorOfPoints's bound of the same triangle.
-inline ChordError chordErrorOfSides(const Motion& m, double speed, const double c[3], const double side2[3],
-                                    double xm_min, double tolerance = INFINITY) {
+// chordErrorOfPoints from the sides' squared M-lengths, for a caller that has them already (the
+// refinement's first pass keeps |u|_M^2 per mesh edge, slice.cpp refineFrame): terms(side2) sets
+// side2[e] of side e (corners e, e + 1; normM2 of either direction, the same bits) and returns the
+// least |x_i|_M of the corners, called only when the bubbles pass (R is needed). Bit for bit
+// chordErrorOfPoints's bound and quadratic part of the same triangle.
+template <class Terms>
+inline ChordError chordErrorOfSides(const Motion& m, double speed, const double c[3], Terms terms,
+                                    double tolerance = INFINITY) {
     ChordError r;
     if (speed == 0) return r;
     const double Q = bubbleMax(c[0], c[1], c[2]);
@@ -299,6 +301,8 @@ inline ChordError chordErrorOfSides(const Motion& m, double speed, const double 
         r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
         return r;
     }
+    double side2[3];
+    const double xm_min = terms(side2);
     r.bound = std::min(double(INFINITY), speed * (Q + thirdOrderTerm(m, side2, xm_min)));
     return r;
 }

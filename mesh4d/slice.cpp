@@ -1385,9 +1385,11 @@ struct FrameBuilder {
             const VTerms &k0 = terms[t[0]], &k1 = terms[t[1]], &k2 = terms[t[2]];
             ChordError ce;
             if (edge_spread) {
-                const double side2[3] = {spreads[te[0]], spreads[te[1]], spreads[te[2]]};
-                ce = chordErrorOfSides(world.motion, bound_speed, c, side2, std::min(std::min(k0.xm, k1.xm), k2.xm),
-                                       settings.tolerance);
+                auto sides = [&](double side2[3]) {
+                    for (int k = 0; k < 3; ++k) side2[k] = spreads[te[k]];
+                    return std::min(std::min(k0.xm, k1.xm), k2.xm);
+                };
+                ce = chordErrorOfSides(world.motion, bound_speed, c, sides, settings.tolerance);
             } else {
                 ce = pointsBound(c, k0, k1, k2);
             }

@@ -1386,7 +1386,10 @@ TEST(Refine, BoundFromEdgeSpreadsIsThePointsBoundBitForBit) {
                     const Vec3 &a = p[e].s, &b = p[(e + 1) % 3].s;
                     side2[e] = (flips >> e) & 1 ? spreadOf(m, b, a) : spreadOf(m, a, b);
                 }
-                const ChordError from_sides = chordErrorOfSides(m, speed, c, side2, xm_min, T);
+                const ChordError from_sides = chordErrorOfSides(m, speed, c, [&](double out[3]) {
+                    for (int e = 0; e < 3; ++e) out[e] = side2[e];
+                    return xm_min;
+                }, T);
                 EXPECT_TRUE(same(from_sides.bound, direct.bound)) << "trial " << trial;
                 EXPECT_TRUE(same(from_sides.quadratic, direct.quadratic)) << "trial " << trial;
                 ++checked;
