@@ -268,8 +268,15 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
 // displaced one (displacedChordError).
 // chordErrorOfPoints takes the corners' terms in place (the refinement keeps them per point: no
 // copy per piece); chordErrorOfBubbles is it, bit for bit, from arrays.
-inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3], const PointTerms& p0,
-                                     const PointTerms& p1, const PointTerms& p2, double tolerance = INFINITY) {
+// chordErrorOfSides is the bound itself, from the sides' squared M-lengths and the corners' least
+// |x_i|_M, which terms(side2) makes only when the bubbles pass (R is needed); chordErrorOfPoints
+// makes them from its corners' terms. A caller that has the lengths already (the refinement's first
+// pass keeps |u|_M^2 per mesh edge, slice.cpp refineFrame) passes them: side2[e] of side e
+// (corners e, e + 1) is normM2 of either direction, the same bits. (Always inlined: left to the
+// compiler, refine_bench --count rows counted 0.1 to 1 % more instructions.)
+template <class Terms>
+[[gnu::always_inline]] inline ChordError chordErrorOfSides(const Motion& m, double speed, const double c[3],
+                                                           Terms terms, double tolerance = INFINITY) {
     ChordError r;
     if (speed == 0) return r;
     const double Q = bubbleMax(c[0], c[1], c[2]);
@@ -279,11 +286,22 @@ inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double
         r.bound = r.quadratic == r.quadratic ? r.quadratic : INFINITY;
         return r;
     }
-    // The sides' squared M-lengths (c[e]'s side: corners e, e + 1) give r_M (thirdOrderTerm).
-    const double side2[3] = {normM2(m, p1.s - p0.s), normM2(m, p2.s - p1.s), normM2(m, p0.s - p2.s)};
-    const double R = thirdOrderTerm(m, side2, std::min(std::min(p0.xm, p1.xm), p2.xm));
+    double side2[3];
+    const double xm_min = terms(side2);
+    const double R = thirdOrderTerm(m, side2, xm_min);
     r.bound = std::min(double(INFINITY), speed * (Q + R));  // NaN from a degenerate input: INFINITY, never accepted
     return r;
+}
+inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3], const PointTerms& p0,
+                                     const PointTerms& p1, const PointTerms& p2, double tolerance = INFINITY) {
+    // The sides' squared M-lengths (c[e]'s side: corners e, e + 1) give r_M (thirdOrderTerm).
+    auto terms = [&](double side2[3]) {
+        side2[0] = normM2(m, p1.s - p0.s);
+        side2[1] = normM2(m, p2.s - p1.s);
+        side2[2] = normM2(m, p0.s - p2.s);
+        return std::min(std::min(p0.xm, p1.xm), p2.xm);
+    };
+    return chordErrorOfSides(m, speed, c, terms, tolerance);
 }
 inline ChordError chordErrorOfBubbles(const Motion& m, double speed, const double c[3], const Vec3 s[3],
                                       const double xm[3], double tolerance = INFINITY) {

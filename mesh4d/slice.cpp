@@ -1378,10 +1378,21 @@ struct FrameBuilder {
                     c[k] = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]).c;
                 }
             }
-            // The corners' terms in place (the drain's pointsBound on the same record: the same bits).
+            // The corners' terms in place (the drain's pointsBound on the same record: the same
+            // bits); the sides' |u|_M^2 are the edges' spreads when made (normM2 of the side
+            // either way round: the same bits, chord_error.h chordErrorOfSides).
             const auto& t = world.mesh.triangles[f];
             const VTerms &k0 = terms[t[0]], &k1 = terms[t[1]], &k2 = terms[t[2]];
-            const ChordError ce = pointsBound(c, k0, k1, k2);
+            ChordError ce;
+            if (edge_spread) {
+                auto sides = [&](double side2[3]) {
+                    for (int k = 0; k < 3; ++k) side2[k] = spreads[te[k]];
+                    return std::min(std::min(k0.xm, k1.xm), k2.xm);
+                };
+                ce = chordErrorOfSides(world.motion, bound_speed, c, sides, settings.tolerance);
+            } else {
+                ce = pointsBound(c, k0, k1, k2);
+            }
             const double bound = ce.bound;
             if (bound > settings.tolerance &&
                 !(ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s))) {

@@ -1339,3 +1339,65 @@ TEST(Refine, NothingToRefineIsVertexModesOutputBitForBit) {
     }
     EXPECT_EQ(unrefined, 6);
 }
+
+// (helper "order", issue 13.) The refinement's first pass takes a candidate triangle's sides'
+// |u|_M^2 from the edges' spreads (one per mesh edge, from its lo end to its hi end) and its bound
+// from chordErrorOfSides: that must be chordErrorOfPoints's bound and quadratic part bit for bit,
+// whatever the orientation of each side, with the bubbles' coefficients from edgeBubble, near the
+// camera (R infinite), at T between the quadratic part and the bound (R computed) and below the
+// quadratic part (early out), and at speed 0.
+TEST(Refine, BoundFromEdgeSpreadsIsThePointsBoundBitForBit) {
+    std::mt19937 rng(67);
+    std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
+    auto spreadOf = [](const Motion& m, const Vec3& from, const Vec3& to) {
+        const Vec3 d = to - from;
+        const double dv = dot(d, m.velocity);
+        return dv * dv + m.one_minus_beta2 * norm2(d);
+    };
+    auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; };
+    int checked = 0, with_r = 0, early = 0, infinite = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
+        const Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -10 * size}, velocity);
+        const double distance = size * (trial % 4 == 0 ? 0.7 : std::pow(10.0, 2 * w(rng)));
+        const Vec3 E{0, 0, -distance};
+        PointTerms p[3];
+        for (auto& pi : p) {
+            pi.s = Vec3{u(rng), u(rng), u(rng)} * size;
+            pi.xm = normMOfShape(m, E, pi.s);
+        }
+        double c[3];
+        for (int e = 0; e < 3; ++e) c[e] = edgeBubble(m, E, p[e], p[(e + 1) % 3]).c;
+        const double speed = trial % 50 == 0 ? 0.0 : m.beta;
+        const ChordError full = chordErrorOfPoints(m, speed, c, p[0], p[1], p[2]);
+        // T: above the bound, between the quadratic part and the bound, below the quadratic part.
+        const double ts[3] = {2 * full.bound + 1, 0.5 * (full.quadratic + std::min(full.bound, 4 * full.quadratic)),
+                              0.5 * full.quadratic};
+        const double xm_min = std::min(std::min(p[0].xm, p[1].xm), p[2].xm);
+        for (double T : ts) {
+            const ChordError direct = chordErrorOfPoints(m, speed, c, p[0], p[1], p[2], T);
+            if (direct.bound == INFINITY) ++infinite;
+            if (direct.quadratic <= T) ++with_r; else ++early;
+            for (int flips = 0; flips < 8; ++flips) {
+                double side2[3];
+                for (int e = 0; e < 3; ++e) {
+                    const Vec3 &a = p[e].s, &b = p[(e + 1) % 3].s;
+                    side2[e] = (flips >> e) & 1 ? spreadOf(m, b, a) : spreadOf(m, a, b);
+                }
+                const ChordError from_sides = chordErrorOfSides(m, speed, c, [&](double out[3]) {
+                    for (int e = 0; e < 3; ++e) out[e] = side2[e];
+                    return xm_min;
+                }, T);
+                EXPECT_TRUE(same(from_sides.bound, direct.bound)) << "trial " << trial;
+                EXPECT_TRUE(same(from_sides.quadratic, direct.quadratic)) << "trial " << trial;
+                ++checked;
+            }
+        }
+    }
+    EXPECT_EQ(checked, 3000 * 3 * 8);
+    EXPECT_GT(with_r, 3000);
+    EXPECT_GT(early, 1000);
+    EXPECT_GT(infinite, 100);
+}
