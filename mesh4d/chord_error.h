@@ -345,184 +345,22 @@ struct PieceForm {
     double centre[3] = {0, 0, 0};                  // the same with H(x_c) alone
     bool finite = false;                           // false when the piece may reach the camera (m <= 0)
 };
-// Two doubles in one SSE2 register: the six steps of pieceFormTerms and the direct form's
-// candidates two at a time. Each lane is the same IEEE operations in the same order as the scalar
-// code it stands for (the build makes no contraction: no FMA), so the same bits (as normals.cpp's
-// unitPair).
-typedef double FormPair __attribute__((vector_size(16)));
-typedef long long FormMask __attribute__((vector_size(16)));
-// std::max(a, b) and std::min(a, b) lane by lane, NaNs alike (the first operand unless the
-// comparison holds).
-inline FormPair maxPair(FormPair a, FormPair b) { return a < b ? b : a; }
-inline FormPair minPair(FormPair a, FormPair b) { return b < a ? b : a; }
-inline FormPair splat(double a) { return FormPair{a, a}; }
-
-// The terms all of a piece's candidate forms are made from (pieceFormTerms): the centroid's
-// |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts across and along y_c^ (|e_perp|^2 and
-// alpha^2) and the two terms of H(x_c)'s coefficient; the direct form's m, sin^2 bound and factor.
-struct PieceFormTerms {
-    double k;                  // 1 - b^2
-    double xm2, xm;            // |x_c|_M^2, |x_c|_M
-    double q;                  // r_M^2, the largest squared M-distance from the centroid to a corner
-    double m1;                 // the direct form's m (bounded when > 0; sin2, inv, a[3], b set then)
-    double a[4], b[4];         // the balances' across and along parts: the sides' (a[e] = |e_perp|^2), then their sums
-    double along2[3];          // alpha^2 of each side
-    double l2[3], uMx2[3];     // |e|_M^2 and (e^T M x_c)^2 (pieceCentre)
-    double sin2, inv;          // the sin^2 theta bound and 1 / (2 (1 - b^2) m)
-};
-inline PieceFormTerms pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3]) {
-    PieceFormTerms t;
-    const double k = t.k = m.one_minus_beta2;
-    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
-    const Vec3 x = E + centre;
-    const double xv = dot(x, m.velocity);
-    const double xm2 = t.xm2 = xv * xv + k * norm2(x);
-    const double xm = t.xm = std::sqrt(xm2);
-    // The six steps u, two to a pair: the corners' offsets d_i = s_i - centre and the sides
-    // e = s[e + 1] - s[e], lanes (d0, d1), (d2, e0), (e1, e2); each one's |u|_M^2 (uv^2 + k |u|^2)
-    // and u^T M x (uv xv + k u.x), as dot and norm2 make them (x, then y, then z).
-    const FormPair ux[3] = {FormPair{s[0].x, s[1].x} - splat(centre.x), FormPair{s[2].x, s[1].x} - FormPair{centre.x, s[0].x},
-                            FormPair{s[2].x, s[0].x} - FormPair{s[1].x, s[2].x}};
-    const FormPair uy[3] = {FormPair{s[0].y, s[1].y} - splat(centre.y), FormPair{s[2].y, s[1].y} - FormPair{centre.y, s[0].y},
-                            FormPair{s[2].y, s[0].y} - FormPair{s[1].y, s[2].y}};
-    const FormPair uz[3] = {FormPair{s[0].z, s[1].z} - splat(centre.z), FormPair{s[2].z, s[1].z} - FormPair{centre.z, s[0].z},
-                            FormPair{s[2].z, s[0].z} - FormPair{s[1].z, s[2].z}};
-    FormPair l2[3], uMx[3];
-    for (int p = 0; p < 3; ++p) {
-        const FormPair uv = ux[p] * m.velocity.x + uy[p] * m.velocity.y + uz[p] * m.velocity.z;
-        l2[p] = uv * uv + k * (ux[p] * ux[p] + uy[p] * uy[p] + uz[p] * uz[p]);
-        uMx[p] = uv * xv + k * (ux[p] * x.x + uy[p] * x.y + uz[p] * x.z);
-    }
-    // The corners (d2 = l2, along = y_c^.d_i): r_M^2, the piece's reach towards the camera
-    // max_i (-y_c^.d_i) and p^2 = max_i |d_i,perp|^2, each from 0 over corners 0, 1, 2.
-    const FormPair along01 = uMx[0] / xm, along2x = uMx[1] / xm;
-    const FormPair perp01 = l2[0] - along01 * along01, perp2x = l2[1] - along2x * along2x;
-    t.q = std::max(std::max(std::max(0.0, l2[0][0]), l2[0][1]), l2[1][0]);
-    const double reach = std::max(std::max(std::max(0.0, -along01[0]), -along01[1]), -along2x[0]);
-    const double perp2 = std::max(std::max(std::max(0.0, perp01[0]), perp01[1]), perp2x[0]);
-    // The sides: alpha^2 = (e^T M x_c)^2 / |x_c|_M^2 and |e_perp|^2 = |e|_M^2 - alpha^2 (at least 0).
-    const FormPair m0[2] = {uMx[1] * uMx[1], uMx[2] * uMx[2]};
-    const FormPair al0 = m0[0] / xm2, al1 = m0[1] / xm2;
-    const FormPair ac0 = maxPair(splat(0.0), l2[1] - al0), ac1 = maxPair(splat(0.0), l2[2] - al1);
-    t.l2[0] = l2[1][1], t.l2[1] = l2[2][0], t.l2[2] = l2[2][1];
-    t.uMx2[0] = m0[0][1], t.uMx2[1] = m0[1][0], t.uMx2[2] = m0[1][1];
-    t.along2[0] = al0[1], t.along2[1] = al1[0], t.along2[2] = al1[1];
-    t.a[0] = ac0[1], t.a[1] = ac1[0], t.a[2] = ac1[1];
-    const double m1 = t.m1 = xm - reach;
-    if (m1 > 0) {
-        const double sin2 = t.sin2 = std::min(1.0, std::max(0.0, perp2) / (m1 * m1));
-        t.inv = 0.5 / (k * m1);
-        for (int e = 0; e < 3; ++e) t.b[e] = sin2 * t.along2[e];
-        t.a[3] = t.a[0] + t.a[1] + t.a[2];
-        t.b[3] = t.b[0] + t.b[1] + t.b[2];
-    }
-    return t;
-}
-// H(x_c)'s coefficients of the sides (PieceForm::centre).
-inline void pieceCentre(const PieceFormTerms& t, double centre_c[3]) {
-    for (int e = 0; e < 3; ++e)
-        centre_c[e] = 0.5 * std::max(0.0, t.l2[e] * t.xm2 - t.uMx2[e]) / (t.k * t.xm2 * t.xm);
-}
-
-// bubbleMax of two triangles at once (lane l: c01[l], c12[l], c20[l]).
-inline FormPair bubbleMaxPair(FormPair c01, FormPair c12, FormPair c20) {
-    const FormPair a0 = c12, a1 = c20, a2 = c01;
-    const FormPair quarter = {0.25, 0.25}, zero = {0, 0};
-    const FormPair edge = quarter * maxPair(maxPair(a0, a1), a2);
-    const FormPair w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
-    const FormPair den = w0 + w1 + w2;
-    const FormMask inside = (w0 >= zero) & (w1 >= zero) & (w2 >= zero) & (den > zero);
-    return inside ? maxPair(edge, a0 * a1 * a2 / den) : edge;
-}
-// The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
-// one (mu = 1e-6 and no along term).
-inline int directCandidates(const PieceFormTerms& t) { return t.b[3] > 0 ? 4 : 1; }
-// Candidates j and j + 1 (j = 0 or 2; with one candidate, both lanes are it): their sides'
-// coefficients c[e] and the least value bubbleMax can give each: its first term, 0.25 max c with
-// the same operands in the same order, which bubbleMax returns or exceeds (std::max), and which
-// is NaN only when c[1] is, bubbleMax's value then NaN too. A candidate whose least value already
-// loses is never chosen: its bubbleMax need not be made.
-inline void directPair(const PieceFormTerms& t, int j, FormPair c[3], FormPair* least) {
-    const FormPair one = {1, 1}, low = {1e-6, 1e-6}, high = {1e6, 1e6}, zero = {0, 0};
-    FormPair mu = low, fb = zero;
-    if (t.b[3] > 0) {
-        const FormPair a = {t.a[j], t.a[j + 1]}, b = {t.b[j], t.b[j + 1]};
-        mu = a > zero ? minPair(high, maxPair(low, __builtin_ia32_sqrtpd(b / a))) : high;
-        fb = one + one / mu;
-    }
-    const FormPair fa = one + mu, fbs = fb * t.sin2;
-    for (int e = 0; e < 3; ++e) c[e] = t.inv * (fa * t.a[e] + fbs * t.along2[e]);
-    *least = FormPair{0.25, 0.25} * maxPair(maxPair(c[1], c[2]), c[0]);
-}
-// The Taylor form's coefficients from H(x_c)'s (pieceCentre) and its least value (as
-// directPair's); false when it is unbounded (m_r <= 0).
-inline bool taylorForm(const PieceFormTerms& t, const double centre_c[3], double c[3], double* least) {
-    const double rM = std::sqrt(t.q);
-    const double mlow = t.xm - rM;
-    if (!(mlow > 0)) return false;
-    const double K = 2 / 1.7320508075688772 * rM / (t.k * mlow * mlow);
-    for (int e = 0; e < 3; ++e) c[e] = centre_c[e] + 0.5 * K * (t.a[e] + t.along2[e]);
-    *least = 0.25 * std::max(std::max(c[1], c[2]), c[0]);
-    return true;
-}
-
-// pieceForm: the candidates in order (the direct form's, then the Taylor form), the first with
-// the least bubbleMax kept. A candidate whose least value is not below the best so far has a
-// bubbleMax not below it either, so it is passed without its bubbleMax: the same choice.
-inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
-    PieceForm r;
-    const PieceFormTerms t = pieceFormTerms(m, E, s);
-    pieceCentre(t, r.centre);
-    double best = INFINITY;
-    if (t.m1 > 0)
-        for (int j = 0, n = directCandidates(t); j < n; j += 2) {
-            FormPair c[3], least;
-            directPair(t, j, c, &least);
-            if (!(least[0] < best) && !(least[1] < best)) continue;
-            const FormPair v = bubbleMaxPair(c[0], c[1], c[2]);
-            for (int l = 0; l < 2 && j + l < n; ++l)
-                if (v[l] < best) {
-                    best = v[l];
-                    for (int e = 0; e < 3; ++e) r.c[e] = c[e][l];
-                }
-        }
-    double c[3], least;
-    if (taylorForm(t, r.centre, c, &least) && least < best) {
-        const double v = bubbleMax(c[0], c[1], c[2]);
-        if (v < best) {
-            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
-        }
-    }
-    r.finite = r.c[0] < INFINITY && r.c[1] < INFINITY && r.c[2] < INFINITY;  // false for a NaN too
-    return r;
-}
+// The form of the piece with corners' shape offsets s (E = nowBase): the candidates of (1) and
+// (2) in order (the direct form's mu for each side, then for their sums; the Taylor form), the first
+// with the least bubbleMax on the piece's sides kept; `centre` always made. Not finite when no
+// candidate is bounded (a piece reaching the camera) or has numbers only.
+// How (chord_error.cpp): the terms every candidate shares, the direct candidates two at a time in
+// the lanes of an SSE2 register (each lane the scalar arithmetic's operations in its order: the
+// same bits), and a candidate's bubbleMax skipped where its first term (0.25 max c, which
+// bubbleMax never falls below) already loses. Refine.PieceFormsMatchTheReferenceBitForBit
+// compares it with the scalar code of one candidate after the other it replaced.
+PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]);
 
 // Whether pieceForm(m, E, s) is finite and speed bubbleMax(its c) <= tolerance, without the
 // candidates after the first that passes: the least candidate passes when any does (the product
 // by speed is monotonic), so the answer is pieceForm's whenever its coefficients are numbers.
 // A candidate with speed times its least value over the tolerance fails without its bubbleMax
-// (speed >= 0: rounding is monotonic, and bubbleMax is not below its least), and H(x_c) is made
-// only for the Taylor form.
-inline bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance) {
-    const PieceFormTerms t = pieceFormTerms(m, E, s);
-    const bool prune = speed >= 0;
-    auto fails = [&](double least) { return prune && speed * least > tolerance; };
-    auto passes = [&](double c0, double c1, double c2, double v) {
-        return c0 < INFINITY && c1 < INFINITY && c2 < INFINITY && speed * v <= tolerance;
-    };
-    if (t.m1 > 0)
-        for (int j = 0, n = directCandidates(t); j < n; j += 2) {
-            FormPair c[3], least;
-            directPair(t, j, c, &least);
-            const bool skip0 = fails(least[0]), skip1 = j + 1 >= n || fails(least[1]);
-            if (skip0 && skip1) continue;
-            const FormPair v = bubbleMaxPair(c[0], c[1], c[2]);
-            if (!skip0 && passes(c[0][0], c[1][0], c[2][0], v[0])) return true;
-            if (!skip1 && passes(c[0][1], c[1][1], c[2][1], v[1])) return true;
-        }
-    double centre[3], c[3], least;
-    pieceCentre(t, centre);
-    return taylorForm(t, centre, c, &least) && !fails(least) && passes(c[0], c[1], c[2], bubbleMax(c[0], c[1], c[2]));
-}
+// (speed >= 0: rounding is monotonic, and bubbleMax is not below its least).
+bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance);
 
 }  // namespace mesh4d
