@@ -352,7 +352,7 @@ struct PieceForm {
 // The form of the piece with corners' shape offsets s (E = nowBase): the candidates of (1) and
 // (2) in order (the direct form's mu for each side, then for their sums; the Taylor form), the first
 // with the least bubbleMax on the piece's sides kept; `centre` always made. Not finite when no
-// candidate is bounded (a piece reaching the camera) or has numbers only.
+// candidate is bounded (a piece reaching the camera) or a kept coefficient is NaN or +infinity.
 // How (chord_error.cpp): the terms every candidate shares, the direct candidates two at a time in
 // the lanes of an SSE2 register (each lane the scalar arithmetic's operations in its order: the
 // same bits), and a candidate's bubbleMax skipped where its first term (0.25 max c, which
