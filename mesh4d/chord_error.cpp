@@ -47,4 +47,186 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
     return chordErrorFromSpread(cornerSpread(s, m), xm, m);
 }
 
+namespace {
+
+// Two doubles in one SSE2 register: the six steps of pieceFormTerms and the direct form's
+// candidates two at a time. Each lane is the same IEEE operations in the same order as the scalar
+// code it stands for (the build makes no contraction: no FMA), so the same bits (as normals.cpp's
+// unitPair).
+typedef double FormPair __attribute__((vector_size(16)));
+typedef long long FormMask __attribute__((vector_size(16)));
+// std::max(a, b) and std::min(a, b) lane by lane, NaNs alike (the first operand unless the
+// comparison holds).
+FormPair maxPair(FormPair a, FormPair b) { return a < b ? b : a; }
+FormPair minPair(FormPair a, FormPair b) { return b < a ? b : a; }
+FormPair splat(double a) { return FormPair{a, a}; }
+
+// The terms all of a piece's candidate forms are made from (pieceFormTerms, as chord_error.h
+// defines them): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts across and
+// along y_c^ (|e_perp|^2 and alpha^2) and H(x_c)'s coefficient; the direct form's m, sin^2 theta
+// bound and factor.
+struct PieceFormTerms {
+    double k;                  // 1 - b^2
+    double xm2, xm;            // |x_c|_M^2, |x_c|_M
+    double q;                  // r_M^2, the largest squared M-distance from the centroid to a corner
+    double m1;                 // the direct form's m (bounded when > 0; sin2, inv, a[3], b set then)
+    double a[4], b[4];         // the balances' across and along parts: the sides' (a[e] = |e_perp|^2), then their sums
+    double along2[3];          // alpha^2 of each side
+    double centre[3];          // H(x_c)'s coefficients (PieceForm::centre)
+    double sin2, inv;          // the sin^2 theta bound and 1 / (2 (1 - b^2) m)
+};
+PieceFormTerms pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3]) {
+    PieceFormTerms t;
+    const double k = t.k = m.one_minus_beta2;
+    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
+    const Vec3 x = E + centre;
+    const double xv = dot(x, m.velocity);
+    const double xm2 = t.xm2 = xv * xv + k * norm2(x);
+    const double xm = t.xm = std::sqrt(xm2);
+    // The six steps u, two to a pair: the corners' offsets d_i = s_i - centre and the sides
+    // e = s[e + 1] - s[e], lanes (d0, d1), (d2, e0), (e1, e2); each one's |u|_M^2 (uv^2 + k |u|^2)
+    // and u^T M x (uv xv + k u.x), as dot and norm2 make them (x, then y, then z).
+    const FormPair vx = splat(m.velocity.x), vy = splat(m.velocity.y), vz = splat(m.velocity.z);
+    const FormPair kk = splat(k), xvv = splat(xv), xx = splat(x.x), xy = splat(x.y), xz = splat(x.z);
+    FormPair l2[3], uMx[3];
+    auto step = [&](int p, FormPair ux, FormPair uy, FormPair uz) {
+        const FormPair uv = ux * vx + uy * vy + uz * vz;
+        l2[p] = uv * uv + kk * (ux * ux + uy * uy + uz * uz);
+        uMx[p] = uv * xvv + kk * (ux * xx + uy * xy + uz * xz);
+    };
+    step(0, FormPair{s[0].x, s[1].x} - splat(centre.x), FormPair{s[0].y, s[1].y} - splat(centre.y),
+         FormPair{s[0].z, s[1].z} - splat(centre.z));
+    step(1, FormPair{s[2].x, s[1].x} - FormPair{centre.x, s[0].x}, FormPair{s[2].y, s[1].y} - FormPair{centre.y, s[0].y},
+         FormPair{s[2].z, s[1].z} - FormPair{centre.z, s[0].z});
+    step(2, FormPair{s[2].x, s[0].x} - FormPair{s[1].x, s[2].x}, FormPair{s[2].y, s[0].y} - FormPair{s[1].y, s[2].y},
+         FormPair{s[2].z, s[0].z} - FormPair{s[1].z, s[2].z});
+    // The corners (d2 = l2, along = y_c^.d_i): r_M^2, the piece's reach towards the camera
+    // max_i (-y_c^.d_i) and p^2 = max_i |d_i,perp|^2, each from 0 over corners 0, 1, 2.
+    const FormPair along01 = uMx[0] / xm, along2x = uMx[1] / xm;
+    const FormPair perp01 = l2[0] - along01 * along01, perp2x = l2[1] - along2x * along2x;
+    t.q = std::max(std::max(std::max(0.0, l2[0][0]), l2[0][1]), l2[1][0]);
+    const double reach = std::max(std::max(std::max(0.0, -along01[0]), -along01[1]), -along2x[0]);
+    const double perp2 = std::max(std::max(std::max(0.0, perp01[0]), perp01[1]), perp2x[0]);
+    // The sides (lane 1 of the second pair, both of the third): alpha^2 = (e^T M x_c)^2 / |x_c|_M^2,
+    // |e_perp|^2 = |e|_M^2 - alpha^2 and H(x_c)'s coefficient (|e|_M^2 |x_c|_M^2 - (e^T M x_c)^2) / (2 (1 - b^2) |x_c|_M^3),
+    // both at least 0.
+    const FormPair zero = {0, 0}, den = splat(k * xm2 * xm);
+    FormPair al[2], ac[2], cc[2];
+    for (int p = 0; p < 2; ++p) {
+        const FormPair uMx2 = uMx[p + 1] * uMx[p + 1];
+        al[p] = uMx2 / xm2;
+        ac[p] = maxPair(zero, l2[p + 1] - al[p]);
+        cc[p] = 0.5 * maxPair(zero, l2[p + 1] * xm2 - uMx2) / den;
+    }
+    t.along2[0] = al[0][1], t.along2[1] = al[1][0], t.along2[2] = al[1][1];
+    t.a[0] = ac[0][1], t.a[1] = ac[1][0], t.a[2] = ac[1][1];
+    t.centre[0] = cc[0][1], t.centre[1] = cc[1][0], t.centre[2] = cc[1][1];
+    const double m1 = t.m1 = xm - reach;
+    if (m1 > 0) {
+        const double sin2 = t.sin2 = std::min(1.0, std::max(0.0, perp2) / (m1 * m1));
+        t.inv = 0.5 / (k * m1);
+        for (int e = 0; e < 3; ++e) t.b[e] = sin2 * t.along2[e];
+        t.a[3] = t.a[0] + t.a[1] + t.a[2];
+        t.b[3] = t.b[0] + t.b[1] + t.b[2];
+    }
+    return t;
+}
+
+// bubbleMax of two triangles at once (lane l: c01[l], c12[l], c20[l]), its operations lane by lane
+// (the interior value made in both lanes and selected where the point is inside).
+FormPair bubbleMaxPair(FormPair c01, FormPair c12, FormPair c20) {
+    const FormPair a0 = c12, a1 = c20, a2 = c01;
+    const FormPair quarter = {0.25, 0.25}, zero = {0, 0};
+    const FormPair edge = quarter * maxPair(maxPair(a0, a1), a2);
+    const FormPair w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
+    const FormPair den = w0 + w1 + w2;
+    const FormMask inside = (w0 >= zero) & (w1 >= zero) & (w2 >= zero) & (den > zero);
+    return inside ? maxPair(edge, a0 * a1 * a2 / den) : edge;
+}
+// The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
+// one (mu = 1e-6 and no along term).
+int directCandidates(const PieceFormTerms& t) { return t.b[3] > 0 ? 4 : 1; }
+// Candidates j and j + 1 (j = 0 or 2; with one candidate, both lanes are it): their sides'
+// coefficients c[e] and the least value bubbleMax can give each: its first term, 0.25 max c with
+// the same operands in the same order, which bubbleMax returns or exceeds (std::max), and which
+// is NaN only when c[1] is, bubbleMax's value then NaN too. A candidate whose least value already
+// loses is never chosen: its bubbleMax need not be made.
+void directPair(const PieceFormTerms& t, int j, FormPair c[3], FormPair* least) {
+    const FormPair one = {1, 1}, low = {1e-6, 1e-6}, high = {1e6, 1e6}, zero = {0, 0};
+    FormPair mu = low, fb = zero;
+    if (t.b[3] > 0) {
+        const FormPair a = {t.a[j], t.a[j + 1]}, b = {t.b[j], t.b[j + 1]};
+        mu = a > zero ? minPair(high, maxPair(low, __builtin_ia32_sqrtpd(b / a))) : high;
+        fb = one + one / mu;
+    }
+    const FormPair fa = one + mu, fbs = fb * t.sin2;
+    for (int e = 0; e < 3; ++e) c[e] = t.inv * (fa * t.a[e] + fbs * t.along2[e]);
+    *least = FormPair{0.25, 0.25} * maxPair(maxPair(c[1], c[2]), c[0]);
+}
+// The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as
+// directPair's); false when it is unbounded (m_r <= 0).
+bool taylorForm(const PieceFormTerms& t, const double centre_c[3], double c[3], double* least) {
+    const double rM = std::sqrt(t.q);
+    const double mlow = t.xm - rM;
+    if (!(mlow > 0)) return false;
+    const double K = 2 / 1.7320508075688772 * rM / (t.k * mlow * mlow);
+    for (int e = 0; e < 3; ++e) c[e] = centre_c[e] + 0.5 * K * (t.a[e] + t.along2[e]);
+    *least = 0.25 * std::max(std::max(c[1], c[2]), c[0]);
+    return true;
+}
+
+}  // namespace
+
+// The candidates in order, the first with the least bubbleMax kept. A candidate whose least value
+// is not below the best so far has a bubbleMax not below it either (or NaN), so it is passed
+// without its bubbleMax: the same choice.
+PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
+    PieceForm r;
+    const PieceFormTerms t = pieceFormTerms(m, E, s);
+    for (int e = 0; e < 3; ++e) r.centre[e] = t.centre[e];
+    double best = INFINITY;
+    if (t.m1 > 0)
+        for (int j = 0, n = directCandidates(t); j < n; j += 2) {
+            FormPair c[3], least;
+            directPair(t, j, c, &least);
+            if (!(least[0] < best) && !(least[1] < best)) continue;
+            const FormPair v = bubbleMaxPair(c[0], c[1], c[2]);
+            for (int l = 0; l < 2 && j + l < n; ++l)
+                if (v[l] < best) {
+                    best = v[l];
+                    for (int e = 0; e < 3; ++e) r.c[e] = c[e][l];
+                }
+        }
+    double c[3], least;
+    if (taylorForm(t, r.centre, c, &least) && least < best) {
+        const double v = bubbleMax(c[0], c[1], c[2]);
+        if (v < best) {
+            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
+        }
+    }
+    r.finite = r.c[0] < INFINITY && r.c[1] < INFINITY && r.c[2] < INFINITY;  // false for a NaN too
+    return r;
+}
+
+bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance) {
+    const PieceFormTerms t = pieceFormTerms(m, E, s);
+    const bool prune = speed >= 0;
+    auto fails = [&](double least) { return prune && speed * least > tolerance; };
+    auto passes = [&](double c0, double c1, double c2, double v) {
+        return c0 < INFINITY && c1 < INFINITY && c2 < INFINITY && speed * v <= tolerance;
+    };
+    if (t.m1 > 0)
+        for (int j = 0, n = directCandidates(t); j < n; j += 2) {
+            FormPair c[3], least;
+            directPair(t, j, c, &least);
+            const bool skip0 = fails(least[0]), skip1 = j + 1 >= n || fails(least[1]);
+            if (skip0 && skip1) continue;
+            const FormPair v = bubbleMaxPair(c[0], c[1], c[2]);
+            if (!skip0 && passes(c[0][0], c[1][0], c[2][0], v[0])) return true;
+            if (!skip1 && passes(c[0][1], c[1][1], c[2][1], v[1])) return true;
+        }
+    double c[3], least;
+    return taylorForm(t, t.centre, c, &least) && !fails(least) && passes(c[0], c[1], c[2], bubbleMax(c[0], c[1], c[2]));
+}
+
 }  // namespace mesh4d

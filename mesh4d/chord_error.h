@@ -292,8 +292,12 @@ template <class Terms>
     r.bound = std::min(double(INFINITY), speed * (Q + R));  // NaN from a degenerate input: INFINITY, never accepted
     return r;
 }
-inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3], const PointTerms& p0,
-                                     const PointTerms& p1, const PointTerms& p2, double tolerance = INFINITY) {
+// (chordErrorOfPoints always inline too: the refinement's drain and first pass call it per piece,
+// and GCC's size budget for the large drain otherwise flips with unrelated edits to it: a call per
+// piece, about 2 % of refine_bench --count 1 3's instructions.)
+[[gnu::always_inline]] inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3],
+                                                            const PointTerms& p0, const PointTerms& p1,
+                                                            const PointTerms& p2, double tolerance = INFINITY) {
     // The sides' squared M-lengths (c[e]'s side: corners e, e + 1) give r_M (thirdOrderTerm).
     auto terms = [&](double side2[3]) {
         side2[0] = normM2(m, p1.s - p0.s);
@@ -363,94 +367,22 @@ struct PieceForm {
     double centre[3] = {0, 0, 0};                  // the same with H(x_c) alone
     bool finite = false;                           // false when the piece may reach the camera (m <= 0)
 };
-// The candidate forms of pieceForm, in its order: visit(c, v) for each, c its sides' coefficients
-// and v = bubbleMax(c); the scan stops when visit returns true. centre: H(x_c)'s coefficients.
-template <class Visit>
-inline void scanPieceForms(const Motion& m, const Vec3& E, const Vec3 s[3], double centre_c[3], Visit visit) {
-    const double k = m.one_minus_beta2;
-    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
-    const Vec3 x = E + centre;
-    const double xv = dot(x, m.velocity);
-    const double xm2 = xv * xv + k * norm2(x);
-    const double xm = std::sqrt(xm2);
-    double q = 0;       // r_M^2
-    double reach = 0;   // max_i (-y_c^.d_i): the piece's reach towards the camera
-    double perp2 = 0;   // p^2 = max_i |d_i,perp|^2
-    for (int i = 0; i < 3; ++i) {
-        const Vec3 u = s[i] - centre;
-        const double uv = dot(u, m.velocity);
-        const double d2 = uv * uv + k * norm2(u);
-        const double along = (uv * xv + k * dot(u, x)) / xm;  // y_c^.d_i
-        q = std::max(q, d2);
-        reach = std::max(reach, -along);
-        perp2 = std::max(perp2, d2 - along * along);
-    }
-    // The sides' parts across and along y_c^ (|e_perp|^2, alpha^2), and H(x_c)'s coefficients.
-    double across[3], along2[3];
-    for (int e = 0; e < 3; ++e) {
-        const Vec3 u = s[(e + 1) % 3] - s[e];
-        const double uv = dot(u, m.velocity);
-        const double l2 = uv * uv + k * norm2(u);
-        const double uMx = uv * xv + k * dot(u, x);
-        centre_c[e] = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
-        along2[e] = uMx * uMx / xm2;
-        across[e] = std::max(0.0, l2 - along2[e]);
-    }
-    // (1) The direct form.
-    const double m1 = xm - reach;
-    if (m1 > 0) {
-        const double sin2 = std::min(1.0, std::max(0.0, perp2) / (m1 * m1));
-        const double inv = 0.5 / (k * m1);
-        double a[4] = {across[0], across[1], across[2], across[0] + across[1] + across[2]};
-        double b[4] = {sin2 * along2[0], sin2 * along2[1], sin2 * along2[2], 0};
-        b[3] = b[0] + b[1] + b[2];
-        for (int j = 0; j < 4; ++j) {
-            double mu = 1e-6;
-            if (b[3] > 0) mu = a[j] > 0 ? std::min(1e6, std::max(1e-6, std::sqrt(b[j] / a[j]))) : 1e6;
-            const double fa = 1 + mu, fb = b[3] > 0 ? 1 + 1 / mu : 0;
-            double c[3];
-            for (int e = 0; e < 3; ++e) c[e] = inv * (fa * across[e] + fb * sin2 * along2[e]);
-            if (visit(c, bubbleMax(c[0], c[1], c[2]))) return;
-            if (b[3] == 0) break;
-        }
-    }
-    // (2) The Taylor form.
-    const double rM = std::sqrt(q);
-    const double mlow = xm - rM;
-    if (mlow > 0) {
-        const double K = 2 / 1.7320508075688772 * rM / (k * mlow * mlow);
-        double c[3];
-        for (int e = 0; e < 3; ++e) c[e] = centre_c[e] + 0.5 * K * (across[e] + along2[e]);
-        visit(c, bubbleMax(c[0], c[1], c[2]));
-    }
-}
-
-inline PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
-    PieceForm r;
-    double best = INFINITY;
-    scanPieceForms(m, E, s, r.centre, [&](const double c[3], double v) {
-        if (v < best) {
-            best = v;
-            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
-        }
-        return false;
-    });
-    r.finite = r.c[0] == r.c[0] && r.c[1] == r.c[1] && r.c[2] == r.c[2] && r.c[0] < INFINITY &&
-               r.c[1] < INFINITY && r.c[2] < INFINITY;
-    return r;
-}
+// The form of the piece with corners' shape offsets s (E = nowBase): the candidates of (1) and
+// (2) in order (the direct form's mu for each side, then for their sums; the Taylor form), the first
+// with the least bubbleMax on the piece's sides kept; `centre` always made. Not finite when no
+// candidate is bounded (a piece reaching the camera) or a kept coefficient is NaN or +infinity.
+// How (chord_error.cpp): the terms every candidate shares, the direct candidates two at a time in
+// the lanes of an SSE2 register (each lane the scalar arithmetic's operations in its order: the
+// same bits), and a candidate's bubbleMax skipped where its first term (0.25 max c, which
+// bubbleMax never falls below) already loses. Refine.PieceFormsMatchTheReferenceBitForBit
+// compares it with the scalar code of one candidate after the other it replaced.
+PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]);
 
 // Whether pieceForm(m, E, s) is finite and speed bubbleMax(its c) <= tolerance, without the
 // candidates after the first that passes: the least candidate passes when any does (the product
 // by speed is monotonic), so the answer is pieceForm's whenever its coefficients are numbers.
-inline bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance) {
-    double centre[3];
-    bool within = false;
-    scanPieceForms(m, E, s, centre, [&](const double c[3], double v) {
-        within = c[0] < INFINITY && c[1] < INFINITY && c[2] < INFINITY && speed * v <= tolerance;
-        return within;
-    });
-    return within;
-}
+// A candidate with speed times its least value over the tolerance fails without its bubbleMax
+// (speed >= 0: rounding is monotonic, and bubbleMax is not below its least).
+bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance);
 
 }  // namespace mesh4d

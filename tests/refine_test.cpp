@@ -1401,3 +1401,192 @@ TEST(Refine, BoundFromEdgeSpreadsIsThePointsBoundBitForBit) {
     EXPECT_GT(early, 1000);
     EXPECT_GT(infinite, 100);
 }
+
+// ---- Helper "form" (issue 13): the whole-piece forms at fewer instructions, the same bits ----
+namespace form_reference {
+
+// A straightforward copy of bubbleMax, scanPieceForms, pieceForm and pieceFormWithin as they were
+// at main 54ad466 (chord_error.h, before the forms' terms were made two lanes at a time and a
+// candidate's bubbleMax skipped when its first term already loses): the independent reference the
+// rewritten code must match bit for bit.
+double bubbleMax(double c01, double c12, double c20) {
+    const double a0 = c12, a1 = c20, a2 = c01;
+    double best = 0.25 * std::max(std::max(a0, a1), a2);
+    const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
+    const double den = w0 + w1 + w2;
+    if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);
+    return best;
+}
+
+template <class Visit>
+void scanPieceForms(const Motion& m, const Vec3& E, const Vec3 s[3], double centre_c[3], Visit visit) {
+    const double k = m.one_minus_beta2;
+    const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
+    const Vec3 x = E + centre;
+    const double xv = dot(x, m.velocity);
+    const double xm2 = xv * xv + k * norm2(x);
+    const double xm = std::sqrt(xm2);
+    double q = 0, reach = 0, perp2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = s[i] - centre;
+        const double uv = dot(u, m.velocity);
+        const double d2 = uv * uv + k * norm2(u);
+        const double along = (uv * xv + k * dot(u, x)) / xm;
+        q = std::max(q, d2);
+        reach = std::max(reach, -along);
+        perp2 = std::max(perp2, d2 - along * along);
+    }
+    double across[3], along2[3];
+    for (int e = 0; e < 3; ++e) {
+        const Vec3 u = s[(e + 1) % 3] - s[e];
+        const double uv = dot(u, m.velocity);
+        const double l2 = uv * uv + k * norm2(u);
+        const double uMx = uv * xv + k * dot(u, x);
+        centre_c[e] = 0.5 * std::max(0.0, l2 * xm2 - uMx * uMx) / (k * xm2 * xm);
+        along2[e] = uMx * uMx / xm2;
+        across[e] = std::max(0.0, l2 - along2[e]);
+    }
+    const double m1 = xm - reach;
+    if (m1 > 0) {
+        const double sin2 = std::min(1.0, std::max(0.0, perp2) / (m1 * m1));
+        const double inv = 0.5 / (k * m1);
+        double a[4] = {across[0], across[1], across[2], across[0] + across[1] + across[2]};
+        double b[4] = {sin2 * along2[0], sin2 * along2[1], sin2 * along2[2], 0};
+        b[3] = b[0] + b[1] + b[2];
+        for (int j = 0; j < 4; ++j) {
+            double mu = 1e-6;
+            if (b[3] > 0) mu = a[j] > 0 ? std::min(1e6, std::max(1e-6, std::sqrt(b[j] / a[j]))) : 1e6;
+            const double fa = 1 + mu, fb = b[3] > 0 ? 1 + 1 / mu : 0;
+            double c[3];
+            for (int e = 0; e < 3; ++e) c[e] = inv * (fa * across[e] + fb * sin2 * along2[e]);
+            if (visit(c, bubbleMax(c[0], c[1], c[2]))) return;
+            if (b[3] == 0) break;
+        }
+    }
+    const double rM = std::sqrt(q);
+    const double mlow = xm - rM;
+    if (mlow > 0) {
+        const double K = 2 / 1.7320508075688772 * rM / (k * mlow * mlow);
+        double c[3];
+        for (int e = 0; e < 3; ++e) c[e] = centre_c[e] + 0.5 * K * (across[e] + along2[e]);
+        visit(c, bubbleMax(c[0], c[1], c[2]));
+    }
+}
+
+// pieceForm as it was; *winner: the index of the candidate kept (0 .. 3 direct, the last the
+// Taylor form; -1: none), *candidates: how many were offered.
+PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3], int* winner, int* candidates) {
+    PieceForm r;
+    double best = INFINITY;
+    *winner = -1;
+    *candidates = 0;
+    scanPieceForms(m, E, s, r.centre, [&](const double c[3], double v) {
+        if (v < best) {
+            best = v;
+            *winner = *candidates;
+            for (int e = 0; e < 3; ++e) r.c[e] = c[e];
+        }
+        ++*candidates;
+        return false;
+    });
+    r.finite = r.c[0] == r.c[0] && r.c[1] == r.c[1] && r.c[2] == r.c[2] && r.c[0] < INFINITY &&
+               r.c[1] < INFINITY && r.c[2] < INFINITY;
+    return r;
+}
+
+bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance) {
+    double centre[3];
+    bool within = false;
+    scanPieceForms(m, E, s, centre, [&](const double c[3], double v) {
+        within = c[0] < INFINITY && c[1] < INFINITY && c[2] < INFINITY && speed * v <= tolerance;
+        return within;
+    });
+    return within;
+}
+
+// The same double: the same bits, or both NaN (a NaN's payload depends on which operand the
+// compiler puts first; a form with a NaN coefficient is not finite and its coefficients unused).
+bool sameDouble(double a, double b) { return (a != a && b != b) || std::memcmp(&a, &b, sizeof(double)) == 0; }
+
+}  // namespace form_reference
+
+// pieceForm and pieceFormWithin against the copy of the code they replace (form_reference): the
+// same coefficients, centre coefficients and finiteness bit for bit, and the same answer at
+// tolerances on and around each piece's own bound, at the speeds the refinement uses (b, 0) and
+// others (a displaced speed, a negative and a NaN one). Random pieces near and far from the
+// camera, and the cases the arithmetic must carry alike: degenerate pieces (coincident and
+// collinear corners, a point), pieces around the camera (m <= 0: the direct form, or both forms,
+// unbounded), sides all across the line of sight (the along-parts exactly zero: one direct
+// candidate), NaN and infinite corners, and 1 - b^2 of 0 and below.
+TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
+    std::mt19937 rng(613);
+    std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
+    int finite = 0, single = 0, unbounded = 0, nan_input = 0, within_true = 0, within_false = 0, checked = 0;
+    int winners[6] = {0, 0, 0, 0, 0, 0};  // direct 0 .. 3, Taylor, none
+    for (int trial = 0; trial < 6000; ++trial) {
+        Vec3 velocity;
+        double size;
+        randomSpeedAndSize(rng, &velocity, &size);
+        const int kind = trial % 12;
+        if (kind == 8) velocity = {0, 0, velocity.z};  // along the line of sight below
+        const double distance = size * (trial % 3 == 0 ? 0.6 + w(rng) : std::pow(10.0, 0.3 + 2 * w(rng)));
+        Motion m = makeMotion(Kinematics::Lorentz, 0.0, {0, 0, -distance}, velocity);
+        const ViewSurface view{ViewKind::PastCone, distance * (1 + 0.5 * u(rng)), {0, 0, 0}};
+        Vec3 E = nowBase(view, m);
+        Vec3 s[3];
+        const double piece = size * std::pow(10.0, -2 * w(rng));
+        for (auto& si : s) si = shapeOffset(m, Vec3{u(rng), u(rng), u(rng)} * (0.5 * piece));
+        switch (kind) {
+            case 1: s[1] = s[0]; break;                                     // two corners coincide
+            case 2: s[1] = s[2] = s[0]; break;                              // a point
+            case 3: s[2] = s[0] + (s[1] - s[0]) * (0.25 + 0.5 * w(rng)); break;  // collinear
+            case 4: for (auto& si : s) si = si - E; break;                  // around the camera
+            case 5: for (auto& si : s) si = si * 40.0 - E * (0.9 + 0.2 * w(rng)); break;  // reaching towards it
+            case 6: s[trial % 3] = {NAN, s[0].y, s[0].z}; break;
+            case 7: s[trial % 3].z = (trial / 12) % 2 ? INFINITY : -INFINITY; break;
+            case 8:  // sides in the plane z = 0, E and v along z: every side's along-part exactly 0
+                E = {0, 0, E.z};
+                for (auto& si : s) si.z = 0;
+                break;
+            case 9: m.one_minus_beta2 = (trial / 12) % 2 ? 0.0 : -0.25; break;
+            case 10: for (auto& si : s) si = si * 1e-160; break;            // squares below the normal range
+            default: break;
+        }
+        int winner, candidates;
+        const PieceForm want = form_reference::pieceForm(m, E, s, &winner, &candidates);
+        const PieceForm got = pieceForm(m, E, s);
+        for (int e = 0; e < 3; ++e) {
+            EXPECT_TRUE(form_reference::sameDouble(got.c[e], want.c[e])) << "trial " << trial << " c[" << e << "] " << got.c[e] << " " << want.c[e];
+            EXPECT_TRUE(form_reference::sameDouble(got.centre[e], want.centre[e])) << "trial " << trial << " centre[" << e << "]";
+        }
+        EXPECT_EQ(got.finite, want.finite) << "trial " << trial;
+        finite += want.finite;
+        // The reference offers 0, 1 or 4 direct candidates, then the Taylor form when it is bounded.
+        const bool taylor = candidates == 2 || candidates == 5;
+        single += candidates - taylor == 1;
+        unbounded += candidates == 0;
+        nan_input += (kind == 6 || kind == 7) && !want.finite;
+        winners[winner < 0 ? 5 : (taylor && winner == candidates - 1 ? 4 : winner)]++;
+        const double value = m.beta * form_reference::bubbleMax(want.c[0], want.c[1], want.c[2]);
+        const double ladder[7] = {value, std::nextafter(value, 0.0), std::nextafter(value, INFINITY), 0.5 * value,
+                                  2 * value, value * (0.5 + w(rng)), piece * 1e-3};
+        for (double T : ladder)
+            for (double speed : {m.beta, 0.0, m.beta * (0.5 + w(rng)), -m.beta, double(NAN)}) {
+                const bool expected = form_reference::pieceFormWithin(m, E, s, speed, T);
+                EXPECT_EQ(pieceFormWithin(m, E, s, speed, T), expected) << "trial " << trial << " T " << T << " speed " << speed;
+                (expected ? within_true : within_false)++;
+                ++checked;
+            }
+    }
+    // Every case was met: finite forms won by each direct candidate and by the Taylor form, the
+    // single candidate, unbounded and NaN forms, both answers of the test.
+    EXPECT_GT(finite, 3000);
+    for (int i = 0; i < 5; ++i) EXPECT_GT(winners[i], 30) << "candidate " << i;
+    EXPECT_GT(winners[5], 100);
+    EXPECT_GT(single, 100);
+    EXPECT_GT(unbounded, 100);
+    EXPECT_GT(nan_input, 900);
+    EXPECT_GT(within_true, 20000);
+    EXPECT_GT(within_false, 20000);
+    EXPECT_EQ(checked, 6000 * 7 * 5);
+}
