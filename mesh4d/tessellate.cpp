@@ -262,9 +262,9 @@ bool TessLayout::tessellate(const TessForm* form, std::vector<std::array<uint32_
     for (int j = 1; j + 2 < N; ++j) {
         const uint32_t next = rs + uint32_t(N - 1 - j);
         for (int i = 1; i + j + 2 <= N; ++i) {
-            const uint32_t a = rs + uint32_t(i - 1), c = next + uint32_t(i - 1);
-            out.push_back({a, a + 1, c});
-            if (i + j + 3 <= N) out.push_back({a + 1, c + 1, c});
+            const uint32_t p = rs + uint32_t(i - 1), c = next + uint32_t(i - 1);
+            out.push_back({p, p + 1, c});
+            if (i + j + 3 <= N) out.push_back({p + 1, c + 1, c});
         }
         rs = next;
     }
