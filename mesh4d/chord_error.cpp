@@ -60,9 +60,18 @@ typedef long long FormMask __attribute__((vector_size(16)));
 FormPair maxPair(FormPair a, FormPair b) { return a < b ? b : a; }
 FormPair minPair(FormPair a, FormPair b) { return b < a ? b : a; }
 FormPair splat(double a) { return FormPair{a, a}; }
+// The square root lane by lane (correctly rounded either way: the same bits); SSE2's sqrtpd where
+// the target has it, else one std::sqrt per lane.
+FormPair sqrtPair(FormPair a) {
+#if defined(__SSE2__)
+    return __builtin_ia32_sqrtpd(a);
+#else
+    return FormPair{std::sqrt(a[0]), std::sqrt(a[1])};
+#endif
+}
 
-// The terms all of a piece's candidate forms are made from (pieceFormTerms, as chord_error.h
-// defines them): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts across and
+// The terms all of a piece's candidate forms are made from (the quantities of chord_error.h's
+// "The whole-piece bound"): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts across and
 // along y_c^ (|e_perp|^2 and alpha^2) and H(x_c)'s coefficient; the direct form's m, sin^2 theta
 // bound and factor.
 struct PieceFormTerms {
@@ -75,8 +84,8 @@ struct PieceFormTerms {
     double centre[3];          // H(x_c)'s coefficients (PieceForm::centre)
     double sin2, inv;          // the sin^2 theta bound and 1 / (2 (1 - b^2) m)
 };
-PieceFormTerms pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3]) {
-    PieceFormTerms t;
+// Fills t in place (the direct form's fields only when m1 > 0: no copy of the others is made).
+void pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3], PieceFormTerms& t) {
     const double k = t.k = m.one_minus_beta2;
     const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
     const Vec3 x = E + centre;
@@ -129,7 +138,6 @@ PieceFormTerms pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3]) {
         t.a[3] = t.a[0] + t.a[1] + t.a[2];
         t.b[3] = t.b[0] + t.b[1] + t.b[2];
     }
-    return t;
 }
 
 // bubbleMax of two triangles at once (lane l: c01[l], c12[l], c20[l]), its operations lane by lane
@@ -156,12 +164,12 @@ void directPair(const PieceFormTerms& t, int j, FormPair c[3], FormPair* least) 
     FormPair mu = low, fb = zero;
     if (t.b[3] > 0) {
         const FormPair a = {t.a[j], t.a[j + 1]}, b = {t.b[j], t.b[j + 1]};
-        mu = a > zero ? minPair(high, maxPair(low, __builtin_ia32_sqrtpd(b / a))) : high;
+        mu = a > zero ? minPair(high, maxPair(low, sqrtPair(b / a))) : high;
         fb = one + one / mu;
     }
     const FormPair fa = one + mu, fbs = fb * t.sin2;
     for (int e = 0; e < 3; ++e) c[e] = t.inv * (fa * t.a[e] + fbs * t.along2[e]);
-    *least = FormPair{0.25, 0.25} * maxPair(maxPair(c[1], c[2]), c[0]);
+    *least = FormPair{0.25, 0.25} * maxPair(maxPair(c[1], c[2]), c[0]);  // bubbleFirst lane by lane
 }
 // The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as
 // directPair's); false when it is unbounded (m_r <= 0).
@@ -171,7 +179,7 @@ bool taylorForm(const PieceFormTerms& t, const double centre_c[3], double c[3], 
     if (!(mlow > 0)) return false;
     const double K = 2 / 1.7320508075688772 * rM / (t.k * mlow * mlow);
     for (int e = 0; e < 3; ++e) c[e] = centre_c[e] + 0.5 * K * (t.a[e] + t.along2[e]);
-    *least = 0.25 * std::max(std::max(c[1], c[2]), c[0]);
+    *least = bubbleFirst(c[0], c[1], c[2]);
     return true;
 }
 
@@ -182,7 +190,8 @@ bool taylorForm(const PieceFormTerms& t, const double centre_c[3], double c[3], 
 // without its bubbleMax: the same choice.
 PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
     PieceForm r;
-    const PieceFormTerms t = pieceFormTerms(m, E, s);
+    PieceFormTerms t;
+    pieceFormTerms(m, E, s, t);
     for (int e = 0; e < 3; ++e) r.centre[e] = t.centre[e];
     double best = INFINITY;
     if (t.m1 > 0)
@@ -209,7 +218,8 @@ PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
 }
 
 bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance) {
-    const PieceFormTerms t = pieceFormTerms(m, E, s);
+    PieceFormTerms t;
+    pieceFormTerms(m, E, s, t);
     const bool prune = speed >= 0;
     auto fails = [&](double least) { return prune && speed * least > tolerance; };
     auto passes = [&](double c0, double c1, double c2, double v) {

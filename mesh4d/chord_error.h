@@ -67,10 +67,15 @@ inline double normMOfEvent(const ViewAnchor& anchor, const Motion& m, const Even
 // k), with value a0 a1 a2 / (2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2) when the three a
 // satisfy the triangle inequality (the point is inside then).
 
+// bubbleFirst is bubbleMax's first term, its value at the edge middles (c/4 of the largest c, NaNs
+// alike): bubbleMax returns it or more, and is NaN when it is (when c12 is). The whole-piece forms
+// (chord_error.cpp) pass a candidate whose bubbleFirst already loses without its bubbleMax, which
+// is sound only while both are this one expression.
+inline double bubbleFirst(double c01, double c12, double c20) { return 0.25 * std::max(std::max(c12, c20), c01); }
 inline double bubbleMax(double c01, double c12, double c20) {
     // a_k: coefficient of the edge opposite corner k.
     const double a0 = c12, a1 = c20, a2 = c01;
-    double best = 0.25 * std::max(std::max(a0, a1), a2);  // edge middles (std::max({a0, a1, a2}), NaNs alike)
+    double best = bubbleFirst(c01, c12, c20);  // edge middles (std::max({a0, a1, a2}), NaNs alike)
     const double w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
     const double den = w0 + w1 + w2;  // = 2 (a0 a1 + a1 a2 + a2 a0) - a0^2 - a1^2 - a2^2
     if (w0 >= 0 && w1 >= 0 && w2 >= 0 && den > 0) best = std::max(best, a0 * a1 * a2 / den);

@@ -25,6 +25,15 @@ constexpr size_t kGrain = 16384;  // elements per parallel task
 // same order on SSE2 lanes (no contraction: the build has no FMA). `length` receives the norms.
 typedef double Pair __attribute__((vector_size(16)));
 typedef long long PairMask __attribute__((vector_size(16)));
+// The square root lane by lane (correctly rounded either way): SSE2's sqrtpd where the target has
+// it, else one std::sqrt per lane.
+Pair sqrtPair(Pair a) {
+#if defined(__SSE2__)
+    return __builtin_ia32_sqrtpd(a);
+#else
+    return Pair{std::sqrt(a[0]), std::sqrt(a[1])};
+#endif
+}
 void unitPair(Pair x, Pair y, Pair z, Pair* ux, Pair* uy, Pair* uz, Pair* length) {
     const PairMask sign = {(long long)0x8000000000000000ull, (long long)0x8000000000000000ull};
     auto abs = [&](Pair v) { return (Pair)((PairMask)v & ~sign); };
@@ -35,7 +44,7 @@ void unitPair(Pair x, Pair y, Pair z, Pair* ux, Pair* uy, Pair* uz, Pair* length
     const PairMask is_zero = a == zero;
     const Pair safe = is_zero ? one : a;
     const Pair qx = ax / safe, qy = ay / safe, qz = az / safe;
-    const Pair len = safe * __builtin_ia32_sqrtpd(qx * qx + qy * qy + qz * qz);
+    const Pair len = safe * sqrtPair(qx * qx + qy * qy + qz * qz);
     *length = is_zero ? zero : len;
     const Pair d = is_zero ? one : len;
     *ux = x / d;

@@ -1345,7 +1345,10 @@ TEST(Refine, NothingToRefineIsVertexModesOutputBitForBit) {
 // from chordErrorOfSides: that must be chordErrorOfPoints's bound and quadratic part bit for bit,
 // whatever the orientation of each side, with the bubbles' coefficients from edgeBubble, near the
 // camera (R infinite), at T between the quadratic part and the bound (R computed) and below the
-// quadratic part (early out), and at speed 0.
+// quadratic part (early out), and at speed 0. (chordErrorOfPoints is chordErrorOfSides with the
+// sides made from the corners, so what this checks is the sides' lengths from the spreads, in
+// either direction; that slice.cpp passes each triangle's own edges is checked by the pinned
+// outputs: refine_bench --count's hashes, Refine.NearCameraBisectionBytesPinned, stage_test.cpp.)
 TEST(Refine, BoundFromEdgeSpreadsIsThePointsBoundBitForBit) {
     std::mt19937 rng(67);
     std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
