@@ -181,7 +181,8 @@ def split_blocks(md_path, lines):
             open_name, open_at = name, i
         elif e:
             if e.group(1) != open_name:
-                raise BadInput(f"{md_path}: line {i + 1}: end of block '{e.group(1)}' without its begin marker")
+                raise BadInput(f"{md_path}: line {i + 1}: '<!-- end generated: {e.group(1)} -->' without its "
+                               f"'<!-- generated: {e.group(1)} -->' marker before it; nothing written")
             spans[open_name] = (open_at, i)
             open_name = None
     if open_name is not None:
