@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The speed-accuracy trade of docs/ACCURACY.md: `apparent trade` on the five trade scenes (the
-# default flanges, data/scenes/trade/*.json), then scripts/accuracy_report.py turns their CSVs into
-# docs/ACCURACY.md (with the adaptive / uniform ratios at equal error) and docs/accuracy.png;
+# default flanges, data/scenes/trade/*.json), then scripts/accuracy_report.py fills the generated blocks
+# of docs/ACCURACY.md from them (the adaptive / uniform ratios at equal error, the tables; the text
+# outside the blocks' markers is kept) and makes docs/accuracy.png;
 # scripts/trade_end_to_end.py times whole renders at equal error (docs/trade/end_to_end.md).
 # Usage: scripts/accuracy_report.sh [BUILD_DIR]      needs: python3, gnuplot (apt gnuplot-nox)
 set -euo pipefail
@@ -12,6 +13,8 @@ cmake --build "$build" --target apparent -j "$(nproc)" >/dev/null
 out=$root/docs/trade
 mkdir -p "$out"
 cd "$root"
+# The method paragraph of docs/ACCURACY.md says when and from which source this was measured.
+echo "$(date -u '+%Y-%m-%d %H:%M UTC'), source at $(git rev-parse --short HEAD 2>/dev/null || echo 'an unknown commit')$(git diff --quiet HEAD -- 2>/dev/null || echo ' with local changes')" > "$out/measured.txt"
 # A finer ladder than trade's default (about 1.5x apart instead of 3x): the comparison at equal error
 # interpolates between the two tolerances that bracket each uniform level's error.
 ladder=1e-1,5e-2,3e-2,2e-2,1e-2,7e-3,5e-3,3e-3,2e-3,1.4e-3,1e-3,7e-4,5e-4,3e-4,2e-4,1.4e-4,1e-4
