@@ -239,4 +239,43 @@ bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double spe
     return taylorForm(t, t.centre, c, &least) && !fails(least) && passes(c[0], c[1], c[2], bubbleMax(c[0], c[1], c[2]));
 }
 
+// edgeBubble (chord_error.h) on two lanes: the same operations in the same order per lane, both
+// branches made and selected per lane (me > 0, then me >= l; a NaN compares false in both, as
+// there), the closing min and max as std::min and std::max make them (first operand on a NaN).
+void edgeBubblePair(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
+                    const PointTerms& b1, EdgeBubble out[2]) {
+    const double k = m.one_minus_beta2;
+    const FormPair kk = splat(k), half = splat(0.5), zero = splat(0);
+    const FormPair vx = splat(m.velocity.x), vy = splat(m.velocity.y), vz = splat(m.velocity.z);
+    // x = E + (a.s + b.s) * 0.5, u = b.s - a.s, component by component.
+    const FormPair xx = splat(E.x) + (FormPair{a0.s.x, a1.s.x} + FormPair{b0.s.x, b1.s.x}) * half;
+    const FormPair xy = splat(E.y) + (FormPair{a0.s.y, a1.s.y} + FormPair{b0.s.y, b1.s.y}) * half;
+    const FormPair xz = splat(E.z) + (FormPair{a0.s.z, a1.s.z} + FormPair{b0.s.z, b1.s.z}) * half;
+    const FormPair ux = FormPair{b0.s.x, b1.s.x} - FormPair{a0.s.x, a1.s.x};
+    const FormPair uy = FormPair{b0.s.y, b1.s.y} - FormPair{a0.s.y, a1.s.y};
+    const FormPair uz = FormPair{b0.s.z, b1.s.z} - FormPair{a0.s.z, a1.s.z};
+    const FormPair xv = xx * vx + xy * vy + xz * vz;
+    const FormPair xm2 = xv * xv + kk * (xx * xx + xy * xy + xz * xz);
+    const FormPair xm = sqrtPair(xm2);
+    const FormPair uv = ux * vx + uy * vy + uz * vz;
+    const FormPair l2 = uv * uv + kk * (ux * ux + uy * uy + uz * uz);
+    const FormPair uMx = uv * xv + kk * (ux * xx + uy * xy + uz * xz);
+    const FormPair half_h = half * maxPair(zero, l2 * xm2 - uMx * uMx) / (kk * xm2 * xm);
+    const FormPair l = sqrtPair(l2);
+    const FormPair me = xm - half * l;
+    constexpr double kThird = 8 / (9 * 1.7320508075688772);  // as edgeBubble's
+    const FormPair third = splat(kThird), inf = splat(INFINITY);
+    // me > 0:
+    const FormPair inv = splat(1) / (kk * me * me * me);
+    const FormPair c_near = half_h + l2 * l2 * inv / splat(32);
+    const FormPair tail = me >= l ? me * inv : splat(1) / (kk * l2);
+    const FormPair len_near = half_h + third * l * l2 * tail;
+    // me <= 0 (or NaN):
+    const FormPair len_far = half_h + third * l / kk;
+    const FormMask near = me > zero;
+    const FormPair c = minPair(inf, near ? c_near : inf);
+    const FormPair length = maxPair(zero, near ? len_near : len_far);
+    for (int p = 0; p < 2; ++p) out[p] = EdgeBubble{c[p], length[p], xm[p]};
+}
+
 }  // namespace mesh4d

@@ -266,6 +266,13 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
     r.length = std::max(0.0, r.length);
     return r;
 }
+// edgeBubble of two edges at once (a0 -> b0 into out[0], a1 -> b1 into out[1]), bit for bit: each
+// of two SSE2 lanes (chord_error.cpp) makes the same IEEE operations in the same order, both sides
+// of edgeBubble's branches made and the lane's own selected, so the two edges' square roots and
+// divisions overlap instead of waiting on each other. For a caller that needs two edges' bounds at
+// the same point (the refinement's split: the edge's halves, the new interior edges).
+void edgeBubblePair(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
+                    const PointTerms& b1, EdgeBubble out[2]);
 
 // The bound of chordErrorOfTerms from the three edges' coefficients c (c[e] on corners e, e + 1)
 // instead of the measured bubbles, and the corners' shape offsets and |x|_M.

@@ -546,6 +546,15 @@ struct FrameBuilder {
     [[gnu::noinline]] void makeEdge(REdge& e, uint32_t a, uint32_t b) const {
         storeEdge(e, edgeBubble(world.motion, r_now, r_term_data[std::min(a, b)], r_term_data[std::max(a, b)]));
     }
+    // Two edges' records at once (chord_error.h edgeBubblePair: the same bits as makeEdge's, the
+    // two square-root and division chains side by side).
+    void makeEdgePair(REdge& e0, uint32_t a0, uint32_t b0, REdge& e1, uint32_t a1, uint32_t b1) const {
+        EdgeBubble eb[2];
+        edgeBubblePair(world.motion, r_now, r_term_data[std::min(a0, b0)], r_term_data[std::max(a0, b0)],
+                       r_term_data[std::min(a1, b1)], r_term_data[std::max(a1, b1)], eb);
+        storeEdge(e0, eb[0]);
+        storeEdge(e1, eb[1]);
+    }
     static void storeEdge(REdge& e, const EdgeBubble& eb) {
         e.len = eb.length;
         e.c = eb.c;
@@ -585,9 +594,13 @@ struct FrameBuilder {
     // records; each triangle's new inner edge (m, o) gets its own record.
     // members: the edge's cycle from slot c of id, n slots (the walk that chose the edge collected
     // it; their records are made).
+    // The new edges' bounds are made here, two at a time (makeEdgePair): every new piece is judged
+    // on all three of its edges when popped, and these are its unmade ones.
     void splitEdge(uint32_t id, int c, const uint32_t* members, uint32_t n, std::vector<uint32_t>& stack) {
         const uint32_t m = midVertex(id, c);
         const uint32_t lo = std::min(rt[id].v[c], rt[id].v[kSucc[c]]);
+        const uint32_t hi = std::max(rt[id].v[c], rt[id].v[kSucc[c]]);
+        uint32_t pending = kUnset, pending_o = 0;  // an inner edge (m, pending_o) waiting for its pair
         const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
         r_edges.resize(r_edges.size() + 2 + n, REdge{kUnset, NAN, NAN, NAN});
         r_edge_data = r_edges.data();
@@ -627,6 +640,13 @@ struct FrameBuilder {
                 link(slotOf(B, 0), lo_first, lo_prev);
                 link(q, hi_first, hi_prev);
             }
+            if (pending == kUnset) {
+                pending = inner;
+                pending_o = o;
+            } else {
+                makeEdgePair(r_edge_data[pending], m, pending_o, r_edge_data[inner], m, o);
+                pending = kUnset;
+            }
             ++inner;
             ++r_leaves;  // one piece became two
             stack.push_back(B);
@@ -634,6 +654,8 @@ struct FrameBuilder {
         }
         rn[lo_prev] = lo_first;  // close the two cycles
         rn[hi_prev] = hi_first;
+        makeEdgePair(r_edge_data[lo_rec], lo, m, r_edge_data[hi_rec], m, hi);
+        if (pending != kUnset) makeEdge(r_edge_data[pending], m, pending_o);
     }
 
     // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is

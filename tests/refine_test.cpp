@@ -1593,3 +1593,65 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
     EXPECT_GT(within_false, 20000);
     EXPECT_EQ(checked, 6000 * 7 * 5);
 }
+
+// (helper "pairs") edgeBubblePair, the refinement's split making two edges' bounds at once, is
+// edgeBubble on each lane bit for bit: random edges near the camera (m_e <= 0, m_e < l) and far,
+// at rest (b = 0) and moving in both kinematics, with NaN and infinite offsets; the scalar
+// edgeBubble is the reference. Each lane's edge is paired with an unrelated one, both orders.
+TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
+    std::mt19937_64 rng(1313);
+    std::uniform_real_distribution<double> unit(-1, 1), w(0, 1);
+    auto same = [](double a, double b) { return (a != a && b != b) || std::memcmp(&a, &b, sizeof(double)) == 0; };
+    auto randomVec = [&](double scale) { return Vec3{unit(rng), unit(rng), unit(rng)} * scale; };
+    int near = 0, inside = 0, far = 0, infinite_c = 0, odd_input = 0, checked = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const int kind = trial % 8;
+        const double beta = kind == 0 ? 0.0 : 0.999 * w(rng);
+        const Kinematics kin = trial % 2 ? Kinematics::Lorentz : Kinematics::Galilean;
+        const Vec3 dir = kind == 0 ? Vec3{1, 0, 0} : randomVec(1.0);
+        const double dn = std::sqrt(norm2(dir));
+        const Motion m = makeMotion(kin, 0.0, {0, 0, -5}, dn > 0 ? dir * (beta / dn) : Vec3{});
+        // The camera's distance to the edges against their size: at the edge (near), a few sizes
+        // away, far off.
+        const double size = std::pow(10.0, 4 * unit(rng));
+        const double distance = size * (kind % 3 == 0 ? 0.3 * w(rng) : kind % 3 == 1 ? 2 * w(rng) : 1e3 * (1 + w(rng)));
+        const Vec3 E = randomVec(distance);
+        PointTerms p[4];
+        for (PointTerms& t : p) t = PointTerms{randomVec(size), 0.0};
+        if (kind == 7) p[trial % 4].s = p[(trial + 1) % 4].s;  // zero-length edges too
+        if (kind == 6) {  // a NaN or an infinity in one end's offset or in E
+            const double bad[3] = {double(NAN), double(INFINITY), -double(INFINITY)};
+            const double v = bad[(trial / 8) % 3];
+            const int which = (trial / 24) % 5;
+            if (which < 4) p[which].s.y = v;
+        }
+        const Vec3 E_used = kind == 6 && (trial / 24) % 5 == 4 ? Vec3{E.x, double(NAN), E.z} : E;
+        const EdgeBubble want[2] = {edgeBubble(m, E_used, p[0], p[1]), edgeBubble(m, E_used, p[2], p[3])};
+        EdgeBubble got[2], swapped[2];
+        edgeBubblePair(m, E_used, p[0], p[1], p[2], p[3], got);
+        edgeBubblePair(m, E_used, p[2], p[3], p[0], p[1], swapped);
+        for (int e = 0; e < 2; ++e) {
+            for (const EdgeBubble* g : {&got[e], &swapped[1 - e]}) {
+                EXPECT_TRUE(same(g->c, want[e].c)) << "trial " << trial << " edge " << e << " c " << g->c << " " << want[e].c;
+                EXPECT_TRUE(same(g->length, want[e].length)) << "trial " << trial << " edge " << e;
+                EXPECT_TRUE(same(g->xm_mid, want[e].xm_mid)) << "trial " << trial << " edge " << e;
+                ++checked;
+            }
+            // Which branches the reference took (recomputed here from the definitions).
+            const double l = std::sqrt(normM2(m, p[2 * e + 1].s - p[2 * e].s));
+            const double me = normMOfShape(m, E_used, (p[2 * e].s + p[2 * e + 1].s) * 0.5) - 0.5 * l;
+            if (kind == 6) ++odd_input;
+            else if (!(me > 0)) ++inside;
+            else if (me < l) ++near;
+            else ++far;
+            infinite_c += want[e].c == INFINITY;
+        }
+    }
+    // Every branch was met: m_e <= 0, 0 < m_e < l, m_e >= l, unbounded c, odd inputs.
+    EXPECT_GT(inside, 2000);
+    EXPECT_GT(near, 1000);
+    EXPECT_GT(far, 10000);
+    EXPECT_GT(infinite_c, 2000);
+    EXPECT_GT(odd_input, 4000);
+    EXPECT_EQ(checked, 20000 * 4);
+}
