@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lanes.h"
+
 namespace mesh4d {
 
 ChordError chordError(const ViewAnchor& anchor, const Motion& m, const Event corner[3], const Event mid[3],
@@ -49,26 +51,9 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
 
 namespace {
 
-// Two doubles in one SSE2 register: the six steps of pieceFormTerms and the direct form's
-// candidates two at a time. Each lane is the same IEEE operations in the same order as the scalar
-// code it stands for (the build makes no contraction: no FMA), so the same bits (as normals.cpp's
-// unitPair).
-typedef double FormPair __attribute__((vector_size(16)));
-typedef long long FormMask __attribute__((vector_size(16)));
-// std::max(a, b) and std::min(a, b) lane by lane, NaNs alike (the first operand unless the
-// comparison holds).
-FormPair maxPair(FormPair a, FormPair b) { return a < b ? b : a; }
-FormPair minPair(FormPair a, FormPair b) { return b < a ? b : a; }
-FormPair splat(double a) { return FormPair{a, a}; }
-// The square root lane by lane (correctly rounded either way: the same bits); SSE2's sqrtpd where
-// the target has it, else one std::sqrt per lane.
-FormPair sqrtPair(FormPair a) {
-#if defined(__SSE2__)
-    return __builtin_ia32_sqrtpd(a);
-#else
-    return FormPair{std::sqrt(a[0]), std::sqrt(a[1])};
-#endif
-}
+// The six steps of pieceFormTerms, the direct form's candidates and two edge bounds are made two
+// at a time on the lanes of lanes.h: each lane the same IEEE operations in the same order as the
+// scalar code it stands for, so the same bits (as normals.cpp's unitPair).
 
 // The terms all of a piece's candidate forms are made from (the quantities of chord_error.h's
 // "The whole-piece bound"): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts across and
@@ -95,37 +80,37 @@ void pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3], PieceFormTe
     // The six steps u, two to a pair: the corners' offsets d_i = s_i - centre and the sides
     // e = s[e + 1] - s[e], lanes (d0, d1), (d2, e0), (e1, e2); each one's |u|_M^2 (uv^2 + k |u|^2)
     // and u^T M x (uv xv + k u.x), as dot and norm2 make them (x, then y, then z).
-    const FormPair vx = splat(m.velocity.x), vy = splat(m.velocity.y), vz = splat(m.velocity.z);
-    const FormPair kk = splat(k), xvv = splat(xv), xx = splat(x.x), xy = splat(x.y), xz = splat(x.z);
-    FormPair l2[3], uMx[3];
-    auto step = [&](int p, FormPair ux, FormPair uy, FormPair uz) {
-        const FormPair uv = ux * vx + uy * vy + uz * vz;
+    const Lanes2 vx = splatLanes(m.velocity.x), vy = splatLanes(m.velocity.y), vz = splatLanes(m.velocity.z);
+    const Lanes2 kk = splatLanes(k), xvv = splatLanes(xv), xx = splatLanes(x.x), xy = splatLanes(x.y), xz = splatLanes(x.z);
+    Lanes2 l2[3], uMx[3];
+    auto step = [&](int p, Lanes2 ux, Lanes2 uy, Lanes2 uz) {
+        const Lanes2 uv = ux * vx + uy * vy + uz * vz;
         l2[p] = uv * uv + kk * (ux * ux + uy * uy + uz * uz);
         uMx[p] = uv * xvv + kk * (ux * xx + uy * xy + uz * xz);
     };
-    step(0, FormPair{s[0].x, s[1].x} - splat(centre.x), FormPair{s[0].y, s[1].y} - splat(centre.y),
-         FormPair{s[0].z, s[1].z} - splat(centre.z));
-    step(1, FormPair{s[2].x, s[1].x} - FormPair{centre.x, s[0].x}, FormPair{s[2].y, s[1].y} - FormPair{centre.y, s[0].y},
-         FormPair{s[2].z, s[1].z} - FormPair{centre.z, s[0].z});
-    step(2, FormPair{s[2].x, s[0].x} - FormPair{s[1].x, s[2].x}, FormPair{s[2].y, s[0].y} - FormPair{s[1].y, s[2].y},
-         FormPair{s[2].z, s[0].z} - FormPair{s[1].z, s[2].z});
+    step(0, Lanes2{s[0].x, s[1].x} - splatLanes(centre.x), Lanes2{s[0].y, s[1].y} - splatLanes(centre.y),
+         Lanes2{s[0].z, s[1].z} - splatLanes(centre.z));
+    step(1, Lanes2{s[2].x, s[1].x} - Lanes2{centre.x, s[0].x}, Lanes2{s[2].y, s[1].y} - Lanes2{centre.y, s[0].y},
+         Lanes2{s[2].z, s[1].z} - Lanes2{centre.z, s[0].z});
+    step(2, Lanes2{s[2].x, s[0].x} - Lanes2{s[1].x, s[2].x}, Lanes2{s[2].y, s[0].y} - Lanes2{s[1].y, s[2].y},
+         Lanes2{s[2].z, s[0].z} - Lanes2{s[1].z, s[2].z});
     // The corners (d2 = l2, along = y_c^.d_i): r_M^2, the piece's reach towards the camera
     // max_i (-y_c^.d_i) and p^2 = max_i |d_i,perp|^2, each from 0 over corners 0, 1, 2.
-    const FormPair along01 = uMx[0] / xm, along2x = uMx[1] / xm;
-    const FormPair perp01 = l2[0] - along01 * along01, perp2x = l2[1] - along2x * along2x;
+    const Lanes2 along01 = uMx[0] / xm, along2x = uMx[1] / xm;
+    const Lanes2 perp01 = l2[0] - along01 * along01, perp2x = l2[1] - along2x * along2x;
     t.q = std::max(std::max(std::max(0.0, l2[0][0]), l2[0][1]), l2[1][0]);
     const double reach = std::max(std::max(std::max(0.0, -along01[0]), -along01[1]), -along2x[0]);
     const double perp2 = std::max(std::max(std::max(0.0, perp01[0]), perp01[1]), perp2x[0]);
     // The sides (lane 1 of the second pair, both of the third): alpha^2 = (e^T M x_c)^2 / |x_c|_M^2,
     // |e_perp|^2 = |e|_M^2 - alpha^2 and H(x_c)'s coefficient (|e|_M^2 |x_c|_M^2 - (e^T M x_c)^2) / (2 (1 - b^2) |x_c|_M^3),
     // both at least 0.
-    const FormPair zero = {0, 0}, den = splat(k * xm2 * xm);
-    FormPair al[2], ac[2], cc[2];
+    const Lanes2 zero = {0, 0}, den = splatLanes(k * xm2 * xm);
+    Lanes2 al[2], ac[2], cc[2];
     for (int p = 0; p < 2; ++p) {
-        const FormPair uMx2 = uMx[p + 1] * uMx[p + 1];
+        const Lanes2 uMx2 = uMx[p + 1] * uMx[p + 1];
         al[p] = uMx2 / xm2;
-        ac[p] = maxPair(zero, l2[p + 1] - al[p]);
-        cc[p] = 0.5 * maxPair(zero, l2[p + 1] * xm2 - uMx2) / den;
+        ac[p] = maxLanes(zero, l2[p + 1] - al[p]);
+        cc[p] = 0.5 * maxLanes(zero, l2[p + 1] * xm2 - uMx2) / den;
     }
     t.along2[0] = al[0][1], t.along2[1] = al[1][0], t.along2[2] = al[1][1];
     t.a[0] = ac[0][1], t.a[1] = ac[1][0], t.a[2] = ac[1][1];
@@ -142,14 +127,14 @@ void pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3], PieceFormTe
 
 // bubbleMax of two triangles at once (lane l: c01[l], c12[l], c20[l]), its operations lane by lane
 // (the interior value made in both lanes and selected where the point is inside).
-FormPair bubbleMaxPair(FormPair c01, FormPair c12, FormPair c20) {
-    const FormPair a0 = c12, a1 = c20, a2 = c01;
-    const FormPair quarter = {0.25, 0.25}, zero = {0, 0};
-    const FormPair edge = quarter * maxPair(maxPair(a0, a1), a2);
-    const FormPair w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
-    const FormPair den = w0 + w1 + w2;
-    const FormMask inside = (w0 >= zero) & (w1 >= zero) & (w2 >= zero) & (den > zero);
-    return inside ? maxPair(edge, a0 * a1 * a2 / den) : edge;
+Lanes2 bubbleMaxPair(Lanes2 c01, Lanes2 c12, Lanes2 c20) {
+    const Lanes2 a0 = c12, a1 = c20, a2 = c01;
+    const Lanes2 quarter = {0.25, 0.25}, zero = {0, 0};
+    const Lanes2 edge = quarter * maxLanes(maxLanes(a0, a1), a2);
+    const Lanes2 w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
+    const Lanes2 den = w0 + w1 + w2;
+    const Lanes2Mask inside = (w0 >= zero) & (w1 >= zero) & (w2 >= zero) & (den > zero);
+    return inside ? maxLanes(edge, a0 * a1 * a2 / den) : edge;
 }
 // The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
 // one (mu = 1e-6 and no along term).
@@ -159,17 +144,17 @@ int directCandidates(const PieceFormTerms& t) { return t.b[3] > 0 ? 4 : 1; }
 // the same operands in the same order, which bubbleMax returns or exceeds (std::max), and which
 // is NaN only when c[1] is, bubbleMax's value then NaN too. A candidate whose least value already
 // loses is never chosen: its bubbleMax need not be made.
-void directPair(const PieceFormTerms& t, int j, FormPair c[3], FormPair* least) {
-    const FormPair one = {1, 1}, low = {1e-6, 1e-6}, high = {1e6, 1e6}, zero = {0, 0};
-    FormPair mu = low, fb = zero;
+void directPair(const PieceFormTerms& t, int j, Lanes2 c[3], Lanes2* least) {
+    const Lanes2 one = {1, 1}, low = {1e-6, 1e-6}, high = {1e6, 1e6}, zero = {0, 0};
+    Lanes2 mu = low, fb = zero;
     if (t.b[3] > 0) {
-        const FormPair a = {t.a[j], t.a[j + 1]}, b = {t.b[j], t.b[j + 1]};
-        mu = a > zero ? minPair(high, maxPair(low, sqrtPair(b / a))) : high;
+        const Lanes2 a = {t.a[j], t.a[j + 1]}, b = {t.b[j], t.b[j + 1]};
+        mu = a > zero ? minLanes(high, maxLanes(low, sqrtLanes(b / a))) : high;
         fb = one + one / mu;
     }
-    const FormPair fa = one + mu, fbs = fb * t.sin2;
+    const Lanes2 fa = one + mu, fbs = fb * t.sin2;
     for (int e = 0; e < 3; ++e) c[e] = t.inv * (fa * t.a[e] + fbs * t.along2[e]);
-    *least = FormPair{0.25, 0.25} * maxPair(maxPair(c[1], c[2]), c[0]);  // bubbleFirst lane by lane
+    *least = Lanes2{0.25, 0.25} * maxLanes(maxLanes(c[1], c[2]), c[0]);  // bubbleFirst lane by lane
 }
 // The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as
 // directPair's); false when it is unbounded (m_r <= 0).
@@ -196,10 +181,10 @@ PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
     double best = INFINITY;
     if (t.m1 > 0)
         for (int j = 0, n = directCandidates(t); j < n; j += 2) {
-            FormPair c[3], least;
+            Lanes2 c[3], least;
             directPair(t, j, c, &least);
             if (!(least[0] < best) && !(least[1] < best)) continue;
-            const FormPair v = bubbleMaxPair(c[0], c[1], c[2]);
+            const Lanes2 v = bubbleMaxPair(c[0], c[1], c[2]);
             for (int l = 0; l < 2 && j + l < n; ++l)
                 if (v[l] < best) {
                     best = v[l];
@@ -227,11 +212,11 @@ bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double spe
     };
     if (t.m1 > 0)
         for (int j = 0, n = directCandidates(t); j < n; j += 2) {
-            FormPair c[3], least;
+            Lanes2 c[3], least;
             directPair(t, j, c, &least);
             const bool skip0 = fails(least[0]), skip1 = j + 1 >= n || fails(least[1]);
             if (skip0 && skip1) continue;
-            const FormPair v = bubbleMaxPair(c[0], c[1], c[2]);
+            const Lanes2 v = bubbleMaxPair(c[0], c[1], c[2]);
             if (!skip0 && passes(c[0][0], c[1][0], c[2][0], v[0])) return true;
             if (!skip1 && passes(c[0][1], c[1][1], c[2][1], v[1])) return true;
         }
@@ -245,36 +230,36 @@ bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double spe
 void edgeBubblePair(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
                     const PointTerms& b1, EdgeBubble out[2]) {
     const double k = m.one_minus_beta2;
-    const FormPair kk = splat(k), half = splat(0.5), zero = splat(0);
-    const FormPair vx = splat(m.velocity.x), vy = splat(m.velocity.y), vz = splat(m.velocity.z);
+    const Lanes2 kk = splatLanes(k), half = splatLanes(0.5), zero = splatLanes(0);
+    const Lanes2 vx = splatLanes(m.velocity.x), vy = splatLanes(m.velocity.y), vz = splatLanes(m.velocity.z);
     // x = E + (a.s + b.s) * 0.5, u = b.s - a.s, component by component.
-    const FormPair xx = splat(E.x) + (FormPair{a0.s.x, a1.s.x} + FormPair{b0.s.x, b1.s.x}) * half;
-    const FormPair xy = splat(E.y) + (FormPair{a0.s.y, a1.s.y} + FormPair{b0.s.y, b1.s.y}) * half;
-    const FormPair xz = splat(E.z) + (FormPair{a0.s.z, a1.s.z} + FormPair{b0.s.z, b1.s.z}) * half;
-    const FormPair ux = FormPair{b0.s.x, b1.s.x} - FormPair{a0.s.x, a1.s.x};
-    const FormPair uy = FormPair{b0.s.y, b1.s.y} - FormPair{a0.s.y, a1.s.y};
-    const FormPair uz = FormPair{b0.s.z, b1.s.z} - FormPair{a0.s.z, a1.s.z};
-    const FormPair xv = xx * vx + xy * vy + xz * vz;
-    const FormPair xm2 = xv * xv + kk * (xx * xx + xy * xy + xz * xz);
-    const FormPair xm = sqrtPair(xm2);
-    const FormPair uv = ux * vx + uy * vy + uz * vz;
-    const FormPair l2 = uv * uv + kk * (ux * ux + uy * uy + uz * uz);
-    const FormPair uMx = uv * xv + kk * (ux * xx + uy * xy + uz * xz);
-    const FormPair half_h = half * maxPair(zero, l2 * xm2 - uMx * uMx) / (kk * xm2 * xm);
-    const FormPair l = sqrtPair(l2);
-    const FormPair me = xm - half * l;
+    const Lanes2 xx = splatLanes(E.x) + (Lanes2{a0.s.x, a1.s.x} + Lanes2{b0.s.x, b1.s.x}) * half;
+    const Lanes2 xy = splatLanes(E.y) + (Lanes2{a0.s.y, a1.s.y} + Lanes2{b0.s.y, b1.s.y}) * half;
+    const Lanes2 xz = splatLanes(E.z) + (Lanes2{a0.s.z, a1.s.z} + Lanes2{b0.s.z, b1.s.z}) * half;
+    const Lanes2 ux = Lanes2{b0.s.x, b1.s.x} - Lanes2{a0.s.x, a1.s.x};
+    const Lanes2 uy = Lanes2{b0.s.y, b1.s.y} - Lanes2{a0.s.y, a1.s.y};
+    const Lanes2 uz = Lanes2{b0.s.z, b1.s.z} - Lanes2{a0.s.z, a1.s.z};
+    const Lanes2 xv = xx * vx + xy * vy + xz * vz;
+    const Lanes2 xm2 = xv * xv + kk * (xx * xx + xy * xy + xz * xz);
+    const Lanes2 xm = sqrtLanes(xm2);
+    const Lanes2 uv = ux * vx + uy * vy + uz * vz;
+    const Lanes2 l2 = uv * uv + kk * (ux * ux + uy * uy + uz * uz);
+    const Lanes2 uMx = uv * xv + kk * (ux * xx + uy * xy + uz * xz);
+    const Lanes2 half_h = half * maxLanes(zero, l2 * xm2 - uMx * uMx) / (kk * xm2 * xm);
+    const Lanes2 l = sqrtLanes(l2);
+    const Lanes2 me = xm - half * l;
     constexpr double kThird = 8 / (9 * 1.7320508075688772);  // as edgeBubble's
-    const FormPair third = splat(kThird), inf = splat(INFINITY);
+    const Lanes2 third = splatLanes(kThird), inf = splatLanes(INFINITY);
     // me > 0:
-    const FormPair inv = splat(1) / (kk * me * me * me);
-    const FormPair c_near = half_h + l2 * l2 * inv / splat(32);
-    const FormPair tail = me >= l ? me * inv : splat(1) / (kk * l2);
-    const FormPair len_near = half_h + third * l * l2 * tail;
+    const Lanes2 inv = splatLanes(1) / (kk * me * me * me);
+    const Lanes2 c_near = half_h + l2 * l2 * inv / splatLanes(32);
+    const Lanes2 tail = me >= l ? me * inv : splatLanes(1) / (kk * l2);
+    const Lanes2 len_near = half_h + third * l * l2 * tail;
     // me <= 0 (or NaN):
-    const FormPair len_far = half_h + third * l / kk;
-    const FormMask near = me > zero;
-    const FormPair c = minPair(inf, near ? c_near : inf);
-    const FormPair length = maxPair(zero, near ? len_near : len_far);
+    const Lanes2 len_far = half_h + third * l / kk;
+    const Lanes2Mask near = me > zero;
+    const Lanes2 c = minLanes(inf, near ? c_near : inf);
+    const Lanes2 length = maxLanes(zero, near ? len_near : len_far);
     for (int p = 0; p < 2; ++p) out[p] = EdgeBubble{c[p], length[p], xm[p]};
 }
 

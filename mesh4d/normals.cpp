@@ -8,6 +8,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "angles.h"
+#include "lanes.h"
 
 namespace mesh4d {
 
@@ -22,31 +23,21 @@ constexpr size_t kGrain = 16384;  // elements per parallel task
 // v / norm(v) for two vectors at once, bit for bit what the scalar code gives: norm() is
 // std::hypot(x, y, z), which libstdc++ computes as a * sqrt((x/a)^2 + (y/a)^2 + (z/a)^2) with a
 // the largest magnitude (0 when a is 0), and every step here is the same IEEE operation in the
-// same order on SSE2 lanes (no contraction: the build has no FMA). `length` receives the norms.
-typedef double Pair __attribute__((vector_size(16)));
-typedef long long PairMask __attribute__((vector_size(16)));
-// The square root lane by lane (correctly rounded either way): SSE2's sqrtpd where the target has
-// it, else one std::sqrt per lane.
-Pair sqrtPair(Pair a) {
-#if defined(__SSE2__)
-    return __builtin_ia32_sqrtpd(a);
-#else
-    return Pair{std::sqrt(a[0]), std::sqrt(a[1])};
-#endif
-}
-void unitPair(Pair x, Pair y, Pair z, Pair* ux, Pair* uy, Pair* uz, Pair* length) {
-    const PairMask sign = {(long long)0x8000000000000000ull, (long long)0x8000000000000000ull};
-    auto abs = [&](Pair v) { return (Pair)((PairMask)v & ~sign); };
-    const Pair ax = abs(x), ay = abs(y), az = abs(z);
-    const Pair t1 = ay < az ? az : ay, t2 = ax < az ? az : ax;
-    const Pair a = ax < ay ? t1 : t2;
-    const Pair zero = {0, 0}, one = {1, 1};
-    const PairMask is_zero = a == zero;
-    const Pair safe = is_zero ? one : a;
-    const Pair qx = ax / safe, qy = ay / safe, qz = az / safe;
-    const Pair len = safe * sqrtPair(qx * qx + qy * qy + qz * qz);
+// same order on the lanes of lanes.h (no contraction: -ffp-contract=off, CMakeLists.txt).
+// `length` receives the norms.
+void unitPair(Lanes2 x, Lanes2 y, Lanes2 z, Lanes2* ux, Lanes2* uy, Lanes2* uz, Lanes2* length) {
+    const Lanes2Mask sign = {(long long)0x8000000000000000ull, (long long)0x8000000000000000ull};
+    auto abs = [&](Lanes2 v) { return (Lanes2)((Lanes2Mask)v & ~sign); };
+    const Lanes2 ax = abs(x), ay = abs(y), az = abs(z);
+    const Lanes2 t1 = ay < az ? az : ay, t2 = ax < az ? az : ax;
+    const Lanes2 a = ax < ay ? t1 : t2;
+    const Lanes2 zero = {0, 0}, one = {1, 1};
+    const Lanes2Mask is_zero = a == zero;
+    const Lanes2 safe = is_zero ? one : a;
+    const Lanes2 qx = ax / safe, qy = ay / safe, qz = az / safe;
+    const Lanes2 len = safe * sqrtLanes(qx * qx + qy * qy + qz * qz);
     *length = is_zero ? zero : len;
-    const Pair d = is_zero ? one : len;
+    const Lanes2 d = is_zero ? one : len;
     *ux = x / d;
     *uy = y / d;
     *uz = z / d;
@@ -118,7 +109,7 @@ struct VertexPass {
         for (size_t i = lo; i < hi; i += 2) {
             const size_t j = std::min(i + 1, hi - 1);  // an odd end repeats its last vertex
             const Vec3 s0 = normal[i], s1 = normal[j];
-            Pair x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
+            Lanes2 x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
             unitPair(x, y, z, &ux, &uy, &uz, &len);
             for (int k = 0; k < 2; ++k) {
                 const size_t at = k == 0 ? i : j;
