@@ -125,16 +125,21 @@ void pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3], PieceFormTe
     }
 }
 
+// bubbleFirst (chord_error.h) lane by lane: bubbleMax's value at the edge middles, the least it
+// returns.
+Lanes2 bubbleFirstLanes(Lanes2 c01, Lanes2 c12, Lanes2 c20) {
+    return Lanes2{0.25, 0.25} * maxLanes(maxLanes(c12, c20), c01);
+}
 // bubbleMax of two triangles at once (lane l: c01[l], c12[l], c20[l]), its operations lane by lane
-// (the interior value made in both lanes and selected where the point is inside).
-Lanes2 bubbleMaxPair(Lanes2 c01, Lanes2 c12, Lanes2 c20) {
+// (the interior value made in both lanes and selected where the point is inside), from its first
+// term `first` = bubbleFirstLanes(c01, c12, c20), which the caller has made already.
+Lanes2 bubbleMaxPair(Lanes2 c01, Lanes2 c12, Lanes2 c20, Lanes2 first) {
     const Lanes2 a0 = c12, a1 = c20, a2 = c01;
-    const Lanes2 quarter = {0.25, 0.25}, zero = {0, 0};
-    const Lanes2 edge = quarter * maxLanes(maxLanes(a0, a1), a2);
+    const Lanes2 zero = {0, 0};
     const Lanes2 w0 = a0 * (a1 + a2 - a0), w1 = a1 * (a0 + a2 - a1), w2 = a2 * (a0 + a1 - a2);
     const Lanes2 den = w0 + w1 + w2;
     const Lanes2Mask inside = (w0 >= zero) & (w1 >= zero) & (w2 >= zero) & (den > zero);
-    return inside ? maxLanes(edge, a0 * a1 * a2 / den) : edge;
+    return inside ? maxLanes(first, a0 * a1 * a2 / den) : first;
 }
 // The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
 // one (mu = 1e-6 and no along term).
@@ -154,7 +159,7 @@ void directPair(const PieceFormTerms& t, int j, Lanes2 c[3], Lanes2* least) {
     }
     const Lanes2 fa = one + mu, fbs = fb * t.sin2;
     for (int e = 0; e < 3; ++e) c[e] = t.inv * (fa * t.a[e] + fbs * t.along2[e]);
-    *least = Lanes2{0.25, 0.25} * maxLanes(maxLanes(c[1], c[2]), c[0]);  // bubbleFirst lane by lane
+    *least = bubbleFirstLanes(c[0], c[1], c[2]);
 }
 // The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as
 // directPair's); false when it is unbounded (m_r <= 0).
@@ -184,7 +189,7 @@ PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
             Lanes2 c[3], least;
             directPair(t, j, c, &least);
             if (!(least[0] < best) && !(least[1] < best)) continue;
-            const Lanes2 v = bubbleMaxPair(c[0], c[1], c[2]);
+            const Lanes2 v = bubbleMaxPair(c[0], c[1], c[2], least);
             for (int l = 0; l < 2 && j + l < n; ++l)
                 if (v[l] < best) {
                     best = v[l];
@@ -216,7 +221,7 @@ bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double spe
             directPair(t, j, c, &least);
             const bool skip0 = fails(least[0]), skip1 = j + 1 >= n || fails(least[1]);
             if (skip0 && skip1) continue;
-            const Lanes2 v = bubbleMaxPair(c[0], c[1], c[2]);
+            const Lanes2 v = bubbleMaxPair(c[0], c[1], c[2], least);
             if (!skip0 && passes(c[0][0], c[1][0], c[2][0], v[0])) return true;
             if (!skip1 && passes(c[0][1], c[1][1], c[2][1], v[1])) return true;
         }

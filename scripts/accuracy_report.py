@@ -241,7 +241,7 @@ def main(trade_dir, docs):
         lines[b + 1:e] = [""] + new[name] + [""]
     write_atomically(md_path, "\n".join(lines))
 
-    for i, name in enumerate(SCENES):
+    for name in SCENES:
         if name not in scene_rows:
             continue
         with open(os.path.join(docs, f"accuracy_{name}.dat"), "w") as d:
