@@ -1,5 +1,5 @@
 #!/bin/bash
-# Render a long sequence as a Slurm job array, then merge the .glb (README "Frames across
+# Render a long sequence as a Slurm job array, then merge the .glb (docs/DISTRIBUTED.md "Frames across
 # processes"). Each array task renders one shard of the frames (frames k with k - first = I mod N);
 # PLY/OBJ frames go straight to OUT/<model>/, the .glb's frames into OUT/shards/. A second job,
 # started only when every task succeeded, assembles OUT/<model>.glb, byte-identical to one process.

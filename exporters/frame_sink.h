@@ -1,4 +1,4 @@
-// Where the frames of a sequence go: one sink per output format (.glb, PLY, OBJ; README "Adding a
+// Where the frames of a sequence go: one sink per output format (.glb, PLY, OBJ; CONTRIBUTING.md "Adding a
 // format"). The frame loop (pipeline/frame_loop.h) calls, for one model:
 //   begin(info)                 once, before any frame;
 //   prepare(frame)              on worker threads, several frames at once (optional conversion);

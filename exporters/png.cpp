@@ -116,7 +116,7 @@ bool writePng(const std::string& path, const RgbImage& image, std::string* error
     png_write_info(png, info);
     png_write_image(png, rows.data());
     png_write_end(png, info);
-    // Flushed, synced and closed, each checked (as every output: README "Hostile input").
+    // Flushed, synced and closed, each checked (as every output: docs/HOSTILE_INPUT.md).
     if (const int failed = session.closeChecked()) {
         *error = path + ": write failed: " + std::strerror(failed);
         return false;

@@ -19,8 +19,9 @@ namespace {
 
 constexpr const char* kDescription =
     "apparent: what objects moving near the speed of light look like, as 3D geometry.\n"
-    "Extrudes meshes in uniform motion into 4D histories, cuts them with the camera's past\n"
-    "lightcone for every frame and exports the apparent shapes (Black et al., Am. J. Phys. 2007).\n"
+    "Extrudes meshes of moving objects (uniform, spinning or rolling, accelerated, keyframed; the\n"
+    "camera at rest or moving) into 4D histories, cuts them with the camera's past lightcone for\n"
+    "every frame and exports the apparent shapes (Black et al., Am. J. Phys. 2007).\n"
     "Units: light-seconds and seconds, c = 1.";
 
 constexpr const char* kRenderFooter =

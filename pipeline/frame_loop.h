@@ -48,9 +48,9 @@ private:
 // most the input plus the pieces of clipped triangles, which this covers), and never less than
 // kMinFrameTriangleBudget, so that refinement has room. The budget bounds memory: the frame loop
 // holds at most threads + 1 frames, and a refined frame costs a few hundred bytes per
-// output triangle at its peak (measured: `/usr/bin/time -f %M` on a budget-stopped run, README
-// "Hostile input"), so a run the default budget stops on a small input stays under 500 MB on the
-// 2-core machine the README's figures come from.
+// output triangle at its peak (measured: `/usr/bin/time -f %M` on a budget-stopped run,
+// docs/HOSTILE_INPUT.md), so a run the default budget stops on a small input stays under 500 MB on the
+// 2-core machine those figures come from.
 constexpr long long kMinFrameTriangleBudget = 500'000;
 long long defaultFrameTriangleBudget(const Stage& stage);
 

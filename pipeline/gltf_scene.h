@@ -1,4 +1,4 @@
-// A scene authored in glTF (README "Scenes in glTF"): the camera, the objects and the scene
+// A scene authored in glTF (docs/SCENES.md "Scenes in glTF"): the camera, the objects and the scene
 // settings come from the default scene of a .gltf/.glb file instead of a JSON scene file.
 //
 // - Objects: every node whose `extras` hold an object field other than name, mesh and position

@@ -2,7 +2,7 @@
 // object (Galilean or Lorentz), its motion (a worldline through (t0, position) with the stated
 // velocity, or direction with gamma or rapidity), and the camera's view surface per frame (the past
 // lightcone for finite and relativistic, the hyperplane t = t_c - instant_delay for instant and
-// contracted). A new motion model starts here (README "Adding a motion model").
+// contracted). A new motion model starts here (CONTRIBUTING.md "Adding a motion model").
 #pragma once
 
 #include "mesh4d/boost.h"

@@ -50,7 +50,7 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
                       std::ostream& log, bool quiet) {
     std::map<std::string, LoadedMesh> cache;  // one read per mesh file
     for (const ObjectSpec& spec : scene.objects) {
-        // Step: the mesh path must stay where the scene may read (README "Hostile input").
+        // Step: the mesh path must stay where the scene may read (docs/HOSTILE_INPUT.md).
         if (!limits.allow_outside)
             if (Status s = checkMeshInside(scene.path, spec.field_path + ".mesh",
                                            spec.mesh_text.empty() ? spec.mesh_path : spec.mesh_text, spec.mesh_path);

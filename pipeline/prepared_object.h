@@ -22,7 +22,7 @@ struct PreparedObject {
 // The base colour object i is drawn with (linear RGBA): its mesh file's, else a palette colour.
 std::array<double, 4> objectBaseColor(const std::vector<PreparedObject>& objects, size_t i);
 
-// Loads every object's mesh (each file once; its path confined as README "Hostile input" says
+// Loads every object's mesh (each file once; its path confined as docs/HOSTILE_INPUT.md says
 // unless limits.allow_outside) and applies scale, then rotation (X, Y, Z about fixed axes), then
 // the spec's linear map; a map with negative determinant flips the triangles back. Counted
 // warnings go to `log` as "warning: FILE: ..." unless `quiet`. On failure the message names the

@@ -102,7 +102,7 @@ bool isSlabbed(const ObjectSpec& spec) {
 //   l_L = (P_L - x_L) / |P_L - x_L| (in F the light moves, and this is the direction to its
 //   retarded event seen from the hit, aberrated into F);
 // - a directional light (and the default pair, scene.h): l_L = direction, as given (in F it is
-//   aberrated as a star's direction is, README "A moving camera");
+//   aberrated as a star's direction is, docs/MOTION.md "A moving camera");
 // - the normal: the hit's prism lies in a 3-flat {E : N . E = const} of spacetime. Its F form is
 //   N_F = (-(n_F . w), n_F): n_F = lab_normal (ray4d.h: the spatial part of the flat's normal,
 //   turned so that N_F . D_F < 0 for the ray's 4D direction D_F) annihilates the triangle's

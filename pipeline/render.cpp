@@ -18,7 +18,7 @@ namespace {
 
 // One output format: its --format name and how its sink is made for a model. `base` is
 // DIR/<model>: the folder of per-frame files and the stem of a file per sequence. A new format is
-// one more entry here and one sink in exporters/ (README "Adding a motion model, a format, a command").
+// one more entry here and one sink in exporters/ (CONTRIBUTING.md "Adding a motion model, a format, a command").
 struct OutputFormat {
     std::string name;
     std::function<std::unique_ptr<FrameSink>(const RenderSettings&, const std::string& base)> make;

@@ -52,7 +52,7 @@ bool isGltfPath(const std::string& path) {
 
 namespace {
 
-// The JSON scene file's fields (README "Scene format"), read by the shared field readers.
+// The JSON scene file's fields (docs/SCENES.md), read by the shared field readers.
 Status readJsonScene(const json& root, const std::string& path, Scene* scene) {
     *scene = Scene{};
     scene->path = path;

@@ -1,4 +1,4 @@
-// The scene file: camera, frame range, model, tolerance and the moving objects (README "Scene
+// The scene file: camera, frame range, model, tolerance and the moving objects (docs/SCENES.md "Scene
 // format"). Units: light-seconds and seconds, c = 1, velocities as fractions of c.
 #pragma once
 
@@ -29,11 +29,11 @@ struct CameraSpec {
     // objects where the light-speed models do (Black et al. 2007 advance their camera so).
     double instant_delay = 0;
     // Lab velocity (fraction of c, |v| < 1): the camera's worldline is position + velocity t, and
-    // the outputs are in its rest frame (mesh4d/camera_frame.h; README "A moving camera").
+    // the outputs are in its rest frame (mesh4d/camera_frame.h; docs/MOTION.md "A moving camera").
     mesh4d::Vec3 velocity{0, 0, 0};
 };
 
-// The light that shades the raytracer's pictures, at rest in the lab (README "Scene format"):
+// The light that shades the raytracer's pictures, at rest in the lab (docs/SCENES.md):
 // position and directions are lab coordinates, and every hit is shaded in the lab (its normal and
 // point taken there, pipeline/raytrace.cpp labShading), so with a moving camera (camera.velocity)
 // a face at rest in the lab keeps the shade a camera at rest sees; only where it appears changes.
@@ -121,7 +121,7 @@ struct Scene {
 // days); raise it with --max-frames.
 constexpr long long kDefaultMaxFrames = 100000;
 
-// True for a .gltf or .glb path: a scene authored in glTF (README "Scenes in glTF").
+// True for a .gltf or .glb path: a scene authored in glTF (docs/SCENES.md "Scenes in glTF").
 bool isGltfPath(const std::string& path);
 
 // Reads and validates a scene file, JSON or glTF (dispatching on the extension). On failure the

@@ -193,7 +193,7 @@ void readVelocity(FieldReader& r, const json& j, const std::string& path, const 
     r.axisVec3(j, "velocity", path, &obj->velocity);
 }
 
-// An exactly stated speed: a unit direction with gamma or rapidity (README "Scene format").
+// An exactly stated speed: a unit direction with gamma or rapidity (docs/SCENES.md).
 void readExactSpeed(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
     const bool has_dir = j.contains("direction"), has_gamma = j.contains("gamma"), has_rap = j.contains("rapidity");
     if (r.failed() || !(has_dir || has_gamma || has_rap)) return;
@@ -382,7 +382,7 @@ void readLight(FieldReader& r, const json& parent, const std::string& top, Scene
         // The default key light: towards the camera's side of the scene, a little left and above
         // (back 1, left 0.45, up 0.15 in the camera's basis), 70% of the diffuse share. A box
         // facing the camera then shows front, top and left faces at 0.71, 0.52 and 0.43 of
-        // full light, the others at the ambient 0.2 (README "Scene format").
+        // full light, the others at the ambient 0.2 (docs/SCENES.md).
         const CameraSpec& c = scene->camera;
         const Vec3 f = c.look_at - c.position, right = mesh4d::cross(f, c.up);
         const double nf = mesh4d::norm(f), nr = mesh4d::norm(right);

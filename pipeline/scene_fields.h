@@ -1,6 +1,6 @@
-// The fields of a scene (README "Scene format"), read from JSON values in one place for both
+// The fields of a scene (docs/SCENES.md), read from JSON values in one place for both
 // forms of a scene: the JSON scene file and a scene authored in glTF, whose scene and node
-// `extras` hold the same fields (README "Scenes in glTF"). Every field is read and checked by
+// `extras` hold the same fields (docs/SCENES.md "Scenes in glTF"). Every field is read and checked by
 // the same code whichever file it comes from, so the two forms accept the same values and give
 // the same errors, each one line "file: field path: problem (valid range)".
 //

@@ -53,7 +53,7 @@ struct Stage {
     long long first = 0, last_excl = 0;  // frames [first, last_excl), 0 <= first < last_excl <= frame count
     std::vector<PreparedObject> objects;
     // Each object's tolerance, light-seconds (0: vertex mode): the scene's absolute one, or its
-    // relative one times the object's bounding-box diagonal (README "Accuracy").
+    // relative one times the object's bounding-box diagonal (docs/ACCURACY.md).
     std::vector<double> tolerances;
     std::vector<MirrorPlane> mirrors;  // the planes of the mirror objects (findMirrors)
 };

@@ -1,4 +1,4 @@
-# Opens one of apparent's animated .glb files in Blender, ready to play (README "Blender").
+# Opens one of apparent's animated .glb files in Blender, ready to play (docs/VIEWERS.md "Blender").
 #
 #   blender --python scripts/blender_import.py -- OUT.glb                  # opens it: press Space to play
 #   blender --background --python scripts/blender_import.py -- OUT.glb --save OUT.blend

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzes every input reader (README "Hostile input"): builds the libFuzzer harnesses of tests/fuzz
+# Fuzzes every input reader (docs/HOSTILE_INPUT.md): builds the libFuzzer harnesses of tests/fuzz
 # with clang (-fsanitize=fuzzer,address,undefined) in build-fuzz, writes the seed corpora
 # (tests/fuzz/make_corpus.py: data/, tests/data/gltf-samples, assimp-testmodels) and runs each
 # target for a fixed number of inputs with a fixed seed. Exits non-zero on any crash, leak,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Measures the .glb sizes quoted in the README and docs/GLTF.md: the default flange scene, a
+# Measures the .glb sizes quoted in docs/GLTF.md: the default flange scene, a
 # 20k-triangle torus passing at 0.8c (the one of benchmarks/performance_bench.cpp, BM_Frames) over
 # 100 and 1000 frames, and the Khronos/Collada Duck (from Debian's assimp-testmodels, converted to
 # OBJ by assimp-utils at run time, never committed) passing the camera at 0.9c; each plain, with

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole GoogleTest suite and the kill test under AddressSanitizer (with LeakSanitizer) and
-# UndefinedBehaviorSanitizer, g++ (README "Sanitizers"): a Debug build with -DAPPARENT_SANITIZE=ON
+# UndefinedBehaviorSanitizer, g++ (CONTRIBUTING.md "Tests, fuzzing and sanitizers"): a Debug build with -DAPPARENT_SANITIZE=ON
 # in build-asan, then ctest without the third-party viewers (Chromium, MeshLab, Blender and the
 # glTF-Validator check outputs, not our memory safety). Any sanitizer report fails its test.
 # Environment: BUILD_DIR (default build-asan), JOBS (default 2).

@@ -1,4 +1,4 @@
-// Hostile input and failure (README "Hostile input"): inputs the fuzzers found, scene mesh paths
+// Hostile input and failure (docs/HOSTILE_INPUT.md): inputs the fuzzers found, scene mesh paths
 // confined to the scene's folder or the working folder, the output-size limit, object names that
 // never reach file names, and writes that fail midway (a file size limit standing in for a full
 // disk) leaving the previous file untouched and no temporary file behind.
@@ -586,7 +586,7 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
                        2, "makes more than 2000 triangles (--max-triangles); use a coarser --tolerance or raise --max-triangles");
     // The default per-frame budget (4 x the input triangles, at least 500 000): a 320-triangle
     // sphere at a tolerance just above the floor would make 1.2M triangles per frame; the run stops
-    // at the budget, holding at most threads + 1 frames (2 threads, as on the README's machine).
+    // at the budget, holding at most threads + 1 frames (2 threads, as on the machine of docs/HOSTILE_INPUT.md).
     fs::copy_file(source("data/meshes/icosphere320.obj"), box / "s/sphere.obj");
     {
         std::ofstream(box / "s/sphere.json") << R"({ "frames": { "start": 0, "end": 2, "fps": 10 }, "objects": [ )"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An interrupted render never leaves a truncated output file (README "Hostile input").
+"""An interrupted render never leaves a truncated output file (docs/HOSTILE_INPUT.md).
 
 1. A complete run writes out/relativistic.glb and 200 per-frame PLY files (tolerance 0.01).
 2. A second run (tolerance 0.003, other bytes) into the same folder is killed with SIGKILL after

@@ -258,7 +258,7 @@ TEST(MotionTolerance, CoarseToleranceKeepsVertexModeOutput) {
 
 // The shipped rolling wheel (data/scenes/rolling_wheel.json: wheel.obj, radius 1 ls, b = 0.9, w = -0.9,
 // camera at (0, 0, 5)) at T = 1e-2 of its size, at frames before, during and after it passes: the
-// figures of the README's motion section (err/T, output triangles).
+// figures of docs/MOTION.md (err/T, output triangles).
 TEST(MotionTolerance, RollingWheelSceneWithinTheTolerance) {
     mesh4d::RestMesh mesh;
     FILE* f = std::fopen((std::string(APPARENT_SOURCE_DIR) + "/data/meshes/wheel.obj").c_str(), "r");

@@ -509,7 +509,7 @@ std::string writeFacesScene(const std::filesystem::path& dir, const std::string&
 // n + (gamma - 1)(n . u) u normalised (Lorentz), from the rest mesh and the closed form alone.
 // Before the fix the normal was turned by the spatial test n . d, which aberration flips across
 // the trailing face: a strip of it was lit from the wrong side (about 2x brighter). Lit by a given
-// light, and by the default pair (README "Scene format"): overhead with weight 0.3 and a key light
+// light, and by the default pair (docs/SCENES.md): overhead with weight 0.3 and a key light
 // towards (back 1, left 0.45, up 0.15) in the camera's basis with weight 0.7.
 TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
     const auto dir = std::filesystem::temp_directory_path() / ("apparent_faces_" + std::to_string(::getpid()));

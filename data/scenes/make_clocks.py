@@ -2,8 +2,8 @@
 """Writes clocks.json and its meshes ../meshes/clock_face.gltf (a disc of radius 1 ls, 0.05 ls
 thick, facing +z, light grey) and ../meshes/clock_hand.gltf (a bar 0.1 x 0.8 x 0.04 ls from the
 origin along +y, in front of the face, dark red): two clocks, one passing the camera at 0.8c and
-one at rest, each with a hand that jumps one hour per second of the clock's own time (README
-"Scenes"). Run from this folder; the outputs are committed. The colours are the glTF materials'
+one at rest, each with a hand that jumps one hour per second of the clock's own time (docs/PICTURES.md
+"Gallery"). Run from this folder; the outputs are committed. The colours are the glTF materials'
 (the only way a mesh brings its own colour), the buffers base64 data URIs."""
 import base64
 import json
@@ -62,7 +62,7 @@ for name, y, velocity in (("moving", 0.0, [0.8, 0, 0]), ("resting", 2.6, [0, 0, 
         objects.append({"name": f"{name}_hand_{j:+d}", "mesh": "../meshes/clock_hand.gltf", "position": position,
                         "velocity": velocity, "rotation_deg": [0, 0, -30 * (j % 12)], "exists": [j, j + 1]})
 scene = {
-    "_about": "Clocks (README 'Scenes', written by make_clocks.py): two clock faces 4 ls in front of the camera, each "
+    "_about": "Clocks (docs/PICTURES.md 'Gallery', written by make_clocks.py): two clock faces 4 ls in front of the camera, each "
               "with a hand that jumps one hour per second of the clock's own time (12 hand objects with `exists` on "
               "the clock's proper time: hand j is there while the clock reads [j, j+1) s, 12 o'clock at 0). The lower "
               "clock passes at 0.8c (gamma 5/3) and is at x = 0 at lab time 0, so it is seen face-on at t = 4 s; the "

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes flanges.gltf: the default scene of flanges.json authored as a glTF scene, as a Blender
-user would export it with custom properties (README "Scenes in glTF"). Run from this folder; the
+user would export it with custom properties (docs/SCENES.md "Scenes in glTF"). Run from this folder; the
 output is committed. Meshes come from ../meshes/flange.obj and ../meshes/stage.obj, embedded as
 base64 data URIs so the file is self-contained."""
 import base64

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes keyed.gltf (and keyed_cubic.gltf, its corner as a CUBICSPLINE, at the end): a box that
-follows a keyframed path (README "Keyframed paths"), as a Blender user exports an animated object:
+follows a keyframed path (docs/MOTION.md "Keyframed paths"), as a Blender user exports an animated object:
 LINEAR translation and rotation channels on the object's node,
 key times in seconds (lab time), positions in light-seconds. Run from this folder; the output is
 committed. The box (../meshes/box.obj) follows the path:
@@ -92,6 +92,6 @@ def write(name, times, positions, rotations, tangents=None):
 rotations = [quat_y(0.0), quat_y(math.pi / 4), quat_y(math.pi / 2)]
 write("keyed.gltf", [0.0, 5.0, 10.0], [[-4.0, -1.0, -6.0], [0.0, -1.0, -6.0], [0.0, 2.0, -6.0]], rotations)
 # The same corner as a CUBICSPLINE, slower (keys at 0, 8, 16 s) so that the spline's overshoot and the
-# turn stay below c: the reader samples it into many LINEAR keys (README "Keyframed paths").
+# turn stay below c: the reader samples it into many LINEAR keys (docs/MOTION.md "Keyframed paths").
 write("keyed_cubic.gltf", [0.0, 8.0, 16.0], [[-4.0, -1.0, -6.0], [0.0, -1.0, -6.0], [0.0, 2.0, -6.0]], rotations,
       [[0.5, 0.0, 0.0], [0.25, 0.19, 0.0], [0.0, 0.375, 0.0]])

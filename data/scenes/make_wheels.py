@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes ../meshes/wheel.obj (a wheel of radius 1 ls in the x-y plane, axis z: a rim 0.1 ls deep
 and 0.1 ls thick, four spokes 0.06 ls wide through the hub, 96 rim segments) and the two scenes
-that spin it (README "Spinning and rolling bodies"): rolling_wheel.json, the wheel rolling along the ground y = -1 at
+that spin it (docs/MOTION.md "Spinning and rolling bodies"): rolling_wheel.json, the wheel rolling along the ground y = -1 at
 0.9c (w R = |v| in its centre frame: the contact point is at rest in the lab), and
 spinning_wheel.json, the wheel spinning in place at a rim speed of 0.9c, seen along its axis.
 Run from this folder; the outputs are committed."""
@@ -57,7 +57,7 @@ def main():
         for t in tris:
             f.write("f %d %d %d\n" % (t[0] + 1, t[1] + 1, t[2] + 1))
     rolling = {
-        "_about": "A wheel of radius 1 ls rolls along the ground y = -1 at 0.9c (README, Spinning and rolling bodies): velocity [0.9, 0, 0] "
+        "_about": "A wheel of radius 1 ls rolls along the ground y = -1 at 0.9c (docs/MOTION.md, Spinning and rolling bodies): velocity [0.9, 0, 0] "
                   "with angular_velocity [0, 0, -0.9] in its centre frame (w R = |v|: the contact point is at rest in the "
                   "lab, the top moves at 2v / (1 + v^2) = 0.9945c). It passes 5 ls in front of the camera at t = 5 s, "
                   "seen there at t = 10 s. "
@@ -71,7 +71,7 @@ def main():
     }
     spinning = {
         "_about": "A wheel of radius 1 ls spins in place at a rim speed of 0.9c (angular_velocity 0.9 rad/s about z), "
-                  "seen from 4 ls along its axis (README, Spinning and rolling bodies): the spokes appear as spirals phi0 + w (t_c - "
+                  "seen from 4 ls along its axis (docs/MOTION.md, Spinning and rolling bodies): the spokes appear as spirals phi0 + w (t_c - "
                   "sqrt(D^2 + r^2)), the rim's clocks run at sqrt(1 - 0.81) = 0.436 of the hub's (_PROPER_TIME). "
                   "Written by make_wheels.py.",
         "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 60, "instant_delay": 4},

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ctest entry: a keyframed path authored in Blender (README "Keyframed paths"). make_keyed_scene.py
+# ctest entry: a keyframed path authored in Blender (docs/MOTION.md "Keyframed paths"). make_keyed_scene.py
 # keys a cube from (-2, 0, 0) at frame 0 to (2, 0, 0) at frame 100 at 10 fps (0.4 ls/s for 10 s,
 # turning a quarter turn) and exports it with Blender's glTF exporter, animations on. apparent renders
 # it with no warning; in the instant model (no light delay) the cube's vertex mean at frame k

@@ -1,5 +1,5 @@
 # Authors a keyframed path the way a Blender user would, and exports it with Blender's glTF exporter
-# with animations on (README "Keyframed paths"):
+# with animations on (docs/MOTION.md "Keyframed paths"):
 #
 #   blender -b --factory-startup --python tests/blender/make_keyed_scene.py -- OUT.glb
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ctest entry: the Blender round trip (README "Blender"). A scene authored in Blender (a cube with the custom
+# ctest entry: the Blender round trip (docs/VIEWERS.md "Blender"). A scene authored in Blender (a cube with the custom
 # property velocity = [0, 0.5, 0], "into the screen" in Blender's Z-up axes, and the scene property up = "z")
 # is exported by Blender's glTF exporter, rendered by apparent (instant model, frames 0..10, 1 s apart at the
 # ends), imported back with scripts/blender_import.py and saved; the saved file must have the .glb's fps,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The repository stands on its own (README "Conventions"): no tracked file outside docs/ may
+# The repository stands on its own (CONTRIBUTING.md "Conventions"): no tracked file outside docs/ may
 # refer to the folder beside the checkout that held shared notes and data during development, nor
 # to the development machine's absolute work folders. docs/ may tell that history. Run from ctest (tests/CMakeLists.txt) with the source folder.
 # The searched text is assembled from two parts, so that this file does not match itself.
