@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "keyframes.h"
+#include "motion/keyed.h"
 #include "robust.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 
 #ifdef __GLIBC__
 #include <malloc.h>  // malloc_trim
@@ -209,7 +209,7 @@ double stepWithin(double K, double M, double chord) {
     return 4 * chord / root;
 }
 
-// Segment j's step of a keyframed path (keyframes.h): between two keys the path is straight in its
+// Segment j's step of a keyframed path (keyed.h): between two keys the path is straight in its
 // own frame plus a turn at the segment's rate about the segment's axis, so the spin's bound: K the
 // rate times the largest |axis x e|, M the rate^2 times rho (every |q| bounding its distance from
 // any axis); infinity without a turn (the worldlines are straight between keys).

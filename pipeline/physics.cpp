@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mesh4d/keyframes.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/worldline.h"
 #include "pipeline/scene_fields.h"
 #include "pipeline/worlds.h"
 
@@ -32,7 +32,7 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     mesh4d::Motion m = uniformMotionOf(s, model);
     m.angular_velocity = s.angular_velocity;  // worldline.h: a spin about the origin, centre frame
     m.acceleration = s.acceleration;          // worldline.h: Born-rigid, from t0 on
-    // keyframes.h: the path carried in the frame of its mean velocity (s.velocity, m.velocity).
+    // keyed.h: the path carried in the frame of its mean velocity (s.velocity, m.velocity).
     if (s.keys) m.keyed = mesh4d::makeKeyedMotion(*s.keys, m.kinematics == mesh4d::Kinematics::Lorentz, m.t0, m.origin, m.velocity);
     return m;
 }
@@ -69,7 +69,7 @@ static Status checkKeyedMotion(const PreparedObject& object, Model model, const 
         return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, "a keyframed object");
     };
     if (model == Model::Instant) return tolerance_ok();
-    // Every vertex slower than light over every segment (keyframes.h maxKeyedSpeed: the centre's
+    // Every vertex slower than light over every segment (keyed.h maxKeyedSpeed: the centre's
     // speed and the turn's rim speed together, closed form).
     const mesh4d::Motion m = motionOf(s, model);
     for (size_t i = 0; i < object.rest.positions.size(); ++i) {
@@ -105,7 +105,7 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
         return Status::failure(field + "|angular_velocity| = " + formatNumber(mesh4d::norm(s.angular_velocity)) +
                                " must be <= 1e12 rad/s");
     if (accel) {
-        // Born-rigid (mesh4d/worldline.h): every vertex ahead of the horizon, q.k > -1/|a|.
+        // Born-rigid (mesh4d/motion/worldline.h): every vertex ahead of the horizon, q.k > -1/|a|.
         const double a = mesh4d::norm(s.acceleration);
         if (!(a >= 1e-12 && a <= 1e12))
             return Status::failure(field + "|acceleration| = " + formatNumber(a) + " must be in [1e-12, 1e12] (1/ls)");

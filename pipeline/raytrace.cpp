@@ -20,7 +20,7 @@
 #include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/worldline.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -532,7 +532,7 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
             d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
         } else {
             // The hit's own time kept inside its slab, short of its closing key, so that the segment
-            // is this slab's (keyframes.h gives a key to the segment it starts); the camera is at
+            // is this slab's (keyed.h gives a key to the segment it starts); the camera is at
             // rest for these motions.
             const mesh4d::World4D& slab = *h.world;
             const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));

@@ -205,7 +205,7 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
         for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
     }
     const std::vector<PreparedObject>& objects = stage.objects;
-    // Non-uniform: spinning, accelerated or keyframed (mesh4d/worldline.h).
+    // Non-uniform: spinning, accelerated or keyframed (mesh4d/motion/worldline.h).
     auto beyondUniform = [](const ObjectSpec& s) {
         return s.keys || mesh4d::norm(s.angular_velocity) > 0 || mesh4d::norm(s.acceleration) > 0;
     };

@@ -6,9 +6,9 @@
 
 #include "mesh4d/angles.h"
 #include "mesh4d/box.h"
-#include "mesh4d/keyframes.h"
-#include "mesh4d/latest_crossing.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/latest_crossing.h"
+#include "mesh4d/motion/worldline.h"
 
 namespace apparent {
 
@@ -16,7 +16,7 @@ using mesh4d::Vec3;
 
 namespace {
 
-// pathSpanSeen's refinement of an accelerated body's latest crossing (mesh4d/latest_crossing.h):
+// pathSpanSeen's refinement of an accelerated body's latest crossing (mesh4d/motion/latest_crossing.h):
 // it stops within kLatestTolerance x the slabs' offset (in the body's time) of the latest crossing
 // computed, or after kLatestMaxSplits splits (the bound is sound either way; a looser one costs
 // slabs, at most a few at the spacing of the slab grid).
@@ -45,7 +45,7 @@ mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& res
     // Interior points of a triangle can emit up to diag (1 + b) / (1 - b^2) = diag / (1 - b) later or
     // earlier than its vertices (the crossing time's slope along the surface is at most 1/(1 - b)).
     const double diag = box.diagonal();
-    // A keyframed path: b is its fastest vertex's speed in its own frame (keyframes.h), not V's.
+    // A keyframed path: b is its fastest vertex's speed in its own frame (keyed.h), not V's.
     double b = motion.beta, one_minus_b2 = motion.one_minus_beta2;
     if (motion.keyed) {
         for (const Vec3& p : rest.positions) b = std::max(b, mesh4d::maxKeyedSpeed(*motion.keyed, p).speed);
@@ -58,7 +58,7 @@ mesh4d::World4D extrudeSeenFrom(const ObjectSpec& s, const mesh4d::RestMesh& res
     // it falls, if at all, only back to gamma_V before it rises, so the fastest is at an end of the
     // span. That pad is capped at kPadReach / |a| of the object's time (worldline events stay below
     // e^kPadReach / |a|, their squares finite); the span proven sound (pathSpanSeen,
-    // mesh4d/latest_crossing.h for Born-rigid bodies) is held whatever the pad.
+    // mesh4d/motion/latest_crossing.h for Born-rigid bodies) is held whatever the pad.
     const double a = mesh4d::norm(motion.acceleration);
     double speed_cap = INFINITY;
     mesh4d::ProperTimeSpan sound = seen;
@@ -172,7 +172,7 @@ SeenSpan pathSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::Motion& motion
     if (cone && lorentz && accelerated) {
         // Step: Born-rigid acceleration, the latest crossing of any point of the triangles, bounded
         // in the body's own (Rindler) time and refined to within kLatestTolerance offsets
-        // (mesh4d/latest_crossing.h).
+        // (mesh4d/motion/latest_crossing.h).
         mesh4d::ViewSurface moved = last;
         moved.t_c += slab_shift;
         const mesh4d::LatestCrossing latest = mesh4d::latestCrossing(rest, motion, moved, kLatestTolerance * offset,

@@ -61,7 +61,7 @@ mesh4d::ProperTimeSpan spinSpanSeen(const mesh4d::RestMesh& rest, const mesh4d::
 //     the least vertex crossing of that view.
 //   hi: on a hyperplane h is affine in q, so no point crosses after every vertex. On a cone, with
 //     the slabs' d as for lo (the last view's apex time moved by sqrt(2) d):
-//     - Born-rigid acceleration (relativistic): mesh4d/latest_crossing.h. The body's own time s is
+//     - Born-rigid acceleration (relativistic): mesh4d/motion/latest_crossing.h. The body's own time s is
 //       a static (Rindler) time, in which light crosses rest distance at coordinate speed
 //       min(1, |a| xi) (xi = 1/|a| + q.k), so two points' crossings differ by at most their
 //       distance over that speed: a triangle's points cross at most r / min(1, |a| xi_min) after

@@ -36,9 +36,9 @@
 
 #include <cstddef>
 
-#include "extrude.h"
-#include "lightcone.h"
-#include "worldline.h"
+#include "mesh4d/extrude.h"
+#include "mesh4d/lightcone.h"
+#include "mesh4d/motion/worldline.h"
 
 namespace mesh4d {
 

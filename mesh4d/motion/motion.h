@@ -13,13 +13,13 @@
 
 #include <memory>
 
-#include "event.h"
+#include "mesh4d/event.h"
 
 namespace mesh4d {
 
 enum class Kinematics { Galilean, Lorentz };
 
-struct KeyedMotion;  // keyframes.h
+struct KeyedMotion;  // keyed.h
 
 struct Motion {
     Kinematics kinematics = Kinematics::Galilean;
@@ -33,14 +33,14 @@ struct Motion {
     // as gamma or rapidity (makeMotionExact), else 1 - |v|^2 from the components of v with a
     // compensated sum (robust.h oneMinusNorm2: within 1 ulp, oblique velocities included).
     double one_minus_beta2 = 1;
-    // Motion beyond uniform (mesh4d/worldline.h, the one concept of motion): a spin about the
+    // Motion beyond uniform (mesh4d/motion/worldline.h, the one concept of motion): a spin about the
     // origin at this angular velocity (rad/s, in the centre frame, whose time is tau above). Zero
     // (the default): the uniform motion above, with its closed forms.
     Vec3 angular_velocity;
-    // Constant proper acceleration of the origin from t0 on (mesh4d/worldline.h: Born-rigid
+    // Constant proper acceleration of the origin from t0 on (mesh4d/motion/worldline.h: Born-rigid
     // hyperbolic motion, uniform before t0), in the frame of `velocity`. Zero: uniform.
     Vec3 acceleration;
-    // A keyframed path (mesh4d/keyframes.h: the centre and the turn interpolated between lab keys,
+    // A keyframed path (mesh4d/motion/keyed.h: the centre and the turn interpolated between lab keys,
     // carried rigidly in the frame of `velocity`, the path's mean velocity). Null: none.
     std::shared_ptr<const KeyedMotion> keyed;
 };

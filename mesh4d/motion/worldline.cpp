@@ -1,6 +1,6 @@
-#include "worldline.h"
+#include "mesh4d/motion/worldline.h"
 
-#include "keyframes.h"
+#include "mesh4d/motion/keyed.h"
 
 #include <algorithm>
 #include <cmath>
@@ -68,7 +68,7 @@ Local rigidLocal(const Motion& m, double s, const Vec3& q) {
     return l;
 }
 
-// A keyframed path in its own frame (keyframes.h): T = s.
+// A keyframed path in its own frame (keyed.h): T = s.
 Local keyedLocalEvent(const Motion& m, double s, const Vec3& q) {
     const KeyedLocal k = keyedLocal(*m.keyed, s, q);
     Local l;
@@ -128,7 +128,7 @@ Rel relativeEvent(const Motion& m, double s, const Vec3& q, double t_c, const Ve
     Rel r;
     if (m.kinematics == Kinematics::Galilean) {
         r.e.t = (m.t0 - t_c) + s;
-        if (m.keyed) {  // carried in the lab along the path (keyframes.h)
+        if (m.keyed) {  // carried in the lab along the path (keyed.h)
             const KeyedLocal l = keyedLocal(*m.keyed, s, q);
             r.e.x = (m.origin - apex) + l.y;
             r.rate.dx = l.dy;
