@@ -1,6 +1,7 @@
 #include "mesh4d/motion/worldline.h"
 
 #include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/local.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,65 +9,11 @@
 
 namespace mesh4d {
 
+using namespace motion_detail;
+
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-// Rodrigues' turn of q about unit axis k by angle a, with 1 - cos a = 2 sin^2(a/2) (no cancellation
-// for small angles).
-Vec3 turn(const Vec3& k, double a, const Vec3& q) {
-    const double c = std::cos(a), sn = std::sin(a), h = std::sin(0.5 * a);
-    return q * c + cross(k, q) * sn + k * (dot(k, q) * 2 * h * h);
-}
-
-bool accelerated(const Motion& m) {
-    return m.acceleration.x != 0 || m.acceleration.y != 0 || m.acceleration.z != 0;
-}
-
-// q's event at s in the object's own frame (the centre frame of a spin, the start frame of an
-// acceleration: the rest frame of `velocity`, origin at the event (t0, X0)), its derivatives with
-// respect to s, and the rate of q's clock.
-struct Local {
-    double T = 0;
-    Vec3 Y;
-    double dT = 1;
-    Vec3 dY;
-    double dtau = 1;
-};
-
-Local spinLocal(const Motion& m, double s, const Vec3& q) {
-    Local l;
-    l.T = s;
-    const Vec3& w = m.angular_velocity;
-    const double wn = norm(w);
-    if (!(wn > 0)) {
-        l.Y = q;
-        return l;
-    }
-    l.Y = turn(w / wn, wn * s, q);
-    l.dY = cross(w, l.Y);
-    const double u = norm(cross(w, q));
-    l.dtau = std::sqrt((1 - u) * (1 + u));
-    return l;
-}
-
-// Born-rigid hyperbolic motion from s = 0 on, uniform before (the header).
-Local rigidLocal(const Motion& m, double s, const Vec3& q) {
-    Local l;
-    const double a = norm(m.acceleration);
-    l.T = s;
-    l.Y = q;
-    if (!(s > 0) || !(a > 0)) return l;
-    const Vec3 k = m.acceleration / a;
-    const double xi = 1 / a + dot(q, k);  // distance to the horizon, start frame
-    const double sh = std::sinh(a * s), ch = std::cosh(a * s), h = std::sinh(0.5 * a * s);
-    l.T = xi * sh;
-    l.Y = q + k * (xi * 2 * h * h);  // cosh - 1 = 2 sinh^2(x/2)
-    l.dT = a * xi * ch;
-    l.dY = k * (a * xi * sh);
-    l.dtau = a * xi;
-    return l;
-}
 
 // A keyframed path in its own frame (keyed.h): T = s.
 Local keyedLocalEvent(const Motion& m, double s, const Vec3& q) {
@@ -82,41 +29,6 @@ Local keyedLocalEvent(const Motion& m, double s, const Vec3& q) {
 Local localEvent(const Motion& m, double s, const Vec3& q) {
     if (m.keyed) return keyedLocalEvent(m, s, q);
     return accelerated(m) ? rigidLocal(m, s, q) : spinLocal(m, s, q);
-}
-
-// gamma of `velocity` whatever the kinematics (the Galilean carry of an acceleration follows the
-// origin's relativistic lab path).
-double lorentzGamma(const Motion& m) { return 1.0 / std::sqrt(m.one_minus_beta2); }
-
-// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1): the boost's stretch along v, no division by b.
-Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
-
-// The origin's proper time sigma at lab time t0 + dt > t0 on its hyperbolic lab path:
-// dt = (g / a) (sinh(a sigma) + k (cosh(a sigma) - 1)), k = v.a/|a|, is the quadratic
-// (1 + k) u^2 - 2 (k + c) u + (k - 1) = 0 in u = e^(a sigma), c = a dt / g, whose one positive
-// root is taken without cancellation.
-double originProperTimeAtLab(const Motion& m, double dt) {
-    const double a = norm(m.acceleration);
-    const double k = dot(m.velocity, m.acceleration / a);
-    const double c = a * dt / lorentzGamma(m);
-    const double p = k + c;
-    const double root = std::sqrt(p * p + (1 - k) * (1 + k));
-    const double u = p >= 0 ? (p + root) / (1 + k) : (1 - k) / (root - p);
-    return std::log(u) / a;
-}
-
-// The origin's lab displacement and velocity (per unit lab time) at lab time t0 + dt, Galilean
-// carry of an acceleration.
-void originPath(const Motion& m, double dt, Vec3* disp, Vec3* vel) {
-    if (!(dt > 0)) {
-        *disp = m.velocity * dt;
-        *vel = m.velocity;
-        return;
-    }
-    const double g = lorentzGamma(m);
-    const Local l = rigidLocal(m, originProperTimeAtLab(m, dt), Vec3{0, 0, 0});
-    *disp = l.Y + stretch(m.velocity, g, l.Y) + m.velocity * (g * l.T);
-    *vel = (l.dY + stretch(m.velocity, g, l.dY) + m.velocity * (g * l.dT)) / (g * (l.dT + dot(m.velocity, l.dY)));
 }
 
 // The event of q at s relative to (t_c, C), large terms first, with its s-derivatives.
@@ -156,50 +68,7 @@ Rel relativeEvent(const Motion& m, double s, const Vec3& q, double t_c, const Ve
 
 double sideOf(ViewKind kind, const Event& rel) { return kind == ViewKind::Hyperplane ? -rel.t : -rel.t - norm(rel.x); }
 
-// The closed form of an accelerated point's past-cone crossing on its hyperbolic part (s > 0), in
-// the start frame where the camera event is (Tc, P): with xi = 1/a + q.k, xiC = 1/a + P.k and rho
-// the distance of q - P from the line along k, (Tc - T)^2 = |Y - P|^2 on T = xi sinh(a s),
-// Y.k - P.k = xi cosh(a s) - xiC is, with u = e^(a s),
-//     (xiC - Tc) u^2 - (K / xi) u + (xiC + Tc) = 0,   K = rho^2 + xi^2 + xiC^2 - Tc^2.
-// The root with u > 1 and T < Tc; false when there is none (the crossing is before t0).
-bool hyperbolicCrossing(const ViewSurface& view, const Motion& m, const Vec3& q, double* s_out) {
-    const double a = norm(m.acceleration);
-    const Vec3 k = m.acceleration / a;
-    const double g = m.gamma;
-    const double dt = view.t_c - m.t0;
-    const Vec3 dx = view.apex - m.origin;
-    const double Tc = g * (dt - dot(m.velocity, dx));
-    const Vec3 P = dx + stretch(m.velocity, g, dx) - m.velocity * (g * dt);
-    const double xi = 1 / a + dot(q, k), xiC = 1 / a + dot(P, k);
-    const Vec3 d = q - P;
-    const double rho2 = norm2(d - k * dot(d, k));
-    const double K = rho2 + xi * xi + xiC * xiC - Tc * Tc;
-    const double A = xiC - Tc, B = -K / xi, C = xiC + Tc;
-    double roots[2];
-    int n = 0;
-    if (A == 0) {
-        if (B != 0) roots[n++] = -C / B;
-    } else {
-        const double disc = B * B - 4 * A * C;
-        if (disc >= 0) {
-            const double sq = std::sqrt(disc);
-            const double qq = -0.5 * (B + (B >= 0 ? sq : -sq));  // the same-sign form
-            if (qq != 0) roots[n++] = qq / A, roots[n++] = C / qq;
-        }
-    }
-    for (int i = 0; i < n; ++i) {
-        const double u = roots[i];
-        if (!(u > 1) || !std::isfinite(u)) continue;
-        if (!(xi * 0.5 * (u - 1 / u) < Tc)) continue;  // the future sheet
-        *s_out = std::log(u) / a;
-        return true;
-    }
-    return false;
-}
-
 }  // namespace
-
-Vec3 spunPoint(const Motion& m, double s, const Vec3& q) { return spinLocal(m, s, q).Y; }
 
 Event worldlineEvent(const Motion& m, double s, const Vec3& q) {
     if (isUniform(m)) return labFromRest(m, s, q);
@@ -215,8 +84,6 @@ Vec3 worldlineVelocity(const Motion& m, double s, const Vec3& q) {
     return r.dx / r.dt;
 }
 
-double spinSpeed(const Motion& m, const Vec3& q) { return norm(cross(m.angular_velocity, q)); }
-
 double worldlineProperTime(const Motion& m, double s, const Vec3& q) {
     if (m.kinematics == Kinematics::Galilean || isUniform(m)) return s;
     if (m.keyed) return keyedProperTime(*m.keyed, s, q);
@@ -227,28 +94,6 @@ double worldlineProperTime(const Motion& m, double s, const Vec3& q) {
     }
     const double u = spinSpeed(m, q);
     return s * std::sqrt((1 - u) * (1 + u));
-}
-
-double maxGalileanSpeed(const Motion& m, const Vec3& q) {
-    const Vec3& w = m.angular_velocity;
-    const double wn = norm(w);
-    if (!(wn > 0)) return norm(m.velocity);
-    const Vec3 k = w / wn;
-    const double v_par = dot(m.velocity, k);
-    const double v_perp = norm(m.velocity - k * v_par);
-    const double rim = spinSpeed(m, q);
-    return std::hypot(v_par, v_perp + rim);
-}
-
-double originProperTime(const Motion& m, double dt) {
-    if (!(dt > 0) || !accelerated(m)) return dt;
-    return originProperTimeAtLab(m, dt);
-}
-
-double horizonDistance(const Motion& m, const Vec3& q) {
-    const double a = norm(m.acceleration);
-    if (!(a > 0)) return INFINITY;
-    return 1 / a + dot(q, m.acceleration / a);
 }
 
 WorldlineCrossing crossWorldline(const ViewSurface& view, const Motion& m, const Vec3& q) {

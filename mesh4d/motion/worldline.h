@@ -43,7 +43,7 @@
 // carried along the origin's lab path, x = X0 + q + (origin's lab displacement at t), s = t - t0,
 // the origin's proper time at lab time t from a quadratic in e^(|a| sigma) (closed form).
 // The past-cone crossing after t0 has a closed form (relativistic): a quadratic in u = e^(|a| s)
-// in the start frame (worldline.cpp hyperbolicCrossing), polished by the search below; before t0
+// in the start frame (hyperbolic.cpp hyperbolicCrossing), polished by the search below; before t0
 // the uniform closed form is exact. A body with both a spin and an acceleration is refused by the
 // callers (not modelled).
 //
