@@ -103,7 +103,7 @@ bool hyperbolicCrossing(const ViewSurface& view, const Motion& m, const Vec3& q,
 }  // namespace motion_detail
 
 double originProperTime(const Motion& m, double dt) {
-    if (!(dt > 0) || !accelerated(m)) return dt;
+    if (!(dt > 0) || kindOf(m) != MotionKind::Hyperbolic) return dt;
     return originProperTimeAtLab(m, dt);
 }
 

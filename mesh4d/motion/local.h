@@ -22,11 +22,6 @@ struct Local {
     double dtau = 1;
 };
 
-// Whether the motion has an acceleration (Born-rigid from t0 on).
-inline bool accelerated(const Motion& m) {
-    return m.acceleration.x != 0 || m.acceleration.y != 0 || m.acceleration.z != 0;
-}
-
 // A spin about the origin (spin.cpp); q itself without one.
 Local spinLocal(const Motion& m, double s, const Vec3& q);
 

@@ -1,3 +1,31 @@
+// Motions: the closed list of the ways an object moves, and the questions asked of a motion. This
+// folder (mesh4d/motion/) is the one home of the concept: every question the pipeline asks of a
+// motion is asked here, of a Motion, and each dispatches once on kindOf (a switch over MotionKind,
+// so that a new kind is a compile error, -Wswitch, wherever it still needs an answer).
+//
+// The kinds (MotionKind), each with its derivation in the header named and its code in the file:
+//   Uniform     a boost of the rest frame (below; uniform.cpp); lightcone.h keeps its closed forms.
+//   Spin        an angular velocity about the origin, in the centre frame (worldline.h; spin.cpp).
+//   Hyperbolic  a constant proper acceleration from t0 on, Born-rigid (worldline.h; hyperbolic.cpp,
+//               latest_crossing.h for the latest crossing of a body's triangles).
+//   Keyed       a keyframed path carried in the frame of its mean velocity (keyed.h; keyed.cpp).
+// The camera frame (camera_frame.h): any of them seen from the rest frame of a moving camera.
+//
+// The questions, one line each (declared in the header named):
+//   kindOf (here)                 which kind a Motion is; isUniform (worldline.h): kindOf == Uniform.
+//   mixedKinds (here)             whether a Motion states two kinds at once (callers refuse it).
+//   worldlineEvent (worldline.h)  the lab event of rest point q at the object's time s.
+//   worldlineRate, worldlineVelocity, worldlineProperTime, worldlineDoppler (worldline.h): its
+//                                 derivatives, lab velocity, own clock and Doppler factor there.
+//   crossWorldline (worldline.h)  the crossing of q's worldline with a view surface.
+//   spinVertexSpeed (worldline.h) the speed of a spinning rest point that must stay below light.
+//   originTimeAtCrossing (worldline.h) the origin's own time at its crossing of a view.
+//   paddedSpanSeen (seen.h)       the span of the object's time a range of views sees, padded for
+//                                 the extrusion of its history.
+//   slabSpanSeen (seen.h)         the span a range of views sees on the history's time slabs.
+// Not yet here (they stay with the refinement): the slab step (extrude.h slabSpacing, SlabGrid)
+// and the rates bound (worldline_bound.h).
+//
 // Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
 //
 // Relativistic (Lorentz boost with velocity v, b = |v|, g = 1/sqrt(1 - b^2), u = v/b; docs/DESIGN.md section 3):
@@ -44,6 +72,27 @@ struct Motion {
     // carried rigidly in the frame of `velocity`, the path's mean velocity). Null: none.
     std::shared_ptr<const KeyedMotion> keyed;
 };
+
+// The closed list of the kinds of motion (above).
+enum class MotionKind { Uniform, Spin, Hyperbolic, Keyed };
+
+// Which kind `m` is: Keyed with a keyframed path, else Hyperbolic with a non-zero acceleration, else
+// Spin with a non-zero angular velocity, else Uniform (a Motion stating two is named by the first).
+inline MotionKind kindOf(const Motion& m) {
+    if (m.keyed) return MotionKind::Keyed;
+    if (m.acceleration.x != 0 || m.acceleration.y != 0 || m.acceleration.z != 0) return MotionKind::Hyperbolic;
+    if (m.angular_velocity.x != 0 || m.angular_velocity.y != 0 || m.angular_velocity.z != 0) return MotionKind::Spin;
+    return MotionKind::Uniform;
+}
+
+// Whether `m` states more than one of a keyframed path, an acceleration and a spin (not modelled
+// together: callers refuse such a motion).
+inline bool mixedKinds(const Motion& m) {
+    const bool keyed = bool(m.keyed);
+    const bool accelerated = m.acceleration.x != 0 || m.acceleration.y != 0 || m.acceleration.z != 0;
+    const bool spinning = m.angular_velocity.x != 0 || m.angular_velocity.y != 0 || m.angular_velocity.z != 0;
+    return int(keyed) + int(accelerated) + int(spinning) > 1;
+}
 
 // Builds a Motion. Precondition: |velocity| < 1 when kinematics == Lorentz (callers validate).
 Motion makeMotion(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& velocity);

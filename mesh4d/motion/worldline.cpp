@@ -26,9 +26,18 @@ Local keyedLocalEvent(const Motion& m, double s, const Vec3& q) {
     return l;
 }
 
+// q's event in the object's own frame, by kind (a uniform motion's is the spin's without a turn).
 Local localEvent(const Motion& m, double s, const Vec3& q) {
-    if (m.keyed) return keyedLocalEvent(m, s, q);
-    return accelerated(m) ? rigidLocal(m, s, q) : spinLocal(m, s, q);
+    switch (kindOf(m)) {
+        case MotionKind::Keyed:
+            return keyedLocalEvent(m, s, q);
+        case MotionKind::Hyperbolic:
+            return rigidLocal(m, s, q);
+        case MotionKind::Uniform:
+        case MotionKind::Spin:
+            break;
+    }
+    return spinLocal(m, s, q);
 }
 
 // The event of q at s relative to (t_c, C), large terms first, with its s-derivatives.
@@ -40,20 +49,27 @@ Rel relativeEvent(const Motion& m, double s, const Vec3& q, double t_c, const Ve
     Rel r;
     if (m.kinematics == Kinematics::Galilean) {
         r.e.t = (m.t0 - t_c) + s;
-        if (m.keyed) {  // carried in the lab along the path (keyed.h)
-            const KeyedLocal l = keyedLocal(*m.keyed, s, q);
-            r.e.x = (m.origin - apex) + l.y;
-            r.rate.dx = l.dy;
-        } else if (accelerated(m)) {
-            Vec3 disp, vel;
-            originPath(m, s, &disp, &vel);
-            r.e.x = (m.origin - apex) + (q + disp);
-            r.rate.dx = vel;
-        } else {
-            const Local l = spinLocal(m, s, q);
-            r.e.x = (m.origin - apex) + (l.Y + m.velocity * s);
-            r.rate.dx = l.dY + m.velocity;
+        switch (kindOf(m)) {
+            case MotionKind::Keyed: {  // carried in the lab along the path (keyed.h)
+                const KeyedLocal l = keyedLocal(*m.keyed, s, q);
+                r.e.x = (m.origin - apex) + l.y;
+                r.rate.dx = l.dy;
+                return r;
+            }
+            case MotionKind::Hyperbolic: {
+                Vec3 disp, vel;
+                originPath(m, s, &disp, &vel);
+                r.e.x = (m.origin - apex) + (q + disp);
+                r.rate.dx = vel;
+                return r;
+            }
+            case MotionKind::Uniform:
+            case MotionKind::Spin:
+                break;
         }
+        const Local l = spinLocal(m, s, q);
+        r.e.x = (m.origin - apex) + (l.Y + m.velocity * s);
+        r.rate.dx = l.dY + m.velocity;
         return r;
     }
     const Local l = localEvent(m, s, q);
@@ -85,12 +101,19 @@ Vec3 worldlineVelocity(const Motion& m, double s, const Vec3& q) {
 }
 
 double worldlineProperTime(const Motion& m, double s, const Vec3& q) {
-    if (m.kinematics == Kinematics::Galilean || isUniform(m)) return s;
-    if (m.keyed) return keyedProperTime(*m.keyed, s, q);
-    if (accelerated(m)) {
-        if (!(s > 0)) return s;
-        const double a = norm(m.acceleration);
-        return (1 + a * dot(q, m.acceleration / a)) * s;
+    if (m.kinematics == Kinematics::Galilean) return s;
+    switch (kindOf(m)) {
+        case MotionKind::Uniform:
+            return s;
+        case MotionKind::Keyed:
+            return keyedProperTime(*m.keyed, s, q);
+        case MotionKind::Hyperbolic: {
+            if (!(s > 0)) return s;
+            const double a = norm(m.acceleration);
+            return (1 + a * dot(q, m.acceleration / a)) * s;
+        }
+        case MotionKind::Spin:
+            break;
     }
     const double u = spinSpeed(m, q);
     return s * std::sqrt((1 - u) * (1 + u));
@@ -119,7 +142,7 @@ WorldlineCrossing crossWorldline(const ViewSurface& view, const Motion& m, const
     plain.keyed = nullptr;
     const Event plain_cut = cutRestWorldline(view, plain, nowBase(view, plain), q);
     double s = properTimeAt(plain, q, plain_cut.t);
-    if (accelerated(m)) {
+    if (kindOf(m) == MotionKind::Hyperbolic) {
         if (!(s > 0)) {
             out.event = plain_cut;
             out.s = s;

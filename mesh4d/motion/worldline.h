@@ -75,10 +75,7 @@
 namespace mesh4d {
 
 // True for uniform motion (no spin, no acceleration, no keyframed path): motion.h's closed forms apply.
-inline bool isUniform(const Motion& m) {
-    return !m.keyed && m.angular_velocity.x == 0 && m.angular_velocity.y == 0 && m.angular_velocity.z == 0 &&
-           m.acceleration.x == 0 && m.acceleration.y == 0 && m.acceleration.z == 0;
-}
+inline bool isUniform(const Motion& m) { return kindOf(m) == MotionKind::Uniform; }
 
 // R(w s) q: the rest point q at centre-frame time s, relative to the origin (q itself for uniform motion).
 Vec3 spunPoint(const Motion& m, double s, const Vec3& q);
