@@ -20,6 +20,7 @@
 #include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
+#include "mesh4d/motion/seen.h"
 #include "mesh4d/motion/worldline.h"
 #include "pipeline/worlds.h"
 
@@ -189,16 +190,10 @@ public:
             }
             for (const Scene& v : views) {
                 const mesh4d::ViewSurface first = viewForFrame(v, model_, a), last = viewForFrame(v, model_, b);
-                mesh4d::ProperTimeSpan seen;
-                if (mesh4d::norm(o.motion.angular_velocity) != 0) {
-                    seen = spinSpanSeen(o.rest, o.motion, first, last, o.chord);
-                } else {
-                    const SeenSpan path = pathSpanSeen(o.rest, o.motion, first, last, o.chord);
-                    padded = padded || !path.ok;
-                    seen = path.span;
-                }
-                lo = std::min(lo, seen.lo - margin_);
-                hi = std::max(hi, seen.hi + margin_);
+                const mesh4d::SeenSpan seen = mesh4d::slabSpanSeen(o.rest, o.motion, first, last, o.chord);
+                padded = padded || !seen.ok;
+                lo = std::min(lo, seen.span.lo - margin_);
+                hi = std::max(hi, seen.span.hi + margin_);
             }
         }
         if (padded) {  // the peer, or a seen span that did not close: buildWorld's padded span

@@ -16,6 +16,7 @@
 
 #include "mesh4d/box.h"
 #include "mesh4d/motion/latest_crossing.h"
+#include "mesh4d/motion/seen.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/motion/worldline.h"
@@ -27,6 +28,7 @@
 #include "test_meshes.h"
 
 using namespace apparent;
+using mesh4d::SeenSpan;
 using mesh4d::Vec3;
 
 namespace {

@@ -54,4 +54,8 @@ double maxGalileanSpeed(const Motion& m, const Vec3& q) {
     return std::hypot(v_par, v_perp + rim);
 }
 
+double spinVertexSpeed(const Motion& m, const Vec3& q) {
+    return m.kinematics == Kinematics::Lorentz ? spinSpeed(m, q) : maxGalileanSpeed(m, q);
+}
+
 }  // namespace mesh4d

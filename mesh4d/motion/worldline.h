@@ -100,6 +100,10 @@ double worldlineProperTime(const Motion& m, double s, const Vec3& q);
 // The centre-frame speed of rest point q, |w x q|.
 double spinSpeed(const Motion& m, const Vec3& q);
 
+// The speed of rest point q that must stay below light for a spin: spinSpeed (Lorentz, centre
+// frame), maxGalileanSpeed (Galilean carry, lab).
+double spinVertexSpeed(const Motion& m, const Vec3& q);
+
 // xi = 1/|a| + q.a/|a|: rest point q's distance to the horizon of a Born-rigid acceleration
 // (infinite without one); q has a worldline only where it is > 0.
 double horizonDistance(const Motion& m, const Vec3& q);
