@@ -113,4 +113,9 @@ double horizonDistance(const Motion& m, const Vec3& q) {
     return 1 / a + dot(q, m.acceleration / a);
 }
 
+double originTimeAtCrossing(const Motion& m, const WorldlineCrossing& c) {
+    const double t_lab = c.event.t - m.t0;
+    return m.kinematics == Kinematics::Lorentz ? c.s : originProperTime(m, t_lab);
+}
+
 }  // namespace mesh4d

@@ -122,6 +122,10 @@ struct WorldlineCrossing {
     bool ok = true;    // false only when the search ran out of steps (NaN or infinite input)
 };
 
+// The origin's own time at c, its crossing of a view (crossWorldline of q = 0): c.s (Lorentz),
+// originProperTime at c's lab time (Galilean carry, whose clock is the relativistic path's).
+double originTimeAtCrossing(const Motion& m, const WorldlineCrossing& c);
+
 // The crossing of rest point q's worldline with the view surface. Uniform motion: the closed form
 // (cutRestWorldline) and s from properTimeAt. Otherwise the safeguarded search above.
 // Precondition: the worldline is timelike (see above).
