@@ -23,8 +23,9 @@
 //   paddedSpanSeen (seen.h)       the span of the object's time a range of views sees, padded for
 //                                 the extrusion of its history.
 //   slabSpanSeen (seen.h)         the span a range of views sees on the history's time slabs.
-// Not yet here (they stay with the refinement): the slab step (extrude.h slabSpacing, SlabGrid)
-// and the rates bound (worldline_bound.h).
+// Not yet here (they stay with the refinement): the slab step (extrude.h slabSpacing and
+// SlabGrid, a switch over MotionKind) and the rates bound (worldline_bound.h, which still tests
+// the fields).
 //
 // Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
 //
