@@ -5,7 +5,6 @@
 #include <utility>
 
 #include "mesh4d/angles.h"
-#include "mesh4d/box.h"
 #include "mesh4d/motion/seen.h"
 
 namespace apparent {
