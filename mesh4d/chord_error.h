@@ -47,7 +47,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "boost.h"
+#include "motion/motion.h"
 #include "event.h"
 #include "lightcone.h"
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "keyframes.h"
+#include "motion/keyed.h"
 #include "robust.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 
 #ifdef __GLIBC__
 #include <malloc.h>  // malloc_trim
@@ -209,7 +209,7 @@ double stepWithin(double K, double M, double chord) {
     return 4 * chord / root;
 }
 
-// Segment j's step of a keyframed path (keyframes.h): between two keys the path is straight in its
+// Segment j's step of a keyframed path (keyed.h): between two keys the path is straight in its
 // own frame plus a turn at the segment's rate about the segment's axis, so the spin's bound: K the
 // rate times the largest |axis x e|, M the rate^2 times rho (every |q| bounding its distance from
 // any axis); infinity without a turn (the worldlines are straight between keys).
@@ -251,8 +251,15 @@ double keyedSlabSpacing(const RestMesh& mesh, const KeyedMotion& k, double tau_a
 }  // namespace
 
 double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b, double chord) {
-    if (isUniform(motion)) return INFINITY;
-    if (motion.keyed) return keyedSlabSpacing(mesh, *motion.keyed, tau_a, tau_b, chord);
+    switch (kindOf(motion)) {
+        case MotionKind::Uniform:
+            return INFINITY;
+        case MotionKind::Keyed:
+            return keyedSlabSpacing(mesh, *motion.keyed, tau_a, tau_b, chord);
+        case MotionKind::Spin:
+        case MotionKind::Hyperbolic:
+            break;
+    }
     // M: the largest second derivative of a vertex's own-frame worldline over the span (spin:
     // |w|^2 rho, rho the vertex's distance from the axis); K: the largest difference of the first
     // derivatives of two points of one triangle (extrude.h).
@@ -270,18 +277,24 @@ double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, dou
 }
 
 SlabGrid::SlabGrid(const RestMesh& mesh, const Motion& motion, double chord) : chord_(chord) {
-    if (isUniform(motion)) return;
-    if (motion.keyed) {
-        const KeyedMotion& k = *motion.keyed;
-        const double rho = largestRadius(mesh);
-        kind_ = Kind::Keyed;
-        keys_ = k.s;
-        counts_.assign(k.s.size(), 1.0);
-        for (size_t j = 1; j < k.s.size(); ++j) {
-            const double n = std::ceil((k.s[j] - k.s[j - 1]) / keyedSegmentStep(mesh, k, j, rho, chord));
-            counts_[j] = std::isnan(n) ? kMaxCellSteps : std::clamp(n, 1.0, kMaxCellSteps);
+    switch (kindOf(motion)) {
+        case MotionKind::Uniform:
+            return;
+        case MotionKind::Keyed: {
+            const KeyedMotion& k = *motion.keyed;
+            const double rho = largestRadius(mesh);
+            kind_ = Kind::Keyed;
+            keys_ = k.s;
+            counts_.assign(k.s.size(), 1.0);
+            for (size_t j = 1; j < k.s.size(); ++j) {
+                const double n = std::ceil((k.s[j] - k.s[j - 1]) / keyedSegmentStep(mesh, k, j, rho, chord));
+                counts_[j] = std::isnan(n) ? kMaxCellSteps : std::clamp(n, 1.0, kMaxCellSteps);
+            }
+            return;
         }
-        return;
+        case MotionKind::Spin:
+        case MotionKind::Hyperbolic:
+            break;
     }
     const double a = norm(motion.acceleration);
     if (a > 0) {

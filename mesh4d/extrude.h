@@ -23,7 +23,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "boost.h"
+#include "motion/motion.h"
 #include "box.h"
 #include "event.h"
 #include "lightcone.h"
@@ -123,7 +123,7 @@ World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_
 // at 0.9 rad/s) bends its faces by up to |w x e| ds / 2 off the history, more than the chords do;
 // dropping it would leave that error unbounded. A boost or the Galilean carry stretches these
 // distances by at most gamma (1 + b) in the lab (callers divide the lab chord by it). Uniform
-// motion needs one slab: slabSpacing returns infinity. A keyframed path (keyframes.h) is straight
+// motion needs one slab: slabSpacing returns infinity. A keyframed path (keyed.h) is straight
 // between keys in its own frame plus a turn: the spin's bound with each segment's turn rate and
 // axis over the interval (rho bounded by max |q|), infinity without a turn; slabSamples puts a
 // sample at every key, where the worldlines bend.

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "robust.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 
 namespace mesh4d {
 

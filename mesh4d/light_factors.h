@@ -16,7 +16,7 @@
 //
 // Proper time: the rest-frame time coordinate of the emission event of rest point q (the object's
 // clocks, synchronised in its rest frame, reading 0 at the origin's event): (t_e - t0)/g - w.q for
-// Lorentz kinematics (boost.h properTimeAt); lab time since t0 for Galilean ones. For uniform
+// Lorentz kinematics (motion.h properTimeAt); lab time since t0 for Galilean ones. For uniform
 // motion it equals (t_e - t0)/g - g w.z, z the point's offset from the origin at t_e.
 // A motion that is not uniform (worldline.h, spin) uses the point's own worldline: D =
 // (d tau/ds) / (dt/ds - n.dx/ds) at its crossing (worldlineDoppler) and the clock of

@@ -5,7 +5,7 @@
 
 #include "exact_side.h"
 #include "robust.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 
 namespace mesh4d {
 

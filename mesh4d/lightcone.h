@@ -20,7 +20,7 @@
 // Reference: Black et al., Am. J. Phys. 2007, section III.B; docs/DESIGN.md sections 5 and 6.
 #pragma once
 
-#include "boost.h"
+#include "motion/motion.h"
 #include "event.h"
 
 namespace mesh4d {
@@ -60,7 +60,7 @@ WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Ve
 // the large terms summed first and once (docs/DESIGN.md section 5's e). Anchoring at an event far
 // from t_c instead would make e a difference of large numbers, whose rounding the light delay
 // then multiplies by up to 2 gamma^2. `now_base` = (X0 - C) + v (t_c - t0), computed once a frame.
-// A motion that is not uniform (mesh4d/worldline.h) is sent to crossWorldline by this function,
+// A motion that is not uniform (mesh4d/motion/worldline.h) is sent to crossWorldline by this function,
 // viewAnchor, cutRestLocal and cutRestLocalBatch; uniform motion keeps the closed forms below.
 Vec3 nowBase(const ViewSurface& view, const Motion& m);
 Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q);

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "slice.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 
 namespace mesh4d::measure {
 

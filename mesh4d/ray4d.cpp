@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "worldline.h"
+#include "motion/worldline.h"
 
 namespace mesh4d {
 

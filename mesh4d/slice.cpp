@@ -14,7 +14,7 @@
 #include "form_bisect.h"
 #include "robust.h"
 #include "tessellate.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 #include "worldline_refine.h"
 
 namespace mesh4d {

@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "keyframes.h"
+#include "motion/keyed.h"
 
 namespace mesh4d {
 
@@ -33,7 +33,7 @@ SegmentSpan segmentsIn(const KeyedMotion& k, double s_lo, double s_hi) {
     return {keyedSegment(k, s_lo), keyedSegment(k, s_hi)};
 }
 
-// A keyframed path's corners turned by each key's pose, p = rotate(turns[key], q) (keyframes.h
+// A keyframed path's corners turned by each key's pose, p = rotate(turns[key], q) (keyed.h
 // keyedSegmentTurned): every segment's rates, Lambda and kink start from them, so each is turned
 // once per piece instead of once per use. Lazily per key; a per-thread store stamped per piece.
 class TurnedCorners {
@@ -149,7 +149,7 @@ CornerCrossing cornerCrossing(const ViewSurface& view, const Motion& m, const Ve
 
 namespace {
 
-// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as boost.h.
+// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as motion.h.
 Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
 
 // Lambda of segment j's rates at corner c's exact event (the header: its own segment's is c.lambda).

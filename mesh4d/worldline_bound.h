@@ -98,7 +98,7 @@
 // p = sum l_i q_i, Taylor's theorem with integral remainder from p to each corner gives
 // |F(p) - L(p)| <= (K / 2) sum_i l_i |q_i - p|^2 = (K / 2) sum_{i<j} l_i l_j |q_i - q_j|^2 <= K d^2 / 6.
 //
-// Keyframed paths (keyframes.h). Within one key segment the path is, in its own frame (F_V for
+// Keyframed paths (keyed.h). Within one key segment the path is, in its own frame (F_V for
 // relativistic and contracted, the lab for finite and instant), Y(s) = P_k + u (s - s_k) + R(s) Q_k q:
 // a straight carry at the segment's velocity u plus a turn at the constant rate w about a fixed axis
 // (slerp). At a fixed s that is affine in q, and its rates are those of the Galilean carry of a spin
@@ -111,7 +111,7 @@
 // that segment's rates. The window of s ([s_lo - spread, s_hi + spread], checked like an
 // acceleration's: sigma within G d of the corners') may meet several segments; every rate is then
 // the largest over them, and Lambda is bounded per segment: Lambda_j(q), the cone's combination of
-// segment j's rates (its motion extended past its keys, keyframes.h keyedSegmentLocal) at q's
+// segment j's rates (its motion extended past its keys, keyed.h keyedSegmentLocal) at q's
 // exact event, is computed at the corners for every segment j in the window and is Lipschitz with
 // the L_Lambda above (its derivative along a line is (t_ss + n.x_ss)_j sigma' + (t_sq + n.x_sq)_j u
 // + x_s,j . n', each term bounded as there), so the bootstrap above bounds every Lambda_j, hence
@@ -196,7 +196,7 @@
 
 #include "event.h"
 #include "lightcone.h"
-#include "worldline.h"
+#include "motion/worldline.h"
 
 namespace mesh4d {
 

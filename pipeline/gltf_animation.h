@@ -1,5 +1,5 @@
 // The animation channels of a parsed glTF file that move one node (glTF 2.0 section 3.11), read and
-// checked for the keyframed paths of a glTF-authored scene (gltf_scene.h, mesh4d/keyframes.h).
+// checked for the keyframed paths of a glTF-authored scene (gltf_scene.h, mesh4d/motion/keyed.h).
 //
 // Read: channels whose target is the node's `translation` (VEC3 FLOAT) or `rotation` (VEC4 FLOAT,
 // unit quaternions, normalised on reading), with LINEAR or STEP samplers: key times (SCALAR FLOAT,
@@ -22,7 +22,7 @@
 #include <tiny_gltf.h>
 
 #include "mesh4d/event.h"
-#include "mesh4d/keyframes.h"
+#include "mesh4d/motion/keyed.h"
 #include "pipeline/status.h"
 
 namespace apparent {

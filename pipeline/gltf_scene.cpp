@@ -31,7 +31,7 @@ struct ObjectNode {
     Affine parent;       // the world transform of the node's parent (identity for a root)
 };
 
-// A keyframed object (mesh4d/keyframes.h): the node's animated translation and rotation, composed
+// A keyframed object (mesh4d/motion/keyed.h): the node's animated translation and rotation, composed
 // with its parent's transform as its static ones are, become the lab path; the pose at t0 is the
 // rest pose (obj->linear, obj->position) and each key's turn is relative to it.
 Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, const ObjectNode& o, const json& ex,

@@ -10,7 +10,7 @@
 //   cannot nest.
 // - Keyframed paths: an object node whose translation or rotation is animated (LINEAR, STEP or
 //   CUBICSPLINE channels, gltf_animation.h; a spline through its cubicSamples) follows that path
-//   (mesh4d/keyframes.h): the keys, composed with the parent's transform as the static values
+//   (mesh4d/motion/keyed.h): the keys, composed with the parent's transform as the static values
 //   are, give ObjectSpec::keys; the pose at t0 is the rest pose (position, linear) and the path's
 //   mean velocity is `velocity`. Refused: velocity, direction, gamma, rapidity, angular_velocity,
 //   acceleration or mirror in its extras, a matrix, a STEP jump, a turn under a parent that shears

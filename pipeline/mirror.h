@@ -27,7 +27,7 @@ mesh4d::Vec3 reflectPoint(const MirrorPlane& m, const mesh4d::Vec3& p);
 mesh4d::Vec3 reflectDirection(const MirrorPlane& m, const mesh4d::Vec3& d);
 
 // The direction a backward ray leaves mirror `m` with, in the camera's frame of a moving camera
-// (the mirror moves there): the lab's reflection seen in that frame (mesh4d/camera_frame.h). Along
+// (the mirror moves there): the lab's reflection seen in that frame (mesh4d/motion/camera_frame.h). Along
 // the cone the null direction (-1, d) is taken to the lab, its spatial part reflected, and taken
 // back, d' the spatial part over minus the time part; on a hyperplane (no light travel) d is
 // reflected through the mirror's plane as it is in that frame, normal A n (A the spatial part of
@@ -60,7 +60,7 @@ Status findMirrors(const std::vector<PreparedObject>& objects, const std::string
 //
 // A moving camera (camera.velocity v; mirrors stay at rest in the lab). Light reaching the camera's
 // lab event E by way of the mirror lies on the lab's past cone of the image event E' = (E.t,
-// reflection of E.x); the camera-frame map (Lorentz or Galilean, mesh4d/camera_frame.h) takes
+// reflection of E.x); the camera-frame map (Lorentz or Galilean, mesh4d/motion/camera_frame.h) takes
 // cones to cones, so in the camera's frame the apex is the image of E'. The reflections are made
 // where the mirror is at rest, then mapped:
 //   - finite and relativistic: each object's lab history (its lab motion and rest mesh) is cut by

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mesh4d/keyframes.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/worldline.h"
 #include "pipeline/scene_fields.h"
 #include "pipeline/worlds.h"
 
@@ -32,7 +32,7 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     mesh4d::Motion m = uniformMotionOf(s, model);
     m.angular_velocity = s.angular_velocity;  // worldline.h: a spin about the origin, centre frame
     m.acceleration = s.acceleration;          // worldline.h: Born-rigid, from t0 on
-    // keyframes.h: the path carried in the frame of its mean velocity (s.velocity, m.velocity).
+    // keyed.h: the path carried in the frame of its mean velocity (s.velocity, m.velocity).
     if (s.keys) m.keyed = mesh4d::makeKeyedMotion(*s.keys, m.kinematics == mesh4d::Kinematics::Lorentz, m.t0, m.origin, m.velocity);
     return m;
 }
@@ -57,11 +57,11 @@ static Status checkMotionTolerance(const PreparedObject& object, Model model, co
 }
 
 // A keyframed path's needs (physics.h).
-static Status checkKeyedMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
-                               long long first_frame, long long last_frame) {
+static Status checkKeyedMotion(const PreparedObject& object, const mesh4d::Motion& m, Model model, const Scene& scene,
+                               double tolerance, long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
     const std::string field = scene.path + ": " + s.keys_field + ": ";
-    if (mesh4d::norm(s.angular_velocity) != 0 || mesh4d::norm(s.acceleration) != 0)
+    if (mesh4d::mixedKinds(m))
         return Status::failure(field + "a keyframed path with angular_velocity or acceleration is not modelled (give one)");
     if (cameraMotionOf(scene).moving())
         return Status::failure(field + "a keyframed object needs a camera at rest (camera.velocity is not [0, 0, 0])");
@@ -69,9 +69,8 @@ static Status checkKeyedMotion(const PreparedObject& object, Model model, const 
         return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, "a keyframed object");
     };
     if (model == Model::Instant) return tolerance_ok();
-    // Every vertex slower than light over every segment (keyframes.h maxKeyedSpeed: the centre's
+    // Every vertex slower than light over every segment (keyed.h maxKeyedSpeed: the centre's
     // speed and the turn's rim speed together, closed form).
-    const mesh4d::Motion m = motionOf(s, model);
     for (size_t i = 0; i < object.rest.positions.size(); ++i) {
         const mesh4d::KeyedSpeed v = mesh4d::maxKeyedSpeed(*m.keyed, object.rest.positions[i]);
         if (!(v.speed < 1))
@@ -86,40 +85,49 @@ static Status checkKeyedMotion(const PreparedObject& object, Model model, const 
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
-    if (s.keys) return checkKeyedMotion(object, model, scene, tolerance, first_frame, last_frame);
-    const bool spin = mesh4d::norm(s.angular_velocity) != 0, accel = mesh4d::norm(s.acceleration) != 0;
-    if (!spin && !accel) return Status::success();
+    const mesh4d::Motion m = motionOf(s, model);
+    const mesh4d::MotionKind kind = mesh4d::kindOf(m);
+    switch (kind) {
+        case mesh4d::MotionKind::Uniform:
+            return Status::success();
+        case mesh4d::MotionKind::Keyed:
+            return checkKeyedMotion(object, m, model, scene, tolerance, first_frame, last_frame);
+        case mesh4d::MotionKind::Spin:
+        case mesh4d::MotionKind::Hyperbolic:
+            break;
+    }
+    // A spin with an acceleration (two kinds) is named by its spin, and refused below.
+    const bool mixed = mesh4d::mixedKinds(m);
+    const bool spin = kind == mesh4d::MotionKind::Spin || mixed;
     const std::string field = scene.path + ": " + s.field_path + (spin ? ".angular_velocity: " : ".acceleration: ");
     const std::string what = spin ? "a spinning object" : "an accelerated object";
     // The tolerance (checkMotionTolerance) last, once every vertex is known to have a worldline.
     auto tolerance_ok = [&]() {
         return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, what);
     };
-    if (spin && accel)
+    if (mixed)
         return Status::failure(field + "give angular_velocity or acceleration, not both (not modelled together)");
     if (cameraMotionOf(scene).moving())
         return Status::failure(field + what + " needs a camera at rest (camera.velocity is not [0, 0, 0])");
-    const mesh4d::Motion m = motionOf(s, model);
     // The turned angle |w| s stays finite and meaningful over every time a scene can hold.
-    if (spin && !(mesh4d::norm(s.angular_velocity) <= 1e12))
-        return Status::failure(field + "|angular_velocity| = " + formatNumber(mesh4d::norm(s.angular_velocity)) +
+    if (spin && !(mesh4d::norm(m.angular_velocity) <= 1e12))
+        return Status::failure(field + "|angular_velocity| = " + formatNumber(mesh4d::norm(m.angular_velocity)) +
                                " must be <= 1e12 rad/s");
-    if (accel) {
-        // Born-rigid (mesh4d/worldline.h): every vertex ahead of the horizon, q.k > -1/|a|.
-        const double a = mesh4d::norm(s.acceleration);
+    if (kind == mesh4d::MotionKind::Hyperbolic) {
+        // Born-rigid (mesh4d/motion/worldline.h): every vertex ahead of the horizon, q.k > -1/|a|.
+        const double a = mesh4d::norm(m.acceleration);
         if (!(a >= 1e-12 && a <= 1e12))
             return Status::failure(field + "|acceleration| = " + formatNumber(a) + " must be in [1e-12, 1e12] (1/ls)");
         for (size_t i = 0; i < object.rest.positions.size(); ++i)
             if (!(mesh4d::horizonDistance(m, object.rest.positions[i]) > 0))
                 return Status::failure(field + "vertex " + std::to_string(i) + " lies " +
-                                       formatNumber(-mesh4d::dot(object.rest.positions[i], s.acceleration / a)) +
+                                       formatNumber(-mesh4d::dot(object.rest.positions[i], m.acceleration / a)) +
                                        " behind the origin along the acceleration, at or beyond the horizon of a "
                                        "Born-rigid body (1/|acceleration| = " + formatNumber(1 / a) + ")");
         // The origin's rapidity at the frames' ends, within the limit of the gamma field (1e15).
         for (long long k : {first_frame, last_frame}) {
             const mesh4d::WorldlineCrossing c = mesh4d::crossWorldline(viewForFrame(scene, model, k), m, {0, 0, 0});
-            const double t_lab = c.event.t - s.t0;
-            const double sigma = m.kinematics == mesh4d::Kinematics::Lorentz ? c.s : mesh4d::originProperTime(m, t_lab);
+            const double sigma = mesh4d::originTimeAtCrossing(m, c);
             if (!c.ok || !(std::fabs(a * sigma) <= kMaxRapidity))
                 return Status::failure(field + "the origin's rapidity |a| tau reaches " + formatNumber(a * sigma) +
                                        " in frame " + std::to_string(k) + ", beyond " + formatNumber(kMaxRapidity) +
@@ -129,9 +137,7 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
     }
     // The fastest vertex (a point inside a triangle is never faster: the speed is convex in q).
     double fastest = 0;
-    for (const mesh4d::Vec3& q : object.rest.positions)
-        fastest = std::max(fastest, m.kinematics == mesh4d::Kinematics::Lorentz ? mesh4d::spinSpeed(m, q)
-                                                                                : mesh4d::maxGalileanSpeed(m, q));
+    for (const mesh4d::Vec3& q : object.rest.positions) fastest = std::max(fastest, mesh4d::spinVertexSpeed(m, q));
     if (!std::isfinite(fastest))
         return Status::failure(field + "the speed of a vertex is not finite");
     if (model == Model::Instant) return tolerance_ok();

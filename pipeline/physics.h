@@ -5,8 +5,8 @@
 // contracted). A new motion model starts here (CONTRIBUTING.md "Adding a motion model").
 #pragma once
 
-#include "mesh4d/boost.h"
-#include "mesh4d/camera_frame.h"
+#include "mesh4d/motion/motion.h"
+#include "mesh4d/motion/camera_frame.h"
 #include "mesh4d/extrude.h"
 #include "mesh4d/lightcone.h"
 #include "pipeline/prepared_object.h"
@@ -21,7 +21,7 @@ mesh4d::Kinematics kinematicsOf(Model model);
 // checkSceneForModel.
 mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
 
-// What an object's motion beyond uniform (angular_velocity or acceleration, mesh4d/worldline.h)
+// What an object's motion beyond uniform (angular_velocity or acceleration, mesh4d/motion/worldline.h)
 // needs, one line naming file, field and problem when refused: not both; a camera at rest; a
 // tolerance (mesh4d/worldline_refine.h) only for an object that exists throughout the frames (no
 // real cap) and in a scene without a mirror, else vertex mode (tolerance 0). Spin: |w| <= 1e12 rad/s, every vertex slower than light, |w x q| < 1 in the centre frame
@@ -39,7 +39,7 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
 mesh4d::CameraMotion cameraMotionOf(const Scene& scene);
 
 // The motion of `object` in the camera's rest frame, where every output is (camera.velocity:
-// mesh4d/camera_frame.h), with the Thomas-Wigner rotation of its rest points; the lab motion,
+// mesh4d/motion/camera_frame.h), with the Thomas-Wigner rotation of its rest points; the lab motion,
 // unchanged, for a camera at rest.
 mesh4d::MotionInCameraFrame cameraFrameMotionOf(const ObjectSpec& object, Model model, const Scene& scene);
 

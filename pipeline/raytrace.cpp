@@ -20,7 +20,8 @@
 #include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/seen.h"
+#include "mesh4d/motion/worldline.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -85,8 +86,20 @@ mesh4d::World4D traceWorld(const PreparedObject& object, Model model, const Scen
     return mesh4d::extrude(rest, direct.motion, tau_a, tau_b, real_a, real_b);
 }
 
-bool isSlabbed(const ObjectSpec& spec) {
-    return mesh4d::norm(spec.angular_velocity) != 0 || mesh4d::norm(spec.acceleration) != 0 || spec.keys;
+bool isSlabbed(const mesh4d::Motion& motion) { return !mesh4d::isUniform(motion); }
+
+// The scene field that states a slabbed object's motion (for messages).
+std::string motionField(const ObjectSpec& spec, const mesh4d::Motion& motion) {
+    switch (mesh4d::kindOf(motion)) {
+        case mesh4d::MotionKind::Keyed:
+            return spec.keys_field;
+        case mesh4d::MotionKind::Spin:
+            return spec.field_path + ".angular_velocity";
+        case mesh4d::MotionKind::Uniform:
+        case mesh4d::MotionKind::Hyperbolic:
+            break;
+    }
+    return spec.field_path + ".acceleration";
 }
 
 // The hit's normal and point in the lab, where the scene's light is at rest (scene.h LightSpec):
@@ -161,7 +174,7 @@ public:
                 Model model, bool padded, double margin = 0)
         : scene_(scene), mirrors_(mirrors), model_(model), padded_(padded), margin_(margin) {
         for (size_t i = 0; i < objects.size(); ++i) {
-            if (!isSlabbed(objects[i].spec)) continue;
+            if (!isSlabbed(motionOf(objects[i].spec, model))) continue;
             Slabbed o;
             o.object = i;
             o.prepared = objects[i];
@@ -189,16 +202,10 @@ public:
             }
             for (const Scene& v : views) {
                 const mesh4d::ViewSurface first = viewForFrame(v, model_, a), last = viewForFrame(v, model_, b);
-                mesh4d::ProperTimeSpan seen;
-                if (mesh4d::norm(o.motion.angular_velocity) != 0) {
-                    seen = spinSpanSeen(o.rest, o.motion, first, last, o.chord);
-                } else {
-                    const SeenSpan path = pathSpanSeen(o.rest, o.motion, first, last, o.chord);
-                    padded = padded || !path.ok;
-                    seen = path.span;
-                }
-                lo = std::min(lo, seen.lo - margin_);
-                hi = std::max(hi, seen.hi + margin_);
+                const mesh4d::SeenSpan seen = mesh4d::slabSpanSeen(o.rest, o.motion, first, last, o.chord);
+                padded = padded || !seen.ok;
+                lo = std::min(lo, seen.span.lo - margin_);
+                hi = std::max(hi, seen.span.hi + margin_);
             }
         }
         if (padded) {  // the peer, or a seen span that did not close: buildWorld's padded span
@@ -290,10 +297,7 @@ Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, lon
             size_t worst = 0, n = 0;
             planner.fits(k, k, kMaxTraceSlabs, &worst, &n);
             const SlabPlanner::Slabbed& o = planner.objects()[worst];
-            const ObjectSpec& spec = o.prepared.spec;
-            return Status::failure(stage.scene.path + ": " +
-                                   (spec.keys ? spec.keys_field
-                                              : spec.field_path + (mesh4d::norm(spec.angular_velocity) != 0 ? ".angular_velocity" : ".acceleration")) +
+            return Status::failure(stage.scene.path + ": " + motionField(o.prepared.spec, o.motion) +
                                    ": the raytracer would need " + (n > kMaxTraceSlabs ? "more than " + std::to_string(kMaxTraceSlabs)
                                                                                        : std::to_string(n)) +
                                    " time slabs of " + std::to_string(o.rest.triangles.size()) + " prisms for frame " +
@@ -342,7 +346,7 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
         colors_.push_back(objectBaseColor(objects, i));
         lab_motions_.push_back(motionOf(objects[i].spec, model));
         motions_.push_back(cutMotionOf(objects[i].spec, model, scene).motion);
-        if (isSlabbed(objects[i].spec)) continue;
+        if (isSlabbed(lab_motions_.back())) continue;
         objects_[i].chunks = {
             makeChunk({std::make_shared<const mesh4d::World4D>(traceWorld(objects[i], model, scene, mirrors_, first_frame, last_frame))},
                       false)};
@@ -532,7 +536,7 @@ std::array<double, 3> SceneTracer::shadeWith(const Hit& h, const mesh4d::Motion&
             d = mesh4d::dopplerFactor(motion, kind, receiver, emitted_at, receiver_velocity);
         } else {
             // The hit's own time kept inside its slab, short of its closing key, so that the segment
-            // is this slab's (keyframes.h gives a key to the segment it starts); the camera is at
+            // is this slab's (keyed.h gives a key to the segment it starts); the camera is at
             // rest for these motions.
             const mesh4d::World4D& slab = *h.world;
             const double s = std::max(slab.tau_a, std::min(h.hit.own_time, std::nextafter(slab.tau_b, slab.tau_a)));

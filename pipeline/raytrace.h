@@ -66,7 +66,7 @@ class SlabPlanner;
 // The scene's worlds for one model, prepared for tracing frames first..last (global numbers).
 // Uniform motions: one world each, extruded once over the span the camera and each mirror image
 // of it can see in first..last. Motions that are not uniform: time slabs on the motion's slab grid
-// (extrude.h SlabGrid) over the span a window of frames sees (worlds.h spinSpanSeen, pathSpanSeen),
+// (extrude.h SlabGrid) over the span a window of frames sees (mesh4d/motion/seen.h slabSpanSeen),
 // the window the longest run of frames from the first one traced whose slabs fit in
 // options.window_slabs and kMaxTraceSlabPrisms per object; a frame outside it gets a new window
 // from that frame. The grid makes a slab the same in every window that holds it, so each frame's

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "mesh4d/event.h"
-#include "mesh4d/keyframes.h"
+#include "mesh4d/motion/keyed.h"
 #include "pipeline/status.h"
 
 namespace apparent {
@@ -29,7 +29,7 @@ struct CameraSpec {
     // objects where the light-speed models do (Black et al. 2007 advance their camera so).
     double instant_delay = 0;
     // Lab velocity (fraction of c, |v| < 1): the camera's worldline is position + velocity t, and
-    // the outputs are in its rest frame (mesh4d/camera_frame.h; docs/MOTION.md "A moving camera").
+    // the outputs are in its rest frame (mesh4d/motion/camera_frame.h; docs/MOTION.md "A moving camera").
     mesh4d::Vec3 velocity{0, 0, 0};
 };
 
@@ -68,10 +68,10 @@ struct ObjectSpec {
     mesh4d::Vec3 direction;            // unit vector (with Speed::Gamma or Speed::Rapidity)
     double gamma = 1, rapidity = 0;
     // Spin (rad/s) in the object's centre frame about its origin, combined with the velocity
-    // (mesh4d/worldline.h); zero: uniform motion.
+    // (mesh4d/motion/worldline.h); zero: uniform motion.
     mesh4d::Vec3 angular_velocity;
     // Constant proper acceleration of the origin from t0 on (1/ls, c = 1: light-seconds per second
-    // squared), Born-rigid, in the frame of `velocity` (mesh4d/worldline.h); zero: uniform.
+    // squared), Born-rigid, in the frame of `velocity` (mesh4d/motion/worldline.h); zero: uniform.
     mesh4d::Vec3 acceleration;
     mesh4d::Vec3 rotation_deg;         // rest-frame rotation, degrees, applied X then Y then Z
     mesh4d::Vec3 scale{1, 1, 1};       // rest-frame scale, applied before the rotation
@@ -85,7 +85,7 @@ struct ObjectSpec {
     // A planar mirror at rest: the raytracer bounces rays off it once, and the mesh pipeline adds
     // the retarded reflections it shows (docs/DESIGN.md section 8).
     bool mirror = false;
-    // A keyframed path (glTF animation channels of the object's node: mesh4d/keyframes.h), in the
+    // A keyframed path (glTF animation channels of the object's node: mesh4d/motion/keyed.h), in the
     // lab; null for none. `position` is then the centre at t0 on the path, `velocity` the path's
     // mean velocity, and `linear` holds the pose at t0. keys_field names the channels, for messages.
     std::shared_ptr<const mesh4d::KeyPath> keys;

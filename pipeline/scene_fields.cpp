@@ -276,7 +276,7 @@ void readExists(FieldReader& r, const json& j, const std::string& path, const Ob
     obj->exists_to = v[1];
 }
 
-// A spin about the object's origin, rad/s in its centre frame (mesh4d/worldline.h); an axial
+// A spin about the object's origin, rad/s in its centre frame (mesh4d/motion/worldline.h); an axial
 // vector, turned with the scene's axes as positions are (a rotation keeps axial vectors' rule).
 // Read after the mirror: a mirror must be at rest.
 void readAngularVelocity(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
@@ -285,7 +285,7 @@ void readAngularVelocity(FieldReader& r, const json& j, const std::string& path,
         r.fail(path + ".angular_velocity", "a mirror must be at rest (angular_velocity [0, 0, 0])");
 }
 
-// A constant proper acceleration of the origin (mesh4d/worldline.h), in the scene's axes.
+// A constant proper acceleration of the origin (mesh4d/motion/worldline.h), in the scene's axes.
 void readAcceleration(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
     r.axisVec3(j, "acceleration", path, &obj->acceleration);
     if (!r.failed() && obj->mirror && mesh4d::norm(obj->acceleration) != 0)

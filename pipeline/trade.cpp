@@ -15,6 +15,7 @@
 #include "exporters/gltf.h"
 #include "mesh4d/box.h"
 #include "mesh4d/measure.h"
+#include "mesh4d/motion/worldline.h"
 #include "mesh4d/subdivide.h"
 #include "pipeline/frame_loop.h"
 #include "pipeline/physics.h"
@@ -205,10 +206,8 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
         for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
     }
     const std::vector<PreparedObject>& objects = stage.objects;
-    // Non-uniform: spinning, accelerated or keyframed (mesh4d/worldline.h).
-    auto beyondUniform = [](const ObjectSpec& s) {
-        return s.keys || mesh4d::norm(s.angular_velocity) > 0 || mesh4d::norm(s.acceleration) > 0;
-    };
+    // Non-uniform: spinning, accelerated or keyframed (mesh4d/motion/motion.h).
+    auto beyondUniform = [&](const ObjectSpec& s) { return !mesh4d::isUniform(motionOf(s, model)); };
     const bool any_beyond = std::any_of(objects.begin(), objects.end(), [&](const PreparedObject& o) { return beyondUniform(o.spec); });
     // The instant model cuts at one lab time, where every motion of worldline.h places the rest
     // mesh affinely (one object time s for all its points); the contracted model too for uniform

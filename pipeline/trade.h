@@ -25,7 +25,7 @@
 // The instant model, and the contracted model when every object moves uniformly, map the rest
 // mesh affinely (a hyperplane cut): vertex mode is exact there, and the command says so instead of
 // measuring.
-// Motions beyond uniform (mesh4d/worldline.h: spinning and rolling bodies, Born-rigid acceleration,
+// Motions beyond uniform (mesh4d/motion/worldline.h: spinning and rolling bodies, Born-rigid acceleration,
 // keyframed paths) are measured the same way, the tolerance rows refined by worldline_refine.h
 // (keyframed: after key_split.h) and the exact surface found from the true worldlines by
 // measure.h's own root search (crossingBySearch); an object that cannot take a tolerance (one that

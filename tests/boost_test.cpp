@@ -5,7 +5,7 @@
 #include <functional>
 #include <random>
 
-#include "mesh4d/boost.h"
+#include "mesh4d/motion/motion.h"
 #include "mesh4d/robust.h"
 
 using namespace mesh4d;

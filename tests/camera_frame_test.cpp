@@ -1,4 +1,4 @@
-// A moving camera (scene camera.velocity; mesh4d/camera_frame.h): the pipeline's outputs are in
+// A moving camera (scene camera.velocity; mesh4d/motion/camera_frame.h): the pipeline's outputs are in
 // the camera's rest frame. Checked against computations written here, independent of the
 // program's boost code: every output event, taken back to the lab by this file's own inverse
 // boost, lies on the camera's past light cone and on the lab worldline of one of the object's rest
@@ -12,8 +12,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "mesh4d/boost.h"
-#include "mesh4d/camera_frame.h"
+#include "mesh4d/motion/motion.h"
+#include "mesh4d/motion/camera_frame.h"
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
 #include "run_command.h"

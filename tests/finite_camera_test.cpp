@@ -15,7 +15,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "mesh4d/boost.h"
+#include "mesh4d/motion/motion.h"
 #include "mesh4d/extrude.h"
 #include "mesh4d/slice.h"
 #include "pipeline/physics.h"

@@ -1,4 +1,4 @@
-// Keyframed paths (issue 18, item 4; mesh4d/keyframes.h, pipeline/gltf_animation.h): glTF
+// Keyframed paths (issue 18, item 4; mesh4d/motion/keyed.h, pipeline/gltf_animation.h): glTF
 // animation channels on an object node, through the whole stage, against the uniform and spin
 // models and against a path, a boost and a clock written out here.
 #include <gtest/gtest.h>
@@ -12,13 +12,13 @@
 #include <vector>
 
 #include "keyed_gltf.h"
-#include "mesh4d/keyframes.h"
-#include "mesh4d/boost.h"
+#include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/motion.h"
 #include "mesh4d/extrude.h"
 #include "mesh4d/light_factors.h"
 #include "mesh4d/ray4d.h"
 #include "mesh4d/slice.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/worldline.h"
 #include "pipeline/physics.h"
 #include "pipeline/worlds.h"
 #include "quiet_stage.h"
@@ -76,7 +76,7 @@ Channel translationKeys(const std::vector<float>& times, const std::vector<Vec3>
 
 }  // namespace
 
-// Two keys at constant velocity are the uniform model with that velocity (keyframes.h: V = v, the
+// Two keys at constant velocity are the uniform model with that velocity (keyed.h: V = v, the
 // centre rests in F_V), in every model, to 1e-9 relative; the clocks too. Key positions are exact
 // in float32 (X0 + v t with these values).
 TEST(Keyframes, TwoKeysAtConstantSpeedAreTheUniformModel) {
@@ -156,7 +156,7 @@ TEST(Keyframes, CornerIsContinuousAndOnTheShiftedPath) {
 }
 
 // A rotation channel is a spin: keys turning about z at a constant rate give the spin model's
-// output (mesh4d/worldline.h, tested against an independent boost in motion_test.cpp), clocks
+// output (mesh4d/motion/worldline.h, tested against an independent boost in motion_test.cpp), clocks
 // included (the rim runs at sqrt(1 - w^2 rho^2)). The rate is taken from the float32 keys.
 TEST(Keyframes, RotationKeysAreTheSpin) {
     const double half = 1.5;
@@ -187,7 +187,7 @@ TEST(Keyframes, RotationKeysAreTheSpin) {
     }
 }
 
-// The clock in closed form across a turning segment (keyframes.h: an elliptic integral) against a
+// The clock in closed form across a turning segment (keyed.h: an elliptic integral) against a
 // plain midpoint sum of d tau = ds sqrt(1 - |dY/ds|^2) over the positions themselves, for a point
 // carried along a path that moves and turns at once.
 TEST(Keyframes, ClockOfAMovingTurningPointIsTheIntegral) {
@@ -218,7 +218,7 @@ TEST(Keyframes, ClockOfAMovingTurningPointIsTheIntegral) {
     }
 }
 
-// A segment's motion at its own keys (keyframes.h keyedSegmentLocal): at its first key the pose
+// A segment's motion at its own keys (keyed.h keyedSegmentLocal): at its first key the pose
 // of that key, at its last (the stored whole turn, KeyedMotion::whole_turn) the pose of the next
 // key, centre P_k plus the key's turn Q_k q, each rotated here by a matrix written out from the
 // quaternion; and the bound's shortcut keyedSegmentTurned (q turned once by the caller) gives

@@ -7,7 +7,7 @@ extern "C" {
 #include <quadmath.h>
 }
 
-#include "mesh4d/boost.h"
+#include "mesh4d/motion/motion.h"
 #include "mesh4d/exact_side.h"
 #include "mesh4d/lightcone.h"
 #include "mesh4d/robust.h"

@@ -17,7 +17,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "mesh4d/boost.h"
+#include "mesh4d/motion/motion.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/mirror.h"
 #include "pipeline/stage.h"

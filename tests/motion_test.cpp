@@ -1,4 +1,4 @@
-// Motion beyond uniform (issue 18; mesh4d/worldline.h): spinning and rolling bodies, against
+// Motion beyond uniform (issue 18; mesh4d/motion/worldline.h): spinning and rolling bodies, against
 // closed forms and against a computation written here that shares nothing with the code under
 // test (its own rotation, its own Lorentz boost as a matrix, its own root search by bisection).
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 #include "mesh4d/slice.h"
 #include "slab_rays.h"
 #include "test_meshes.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/worldline.h"
 #include "quiet_stage.h"
 #include "pipeline/physics.h"
 #include "pipeline/raytrace.h"
@@ -93,7 +93,7 @@ TEST(Motion, CrossingMatchesAnIndependentBisection) {
         }
 }
 
-// Uniform motion keeps its closed forms: the worldline functions hand it to boost.h and lightcone.h.
+// Uniform motion keeps its closed forms: the worldline functions hand it to motion.h and lightcone.h.
 TEST(Motion, UniformMotionIsTheClosedForm) {
     const Motion m = mesh4d::makeMotion(mesh4d::Kinematics::Lorentz, 1, {2, 0, -3}, {0.6, 0.2, 0});
     const Vec3 q{0.3, -0.4, 0.5};

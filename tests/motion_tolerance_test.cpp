@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "mesh4d/extrude.h"
-#include "mesh4d/keyframes.h"
+#include "mesh4d/motion/keyed.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/worldline_bound.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/worldline.h"
 #include "test_meshes.h"
 
 using mesh4d::Event;
@@ -298,7 +298,7 @@ TEST(MotionTolerance, RollingWheelSceneWithinTheTolerance) {
     }
 }
 
-// ---- Keyframed paths (mesh4d/keyframes.h, the bound across keys in worldline_bound.h) ----
+// ---- Keyframed paths (mesh4d/motion/keyed.h, the bound across keys in worldline_bound.h) ----
 
 namespace {
 
@@ -360,7 +360,7 @@ void interpolate(const std::vector<double>& u, const std::vector<Vec3>& C, const
     *angle = a[j - 1] + (a[j] - a[j - 1]) * f;
 }
 
-// The true worldlines of the keyframes.h model, written independently: relativistic and contracted
+// The true worldlines of the keyed.h model, written independently: relativistic and contracted
 // carry the body in the frame of the mean velocity V (keys boosted there by a matrix), then back to
 // the lab; finite carries it in the lab. Parameter: that frame's time (lab time for finite).
 Worldline keyedPath(const TestPath& p, bool lorentz) {
@@ -450,7 +450,7 @@ std::vector<KeyedCase> keyedCases() {
 
 }  // namespace
 
-// The independent worldlines above agree with the code's (keyframes.h, worldline.h) event for event:
+// The independent worldlines above agree with the code's (keyed.h, worldline.h) event for event:
 // the test's exact surface is the model's.
 TEST(MotionTolerance, KeyedTestWorldlinesAreTheModels) {
     for (const KeyedCase& c : keyedCases()) {

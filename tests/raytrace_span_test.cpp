@@ -1,5 +1,5 @@
 // The span of an accelerated body's time that the raytracer extrudes (pipeline/worlds.h
-// pathSpanSeen, mesh4d/latest_crossing.h), checked against crossings found independently: the
+// pathSpanSeen, mesh4d/motion/latest_crossing.h), checked against crossings found independently: the
 // rocket of data/scenes/rocket.json (a Born-rigid box 2 ls long at 0.5 ls/s^2, whose frames
 // see interior points of its faces emit after every vertex) and a turned torus, boosted and
 // accelerated obliquely.
@@ -15,10 +15,11 @@
 #include <vector>
 
 #include "mesh4d/box.h"
-#include "mesh4d/latest_crossing.h"
+#include "mesh4d/motion/latest_crossing.h"
+#include "mesh4d/motion/seen.h"
 #include "mesh4d/measure.h"
 #include "mesh4d/slice.h"
-#include "mesh4d/worldline.h"
+#include "mesh4d/motion/worldline.h"
 #include "pipeline/physics.h"
 #include "pipeline/raytrace.h"
 #include "pipeline/worlds.h"
@@ -27,6 +28,7 @@
 #include "test_meshes.h"
 
 using namespace apparent;
+using mesh4d::SeenSpan;
 using mesh4d::Vec3;
 
 namespace {

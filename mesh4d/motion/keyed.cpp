@@ -1,9 +1,9 @@
-#include "keyframes.h"
+#include "mesh4d/motion/keyed.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "boost.h"
+#include "mesh4d/motion/motion.h"
 
 namespace mesh4d {
 
@@ -18,7 +18,7 @@ Vec3 turnWith(const Vec3& k, double ca, double sa, double h, const Vec3& p) {
 }
 Vec3 turnAbout(const Vec3& k, double a, const Vec3& p) { return turnWith(k, std::cos(a), std::sin(a), std::sin(0.5 * a), p); }
 
-// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as boost.h.
+// (g - 1)(a.u) u = v (a.v) g^2 / (g + 1), as motion.h.
 Vec3 stretch(const Vec3& v, double g, const Vec3& a) { return v * (dot(a, v) * (g * g / (g + 1.0))); }
 
 // The segment holding s (the vectors sized n + 1 of KeyedMotion) and its base key.

@@ -31,7 +31,7 @@
 
 #include <array>
 
-#include "boost.h"
+#include "mesh4d/motion/motion.h"
 
 namespace mesh4d {
 

@@ -1,4 +1,4 @@
-#include "latest_crossing.h"
+#include "mesh4d/motion/latest_crossing.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-#include "boost.h"
+#include "mesh4d/motion/motion.h"
 
-#include "robust.h"
+#include "mesh4d/robust.h"
 
 namespace mesh4d {
 

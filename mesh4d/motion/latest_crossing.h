@@ -17,7 +17,7 @@
 // (h decreases in s). Swapping p and q:
 //     |s*(p) - s*(q)| <= |p - q| / min(1, a xi_min)
 // (the body's own time s is a static time: light between two of its points takes the same s
-// whenever it is sent). For a = 0 this is spinSpanSeen's s in s_o -+ r (pipeline/worlds.h).
+// whenever it is sent). For a = 0 this is spinSpanSeen's s in s_o -+ r (seen.h).
 // A triangle: each of its points is within r of a vertex, r the circumradius when the triangle is
 // not obtuse, else half its longest edge (min_i |p - q_i| is largest at the circumcentre, when it
 // lies in the triangle, or on the boundary, where a point of an edge is within half of it of an
@@ -36,9 +36,9 @@
 
 #include <cstddef>
 
-#include "extrude.h"
-#include "lightcone.h"
-#include "worldline.h"
+#include "mesh4d/extrude.h"
+#include "mesh4d/lightcone.h"
+#include "mesh4d/motion/worldline.h"
 
 namespace mesh4d {
 

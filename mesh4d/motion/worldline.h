@@ -2,7 +2,7 @@
 // object's own time s to a lab event, and back: the crossing of q's worldline with a view surface
 // (lightcone.h) is the apparent point of q in that frame.
 //
-// Uniform motion (Motion::angular_velocity = 0 and acceleration = 0) is boost.h's affine map, s = tau, and keeps its
+// Uniform motion (Motion::angular_velocity = 0 and acceleration = 0) is motion.h's affine map, s = tau, and keeps its
 // closed forms (lightcone.h cutRestWorldline, cutRestLocal): the functions below send it there,
 // bit for bit.
 //
@@ -11,7 +11,7 @@
 // (after rotation_deg and scale) is at Y(s) = R(w s) q at centre-frame time s, where R(w s) turns
 // about w/|w| by |w| s, and s = 0 at the origin's event (t0, X0): the centre-frame helix (s, Y(s)).
 //   Lorentz (relativistic, contracted): the helix is boosted to the lab with v about the origin's
-//     event, the standard boost of boost.h:  t = t0 + g (s + v.Y),  x = X0 + Y + (g - 1)(Y.u) u + g v s.
+//     event, the standard boost of motion.h:  t = t0 + g (s + v.Y),  x = X0 + Y + (g - 1)(Y.u) u + g v s.
 //   Galilean (instant, finite): carried,   t = t0 + s,  x = X0 + Y(s) + v s.
 // (For both motions below, s is the centre's or start frame's time, which reads 0 at t0.)
 // The point's own clock reads tau = s sqrt(1 - |w x q|^2) (Lorentz: d tau = ds sqrt(1 - |w x Y|^2),
@@ -43,11 +43,11 @@
 // carried along the origin's lab path, x = X0 + q + (origin's lab displacement at t), s = t - t0,
 // the origin's proper time at lab time t from a quadratic in e^(|a| sigma) (closed form).
 // The past-cone crossing after t0 has a closed form (relativistic): a quadratic in u = e^(|a| s)
-// in the start frame (worldline.cpp hyperbolicCrossing), polished by the search below; before t0
+// in the start frame (hyperbolic.cpp hyperbolicCrossing), polished by the search below; before t0
 // the uniform closed form is exact. A body with both a spin and an acceleration is refused by the
 // callers (not modelled).
 //
-// Keyframed paths (issue 18, item 4): mesh4d/keyframes.h, the body carried rigidly along the
+// Keyframed paths (issue 18, item 4): mesh4d/motion/keyed.h, the body carried rigidly along the
 // path in the frame of its mean velocity V = Motion::velocity (Lorentz: boosted about (t0, X0) as
 // the spin; Galilean: carried in the lab). s is that frame's time (Lorentz) or lab time since t0;
 // the clock integrates d tau = ds sqrt(1 - |dY/ds|^2) in closed form per segment. A keyframed
@@ -68,17 +68,14 @@
 // |X0 - C| x 1e-16 absolute (the anchored forms of lightcone.h are for uniform motion only).
 #pragma once
 
-#include "boost.h"
-#include "event.h"
-#include "lightcone.h"
+#include "mesh4d/motion/motion.h"
+#include "mesh4d/event.h"
+#include "mesh4d/lightcone.h"
 
 namespace mesh4d {
 
-// True for uniform motion (no spin, no acceleration, no keyframed path): boost.h's closed forms apply.
-inline bool isUniform(const Motion& m) {
-    return !m.keyed && m.angular_velocity.x == 0 && m.angular_velocity.y == 0 && m.angular_velocity.z == 0 &&
-           m.acceleration.x == 0 && m.acceleration.y == 0 && m.acceleration.z == 0;
-}
+// True for uniform motion (no spin, no acceleration, no keyframed path): motion.h's closed forms apply.
+inline bool isUniform(const Motion& m) { return kindOf(m) == MotionKind::Uniform; }
 
 // R(w s) q: the rest point q at centre-frame time s, relative to the origin (q itself for uniform motion).
 Vec3 spunPoint(const Motion& m, double s, const Vec3& q);
@@ -103,6 +100,10 @@ double worldlineProperTime(const Motion& m, double s, const Vec3& q);
 // The centre-frame speed of rest point q, |w x q|.
 double spinSpeed(const Motion& m, const Vec3& q);
 
+// The speed of rest point q that must stay below light for a spin: spinSpeed (Lorentz, centre
+// frame), maxGalileanSpeed (Galilean carry, lab).
+double spinVertexSpeed(const Motion& m, const Vec3& q);
+
 // xi = 1/|a| + q.a/|a|: rest point q's distance to the horizon of a Born-rigid acceleration
 // (infinite without one); q has a worldline only where it is > 0.
 double horizonDistance(const Motion& m, const Vec3& q);
@@ -120,6 +121,10 @@ struct WorldlineCrossing {
     double s = 0;      // the object's time there
     bool ok = true;    // false only when the search ran out of steps (NaN or infinite input)
 };
+
+// The origin's own time at c, its crossing of a view (crossWorldline of q = 0): c.s (Lorentz),
+// originProperTime at c's lab time (Galilean carry, whose clock is the relativistic path's).
+double originTimeAtCrossing(const Motion& m, const WorldlineCrossing& c);
 
 // The crossing of rest point q's worldline with the view surface. Uniform motion: the closed form
 // (cutRestWorldline) and s from properTimeAt. Otherwise the safeguarded search above.

@@ -18,7 +18,7 @@
 // boosted path: rest point q is at  Y(s) = P(s) + R(s) q  at F_V time s, where P is the straight
 // line between the boosted keys (a boost keeps lines straight, and keeps the fraction of a segment:
 // the turn runs at a constant rate in s within a segment). The lab event is the boost of (s, Y(s))
-// with V about (t0, X0): boost.h's map, as for the spin (worldline.h). Why this model:
+// with V about (t0, X0): motion.h's map, as for the spin (worldline.h). Why this model:
 //  - a path that turns a corner gives continuous worldlines (P and R are continuous), so the
 //    output is continuous over frames; "the centre with the body contracted by its momentary
 //    velocity" would jump at every corner of a linear path (the contraction changes at once);
@@ -44,7 +44,7 @@
 #include <memory>
 #include <vector>
 
-#include "event.h"
+#include "mesh4d/event.h"
 
 namespace mesh4d {
 

@@ -1,6 +1,6 @@
-#include "camera_frame.h"
+#include "mesh4d/motion/camera_frame.h"
 
-#include "robust.h"
+#include "mesh4d/robust.h"
 
 namespace mesh4d {
 

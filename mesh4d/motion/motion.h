@@ -1,0 +1,127 @@
+// Motions: the closed list of the ways an object moves, and the questions asked of a motion. This
+// folder (mesh4d/motion/) is the one home of the concept: every question the pipeline asks of a
+// motion is asked here, of a Motion, and each dispatches once on kindOf (a switch over MotionKind,
+// so that a new kind is a compile error, -Wswitch, wherever it still needs an answer).
+//
+// The kinds (MotionKind), each with its derivation in the header named and its code in the file:
+//   Uniform     a boost of the rest frame (below; uniform.cpp); lightcone.h keeps its closed forms.
+//   Spin        an angular velocity about the origin, in the centre frame (worldline.h; spin.cpp).
+//   Hyperbolic  a constant proper acceleration from t0 on, Born-rigid (worldline.h; hyperbolic.cpp,
+//               latest_crossing.h for the latest crossing of a body's triangles).
+//   Keyed       a keyframed path carried in the frame of its mean velocity (keyed.h; keyed.cpp).
+// The camera frame (camera_frame.h): any of them seen from the rest frame of a moving camera.
+//
+// The questions, one line each (declared in the header named):
+//   kindOf (here)                 which kind a Motion is; isUniform (worldline.h): kindOf == Uniform.
+//   mixedKinds (here)             whether a Motion states two kinds at once (callers refuse it).
+//   worldlineEvent (worldline.h)  the lab event of rest point q at the object's time s.
+//   worldlineRate, worldlineVelocity, worldlineProperTime, worldlineDoppler (worldline.h): its
+//                                 derivatives, lab velocity, own clock and Doppler factor there.
+//   crossWorldline (worldline.h)  the crossing of q's worldline with a view surface.
+//   spinVertexSpeed (worldline.h) the speed of a spinning rest point that must stay below light.
+//   originTimeAtCrossing (worldline.h) the origin's own time at its crossing of a view.
+//   paddedSpanSeen (seen.h)       the span of the object's time a range of views sees, padded for
+//                                 the extrusion of its history.
+//   slabSpanSeen (seen.h)         the span a range of views sees on the history's time slabs.
+// Not yet here (they stay with the refinement): the slab step (extrude.h slabSpacing and
+// SlabGrid, a switch over MotionKind) and the rates bound (worldline_bound.h, which still tests
+// the fields).
+//
+// Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
+//
+// Relativistic (Lorentz boost with velocity v, b = |v|, g = 1/sqrt(1 - b^2), u = v/b; docs/DESIGN.md section 3):
+//     t = t0 + g (tau + v.q)
+//     x = X0 + q + (g - 1)(q.u) u + g v tau
+// Pre-relativistic (Galilean, finite light speed only):
+//     t = t0 + tau,   x = X0 + q + v tau
+// q is a mesh vertex after the object's rotation and scale, tau the object's proper time (its own
+// clock, reading 0 at the origin event (t0, X0)). Both maps are affine, so prisms stay prisms.
+// 1 - b^2 is computed as (1 - b)(1 + b) and gamma from it, so b up to 1 - 1e-15 keeps full
+// relative precision in 1/g^2.
+#pragma once
+
+#include <memory>
+
+#include "mesh4d/event.h"
+
+namespace mesh4d {
+
+enum class Kinematics { Galilean, Lorentz };
+
+struct KeyedMotion;  // keyed.h
+
+struct Motion {
+    Kinematics kinematics = Kinematics::Galilean;
+    double t0 = 0;        // lab time of the origin event
+    Vec3 origin;          // lab position X0 of the rest-frame origin at t0
+    Vec3 velocity;        // lab velocity v, |v| < 1 for Lorentz
+    double beta = 0;      // |v|
+    double gamma = 1;     // 1/sqrt(1 - b^2) (Lorentz), 1 (Galilean)
+    double inv_gamma2 = 1;  // 1/g^2 = 1 - b^2 without cancellation (Lorentz), 1 (Galilean)
+    // 1 - b^2 for the light-delay quadratic, in both kinematics; exact when the speed was given
+    // as gamma or rapidity (makeMotionExact), else 1 - |v|^2 from the components of v with a
+    // compensated sum (robust.h oneMinusNorm2: within 1 ulp, oblique velocities included).
+    double one_minus_beta2 = 1;
+    // Motion beyond uniform (mesh4d/motion/worldline.h, the one concept of motion): a spin about the
+    // origin at this angular velocity (rad/s, in the centre frame, whose time is tau above). Zero
+    // (the default): the uniform motion above, with its closed forms.
+    Vec3 angular_velocity;
+    // Constant proper acceleration of the origin from t0 on (mesh4d/motion/worldline.h: Born-rigid
+    // hyperbolic motion, uniform before t0), in the frame of `velocity`. Zero: uniform.
+    Vec3 acceleration;
+    // A keyframed path (mesh4d/motion/keyed.h: the centre and the turn interpolated between lab keys,
+    // carried rigidly in the frame of `velocity`, the path's mean velocity). Null: none.
+    std::shared_ptr<const KeyedMotion> keyed;
+};
+
+// The closed list of the kinds of motion (above).
+enum class MotionKind { Uniform, Spin, Hyperbolic, Keyed };
+
+// Which kind `m` is: Keyed with a keyframed path, else Hyperbolic with a non-zero acceleration, else
+// Spin with a non-zero angular velocity, else Uniform (a Motion stating two is named by the first).
+inline MotionKind kindOf(const Motion& m) {
+    if (m.keyed) return MotionKind::Keyed;
+    if (m.acceleration.x != 0 || m.acceleration.y != 0 || m.acceleration.z != 0) return MotionKind::Hyperbolic;
+    if (m.angular_velocity.x != 0 || m.angular_velocity.y != 0 || m.angular_velocity.z != 0) return MotionKind::Spin;
+    return MotionKind::Uniform;
+}
+
+// Whether `m` states more than one of a keyframed path, an acceleration and a spin (not modelled
+// together: callers refuse such a motion).
+inline bool mixedKinds(const Motion& m) {
+    const bool keyed = bool(m.keyed);
+    const bool accelerated = m.acceleration.x != 0 || m.acceleration.y != 0 || m.acceleration.z != 0;
+    const bool spinning = m.angular_velocity.x != 0 || m.angular_velocity.y != 0 || m.angular_velocity.z != 0;
+    return int(keyed) + int(accelerated) + int(spinning) > 1;
+}
+
+// Builds a Motion. Precondition: |velocity| < 1 when kinematics == Lorentz (callers validate).
+Motion makeMotion(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& velocity);
+
+// The lab event of rest-frame point q at proper time tau.
+Event labFromRest(const Motion& m, double tau, const Vec3& q);
+
+// Proper time of rest-frame point q at lab time t (the inverse of labFromRest's time equation).
+double properTimeAt(const Motion& m, const Vec3& q, double t);
+
+// Builds a Motion from a unit direction and a speed stated without rounding 1 - b^2: one of
+// gamma (>= 1) or rapidity (>= 0). b = tanh(rapidity) = sqrt((g - 1)(g + 1)) / g, and
+// 1 - b^2 = 1 / g^2 exactly as stated, so gamma = 1e7 (b = 1 - 5e-15) keeps full precision where
+// a velocity written as three doubles could not. Precondition: |direction| = 1.
+Motion makeMotionFromGamma(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& direction, double gamma);
+Motion makeMotionFromRapidity(Kinematics kinematics, double t0, const Vec3& origin, const Vec3& direction,
+                              double rapidity);
+
+// Where rest-frame point q is at lab time t: X0 + v (t - t0) + q - (1 - 1/g)(q.u) u (Lorentz),
+// X0 + v (t - t0) + q (Galilean). At a fixed lab time the shape is contracted by 1/g along u.
+Vec3 labPositionAt(const Motion& m, const Vec3& q, double t);
+
+// labPositionAt(m, q, t) minus X0 + v (t - t0): q itself (Galilean) or q contracted by 1/g along
+// u (Lorentz). Affine pieces kept apart so callers can add the large terms last.
+Vec3 shapeOffset(const Motion& m, const Vec3& q);
+
+// The rest-frame point q whose worldline passes through lab position x at lab time t
+// (the inverse of labPositionAt in q).
+Vec3 restFromLab(const Motion& m, const Vec3& x, double t);
+
+}  // namespace mesh4d
