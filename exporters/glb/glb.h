@@ -11,8 +11,8 @@
 //                  (SequenceModel)
 //   document.cpp   what needs the whole sequence (SequenceModel::finish): the animation, the
 //                  reflections' nodes, the targets' weights, and the JSON chunk (jsonChunk)
-//   write.cpp      GlbSequenceWriter (prepare, add, finish), GlbSink, writeAnimatedGlb, and frames
-//                  across processes (GlbSequenceWriter::encode, addEncoded)
+//   write.cpp      GlbSequenceWriter (prepare, add, finish), GlbSink, writeAnimatedGlb
+//   remote.cpp     frames across processes (GlbSequenceWriter::encode, addEncoded)
 #pragma once
 
 #include <array>
