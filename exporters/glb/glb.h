@@ -32,7 +32,7 @@
 
 namespace apparent::glb {
 
-// ---- primitive.cpp, draco.cpp: one primitive's data ----
+// ---- What the stages hand on: one primitive's data, meshopt's frame streams and records ----
 
 // One primitive's KHR_draco_mesh_compression coding (encodeDraco): the Edgebreaker bytes and what
 // the accessors take from the decoded mesh (point and face counts, position bounds, attribute ids).
@@ -88,8 +88,6 @@ struct PrimitiveData {
     template <class V>
     bool has(const V& local, const FileSpan& span) const { return remote.on ? span.length > 0 : !local.empty(); }
 };
-
-// ---- meshopt.cpp ----
 
 // A frame's meshopt vertex streams: every shown object's packed vertices in object order, encoded
 // as one EXT_meshopt_compression ATTRIBUTES view, and their normals either as another view
@@ -169,6 +167,8 @@ struct MeshoptScratch {
     std::vector<unsigned char> inline_records, inline_encoded;  // the same with the normals inline
 };
 
+// ---- primitive.cpp ----
+
 // Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
 // are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
 // With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
@@ -180,6 +180,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
                  MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
                  const std::array<double, 4>& base_color);
+
+// ---- meshopt.cpp ----
 
 // The meshopt form of `d`: positions quantized from the exact relative coordinates `rel` (xyz
 // per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
@@ -193,6 +195,13 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
 // tolerance (T / sqrt(3)), from `bits` (E / (2^bits - 2)), or 14 bits over E in vertex mode; at
 // least E / 65534 so that every coordinate fits int16 (*clamped says when that decided).
 double meshoptStep(double extent, double tolerance, int bits, bool* clamped);
+
+// A frame's meshopt vertex streams (MeshoptFrame) from its objects' packed records (`stride`
+// bytes each): one vertex view and one normal view, or the normals at the end of each record,
+// whichever is smaller with the view's JSON counted (kMeshoptViewJsonBytes). Encoded where the
+// frame is prepared (on a worker thread); `scratch` keeps the streams' capacity.
+void encodeFrameStreams(const std::vector<PrimitiveData>& data, size_t stride, MeshoptScratch* scratch,
+                        MeshoptFrame* out);
 
 // A frame's meshopt index stream: the objects' vertex-cache-ordered lists, one after another.
 void encodeIndexStream(const std::vector<unsigned int>& all, size_t most_vertices, std::vector<unsigned char>* out);

@@ -109,6 +109,51 @@ double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
     return step;
 }
 
+void encodeFrameStreams(const std::vector<PrimitiveData>& data, size_t stride, MeshoptScratch* scratch,
+                        MeshoptFrame* out) {
+    MeshoptFrame& mf = *out;
+    mf.first.assign(data.size(), 0);
+    std::vector<unsigned char>& all = scratch->vertices;
+    std::vector<unsigned char>& normals = scratch->normal_stream;
+    all.clear();
+    normals.clear();
+    for (size_t o = 0; o < data.size(); ++o) {
+        mf.first[o] = all.size() / stride;
+        all.insert(all.end(), data[o].packed.begin(), data[o].packed.end());
+        normals.insert(normals.end(), data[o].packed_normals.begin(), data[o].packed_normals.end());
+    }
+    mf.count = all.size() / stride;
+    mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, stride));
+    mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count, stride));
+    mf.encoded_normals.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptNormalStride));
+    mf.encoded_normals.resize(meshopt_encodeVertexBuffer(mf.encoded_normals.data(), mf.encoded_normals.size(),
+                                                         normals.data(), mf.count, kMeshoptNormalStride));
+    // Step: the records with the int8 normals at their end, encoded too; the smaller wins
+    // (the separate view counted with its JSON).
+    const size_t wide = stride + 4;
+    std::vector<unsigned char>& records = scratch->inline_records;
+    records.resize(mf.count * wide);
+    size_t k = 0;
+    for (size_t o = 0; o < data.size(); ++o) {
+        const PrimitiveData& p = data[o];
+        for (size_t i = 0; i < p.packed.size() / stride; ++i, ++k) {
+            std::memcpy(&records[k * wide], &p.packed[i * stride], stride);
+            std::memcpy(&records[k * wide + stride], &p.packed_snorm[4 * i], 4);
+        }
+    }
+    std::vector<unsigned char>& encoded_inline = scratch->inline_encoded;
+    encoded_inline.resize(meshopt_encodeVertexBufferBound(mf.count, wide));
+    encoded_inline.resize(
+        meshopt_encodeVertexBuffer(encoded_inline.data(), encoded_inline.size(), records.data(), mf.count, wide));
+    mf.stride = stride;
+    mf.normals_inline = encoded_inline.size() <= mf.encoded.size() + mf.encoded_normals.size() + kMeshoptViewJsonBytes;
+    if (mf.normals_inline) {
+        mf.encoded.swap(encoded_inline);
+        mf.encoded_normals.clear();
+        mf.stride = wide;
+    }
+}
+
 void encodeIndexStream(const std::vector<unsigned int>& all, size_t most_vertices, std::vector<unsigned char>* out) {
     out->resize(meshopt_encodeIndexBufferBound(all.size(), most_vertices));
     out->resize(meshopt_encodeIndexBuffer(out->data(), out->size(), all.data(), all.size()));

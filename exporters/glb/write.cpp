@@ -10,9 +10,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
-#include <type_traits>
 
-#include <meshoptimizer.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
@@ -61,9 +59,8 @@ namespace apparent {
 using glb::BinSink;
 using glb::copyRange;
 using glb::encodeDraco;
+using glb::encodeFrameStreams;
 using glb::FramePool;
-using glb::kMeshoptNormalStride;
-using glb::kMeshoptViewJsonBytes;
 using glb::meshoptStep;
 using glb::MeshoptFrame;
 using glb::MeshoptLayout;
@@ -274,48 +271,7 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f, b
         } else if (impl_->options.meshopt) {
             // Step: one vertex stream and one normal stream for the whole frame, encoded here (on the
             // worker thread).
-            const size_t stride = MeshoptLayout(impl_->options).stride;
-            MeshoptFrame& mf = d->meshopt;
-            mf.first.assign(f.objects.size(), 0);
-            std::vector<unsigned char>& all = scratch->meshopt.vertices;
-            std::vector<unsigned char>& normals = scratch->meshopt.normal_stream;
-            all.clear();
-            normals.clear();
-            for (size_t o = 0; o < f.objects.size(); ++o) {
-                mf.first[o] = all.size() / stride;
-                all.insert(all.end(), d->data[o].packed.begin(), d->data[o].packed.end());
-                normals.insert(normals.end(), d->data[o].packed_normals.begin(), d->data[o].packed_normals.end());
-            }
-            mf.count = all.size() / stride;
-            mf.encoded.resize(meshopt_encodeVertexBufferBound(mf.count, stride));
-            mf.encoded.resize(meshopt_encodeVertexBuffer(mf.encoded.data(), mf.encoded.size(), all.data(), mf.count, stride));
-            mf.encoded_normals.resize(meshopt_encodeVertexBufferBound(mf.count, kMeshoptNormalStride));
-            mf.encoded_normals.resize(meshopt_encodeVertexBuffer(mf.encoded_normals.data(), mf.encoded_normals.size(),
-                                                                 normals.data(), mf.count, kMeshoptNormalStride));
-            // Step: the records with the int8 normals at their end, encoded too; the smaller wins
-            // (the separate view counted with its JSON).
-            const size_t wide = stride + 4;
-            std::vector<unsigned char>& records = scratch->meshopt.inline_records;
-            records.resize(mf.count * wide);
-            size_t k = 0;
-            for (size_t o = 0; o < f.objects.size(); ++o) {
-                const PrimitiveData& p = d->data[o];
-                for (size_t i = 0; i < p.packed.size() / stride; ++i, ++k) {
-                    std::memcpy(&records[k * wide], &p.packed[i * stride], stride);
-                    std::memcpy(&records[k * wide + stride], &p.packed_snorm[4 * i], 4);
-                }
-            }
-            std::vector<unsigned char>& encoded_inline = scratch->meshopt.inline_encoded;
-            encoded_inline.resize(meshopt_encodeVertexBufferBound(mf.count, wide));
-            encoded_inline.resize(
-                meshopt_encodeVertexBuffer(encoded_inline.data(), encoded_inline.size(), records.data(), mf.count, wide));
-            mf.stride = stride;
-            mf.normals_inline = encoded_inline.size() <= mf.encoded.size() + mf.encoded_normals.size() + kMeshoptViewJsonBytes;
-            if (mf.normals_inline) {
-                mf.encoded.swap(encoded_inline);
-                mf.encoded_normals.clear();
-                mf.stride = wide;
-            }
+            encodeFrameStreams(d->data, MeshoptLayout(impl_->options).stride, &scratch->meshopt, &d->meshopt);
         }
     }
     return d;
