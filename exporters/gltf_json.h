@@ -1,4 +1,4 @@
-// The JSON chunk of a .glb sequence (exporters/gltf.cpp SequenceModel): the glTF objects the
+// The JSON chunk of a .glb sequence (exporters/glb/ SequenceModel): the glTF objects the
 // exporter makes frame by frame, kept as small records, and their text, written once at the end.
 //
 // The text is the one nlohmann::json::dump() gives for the same document (the exporter's files

@@ -2,7 +2,7 @@
 // until something is added (infinite bounds the wrong way round). Used wherever the code needs
 // bounds: the per-frame cull of triangle runs (extrude.h, slice.h), the raytracer's prism bounds
 // (ray4d.h), a rest mesh's size (mesh4d/motion/seen.cpp, pipeline/mirror.cpp) and a frame's local
-// origin (exporters/gltf.cpp). A box of points only (addPoint) keeps its time range empty.
+// origin (exporters/glb/write.cpp). A box of points only (addPoint) keeps its time range empty.
 #pragma once
 
 #include <algorithm>

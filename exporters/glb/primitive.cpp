@@ -1,0 +1,118 @@
+// An object's cut mesh as the file's float32 arrays (toPrimitive, glb.h): relative to the frame's
+// origin, split along creases, and with meshopt also packed (packMeshopt, meshopt.cpp).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include "exporters/glb/glb.h"
+#include "mesh4d/doppler_colour.h"
+#include "mesh4d/normals.h"
+
+namespace apparent::glb {
+
+namespace {
+
+// Vertices are split along creases sharper than this (degrees).
+constexpr double kCreaseDeg = 30.0;
+
+}  // namespace
+
+void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
+                 double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
+                 MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
+                 const std::array<double, 4>& base_color) {
+    mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
+    const size_t nv = map->source.size();
+    d->positions.resize(3 * nv);
+    d->normals.resize(3 * nv);
+    d->emission.resize(nv);
+    const bool doppler = options.doppler && m.doppler.size() == m.positions.size();
+    const bool proper_time = options.proper_time && m.proper_time.size() == m.positions.size();
+    d->doppler.resize(doppler ? nv : 0);
+    d->proper_time.resize(proper_time ? nv : 0);
+    const bool shade = options.shade_doppler && m.doppler.size() == m.positions.size();
+    d->colors.resize(shade ? 3 * nv : 0);
+    const std::array<double, 3> base{base_color[0], base_color[1], base_color[2]};
+    std::vector<double>& exact = scratch->exact;
+    exact.resize(step > 0 ? 3 * nv : 0);
+    // The object's own origin first: both large terms cancel before the small local one is added.
+    const double shift[3] = {m.origin[0] - origin[0], m.origin[1] - origin[1], m.origin[2] - origin[2]};
+    // The largest rounding and the float32 positions' bounds. std::min and std::max keep the
+    // first of equal values (a signed zero) and the join takes the left part first, so the
+    // bounds are GlbBuilder::bounds()'s in vertex order, bit for bit, whatever the split.
+    struct Reduced {
+        double worst = 0;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    };
+    const Reduced reduced = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 16384), Reduced{},
+        [&](const tbb::blocked_range<size_t>& r, Reduced red) {
+            // Local pointers: through the by-reference captures every array would be reloaded
+            // after each store.
+            const uint32_t* const source = map->source.data();
+            const mesh4d::Vec3* const pos = m.positions.data();
+            const mesh4d::Vec3* const nrm = map->normals.data();
+            float* const out_pos = d->positions.data();
+            float* const out_nrm = d->normals.data();
+            float* const out_emission = d->emission.data();
+            double* const out_exact = step > 0 ? exact.data() : nullptr;
+            const double s0 = shift[0], s1 = shift[1], s2 = shift[2];
+            double w = red.worst;
+            double lo[3] = {red.lo[0], red.lo[1], red.lo[2]}, hi[3] = {red.hi[0], red.hi[1], red.hi[2]};
+            for (size_t k = r.begin(); k < r.end(); ++k) {
+                const uint32_t v = source[k];
+                const double rel[3] = {s0 + pos[v].x, s1 + pos[v].y, s2 + pos[v].z};
+                for (int c = 0; c < 3; ++c) {
+                    const float fv = float(rel[c]);
+                    out_pos[3 * k + c] = fv;
+                    w = std::max(w, std::fabs(double(fv) - rel[c]));
+                    lo[c] = std::min(lo[c], double(fv));
+                    hi[c] = std::max(hi[c], double(fv));
+                    if (out_exact) out_exact[3 * k + c] = rel[c];
+                }
+                out_nrm[3 * k] = float(nrm[k].x);
+                out_nrm[3 * k + 1] = float(nrm[k].y);
+                out_nrm[3 * k + 2] = float(nrm[k].z);
+                out_emission[k] = float(m.absoluteTime(v));
+                if (doppler) d->doppler[k] = float(m.doppler[v]);
+                if (proper_time) d->proper_time[k] = float(m.proper_time[v]);
+                if (shade) {
+                    const std::array<double, 3> c = mesh4d::dopplerColour(base, m.doppler[v]);
+                    for (int j = 0; j < 3; ++j) d->colors[3 * k + size_t(j)] = float(c[size_t(j)]);
+                }
+            }
+            red.worst = w;
+            for (int c = 0; c < 3; ++c) {
+                red.lo[c] = lo[c];
+                red.hi[c] = hi[c];
+            }
+            return red;
+        },
+        [](Reduced a, const Reduced& b) {
+            a.worst = std::max(a.worst, b.worst);
+            for (int c = 0; c < 3; ++c) {
+                a.lo[c] = std::min(a.lo[c], b.lo[c]);
+                a.hi[c] = std::max(a.hi[c], b.hi[c]);
+            }
+            return a;
+        });
+    *max_err = std::max(*max_err, reduced.worst);
+    d->bounded = true;
+    for (int c = 0; c < 3; ++c) {
+        d->lo[c] = reduced.lo[c];
+        d->hi[c] = reduced.hi[c];
+    }
+    d->indices.resize(3 * map->triangles.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, map->triangles.size(), 65536), [&](const tbb::blocked_range<size_t>& r) {
+        std::memcpy(d->indices.data() + 3 * r.begin(), map->triangles.data() + r.begin(), r.size() * sizeof(map->triangles[0]));
+    });
+    if (step > 0)
+        *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), order,
+                                                      &scratch->normals));
+}
+
+}  // namespace apparent::glb
