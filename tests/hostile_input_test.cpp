@@ -28,6 +28,7 @@
 #include "pipeline/scene.h"
 #include "file_bytes.h"
 #include "file_size_limit.h"
+#include "measured_run.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -37,6 +38,8 @@ namespace {
 using testcli::apparentRun;
 using testcli::CommandResult;
 using testcli::source;
+using testcli::Measured;
+using testcli::runMeasured;
 
 // A fresh folder under the temporary folder, removed at the end; restores the working folder.
 class Sandbox {
@@ -425,41 +428,6 @@ TEST(HostileInput, SymlinkedBuffersOutsideTheGltfFolderAreRefused) {
 }
 
 namespace {
-
-// Runs `apparent ARGS` in a child process: its exit code, stderr, peak RSS (getrusage of the
-// child, bytes) and wall time, so that a refused input is shown to stay small and quick.
-struct Measured {
-    int code = -1;
-    std::string err;
-    long long peak_rss = 0;
-    double seconds = 0;
-};
-
-Measured runMeasured(const std::vector<std::string>& args) {
-    int pipe_fd[2];
-    EXPECT_EQ(::pipe(pipe_fd), 0);
-    const auto start = std::chrono::steady_clock::now();
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-        ::close(pipe_fd[0]);
-        const CommandResult r = apparentRun(args);
-        const ssize_t ignored = ::write(pipe_fd[1], r.err.data(), r.err.size());
-        (void)ignored;
-        ::_exit(r.code);
-    }
-    ::close(pipe_fd[1]);
-    Measured m;
-    char buf[4096];
-    for (ssize_t n; (n = ::read(pipe_fd[0], buf, sizeof buf)) > 0;) m.err.append(buf, size_t(n));
-    ::close(pipe_fd[0]);
-    int status = 0;
-    rusage usage{};
-    ::wait4(pid, &status, 0, &usage);
-    m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    m.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    m.peak_rss = (long long)usage.ru_maxrss * 1024;
-    return m;
-}
 
 void expectRefusedSmall(const Measured& m, int code, const std::string& expected) {
     EXPECT_EQ(m.code, code) << m.err;
