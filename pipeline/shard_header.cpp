@@ -123,7 +123,6 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
     o->shade_doppler = flags[7] != 0;
 }
 
-
 }  // namespace
 
 void putShardSequence(std::string* out, const SequenceInfo& info, const GlbOptions& o) {
