@@ -170,6 +170,10 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+// The frame number and object count a frame encoded whole (GlbSequenceWriter::encode without a
+// frame spill: what shard files hold) starts with; false when `bytes` does not start as one.
+bool encodedFrameHead(const std::string& bytes, long long* index, size_t* objects);
+
 // The .glb as a frame sink: one GlbSequenceWriter per sequence (begin() starts it), frames
 // converted by prepare() on the loop's worker threads. finish() reports the file and its size
 // (with Draco or meshopt also the size without it); `verbose` adds the float32 and the codec's

@@ -210,6 +210,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                              "searchlight factor, as render --shade doppler bakes them");
     raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary, no progress");
     addStageLimits(raytrace_cmd, &ts.stage);
+    raytrace_cmd->add_option("--max-slab-memory", ts.max_slab_memory,
+                             "Memory for one window of time slabs (spinning, accelerated, keyframed objects), bytes; "
+                             "a frame that needs more is refused before they are built")
+        ->capture_default_str();
     FigureSettings fs;
     std::string figure_size_text, figure_times_text, figure_frames_text, figure_models_text;
     bool figure_no_labels = false;
@@ -231,6 +235,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
     figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary, no progress");
     addStageLimits(figure_cmd, &fs.stage);
+    figure_cmd->add_option("--max-slab-memory", fs.max_slab_memory,
+                           "As raytrace's (with --video the models share it)")
+        ->capture_default_str();
     figure_cmd->footer(
         "Examples:\n"
         "  apparent figure data/scenes/flanges.json --out sheet.png --times 4,7,8.5,10,13,16 --title \"Flanges at 0.866c\"\n"
@@ -324,6 +331,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         ts.shade_doppler = trace_shade_text == "doppler";
         if (ts.threads < 0 || ts.threads > kMaxThreads) return usage(threadsProblem(ts.threads));
         if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
+        if (ts.max_slab_memory < kTraceBytesPerPrism)
+            return usage("--max-slab-memory: " + std::to_string(ts.max_slab_memory) + " bytes, less than one prism's " +
+                         std::to_string(kTraceBytesPerPrism));
         ts.write_png = ts.video_path.empty() || raytrace_cmd->count("--out") > 0;
         return guarded([&] { return raytrace(ts, out, err); }, err);
     }
@@ -363,6 +373,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!figure_shade_text.empty() && figure_shade_text != "plain" && figure_shade_text != "doppler")
             return usage("--shade: unknown shading '" + figure_shade_text + "' (plain, doppler)");
         fs.shade_doppler = figure_shade_text == "doppler";
+        if (fs.max_slab_memory < kTraceBytesPerPrism)
+            return usage("--max-slab-memory: " + std::to_string(fs.max_slab_memory) + " bytes, less than one prism's " +
+                         std::to_string(kTraceBytesPerPrism));
         return guarded([&] { return figure(fs, out, err); }, err);
     }
     if (trade_cmd->parsed()) {

@@ -35,8 +35,8 @@ Status checkRegularFile(const std::string& path) {
     return Status::success();
 }
 
-Status readRegularFile(const std::string& path, size_t max_bytes, std::string* out, const char* what) {
-    out->clear();
+Status openRegularFile(const std::string& path, int* fd_out, uint64_t* size, const char* what) {
+    *fd_out = -1;
     // The resolved path's type first (stat follows symlinks): a device is never even opened.
     struct stat before {};
     if (::stat(path.c_str(), &before) == 0 && !S_ISREG(before.st_mode)) return notRegular(path, before.st_mode);
@@ -50,12 +50,22 @@ Status readRegularFile(const std::string& path, size_t max_bytes, std::string* o
         ::close(fd);
         return notRegular(path, mode);
     }
-    if (uint64_t(st.st_size) > max_bytes) {
+    *fd_out = fd;
+    *size = uint64_t(st.st_size);
+    return Status::success();
+}
+
+Status readRegularFile(const std::string& path, size_t max_bytes, std::string* out, const char* what) {
+    out->clear();
+    int fd = -1;
+    uint64_t size = 0;
+    if (Status s = openRegularFile(path, &fd, &size, what); !s.ok) return s;
+    if (size > max_bytes) {
         ::close(fd);
-        return Status::failure(path + ": " + std::to_string(st.st_size) + " bytes, larger than the limit of " +
+        return Status::failure(path + ": " + std::to_string(size) + " bytes, larger than the limit of " +
                                std::to_string(max_bytes) + " bytes (raise with --max-file-bytes)");
     }
-    out->resize(size_t(st.st_size));
+    out->resize(size_t(size));
     size_t done = 0;
     while (done < out->size()) {
         const ssize_t r = ::read(fd, &(*out)[done], out->size() - done);

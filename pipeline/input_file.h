@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "pipeline/status.h"
@@ -17,6 +18,9 @@ namespace apparent {
 // "scene file"), "is a FIFO, not a regular file (refused)", "N bytes, larger than the limit of M
 // bytes (raise with --max-file-bytes)".
 Status readRegularFile(const std::string& path, size_t max_bytes, std::string* out, const char* what = "file");
+
+// The same checks, the file left open for reading: its descriptor (the caller closes it) and size.
+Status openRegularFile(const std::string& path, int* fd, uint64_t* size, const char* what = "file");
 
 // The same checks without reading: `path` resolves to an existing regular file.
 Status checkRegularFile(const std::string& path);

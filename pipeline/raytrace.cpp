@@ -233,31 +233,43 @@ public:
         return o.grid.samples(span.tau_a, span.tau_b, max_slabs);
     }
 
-    // Whether every object's slabs for frames a..b fit max_slabs and kMaxTraceSlabPrisms; if not,
-    // *worst is the first object that does not fit, *count its slabs (max_slabs + 1: more).
-    bool fits(long long a, long long b, size_t max_slabs, size_t* worst = nullptr, size_t* count = nullptr) const {
+    // Whether every object's slabs for frames a..b fit max_slabs, and their prisms together
+    // max_prisms; if not, *worst is the first object that does not fit (or the one with the most
+    // prisms), *count its slabs (max_slabs + 1: more), *prisms the prisms of all counted so far.
+    bool fits(long long a, long long b, size_t max_slabs, size_t max_prisms, size_t* worst = nullptr,
+              size_t* count = nullptr, size_t* prisms = nullptr) const {
+        size_t total = 0, most = 0;
         for (size_t i = 0; i < slabbed_.size(); ++i) {
             const Span sp = span(slabbed_[i], a, b);
             if (sp.empty()) continue;
             const std::vector<double> times = samples(slabbed_[i], sp, max_slabs);
             const size_t n = times.empty() ? max_slabs + 1 : times.size() - 1;
-            if (n > max_slabs || n * slabbed_[i].rest.triangles.size() > kMaxTraceSlabPrisms) {
+            const size_t p = n * slabbed_[i].rest.triangles.size();
+            total += p;
+            if (p > most) {
+                most = p;
                 if (worst) *worst = i;
                 if (count) *count = n;
+            }
+            if (n > max_slabs) {
+                if (worst) *worst = i;
+                if (count) *count = n;
+                if (prisms) *prisms = total;
                 return false;
             }
         }
-        return true;
+        if (prisms) *prisms = total;
+        return total <= max_prisms;
     }
 
     // The last frame of the longest window k..end (end <= last) that fits (fits above); k - 1 when
     // frame k alone does not. The spans grow with the window, so a window that fits holds every
     // shorter one: doubling, then bisection.
-    long long windowEnd(long long k, long long last, size_t max_slabs) const {
-        if (!fits(k, k, max_slabs)) return k - 1;
+    long long windowEnd(long long k, long long last, size_t max_slabs, size_t max_prisms) const {
+        if (!fits(k, k, max_slabs, max_prisms)) return k - 1;
         long long good = k, bad = last + 1;
         for (long long step = 1; good + step <= last; step *= 2) {
-            if (!fits(k, good + step, max_slabs)) {
+            if (!fits(k, good + step, max_slabs, max_prisms)) {
                 bad = good + step;
                 break;
             }
@@ -265,7 +277,7 @@ public:
         }
         while (bad - good > 1) {
             const long long mid = good + (bad - good) / 2;
-            if (fits(k, mid, max_slabs)) good = mid;
+            if (fits(k, mid, max_slabs, max_prisms)) good = mid;
             else bad = mid;
         }
         return good;
@@ -283,27 +295,37 @@ private:
 namespace {
 
 // One line when some frame alone would need more slabs than the limits allow (a window of one
-// frame, SceneTracer); longer ranges are traced in windows.
-Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, long long first, long long last) {
+// frame, SceneTracer): more than kMaxTraceSlabs of one object, or more prisms than `slab_memory`
+// holds; longer ranges are traced in windows.
+Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, long long first, long long last,
+                       long long slab_memory) {
+    const size_t max_prisms = slabPrismLimit(slab_memory);
     for (Model model : models) {
         const SlabPlanner planner(stage.scene, stage.objects, stage.mirrors, model, false);
         if (planner.objects().empty()) continue;
         for (long long k = first; k <= last;) {
-            const long long end = planner.windowEnd(k, last, kMaxTraceSlabs);
+            const long long end = planner.windowEnd(k, last, kMaxTraceSlabs, max_prisms);
             if (end >= k) {
                 k = end + 1;
                 continue;
             }
-            size_t worst = 0, n = 0;
-            planner.fits(k, k, kMaxTraceSlabs, &worst, &n);
+            size_t worst = 0, n = 0, prisms = 0;
+            planner.fits(k, k, kMaxTraceSlabs, max_prisms, &worst, &n, &prisms);
             const SlabPlanner::Slabbed& o = planner.objects()[worst];
-            return Status::failure(stage.scene.path + ": " + motionField(o.prepared.spec, o.motion) +
-                                   ": the raytracer would need " + (n > kMaxTraceSlabs ? "more than " + std::to_string(kMaxTraceSlabs)
-                                                                                       : std::to_string(n)) +
-                                   " time slabs of " + std::to_string(o.rest.triangles.size()) + " prisms for frame " +
-                                   std::to_string(k) + " alone (limits " + std::to_string(kMaxTraceSlabs) + " slabs, " +
-                                   std::to_string(kMaxTraceSlabPrisms) + " prisms) for model " + modelName(model) +
-                                   ": use `apparent render`");
+            const std::string where = stage.scene.path + ": " + motionField(o.prepared.spec, o.motion) + ": the raytracer would need ";
+            const std::string model_name = std::string(" for model ") + modelName(model);
+            if (n > kMaxTraceSlabs)
+                return Status::failure(where + "more than " + std::to_string(kMaxTraceSlabs) + " time slabs of " +
+                                       std::to_string(o.rest.triangles.size()) + " prisms for frame " + std::to_string(k) +
+                                       " alone (at most " + std::to_string(kMaxTraceSlabs) + " for one object)" +
+                                       model_name + ": use `apparent render`");
+            return Status::failure(where + std::to_string(n) + " time slabs of " + std::to_string(o.rest.triangles.size()) +
+                                   " prisms for frame " + std::to_string(k) + " alone (" + std::to_string(prisms) +
+                                   " prisms of time slabs in all, about " +
+                                   std::to_string((long long)prisms * kTraceBytesPerPrism >> 20) +
+                                   " MiB, more than --max-slab-memory " + std::to_string(slab_memory) + " bytes holds: " +
+                                   std::to_string(max_prisms) + " prisms)" + model_name +
+                                   ": raise it, or use `apparent render`");
         }
     }
     return Status::success();
@@ -311,8 +333,8 @@ Status checkTraceSlabs(const Stage& stage, const std::vector<Model>& models, lon
 
 // What the raytracer needs of motions beyond uniform: slabs within the limits (their Doppler
 // factors are the worldlines', shadeWith).
-Status checkTracedMotions(const Stage& stage) {
-    return checkTraceSlabs(stage, stage.models, stage.first, stage.last_excl - 1);
+Status checkTracedMotions(const Stage& stage, long long slab_memory) {
+    return checkTraceSlabs(stage, stage.models, stage.first, stage.last_excl - 1, slab_memory);
 }
 
 }  // namespace
@@ -417,7 +439,7 @@ constexpr size_t kChunkSlabs = 256;
 void SceneTracer::buildWindow(long long k) {
     // Step: the window from k: the longest run of frames whose slabs fit (the callers checked that
     // frame k alone does).
-    const long long end = std::max(k, planner_->windowEnd(k, last_, options_.window_slabs));
+    const long long end = std::max(k, planner_->windowEnd(k, last_, options_.window_slabs, options_.window_prisms));
     size_t slabs = 0, built = 0;
     for (const SlabPlanner::Slabbed& o : planner_->objects()) {
         ObjectTraces& traces = objects_[o.object];
@@ -633,7 +655,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
-        if (Status s = checkTracedMotions(stage); !s.ok) {
+        if (Status s = checkTracedMotions(stage, settings.max_slab_memory); !s.ok) {
             error = s.message;
             code = kExitBadInput;
         }
@@ -660,7 +682,9 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
                            (long long)stage.models.size() * (last_excl - first) * settings.height);
     for (Model model : stage.models) {
         const auto start = std::chrono::steady_clock::now();
-        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
+        TracerOptions options;
+        options.window_prisms = slabPrismLimit(settings.max_slab_memory);
+        SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1, options);
         tracer.setShadeDoppler(settings.shade_doppler);
         if (sender) {
             // Step (rank r > 0): trace this rank's frames and send each picture, until rank 0 says END.
@@ -830,7 +854,10 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     const SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, base_text, painter != nullptr);
     std::vector<std::unique_ptr<SceneTracer>> tracers;
     for (Model m : stage.models) {
-        tracers.push_back(std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1));
+        TracerOptions options;  // the models' tracers at once share the budget
+        options.window_prisms = slabPrismLimit(settings.max_slab_memory / (long long)stage.models.size());
+        tracers.push_back(
+            std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1, options));
         tracers.back()->setShadeDoppler(settings.shade_doppler);
     }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
@@ -900,7 +927,8 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
-        if (Status s = checkTracedMotions(stage); !s.ok) {
+        const long long memory = video ? settings.max_slab_memory / (long long)stage.models.size() : settings.max_slab_memory;
+        if (Status s = checkTracedMotions(stage, memory); !s.ok) {
             error = s.message;
             code = kExitBadInput;
         }
@@ -957,7 +985,9 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     // Panel i = r * columns + c: row r's model at column c's frame.
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
-        SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi);
+        TracerOptions options;
+        options.window_prisms = slabPrismLimit(settings.max_slab_memory);
+        SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi, options);
         tracer.setShadeDoppler(settings.shade_doppler);
         for (size_t c = 0; c < frames.size(); ++c) {
             auto make = [&](TraceProgress* p) {

@@ -17,6 +17,7 @@
 // through a key's cap, shared by two slabs, takes the one the hierarchy meets first, deterministic).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <iosfwd>
@@ -46,9 +47,13 @@ struct TracedFrame {
 };
 
 // Time slabs (mesh4d/extrude.h) of one object whose motion is not uniform held at once, and the
-// prisms over all of them (memory grows with both).
+// prisms over every such object's slabs, from a memory budget (raytrace and figure
+// --max-slab-memory BYTES) at kTraceBytesPerPrism each: a prism's tetrahedra, caps and its share
+// of the hierarchies, as peak memory grows per prism (docs/PERFORMANCE.md, "Memory of time slabs").
 constexpr size_t kMaxTraceSlabs = 4096;
-constexpr size_t kMaxTraceSlabPrisms = 20000000;
+constexpr long long kTraceBytesPerPrism = 320;
+constexpr long long kDefaultSlabMemory = 2LL << 30;  // one window's slabs: about 6.7M prisms
+inline size_t slabPrismLimit(long long slab_memory) { return size_t(std::max(0LL, slab_memory) / kTraceBytesPerPrism); }
 
 struct TracerOptions {
     bool hierarchy = true;     // false: every prism tested for every ray (the benchmarks' peer, ray4d.h)
@@ -59,6 +64,7 @@ struct TracerOptions {
     // (negative: narrowed), before its ends go out to the slab grid: the tests' generous peer.
     double span_margin = 0;
     size_t window_slabs = kMaxTraceSlabs;  // one object's time slabs held at once (windows, below)
+    size_t window_prisms = slabPrismLimit(kDefaultSlabMemory);  // every object's slabs' prisms at once
 };
 
 class SlabPlanner;
@@ -68,7 +74,7 @@ class SlabPlanner;
 // of it can see in first..last. Motions that are not uniform: time slabs on the motion's slab grid
 // (extrude.h SlabGrid) over the span a window of frames sees (mesh4d/motion/seen.h slabSpanSeen),
 // the window the longest run of frames from the first one traced whose slabs fit in
-// options.window_slabs and kMaxTraceSlabPrisms per object; a frame outside it gets a new window
+// options.window_slabs per object and options.window_prisms over all; a frame outside it gets a new window
 // from that frame. The grid makes a slab the same in every window that holds it, so each frame's
 // picture is the same whichever windows the frames were traced in (and as one window over a short
 // range). A new window keeps the slabs it shares with the last one, and their hierarchies in
@@ -178,6 +184,7 @@ struct RaytraceSettings {
     int threads = 0;
     bool quiet = false;            // no summary, no progress
     bool shade_doppler = false;    // --shade doppler (SceneTracer::setShadeDoppler)
+    long long max_slab_memory = kDefaultSlabMemory;  // --max-slab-memory: one window's time slabs
 };
 
 // `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame and/or one video (exporters/video.h).
@@ -201,6 +208,7 @@ struct FigureSettings {
     int threads = 0;
     bool quiet = false;
     bool shade_doppler = false;    // --shade doppler, as raytrace's (SceneTracer::setShadeDoppler)
+    long long max_slab_memory = kDefaultSlabMemory;  // --max-slab-memory, as raytrace's (the video's models share it)
 };
 
 // The frames a figure shows in its columns: evenly spaced over the scene's frames, first and last included.

@@ -9,6 +9,7 @@
 
 #include "exporters/obj.h"
 #include "exporters/ply.h"
+#include "pipeline/json_limits.h"
 #include "pipeline/mesh_check.h"
 #include "pipeline/shards.h"
 
@@ -52,6 +53,48 @@ std::vector<std::string> inputFiles(const Stage& stage) {
         if (!mesh.empty() && std::find(files.begin(), files.end(), mesh) == files.end()) files.push_back(mesh);
     }
     return files;
+}
+
+std::string hex(uint64_t v) {
+    std::ostringstream os;
+    os << std::hex << v;
+    return os.str();
+}
+
+// Under mpirun, before any frame: every rank's scene bytes, mesh bytes and output settings (the
+// shard fingerprint's parts) compared with rank 0's. The code of the first rank that differs (2)
+// and, on rank 0, its line naming what differs; 0 when all agree.
+int ranksAgree(FrameGroup& group, const RenderSettings& settings, const Stage& stage, std::string* error) {
+    const std::vector<std::string> files = inputFiles(stage);
+    const std::vector<std::string> meshes(files.begin() + 1, files.end());
+    const std::string options = outputSettings(settings, stage);
+    uint64_t scene_print = 0, mesh_print = 0;
+    std::string problem;
+    bool ok = runFingerprint({files.front()}, "", &scene_print, &problem) &&
+              runFingerprint(meshes, "", &mesh_print, &problem);
+    const std::string mine = hex(scene_print) + "\n" + hex(mesh_print) + "\n" + options;
+    const std::string zero = group.broadcast(mine);
+    if (ok && mine != zero) {
+        const std::string rank = "rank " + std::to_string(group.rank());
+        std::istringstream a(mine), b(zero);
+        std::string line_a, line_b;
+        std::getline(a, line_a);
+        std::getline(b, line_b);
+        if (line_a != line_b) {
+            problem = rank + " read another scene than rank 0: " + files.front() + " differs (fingerprint " + line_a +
+                      ", rank 0 " + line_b + ")";
+        } else if (std::getline(a, line_a), std::getline(b, line_b), line_a != line_b) {
+            problem = rank + " read other meshes than rank 0 (fingerprint " + line_a + ", rank 0 " + line_b + ")";
+        } else {
+            while (std::getline(a, line_a) && std::getline(b, line_b) && line_a == line_b) {}
+            problem = rank + " has another output option than rank 0: '" + printable(line_a, 80) + "', rank 0 '" +
+                      printable(line_b, 80) + "'";
+        }
+        problem += "; every rank must read the same scene and meshes and get the same options";
+        ok = false;
+    }
+    *error = problem;
+    return group.agree(ok ? kExitOk : kExitBadInput, error) != 0 ? kExitBadInput : kExitOk;
 }
 
 // In the order the sinks take each frame (the byte budget checks them in this order too).
@@ -99,6 +142,13 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
     if (const int code = group.agree(loaded ? kExitOk : kExitBadInput, &error)) {
         err << "error: " << error << "\n";
         return code;
+    }
+    if (distributed) {
+        std::string problem;
+        if (const int code = ranksAgree(group, settings, stage, &problem)) {
+            err << "error: " << problem << "\n";
+            return code;
+        }
     }
     uint64_t fingerprint = 0;
     if (settings.sharded && !runFingerprint(inputFiles(stage), outputSettings(settings, stage), &fingerprint, &error)) {

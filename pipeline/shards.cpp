@@ -14,119 +14,12 @@
 
 #include "exporters/atomic_file.h"
 #include "pipeline/frame_loop.h"
+#include "pipeline/input_file.h"
 #include "pipeline/stage.h"
 
 namespace apparent {
 
 namespace {
-
-// The file starts with this line, then the header fields, then one record per frame, then the end
-// record with the frame count: a shard cut short (it cannot be: it is renamed into place only when
-// complete) or of another version is refused.
-const std::string kShardMagic = "apparent shard 1\n";
-constexpr uint64_t kFrameRecord = 1, kEndRecord = 2;
-
-void putU64(std::string* out, uint64_t v) {
-    for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));  // little-endian
-}
-void putDouble(std::string* out, double v) {
-    uint64_t bits = 0;
-    std::memcpy(&bits, &v, 8);
-    putU64(out, bits);
-}
-void putString(std::string* out, const std::string& s) {
-    putU64(out, s.size());
-    *out += s;
-}
-
-// Reads the fields back from a stream; the first failure sticks.
-class ShardReader {
-public:
-    explicit ShardReader(std::istream& in) : in_(in) {}
-    uint64_t u64() {
-        unsigned char b[8] = {};
-        if (ok && !in_.read(reinterpret_cast<char*>(b), 8)) ok = false;
-        uint64_t v = 0;
-        for (int i = 0; i < 8; ++i) v |= uint64_t(b[i]) << (8 * i);
-        return ok ? v : 0;
-    }
-    double real() {
-        const uint64_t bits = u64();
-        double v = 0;
-        std::memcpy(&v, &bits, 8);
-        return v;
-    }
-    // At most `limit` bytes (a bound against a corrupt length).
-    std::string bytes(uint64_t limit) {
-        const uint64_t n = u64();
-        if (!ok || n > limit) {
-            ok = false;
-            return {};
-        }
-        std::string s(size_t(n), '\0');
-        if (n && !in_.read(&s[0], std::streamsize(n))) ok = false;
-        return s;
-    }
-    bool ok = true;
-
-private:
-    std::istream& in_;
-};
-
-// The sequence and .glb options a shard was made with: merge builds the same .glb writer from them.
-void putSequence(std::string* out, const SequenceInfo& info, const GlbOptions& o) {
-    putString(out, info.model);
-    putDouble(out, info.tolerance);
-    putDouble(out, info.fps);
-    putString(out, info.scene_path);
-    putU64(out, info.objects.size());
-    for (const ExportObject& e : info.objects) {
-        putString(out, e.name);
-        for (double c : e.base_color) putDouble(out, c);
-        putU64(out, uint64_t(int64_t(e.mirror_index)));
-        putString(out, e.mirror);
-    }
-    for (const mesh4d::Vec3& v : {info.camera.position, info.camera.look_at, info.camera.up})
-        for (double c : {v.x, v.y, v.z}) putDouble(out, c);
-    putDouble(out, info.camera.fov_deg);
-    for (int v : {int(o.draco), o.position_bits, o.normal_bits, int(o.meshopt), o.meshopt_bits, int(o.doppler),
-                  int(o.proper_time), int(o.shade_doppler)})
-        putU64(out, uint64_t(int64_t(v)));
-}
-
-void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o) {
-    constexpr uint64_t kText = 1 << 20;  // names and paths: far below
-    info->model = in->bytes(kText);
-    info->tolerance = in->real();
-    info->fps = in->real();
-    info->scene_path = in->bytes(kText);
-    const uint64_t n = in->u64();
-    if (n > kText) in->ok = false;
-    for (uint64_t i = 0; in->ok && i < n; ++i) {
-        ExportObject e;
-        e.name = in->bytes(kText);
-        for (double& c : e.base_color) c = in->real();
-        e.mirror_index = int(int64_t(in->u64()));
-        e.mirror = in->bytes(kText);
-        info->objects.push_back(e);
-    }
-    for (mesh4d::Vec3* v : {&info->camera.position, &info->camera.look_at, &info->camera.up}) {
-        v->x = in->real();
-        v->y = in->real();
-        v->z = in->real();
-    }
-    info->camera.fov_deg = in->real();
-    int flags[8];
-    for (int& f : flags) f = int(int64_t(in->u64()));
-    o->draco = flags[0] != 0;
-    o->position_bits = flags[1];
-    o->normal_bits = flags[2];
-    o->meshopt = flags[3] != 0;
-    o->meshopt_bits = flags[4];
-    o->doppler = flags[5] != 0;
-    o->proper_time = flags[6] != 0;
-    o->shade_doppler = flags[7] != 0;
-}
 
 class GlbShardSink final : public FrameSink {
 public:
@@ -150,12 +43,12 @@ public:
             return false;
         }
         std::string head = kShardMagic;
-        putU64(&head, fingerprint_);
-        putU64(&head, uint64_t(split_.part));
-        putU64(&head, uint64_t(split_.parts));
-        putU64(&head, uint64_t(first_));
-        putU64(&head, uint64_t(last_excl_));
-        putSequence(&head, info, options_);
+        putShardU64(&head, fingerprint_);
+        putShardU64(&head, uint64_t(split_.part));
+        putShardU64(&head, uint64_t(split_.parts));
+        putShardU64(&head, uint64_t(first_));
+        putShardU64(&head, uint64_t(last_excl_));
+        putShardSequence(&head, info, options_);
         return write(head, error);
     }
     std::shared_ptr<const PreparedFrame> prepare(const ExportFrame& frame) const override { return glb_.prepare(frame); }
@@ -165,14 +58,14 @@ public:
              std::string* error) override {
         const EncodedOutput e = glb_.encode(frame, prepared);
         std::string record;
-        putU64(&record, kFrameRecord);
-        putU64(&record, e.bytes.size());
+        putShardU64(&record, kShardFrameRecord);
+        putShardU64(&record, e.bytes.size());
         return write(record, error) && write(e.bytes, error) && (++frames_, true);
     }
     bool finish(SinkSummary* summary, std::string* error) override {
         std::string end;
-        putU64(&end, kEndRecord);
-        putU64(&end, frames_);
+        putShardU64(&end, kShardEndRecord);
+        putShardU64(&end, frames_);
         if (!write(end, error)) return false;
         if (::fsync(out_->fd()) != 0) {
             *error = path_ + ": cannot write: " + std::strerror(errno);
@@ -212,14 +105,13 @@ private:
 };
 
 // One shard file opened for merging: its header, then frames read one at a time.
-struct OpenShard {
+struct OpenShard : ShardHeader {
     std::string path;
-    std::ifstream in;
-    uint64_t fingerprint = 0;
-    FrameSplit split;
-    long long first = 0, last_excl = 0;
-    SequenceInfo info;
-    GlbOptions options;
+    int fd = -1;
+    std::unique_ptr<ShardReader> in;
+    ~OpenShard() {
+        if (fd >= 0) ::close(fd);
+    }
 };
 
 std::string hex(uint64_t v) {
@@ -302,20 +194,11 @@ int merge(const MergeSettings& settings, std::ostream& log, std::ostream& err) {
     for (const std::string& name : names) {
         auto s = std::make_unique<OpenShard>();
         s->path = name;
-        s->in.open(name, std::ios::binary);
-        std::string magic(kShardMagic.size(), '\0');
-        if (!s->in.read(&magic[0], std::streamsize(magic.size())) || magic != kShardMagic)
-            return refuse(name + ": not a shard file of this version of apparent");
-        ShardReader r(s->in);
-        s->fingerprint = r.u64();
-        const uint64_t part = r.u64(), parts = r.u64();
-        s->first = (long long)r.u64();
-        s->last_excl = (long long)r.u64();
-        getSequence(&r, &s->info, &s->options);
-        if (!r.ok || parts < 1 || parts > uint64_t(kMaxShards) || part >= parts || s->first < 0 ||
-            s->last_excl <= s->first)
-            return refuse(name + ": shard header is malformed");
-        s->split = FrameSplit{int(part), int(parts)};
+        // Only regular files (a FIFO or device named *.shard is refused, never waited on).
+        uint64_t size = 0;
+        if (Status st = openRegularFile(name, &s->fd, &size, "shard file"); !st.ok) return refuse(st.message);
+        s->in = std::make_unique<ShardReader>(s->fd, size);
+        if (Status st = readShardHeader(s->in.get(), name, s.get()); !st.ok) return refuse(st.message);
         if (reference && s->fingerprint != reference->fingerprint)
             return refuse(name + ": from another scene or option set than " + reference->path + " (fingerprint " +
                           hex(s->fingerprint) + ", not " + hex(reference->fingerprint) +
@@ -328,6 +211,10 @@ int merge(const MergeSettings& settings, std::ostream& log, std::ostream& err) {
         const int parts = shards.front()->split.parts;
         std::vector<const OpenShard*> by_part(size_t(parts), nullptr);
         for (const auto& s : shards) {
+            if (s->first != shards.front()->first || s->last_excl != shards.front()->last_excl ||
+                s->sequence != shards.front()->sequence)
+                return refuse(s->path + ": shard header differs from " + shards.front()->path +
+                              "'s (frames, camera, objects or options) under the same fingerprint");
             if (s->split.parts != parts)
                 return refuse(s->path + ": shard " + std::to_string(s->split.part) + "/" + std::to_string(s->split.parts) +
                               ", but " + shards.front()->path + " is one of " + std::to_string(parts) + " shards");
@@ -355,12 +242,25 @@ int merge(const MergeSettings& settings, std::ostream& log, std::ostream& err) {
         const FrameSplit all{0, head.split.parts};
         for (long long k = head.first; k < head.last_excl; ++k) {
             OpenShard& s = *shards[size_t(all.partOf(k, head.first))];
-            ShardReader r(s.in);
+            ShardReader& r = *s.in;
             const uint64_t tag = r.u64();
             EncodedOutput frame;
-            frame.bytes = r.bytes(uint64_t(1) << 40);
-            if (!r.ok || tag != kFrameRecord)
+            if (tag == kShardFrameRecord) frame.bytes = r.bytes(uint64_t(1) << 40);
+            if (r.overlong)
+                return refuse(s.path + ": frame " + std::to_string(k) + "'s record claims more bytes than the file holds");
+            if (!r.ok || tag != kShardFrameRecord)
                 return refuse(s.path + ": incomplete shard: frame " + std::to_string(k) + " is missing");
+            // Each record carries its frame: placed by it, so a gap, a repeat or disorder is refused.
+            long long carried = 0;
+            size_t objects = 0;
+            if (!encodedFrameHead(frame.bytes, &carried, &objects))
+                return refuse(s.path + ": frame " + std::to_string(k) + "'s record is not a frame of a shard");
+            if (carried != k)
+                return refuse(s.path + ": frame record " + std::to_string(carried) + " where frame " +
+                              std::to_string(k) + " belongs (frames missing, repeated or out of order)");
+            if (objects != head.info.objects.size())
+                return refuse(s.path + ": frame " + std::to_string(k) + " has " + std::to_string(objects) +
+                              " objects, the header " + std::to_string(head.info.objects.size()));
             std::vector<std::string> completed;
             if (!sink.addEncoded(k, frame, &completed, &error)) {
                 // A frame the writer cannot read is the shard's fault; a spill-file error is the output's.
@@ -370,10 +270,10 @@ int merge(const MergeSettings& settings, std::ostream& log, std::ostream& err) {
             }
         }
         for (const auto& s : shards) {
-            ShardReader r(s->in);
+            ShardReader& r = *s->in;
             const uint64_t tag = r.u64(), frames = r.u64();
-            if (!r.ok || tag != kEndRecord || frames != uint64_t(s->split.count(s->first, s->last_excl)) ||
-                s->in.peek() != std::char_traits<char>::eof())
+            if (!r.ok || tag != kShardEndRecord || frames != uint64_t(s->split.count(s->first, s->last_excl)) ||
+                r.left() != 0)
                 return refuse(s->path + ": shard does not end after its " +
                               std::to_string(s->split.count(s->first, s->last_excl)) + " frames");
         }

@@ -27,11 +27,11 @@
 
 #include "exporters/gltf.h"
 #include "pipeline/distribute.h"
+#include "pipeline/shard_header.h"
 
 namespace apparent {
 
 // "I/N" with 0 <= I < N <= kMaxShards into `split`; false when it is not one.
-constexpr int kMaxShards = 100000;
 bool parseShard(const std::string& text, FrameSplit* split);
 
 // FNV-1a (64 bits) of the files' bytes and of `settings` (a text listing every setting that changes

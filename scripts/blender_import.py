@@ -14,6 +14,7 @@
 # --save PATH writes the result as a .blend file. Exit status (with --background): 0 done, 1 the import
 # failed, 2 a usage problem.
 import json
+import math
 import os
 import struct
 import sys
@@ -64,21 +65,51 @@ def scene_extras(glb_path):
         length, kind = struct.unpack('<II', head[12:20])
         if kind != 0x4E4F534A:
             fail(1, f'{glb_path}: the first chunk is not JSON')
-        doc = json.loads(f.read(length))
-    scenes = doc.get('scenes') or [{}]
-    return scenes[doc.get('scene', 0)].get('extras') or {}
+        try:
+            doc = json.loads(f.read(length))
+        except (ValueError, RecursionError) as e:
+            fail(1, f'{glb_path}: the JSON chunk is not valid JSON ({str(e)[:80]})')
+    scenes = doc.get('scenes') if isinstance(doc, dict) else None
+    index = doc.get('scene', 0) if isinstance(doc, dict) else 0
+    if scenes is None:
+        return {}
+    if not isinstance(scenes, list) or isinstance(index, bool) or not isinstance(index, int) \
+            or not 0 <= index < len(scenes) or not isinstance(scenes[index], dict):
+        fail(1, f'{glb_path}: "scenes" / "scene" do not name a scene object')
+    extras = scenes[index].get('extras')
+    if extras is None:
+        return {}
+    if not isinstance(extras, dict):
+        fail(1, f'{glb_path}: the scene\'s "extras" is not an object')
+    return extras
 
 
+def shown(value):
+    """A JSON value for a one-line message, cut short."""
+    text = json.dumps(value)
+    return text if len(text) <= 40 else text[:37] + '...'
+
+
+# The extras this script uses, checked: "fps" a finite number > 0 (24 when absent), "frame_times" a list.
 extras = scene_extras(path)
-fps = float(extras.get('fps', 24))
-frames = len(extras.get('frame_times', [])) or 1
+fps = extras.get('fps', 24)
+if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not math.isfinite(fps) or fps <= 0:
+    fail(1, f'{path}: scene extras "fps": {shown(fps)} is not a finite number > 0')
+fps = float(fps)
+frame_times = extras.get('frame_times', [])
+if not isinstance(frame_times, list):
+    fail(1, f'{path}: scene extras "frame_times": {shown(frame_times)} is not a list')
+frames = len(frame_times) or 1
 
 scene = bpy.context.scene
 for obj in list(scene.objects):
     bpy.data.objects.remove(obj, do_unlink=True)
 # Blender's frame rate is fps / fps_base with an integer fps.
-scene.render.fps = max(1, round(fps))
-scene.render.fps_base = scene.render.fps / fps
+try:
+    scene.render.fps = max(1, round(fps))
+    scene.render.fps_base = scene.render.fps / fps
+except (ValueError, TypeError, OverflowError):
+    fail(1, f'{path}: scene extras "fps": {fps:g} is beyond what Blender\'s frame rate holds')
 try:
     result = bpy.ops.import_scene.gltf(filepath=path)
 except RuntimeError as e:

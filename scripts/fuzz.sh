@@ -15,13 +15,13 @@ build=${BUILD_DIR:-build-fuzz}
 jobs=${JOBS:-2}
 seed=${FUZZ_SEED:-1}
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene obj ply gltf glb)
+[ ${#targets[@]} -gt 0 ] || targets=(scene obj ply gltf glb shard)
 # Inputs per target: sized so that build plus all runs take about 6 minutes on 2 cores (the glTF
 # harnesses run about 5 times slower than the others: tinygltf and Draco per input).
-declare -A runs=([scene]=300000 [obj]=200000 [ply]=300000 [gltf]=50000 [glb]=60000)
+declare -A runs=([scene]=300000 [obj]=200000 [ply]=300000 [gltf]=50000 [glb]=60000 [shard]=200000)
 # The JSON readers take inputs up to 1 MiB (deep nesting needs room: 100 000 levels are 200 KB)
 # with a dictionary of nesting tokens; the mesh text formats up to 64 KiB.
-declare -A max_len=([scene]=1048576 [obj]=65536 [ply]=65536 [gltf]=1048576 [glb]=1048576)
+declare -A max_len=([scene]=1048576 [obj]=65536 [ply]=65536 [gltf]=1048576 [glb]=1048576 [shard]=65536)
 declare -A dict=([scene]=json_nesting.dict [gltf]=json_nesting.dict [glb]=json_nesting.dict)
 
 # Debian 12's clang-14 (the package installs clang++-14; the `clang` package adds the clang++ link).
@@ -38,6 +38,9 @@ cmake --build "$build" -j "$jobs" --target $(printf 'fuzz_%s ' "${targets[@]}") 
 
 rm -rf "$build/fuzz-seeds" "$build/fuzz-work"
 python3 tests/fuzz/make_corpus.py "$build/fuzz-seeds" 65536
+# Shards: the committed shards of the tetra fixture (plain, Draco, meshopt with attributes).
+mkdir -p "$build/fuzz-seeds/shard"
+cp tests/fuzz/shard_seeds/*.shard "$build/fuzz-seeds/shard/"
 
 status=0
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}

@@ -473,6 +473,9 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
         for (int a = 0; ok && a < 6; ++a) ok = in.get(&dc.ids[a]);
         ok = ok && in.get(&dc.quantization_error) && in.getVector(&draco_error);
         dc.error.assign(draco_error.begin(), draco_error.end());
+        // What add() writes as it is: finite attributes (a NaN gives an invalid accessor).
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+            ok = ok && std::all_of(v->begin(), v->end(), [](float x) { return std::isfinite(x); });
         // What add() indexes by: whole vertices, indices within them, the meshopt stream's offsets.
         const size_t nv = p.emission.size();
         ok = ok && p.positions.size() == 3 * nv && p.normals.size() == 3 * nv && p.indices.size() % 3 == 0 &&
@@ -482,12 +485,26 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
                                         [&](uint32_t i) { return size_t(i) < p.packed.size() / record; })) &&
              (!impl_->options.meshopt || f.objects[o].triangles.empty() || p.ordered);
     }
-    ok = ok && in.atEnd() && (d.meshopt.first.empty() || d.meshopt.first.size() == d.data.size());
+    ok = ok && in.atEnd() && (d.meshopt.first.empty() || d.meshopt.first.size() == d.data.size()) &&
+         std::isfinite(d.origin[0]) && std::isfinite(d.origin[1]) && std::isfinite(d.origin[2]) &&
+         std::isfinite(d.step) && std::isfinite(d.far) && std::isfinite(f.t_c);
     if (!ok) {
         *error = impl_->path + ": frame data from another process is malformed (frame " + std::to_string(index) + ")";
         return false;
     }
     return add(f, d, error);
+}
+
+bool encodedFrameHead(const std::string& bytes, long long* index, size_t* objects) {
+    FrameBytesIn in(bytes);
+    uint32_t magic = 0;
+    int64_t k = 0;
+    double t_c = 0;
+    uint64_t n = 0;
+    if (!(in.get(&magic) && magic == kFrameBytesMagic && in.get(&k) && in.get(&t_c) && in.get(&n))) return false;
+    *index = k;
+    *objects = size_t(n);
+    return true;
 }
 
 bool GlbSink::encodesAfterPrevious() const {
