@@ -96,8 +96,8 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
 
 // In vertex mode at least 14 bits over E (Draco's and gltfpack's default): E / 16382 rounded down
 // to a power of 2^(1/4) (at most 19% finer), so that frames of slightly different extents share
-// the step and can be morph targets of one another (gltf.h). A quarter octave: a power of two cost
-// the Duck (clipped, so no morph targets) 2% against 0.3%, and an eighth of one the torus 6% more.
+// the step and can be morph targets of one another (gltf.h; why a quarter octave: docs/GLTF.md,
+// "frame coherence").
 double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
     const double finest = extent / 65534.0;
     double step = bits > 0        ? extent / (std::ldexp(1.0, bits) - 2)
