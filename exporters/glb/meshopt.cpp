@@ -97,7 +97,7 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
 // In vertex mode at least 14 bits over E (Draco's and gltfpack's default): E / 16382 rounded down
 // to a power of 2^(1/4) (at most 19% finer), so that frames of slightly different extents share
 // the step and can be morph targets of one another (gltf.h; why a quarter octave: docs/GLTF.md,
-// "frame coherence").
+// "meshopt: where the bytes go").
 double meshoptStep(double extent, double tolerance, int bits, bool* clamped) {
     const double finest = extent / 65534.0;
     double step = bits > 0        ? extent / (std::ldexp(1.0, bits) - 2)
