@@ -14,7 +14,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "pipeline/cli.h"
 #include "pipeline/prepared_object.h"
 #include "pipeline/worlds.h"

@@ -45,7 +45,7 @@
 #include <string>
 
 #include "mesh4d/slice.h"
-#include "mesh4d/subdivide.h"
+#include "mesh4d/refine/subdivide.h"
 #include "test_meshes.h"
 
 namespace {

@@ -14,9 +14,9 @@
 
 #include "mesh4d/extrude.h"
 #include "mesh4d/keyframes.h"
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "mesh4d/slice.h"
-#include "mesh4d/worldline_bound.h"
+#include "mesh4d/refine/worldline_bound.h"
 #include "mesh4d/worldline.h"
 #include "test_meshes.h"
 

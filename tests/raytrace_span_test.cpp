@@ -16,7 +16,7 @@
 
 #include "mesh4d/box.h"
 #include "mesh4d/latest_crossing.h"
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/worldline.h"
 #include "pipeline/physics.h"

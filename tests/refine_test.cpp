@@ -12,14 +12,14 @@
 #include <random>
 #include <thread>
 
-#include "mesh4d/chord_error.h"
-#include "mesh4d/form_bisect.h"
-#include "mesh4d/tessellate.h"
+#include "mesh4d/refine/chord_error.h"
+#include "mesh4d/refine/form_bisect.h"
+#include "mesh4d/refine/tessellate.h"
 #include "mesh4d/robust.h"
-#include "mesh4d/subdivide.h"
+#include "mesh4d/refine/subdivide.h"
 #include "mesh4d/slice.h"
 #include "pipeline/mesh_check.h"
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "test_meshes.h"
 
 using namespace mesh4d;

@@ -47,9 +47,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "boost.h"
-#include "event.h"
-#include "lightcone.h"
+#include "mesh4d/boost.h"
+#include "mesh4d/event.h"
+#include "mesh4d/lightcone.h"
 
 namespace mesh4d {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "keyframes.h"
+#include "mesh4d/keyframes.h"
 #include "worldline_bound.h"
 
 namespace mesh4d {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "key_split.h"
-#include "worldline.h"
+#include "mesh4d/worldline.h"
 #include "worldline_bound.h"
 
 namespace mesh4d {

@@ -1,4 +1,4 @@
-#include "slice.h"
+#include "mesh4d/slice.h"
 
 #include <algorithm>
 #include <array>
@@ -9,13 +9,13 @@
 #include <set>
 #include <unordered_map>
 
-#include "chord_error.h"
-#include "exact_side.h"
-#include "form_bisect.h"
-#include "robust.h"
-#include "tessellate.h"
-#include "worldline.h"
-#include "worldline_refine.h"
+#include "mesh4d/refine/chord_error.h"
+#include "mesh4d/exact_side.h"
+#include "mesh4d/refine/form_bisect.h"
+#include "mesh4d/robust.h"
+#include "mesh4d/refine/tessellate.h"
+#include "mesh4d/worldline.h"
+#include "mesh4d/refine/worldline_refine.h"
 
 namespace mesh4d {
 

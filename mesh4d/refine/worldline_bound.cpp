@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "keyframes.h"
+#include "mesh4d/keyframes.h"
 
 namespace mesh4d {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lanes.h"
+#include "mesh4d/lanes.h"
 
 namespace mesh4d {
 

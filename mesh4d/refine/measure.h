@@ -12,8 +12,8 @@
 
 #include <vector>
 
-#include "slice.h"
-#include "worldline.h"
+#include "mesh4d/slice.h"
+#include "mesh4d/worldline.h"
 
 namespace mesh4d::measure {
 
