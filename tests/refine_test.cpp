@@ -1557,12 +1557,18 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
         }
         int winner, candidates;
         const PieceForm want = form_reference::pieceForm(m, E, s, &winner, &candidates);
-        const PieceForm got = pieceForm(m, E, s);
-        for (int e = 0; e < 3; ++e) {
-            EXPECT_TRUE(form_reference::sameDouble(got.c[e], want.c[e])) << "trial " << trial << " c[" << e << "] " << got.c[e] << " " << want.c[e];
-            EXPECT_TRUE(form_reference::sameDouble(got.centre[e], want.centre[e])) << "trial " << trial << " centre[" << e << "]";
+#if defined(APPARENT_NO_LANES)
+        const PieceForm forms[1] = {pieceForm(m, E, s)};
+#else
+        const PieceForm forms[2] = {pieceForm(m, E, s), pieceFormLanes(m, E, s)};
+#endif
+        for (const PieceForm& got : forms) {
+            for (int e = 0; e < 3; ++e) {
+                EXPECT_TRUE(form_reference::sameDouble(got.c[e], want.c[e])) << "trial " << trial << " c[" << e << "] " << got.c[e] << " " << want.c[e];
+                EXPECT_TRUE(form_reference::sameDouble(got.centre[e], want.centre[e])) << "trial " << trial << " centre[" << e << "]";
+            }
+            EXPECT_EQ(got.finite, want.finite) << "trial " << trial;
         }
-        EXPECT_EQ(got.finite, want.finite) << "trial " << trial;
         finite += want.finite;
         // The reference offers 0, 1 or 4 direct candidates, then the Taylor form when it is bounded.
         const bool taylor = candidates == 2 || candidates == 5;
@@ -1577,6 +1583,9 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
             for (double speed : {m.beta, 0.0, m.beta * (0.5 + w(rng)), -m.beta, double(NAN)}) {
                 const bool expected = form_reference::pieceFormWithin(m, E, s, speed, T);
                 EXPECT_EQ(pieceFormWithin(m, E, s, speed, T), expected) << "trial " << trial << " T " << T << " speed " << speed;
+#if !defined(APPARENT_NO_LANES)
+                EXPECT_EQ(pieceFormWithinLanes(m, E, s, speed, T), expected) << "trial " << trial << " T " << T << " speed " << speed;
+#endif
                 (expected ? within_true : within_false)++;
                 ++checked;
             }
@@ -1594,11 +1603,12 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
     EXPECT_EQ(checked, 6000 * 7 * 5);
 }
 
-// (helper "pairs") edgeBubblePair, the refinement's split making two edges' bounds at once, is
+#if !defined(APPARENT_NO_LANES)
+// edgeBubbleLanes, the refinement's split making two edges' bounds at once, is
 // edgeBubble on each lane bit for bit: random edges near the camera (m_e <= 0, m_e < l) and far,
 // at rest (b = 0) and moving in both kinematics, with NaN and infinite offsets; the scalar
 // edgeBubble is the reference. Each lane's edge is paired with an unrelated one, both orders.
-TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
+TEST(RefinePairs, EdgeBubbleLanesIsEdgeBubbleBitForBit) {
     std::mt19937_64 rng(1313);
     std::uniform_real_distribution<double> unit(-1, 1), w(0, 1);
     auto same = [](double a, double b) { return (a != a && b != b) || std::memcmp(&a, &b, sizeof(double)) == 0; };
@@ -1628,8 +1638,8 @@ TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
         const Vec3 E_used = kind == 6 && (trial / 24) % 5 == 4 ? Vec3{E.x, double(NAN), E.z} : E;
         const EdgeBubble want[2] = {edgeBubble(m, E_used, p[0], p[1]), edgeBubble(m, E_used, p[2], p[3])};
         EdgeBubble got[2], swapped[2];
-        edgeBubblePair(m, E_used, p[0], p[1], p[2], p[3], got);
-        edgeBubblePair(m, E_used, p[2], p[3], p[0], p[1], swapped);
+        edgeBubbleLanes(m, E_used, p[0], p[1], p[2], p[3], got);
+        edgeBubbleLanes(m, E_used, p[2], p[3], p[0], p[1], swapped);
         for (int e = 0; e < 2; ++e) {
             for (const EdgeBubble* g : {&got[e], &swapped[1 - e]}) {
                 EXPECT_TRUE(same(g->c, want[e].c)) << "trial " << trial << " edge " << e << " c " << g->c << " " << want[e].c;
@@ -1655,3 +1665,4 @@ TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
     EXPECT_GT(odd_input, 4000);
     EXPECT_EQ(checked, 20000 * 4);
 }
+#endif

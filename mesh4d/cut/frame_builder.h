@@ -394,8 +394,8 @@ struct FrameBuilder {
         return e;
     }
     [[gnu::noinline]] void makeEdge(REdge& e, uint32_t a, uint32_t b) const;
-    // Two edges' records at once (chord_error.h edgeBubblePair: the same bits as makeEdge's, the
-    // two square-root and division chains side by side).
+    // Two edges' records at once (chord_error.h edgeBubbleLanes, the same bits as makeEdge's;
+    // makeEdge twice with APPARENT_NO_LANES).
     void makeEdgePair(REdge& e0, uint32_t a0, uint32_t b0, REdge& e1, uint32_t a1, uint32_t b1) const;
     static void storeEdge(REdge& e, const EdgeBubble& eb) {
         e.len = eb.length;

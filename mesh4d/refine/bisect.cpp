@@ -45,11 +45,16 @@ void FrameBuilder::makeEdge(REdge& e, uint32_t a, uint32_t b) const {
 }
 
 void FrameBuilder::makeEdgePair(REdge& e0, uint32_t a0, uint32_t b0, REdge& e1, uint32_t a1, uint32_t b1) const {
+#if defined(APPARENT_NO_LANES)
+    makeEdge(e0, a0, b0);
+    makeEdge(e1, a1, b1);
+#else
     EdgeBubble eb[2];
-    edgeBubblePair(world.motion, r_now, r_term_data[std::min(a0, b0)], r_term_data[std::max(a0, b0)],
-                   r_term_data[std::min(a1, b1)], r_term_data[std::max(a1, b1)], eb);
+    edgeBubbleLanes(world.motion, r_now, r_term_data[std::min(a0, b0)], r_term_data[std::max(a0, b0)],
+                    r_term_data[std::min(a1, b1)], r_term_data[std::max(a1, b1)], eb);
     storeEdge(e0, eb[0]);
     storeEdge(e1, eb[1]);
+#endif
 }
 
 uint32_t FrameBuilder::midVertex(uint32_t id, int c) {

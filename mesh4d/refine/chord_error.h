@@ -266,13 +266,13 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
     r.length = std::max(0.0, r.length);
     return r;
 }
-// edgeBubble of two edges at once (a0 -> b0 into out[0], a1 -> b1 into out[1]), bit for bit: each
-// of two SSE2 lanes (chord_error.cpp) makes the same IEEE operations in the same order, both sides
-// of edgeBubble's branches made and the lane's own selected, so the two edges' square roots and
-// divisions overlap instead of waiting on each other. For a caller that needs two edges' bounds at
-// the same point (the refinement's split: the edge's halves, the new interior edges).
-void edgeBubblePair(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
-                    const PointTerms& b1, EdgeBubble out[2]);
+// edgeBubbleLanes: edgeBubble of two edges at once (a0 -> b0 into out[0], a1 -> b1 into out[1]),
+// bit for bit, on the lanes of lanes.h (see "Scalar and lanes" below). For a caller that needs two
+// edges' bounds at the same point (the refinement's split: the edge's halves, the new interior edges).
+#if !defined(APPARENT_NO_LANES)
+void edgeBubbleLanes(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
+                     const PointTerms& b1, EdgeBubble out[2]);
+#endif
 
 // The bound of chordErrorOfTerms from the three edges' coefficients c (c[e] on corners e, e + 1)
 // instead of the measured bubbles, and the corners' shape offsets and |x|_M.
@@ -383,12 +383,13 @@ struct PieceForm {
 // (2) in order (the direct form's mu for each side, then for their sums; the Taylor form), the first
 // with the least bubbleMax on the piece's sides kept; `centre` always made. Not finite when no
 // candidate is bounded (a piece reaching the camera) or a kept coefficient is NaN or +infinity.
-// How (chord_error.cpp): the terms every candidate shares, the direct candidates two at a time in
-// the lanes of an SSE2 register (each lane the scalar arithmetic's operations in its order: the
-// same bits), and a candidate's bubbleMax skipped where its first term (0.25 max c, which
-// bubbleMax never falls below) already loses. Refine.PieceFormsMatchTheReferenceBitForBit
-// compares it with the scalar code of one candidate after the other it replaced.
+// pieceFormLanes is the same, bit for bit, with the direct candidates two at a time on the lanes
+// of lanes.h. Either passes a candidate without its bubbleMax where its first term (bubbleFirst,
+// which bubbleMax never falls below) already loses.
 PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]);
+#if !defined(APPARENT_NO_LANES)
+PieceForm pieceFormLanes(const Motion& m, const Vec3& E, const Vec3 s[3]);
+#endif
 
 // Whether pieceForm(m, E, s) is finite and speed bubbleMax(its c) <= tolerance, without the
 // candidates after the first that passes: the least candidate passes when any does (the product
@@ -396,5 +397,22 @@ PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]);
 // A candidate with speed times its least value over the tolerance fails without its bubbleMax
 // (speed >= 0: rounding is monotonic, and bubbleMax is not below its least).
 bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance);
+#if !defined(APPARENT_NO_LANES)
+bool pieceFormWithinLanes(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance);
+#endif
+
+// ---- Scalar and lanes ----
+// Each bound above with a two-lane form has its scalar form beside it, named X and XLanes
+// (edgeBubble / edgeBubbleLanes, pieceForm / pieceFormLanes, pieceFormWithin / pieceFormWithinLanes;
+// in chord_error.cpp also bubbleMax / bubbleMaxLanes, bubbleFirst / bubbleFirstLanes, directForm /
+// directFormLanes, pieceFormTerms / pieceFormTermsLanes). A lane makes the scalar form's IEEE
+// operations in the same order (both sides of a branch made and the lane's own selected), so the
+// two give the same bits: +, -, *, / and sqrt are correctly rounded, and nothing is contracted
+// (the mesh4d library is compiled with -ffp-contract=off, CMakeLists.txt: a fused multiply-add
+// rounds once where the scalar code rounds twice, and a compiler may fuse in one form and not the
+// other). The refinement calls the lanes forms; the CMake option APPARENT_NO_LANES (a compile
+// definition) removes them and it calls the scalar forms: CI builds both and compares their bytes
+// (scripts/compare_builds.sh), Refine.PieceFormsMatchTheReferenceBitForBit and
+// RefinePairs.EdgeBubbleLanesIsEdgeBubbleBitForBit compare them directly.
 
 }  // namespace mesh4d

@@ -6,7 +6,11 @@ namespace slicing {
 
 bool FrameBuilder::passesByForm(const Vec3& a, const Vec3& b, const Vec3& c) const {
     const Vec3 s[3] = {a, b, c};
+#if defined(APPARENT_NO_LANES)
     return pieceFormWithin(world.motion, r_now, s, bound_speed, settings.tolerance);
+#else
+    return pieceFormWithinLanes(world.motion, r_now, s, bound_speed, settings.tolerance);
+#endif
 }
 
 bool FrameBuilder::forcedTemplatePays(uint32_t id) {
@@ -21,7 +25,11 @@ bool FrameBuilder::coarseForm(uint32_t id, const Vec3 s[3], bool force) {
     std::vector<uint32_t>& form_of = scratch.form_of;
     if (form_of.size() <= id) form_of.resize(std::max<size_t>(r_tri_size, size_t(id) + 1), kUnset);
     form_of[id] = kUnset;
+#if defined(APPARENT_NO_LANES)
     const PieceForm pf = pieceForm(world.motion, r_now, s);
+#else
+    const PieceForm pf = pieceFormLanes(world.motion, r_now, s);
+#endif
     if (!pf.finite) return false;
     const double whole = bubbleMax(pf.c[0], pf.c[1], pf.c[2]);
     const double need = bound_speed * whole / settings.tolerance;
