@@ -481,15 +481,14 @@ struct FrameBuilder {
     // own, or halved on down to pieces below kMinLevel and bisected to the end (the templates
     // then too small a share of the frame's leaves). Its level is now decided at once. On the
     // pieces the bisection made (near the camera, where the halves gain by adapting to the
-    // varying form) the first estimate is kept: with the new one on every piece the box's
-    // closest frame at T = 1e-4 x size made 14 % more triangles, at 2.8e-4 x size 0.86 of
-    // uniform subdivision's (Refine.FewerTrianglesThanUniformSubdivisionAtEqualError: < 0.8).
+    // varying form) the first estimate is kept: the new one on every piece made the box's
+    // closest frame more triangles (Refine.FewerTrianglesThanUniformSubdivisionAtEqualError;
+    // docs/PERFORMANCE.md, "The refinement's costs").
     // A split that would halve a piece marked kCoarse at a level of kKeptLevel or more (the
     // longest-edge path of a neighbour reaching it) is not made: the neighbour is filled by its
     // own template instead (splitLongestPath's guard), so a template, once chosen, stays whole
     // (near the camera the bisection would otherwise cut every template its neighbours reach,
-    // and each piece cut so pays the bisection's records instead of the template's few tens of
-    // instructions per triangle). The neighbour's forced template rounds its level up, and the
+    // and each piece cut so pays the bisection's records instead of the template's). The neighbour's forced template rounds its level up, and the
     // neighbour may be stretched in the form's metric (no shape rule): where that template
     // would make more than kForceRatio times the triangles its bisection is expected to make
     // (its bubbles' bound over T, about the pieces halving down to T leaves), the split is made
@@ -512,10 +511,8 @@ struct FrameBuilder {
     // triangles up; the global bisection would pay its bounds and records per piece); its sides
     // get the counts FormBisection::sideSegments gives (each segment within 3 T / speed by the
     // form), in the same largest-count-around-each-edge rule, so its neighbours conform. Larger
-    // needs are bisected on: their halves soon get grids, far cheaper per triangle (refine_bench
-    // --count under callgrind: with no limit the plate at T = 1e-4, 1e-5 x size cost about 3
-    // times main's instructions per triangle; with the limit at 32 the plate at 1e-3 x size 1.6
-    // times per triangle; at 8 the sphere at 1e-4 x size lost the gain; docs/ACCURACY.md).
+    // needs are bisected on: their halves soon get grids, far cheaper per triangle (the limit's
+    // choice: docs/PERFORMANCE.md, "The refinement's costs").
     // The template makes no record per output triangle; where it is not used (a level below
     // kMinLevel, or more triangles than the halves') the bisection goes on to pieces that
     // pass, which adapts more finely (docs/ACCURACY.md: the constants keep every trade ratio
@@ -691,6 +688,108 @@ struct FrameBuilder {
     // Step: one triangle: whole, refined, or clipped to the span.
     void addTriangle(size_t f);
 };
+
+// ---- Why the steps hold: the reasoning behind the step headings of the .cpp files ----
+// cut/slice.cpp:
+//   - No real cap, nothing culled, every vertex used, the refinement's batch cut made: output vertex
+//     i is the image of vertex i, copied in bulk (the same points vertexPoint emits).
+//   - Visible vertices first, in input order: when nothing is clipped or refined, output vertex i is
+//     the image of input vertex i (unreferenced input vertices aside).
+//   - The camera among the events: h <= t_c - t there; the light has not left any of them yet, or so
+//     little time ago that whatever shows is narrower than the limit.
+//   - The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
+//     may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box)
+//     and at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms
+//     remain. The margin covers the rounding of these bounds (a few ulps of the largest term).
+//   - Model only what the cut requires: on a hyperplane, or at rest, the map from the rest surface
+//     to the apparent one is affine, so straight edges are exact and nothing is refined (at rest
+//     under a shear it is not: chord_error.h displacedChordError).
+//   - At rest on the past cone with a real cap, the caps' clip curves are circles: those alone are
+//     refined (FrameBuilder::restPlan). A motion that is not uniform (worldline.h) is otherwise cut
+//     in vertex mode: exact points on the true worldlines (lightcone.h sends each cut to
+//     crossWorldline).
+//   - A motion that is not uniform, with a tolerance: worldline_refine.h (no real cap; the callers
+//     refuse a tolerance for such an object that begins or ends existing, and a moving camera).
+//   - Step: the fast path of vertex mode when nothing is clipped: output vertex i is the image of
+//     input vertex i and the triangles are the input's (the same result as below, made in one pass).
+//   - Step: the Galilean map into the output frame, origin and local parts apart (each local point
+//     moves by -shear times its local time, a term of the object's size).
+// refine/first_pass.cpp:
+//   - Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
+//     refinement; the others get the a-priori bound (chordErrorOfBubbles).
+//   - The corners' spread (chord_error.h cornerSpread: the largest |u|_M^2 of a triangle's sides)
+//     from each mesh edge's |u|_M^2, made once per edge instead of once per side of each triangle:
+//     |u|_M^2 is even in u (negating u negates its terms exactly), and the largest of three does not
+//     depend on their order, so each triangle's spread is cornerSpread's bit for bit. (With a cull,
+//     per triangle: most edges may be culled.)
+//   - Every triangle passes when the whole mesh does: its largest spread D with the least |x|_M of
+//     all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at most D (both the
+//     same std::max chain from 0 over the same spreads, which skips a NaN) and its xmin at least X
+//     (no xm is NaN), and passesFromSpread is monotone in both as rounded (chord_error.h): fl(4 d2),
+//     fl(xmin xmin) and fl(beta d2) grow with their operand, and fl(3 (1 - beta^2) T) >= 0 is one
+//     factor of xmin. So the verdict is the triangles' own (no candidates), without the pass over
+//     the triangles (with real caps that pass also counts the clipped triangles: it is made then).
+//   - The least |x|_M of all vertices, and their sum: NaN when one is (an infinity of each sign
+//     makes NaN too, and the pass below is only skipped then). (Its own loop: the terms' loop above
+//     stays vectorised.)
+//   - (The arrays and the tolerance read through locals: the compiler cannot tell that
+//     `candidates`'s stores leave them alone, and would load them again per triangle.)
+//   - The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
+//     chordErrorFromCorners' bit for bit, from the one spread both tests use.
+//   - Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits: ends in
+//     id order), when the candidates are enough to pay for the edge records' reset (a large mesh
+//     with a few candidates computes their edges per triangle instead).
+//   - The corners' terms in place (the drain's pointsBound on the same record: the same bits); the
+//     sides' |u|_M^2 are the edges' spreads when made (normM2 of the side either way round: the same
+//     bits, chord_error.h chordErrorOfSides).
+//   - Room for the pieces and points the refinement is expected to make (growth would copy them). At
+//     most a million: reserving is only a saving, never a bound (max_triangles is).
+//   - Still as the mesh has it (only a split changes a record's corners, and it deepens it; a
+//     neighbour's split may have made the record): the first pass's verdict stands, from the same
+//     terms and edge records (edgeOf: the same bits).
+//   - Step: templates only where they make most of the output: else the few coarse pieces are
+//     bisected on like the rest (the templates' pass over every leaf would cost more than it saves).
+//   - The records still coarse, in id order (as a pass over all records would meet them), from the
+//     list of those marked: no pass over every record.
+//   - Step (no real cap): the output's points, once the splits are done: the visible vertices
+//     (classifyVertices, in input order), then the points the splits (and the templates) made, in
+//     room for all of them made once. Without templates the room is exact: each output array is
+//     allocated once per frame and its points copied once. Templates fill the leaves when the splits
+//     left coarse pieces (no real cap: r_templates).
+//   - Step (no real cap): the leaves filled by their templates. (Without a coarse piece every leaf
+//     is its own output triangle: emitted below as they are.)
+//   - Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then the
+//     pieces the splits appended.
+//   - Nothing clipped: every point a split made is a corner of some leaf, so the points follow the
+//     mesh's visible vertices in id order, copied in bulk.
+// refine/bisect.cpp:
+//   - Without a real cap every point is inside and is given its output place in bulk (refineFrame):
+//     side and vertex_out stay the mesh's.
+//   - A piece back on the stack unchanged (its record is reset when it is halved) keeps its verdict:
+//     its bound is not evaluated again.
+//   - The bubbles pass but the third-order term does not: the whole-piece form (tighter near the
+//     camera, chord_error.h pieceForm) may pass the piece as it is.
+//   - (The form is worth making only for a piece that needs a level of kMinLevel or more: its
+//     bubbles alone say about how much.)
+//   - A split of a coarser neighbour first (kSplitOther) leaves id as it was (its edges are shorter
+//     than the edge halved): id is judged again at once, as if pushed back and popped.
+//   - The split would halve a piece a template fills: this piece is filled by its own template
+//     instead (any level its form asks for), so the template stays whole, unless that template would
+//     make more than kForceRatio times the triangles its bisection is expected to (then the split is
+//     made: the template's halves are judged again).
+// refine/templates.cpp:
+//   - Its shape in the form's metric: area over bound, against the equilateral's (the template's
+//     triangles are the piece's shape, scaled).
+//   - A fill's local points 0..2 are the corners, then each side's n[k] - 1 shared points from
+//     side_first(k): both mapped to the frame's point ids (the sides' points in edge order).
+//   - A piece stretched in its form's metric: the bisection in that metric (form_bisect.h), unless
+//     that fails (past cap^2 triangles, or a fan of slivers along a side held to its points): then
+//     the grid below, on the same side counts.
+//   - Step: each record's level, and each edge's count (the largest level around it). The estimate
+//     bounds the output: a leaf makes at most N^2 + 2 + the extra segments of its sides
+//     (tessellate.h), an edge is on about two leaves.
+//   - A form asking for more than max_segments segments gets that many: the tolerance is not met
+//     there, counted as the depth limit is.
 
 }  // namespace slicing
 }  // namespace mesh4d

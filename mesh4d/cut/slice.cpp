@@ -17,8 +17,7 @@ namespace slicing {
 void FrameBuilder::classifyVertices(const std::vector<uint8_t>* live) {
     const size_t nv = world.mesh.positions.size();
     side.assign(nv, Side::Inside);
-    // No real cap, nothing culled, every vertex used, the refinement's batch cut made: output
-    // vertex i is the image of vertex i, copied in bulk (the same points vertexPoint emits).
+    // No real cap, nothing culled, every vertex used, the refinement's batch cut made.
     if (!world.cap_a_real && !world.cap_b_real && !live && world.simple && r_pos.size() == nv && out.positions.empty()) {
         out.positions.assign(r_pos.begin(), r_pos.end());
         out.emission_times.assign(r_time.begin(), r_time.end());
@@ -41,8 +40,7 @@ void FrameBuilder::classifyVertices(const std::vector<uint8_t>* live) {
         else if (world.cap_a_real && viewSideSign(view, world.events[2 * i]) < 0) side[i] = Side::NotYet;
         else if (world.cap_b_real && viewSideSign(view, world.events[2 * i + 1]) > 0) side[i] = Side::Gone;
     }
-    // Visible vertices first, in input order: when nothing is clipped or refined, output
-    // vertex i is the image of input vertex i (unreferenced input vertices aside).
+    // Visible vertices first, in input order.
     for (size_t i = 0; i < nv; ++i)
         if (side[i] == Side::Inside && world.vertex_used[i]) vertexPoint(uint32_t(i));
 }
@@ -73,8 +71,7 @@ double FrameBuilder::hiddenCrossingRatio(const Event* e, const double* h, int n,
     if (view.kind != ViewKind::PastCone) return 0;  // h is affine on a hyperplane
     const double d = dmin - L;
     if (!(d > 0)) {
-        // The camera among the events: h <= t_c - t there; the light has not left any of them
-        // yet, or so little time ago that whatever shows is narrower than the limit.
+        // The camera among the events.
         return tmax <= limit ? 0 : INFINITY;
     }
     const double excess = L * L / ((n == 2 ? 8.0 : 6.0) * d);
@@ -174,10 +171,7 @@ namespace {
 
 using namespace slicing;
 
-// The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
-// may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box) and
-// at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms remain.
-// The margin covers the rounding of these bounds (a few ulps of the largest term).
+// The 4D-box cull of one run of triangles (SliceSettings::cull).
 bool chunkMayShow(const World4D& world, const ViewSurface& view, const TriangleChunk& c) {
     const bool cone = view.kind == ViewKind::PastCone;
     auto distances = [&](const EventBox& b, double* nearest, double* farthest) {
@@ -216,18 +210,12 @@ namespace {
 
 // The cut in the view's own frame (sliceWorld before the shear).
 ApparentMesh sliceUnsheared(const World4D& world, const ViewSurface& view, const SliceSettings& requested) {
-    // Model only what the cut requires: on a hyperplane, or at rest, the map from the rest
-    // surface to the apparent one is affine, so straight edges are exact and nothing is refined
-    // (at rest under a shear it is not: chord_error.h displacedChordError).
+    // Model only what the cut requires.
     SliceSettings settings = requested;
     const bool at_rest = world.motion.beta == 0 && !view.sheared() && !(settings.displacement > 0);
-    // At rest on the past cone with a real cap, the caps' clip curves are circles: those alone
-    // are refined (FrameBuilder::restPlan).
-    // A motion that is not uniform (worldline.h) is otherwise cut in vertex mode: exact points on
-    // the true worldlines (lightcone.h sends each cut to crossWorldline).
+    // At rest on the past cone with a real cap, the caps' clip curves are circles.
     const bool uniform = isUniform(world.motion);
-    // A motion that is not uniform, with a tolerance: worldline_refine.h (no real cap; the callers
-    // refuse a tolerance for such an object that begins or ends existing, and a moving camera).
+    // A motion that is not uniform, with a tolerance.
     if (!uniform && settings.tolerance > 0 && !world.cap_a_real && !world.cap_b_real && !(settings.displacement >= 0) &&
         !world.empty())
         return refineWorldlines(world, view, settings);
@@ -238,8 +226,7 @@ ApparentMesh sliceUnsheared(const World4D& world, const ViewSurface& view, const
     b.rest_clip = rest_clip;
     b.rest_tolerance = requested.tolerance;
     if (world.empty()) return std::move(b.out);
-    // Step: the fast path of vertex mode when nothing is clipped: output vertex i is the image of
-    // input vertex i and the triangles are the input's (the same result as below, made in one pass).
+    // Step: the fast path of vertex mode when nothing is clipped.
     if (settings.tolerance == 0 && !world.cap_a_real && !world.cap_b_real && world.simple) {
         const size_t nv = world.mesh.positions.size(), nt = world.mesh.triangles.size();
         ApparentMesh& out = b.out;
@@ -298,8 +285,7 @@ Vec3 shearedOrigin(const ViewSurface& view, const ViewAnchor& anchor) {
 ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings) {
     ApparentMesh out = sliceUnsheared(world, view, settings);
     if (!view.sheared()) return out;
-    // Step: the Galilean map into the output frame, origin and local parts apart (each local
-    // point moves by -shear times its local time, a term of the object's size).
+    // Step: the Galilean map into the output frame, origin and local parts apart.
     out.origin = out.origin - view.shear * out.time_origin;
     for (size_t i = 0; i < out.positions.size(); ++i) out.positions[i] -= view.shear * out.emission_times[i];
     return out;

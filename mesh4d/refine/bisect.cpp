@@ -25,8 +25,7 @@ uint32_t FrameBuilder::newVertex(const Vec3& rest, uint32_t a, uint32_t b, doubl
     r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
     r_term_data = r_terms.data();
     r_rest.push_back(rest);
-    // Without a real cap every point is inside and is given its output place in bulk
-    // (refineFrame): side and vertex_out stay the mesh's.
+    // Without a real cap every point is inside and is given its output place in bulk.
     if (r_caps) {
         Event cap[2];
         for (int k = 0; k < 2; ++k) {
@@ -152,8 +151,7 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
             const Side s0 = side[v[0]];
             if (s0 != Side::Inside && side[v[1]] == s0 && side[v[2]] == s0) continue;
         }
-        // A piece back on the stack unchanged (its record is reset when it is halved) keeps
-        // its verdict: its bound is not evaluated again.
+        // A piece back on the stack unchanged (its record is reset when it is halved).
         if (state == kPassed || state == kCoarse) continue;
         if (state == kUnknown || state == kBoundFailed) {
             const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
@@ -169,16 +167,14 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
                     rt[id].state = kPassed;
                     continue;
                 }
-                // The bubbles pass but the third-order term does not: the whole-piece form (tighter
-                // near the camera, chord_error.h pieceForm) may pass the piece as it is.
+                // The bubbles pass but the third-order term does not.
                 if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
                     rt[id].state = kPassed;
                     continue;
                 }
                 quadratic = ce.quadratic;
             }
-            // (The form is worth making only for a piece that needs a level of kMinLevel or
-            // more: its bubbles alone say about how much.)
+            // (The form is worth making only for a piece that needs a level of kMinLevel or more).
             if (r_templates && quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
                 coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                 rt[id].state = kCoarse;
@@ -188,8 +184,7 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
             rt[id].state = kFailed;
             if (rt[id].longest < 0) rt[id].longest = int16_t(longestOf(v, e));
         }
-        // A split of a coarser neighbour first (kSplitOther) leaves id as it was (its edges are
-        // shorter than the edge halved): id is judged again at once, as if pushed back and popped.
+        // A split of a coarser neighbour first (kSplitOther) leaves id as it was.
         for (bool again = true; again;) {
             if (rt[id].depth >= r_max_depth) {
                 r_limited[rt[id].src] = 1;
@@ -203,11 +198,7 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
             const int split = splitLongestPath(id, stack);
             again = split == kSplitOther;
             if (split == kSplitBlocked) {
-                // The split would halve a piece a template fills: this piece is filled by its
-                // own template instead (any level its form asks for), so the template stays
-                // whole, unless that template would make more than kForceRatio times the
-                // triangles its bisection is expected to (then the split is made: the
-                // template's halves are judged again).
+                // The split would halve a piece a template fills.
                 const uint32_t* v = rt[id].v;
                 const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};
                 if (coarseForm(id, s, true)) {

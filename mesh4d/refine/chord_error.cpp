@@ -53,10 +53,7 @@ double chordErrorFromCorners(const ViewAnchor& anchor, const Motion& m, const Ev
 
 namespace {
 
-// The terms all of a piece's candidate forms are made from (the quantities of chord_error.h's
-// "The whole-piece bound"): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts across and
-// along y_c^ (|e_perp|^2 and alpha^2) and H(x_c)'s coefficient; the direct form's m, sin^2 theta
-// bound and factor.
+// The terms all of a piece's candidate forms are made from.
 struct PieceFormTerms {
     double k;                  // 1 - b^2
     double xm2, xm;            // |x_c|_M^2, |x_c|_M
@@ -114,13 +111,10 @@ void pieceFormTerms(const Motion& m, const Vec3& E, const Vec3 s[3], PieceFormTe
     finishTerms(t, reach, perp2);
 }
 
-// The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
-// one (mu = 1e-6 and no along term).
+// The direct form's candidates.
 int directCandidates(const PieceFormTerms& t) { return t.b[3] > 0 ? 4 : 1; }
 
-// Candidate j's sides' coefficients c[e] and the least value bubbleMax can give them (bubbleFirst,
-// which bubbleMax returns or exceeds, NaNs alike): a candidate whose least value already loses is
-// never chosen, so its bubbleMax need not be made.
+// Candidate j's sides' coefficients c[e] and the least value bubbleMax can give them.
 void directForm(const PieceFormTerms& t, int j, double c[3], double* least) {
     double mu = 1e-6, fb = 0;
     if (t.b[3] > 0) {
@@ -132,8 +126,7 @@ void directForm(const PieceFormTerms& t, int j, double c[3], double* least) {
     *least = bubbleFirst(c[0], c[1], c[2]);
 }
 
-// The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as
-// directForm's); false when it is unbounded (m_r <= 0).
+// The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value.
 bool taylorForm(const PieceFormTerms& t, const double centre_c[3], double c[3], double* least) {
     const double rM = std::sqrt(t.q);
     const double mlow = t.xm - rM;
@@ -145,9 +138,7 @@ bool taylorForm(const PieceFormTerms& t, const double centre_c[3], double c[3], 
 }
 
 #if !defined(APPARENT_NO_LANES)
-// pieceFormTerms on the lanes of lanes.h: the six steps u two at a time, lanes (d0, d1), (d2, e0),
-// (e1, e2) (d_i = s_i - centre, e = s[e + 1] - s[e]), each lane pieceFormTerms' operations in
-// its order.
+// pieceFormTerms on the lanes of lanes.h.
 void pieceFormTermsLanes(const Motion& m, const Vec3& E, const Vec3 s[3], PieceFormTerms& t) {
     const double k = t.k = m.one_minus_beta2;
     const Vec3 centre = (s[0] + s[1] + s[2]) / 3.0;
@@ -198,8 +189,7 @@ void pieceFormTermsLanes(const Motion& m, const Vec3& E, const Vec3 s[3], PieceF
 Lanes2 bubbleFirstLanes(Lanes2 c01, Lanes2 c12, Lanes2 c20) {
     return Lanes2{0.25, 0.25} * maxLanes(maxLanes(c12, c20), c01);
 }
-// bubbleMax lane by lane (the interior value made in both lanes and selected where the point is
-// inside), from its first term `first` = bubbleFirstLanes(c01, c12, c20), made by the caller.
+// bubbleMax lane by lane (the interior value made in both lanes, selected per lane).
 Lanes2 bubbleMaxLanes(Lanes2 c01, Lanes2 c12, Lanes2 c20, Lanes2 first) {
     const Lanes2 a0 = c12, a1 = c20, a2 = c01;
     const Lanes2 zero = {0, 0};
@@ -225,8 +215,7 @@ void directFormLanes(const PieceFormTerms& t, int j, Lanes2 c[3], Lanes2* least)
 
 }  // namespace
 
-// Step: the candidates in order, the first with the least bubbleMax kept; a candidate whose least
-// value is not below the best so far is passed without its bubbleMax (the same choice).
+// Step: the candidates in order, the first with the least bubbleMax kept.
 PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]) {
     PieceForm r;
     PieceFormTerms t;
@@ -326,8 +315,7 @@ bool pieceFormWithinLanes(const Motion& m, const Vec3& E, const Vec3 s[3], doubl
            passes(c[0], c[1], c[2], bubbleMax(c[0], c[1], c[2]));
 }
 
-// edgeBubble per lane: both branches made and each lane's own selected (me > 0, then me >= l; a
-// NaN compares false in both, as there), the closing min and max as std::min and std::max.
+// edgeBubble per lane.
 void edgeBubbleLanes(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
                      const PointTerms& b1, EdgeBubble out[2]) {
     const double k = m.one_minus_beta2;

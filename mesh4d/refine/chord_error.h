@@ -284,8 +284,8 @@ void edgeBubbleLanes(const Motion& m, const Vec3& E, const PointTerms& a0, const
 // |x_i|_M, which terms(side2) makes only when the bubbles pass (R is needed); chordErrorOfPoints
 // makes them from its corners' terms. A caller that has the lengths already (the refinement's first
 // pass keeps |u|_M^2 per mesh edge, slice.cpp refineFrame) passes them: side2[e] of side e
-// (corners e, e + 1) is normM2 of either direction, the same bits. (Always inlined: left to the
-// compiler, refine_bench --count rows counted 0.1 to 1 % more instructions.)
+// (corners e, e + 1) is normM2 of either direction, the same bits. (Always inlined: the refinement
+// calls it per piece; docs/PERFORMANCE.md, "The refinement's costs".)
 template <class Terms>
 [[gnu::always_inline]] inline ChordError chordErrorOfSides(const Motion& m, double speed, const double c[3],
                                                            Terms terms, double tolerance = INFINITY) {
@@ -305,8 +305,7 @@ template <class Terms>
     return r;
 }
 // (chordErrorOfPoints always inline too: the refinement's drain and first pass call it per piece,
-// and GCC's size budget for the large drain otherwise flips with unrelated edits to it: a call per
-// piece, about 2 % of refine_bench --count 1 3's instructions.)
+// and GCC's size budget for the large drain otherwise flips with unrelated edits to it.)
 [[gnu::always_inline]] inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3],
                                                             const PointTerms& p0, const PointTerms& p1,
                                                             const PointTerms& p2, double tolerance = INFINITY) {
@@ -414,5 +413,28 @@ bool pieceFormWithinLanes(const Motion& m, const Vec3& E, const Vec3 s[3], doubl
 // definition) removes them and it calls the scalar forms: CI builds both and compares their bytes
 // (scripts/compare_builds.sh), Refine.PieceFormsMatchTheReferenceBitForBit and
 // RefinePairs.EdgeBubbleLanesIsEdgeBubbleBitForBit compare them directly.
+
+// ---- Why the steps hold: the reasoning behind the step headings of the .cpp files ----
+// refine/chord_error.cpp:
+//   - The terms all of a piece's candidate forms are made from (the quantities of chord_error.h's
+//     "The whole-piece bound"): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts
+//     across and along y_c^ (|e_perp|^2 and alpha^2) and H(x_c)'s coefficient; the direct form's m,
+//     sin^2 theta bound and factor.
+//   - The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
+//     one (mu = 1e-6 and no along term).
+//   - Candidate j's sides' coefficients c[e] and the least value bubbleMax can give them
+//     (bubbleFirst, which bubbleMax returns or exceeds, NaNs alike): a candidate whose least value
+//     already loses is never chosen, so its bubbleMax need not be made.
+//   - The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as directForm's);
+//     false when it is unbounded (m_r <= 0).
+//   - pieceFormTerms on the lanes of lanes.h: the six steps u two at a time, lanes (d0, d1), (d2,
+//     e0), (e1, e2) (d_i = s_i - centre, e = s[e + 1] - s[e]), each lane pieceFormTerms' operations
+//     in its order.
+//   - bubbleMax lane by lane (the interior value made in both lanes and selected where the point is
+//     inside), from its first term `first` = bubbleFirstLanes(c01, c12, c20), made by the caller.
+//   - Step: the candidates in order, the first with the least bubbleMax kept; a candidate whose
+//     least value is not below the best so far is passed without its bubbleMax (the same choice).
+//   - edgeBubble per lane: both branches made and each lane's own selected (me > 0, then me >= l; a
+//     NaN compares false in both, as there), the closing min and max as std::min and std::max.
 
 }  // namespace mesh4d

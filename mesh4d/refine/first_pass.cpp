@@ -56,8 +56,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
     scratch.coarse.clear();
     if (caps) classifyVertices(live);  // else every side is Inside (classified below, if anything is refined)
 
-    // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
-    // refinement; the others get the a-priori bound (chordErrorOfBubbles).
+    // Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no refinement.
     std::vector<uint32_t>& candidates = scratch.candidates;
     std::vector<uint32_t>& failing = scratch.failing;
     candidates.clear();
@@ -72,26 +71,13 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
     }
     // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
     const bool displaced = view.sheared() || settings.displacement >= 0;
-    // The corners' spread (chord_error.h cornerSpread: the largest |u|_M^2 of a triangle's
-    // sides) from each mesh edge's |u|_M^2, made once per edge instead of once per side of
-    // each triangle: |u|_M^2 is even in u (negating u negates its terms exactly), and the
-    // largest of three does not depend on their order, so each triangle's spread is
-    // cornerSpread's bit for bit. (With a cull, per triangle: most edges may be culled.)
+    // The corners' spread (chord_error.h cornerSpread).
     std::vector<double>& spread = scratch.spread;
     const bool edge_spread = !displaced && !live;
-    // Every triangle passes when the whole mesh does: its largest spread D with the least
-    // |x|_M of all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at
-    // most D (both the same std::max chain from 0 over the same spreads, which skips a NaN)
-    // and its xmin at least X (no xm is NaN), and passesFromSpread is monotone in both as
-    // rounded (chord_error.h): fl(4 d2), fl(xmin xmin) and fl(beta d2) grow with their
-    // operand, and fl(3 (1 - beta^2) T) >= 0 is one factor of xmin. So the verdict is the
-    // triangles' own (no candidates), without the pass over the triangles (with real caps
-    // that pass also counts the clipped triangles: it is made then).
+    // Every triangle passes when the whole mesh does.
     bool whole_passes = false;
     if (edge_spread) {
-        // The least |x|_M of all vertices, and their sum: NaN when one is (an infinity of
-        // each sign makes NaN too, and the pass below is only skipped then). (Its own loop:
-        // the terms' loop above stays vectorised.)
+        // The least |x|_M of all vertices, and their sum.
         double xm_least = INFINITY, xm_sum = 0;
         for (size_t i = 0; i < r_nv; ++i) {
             const double xm = r_terms[i].xm;
@@ -112,8 +98,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
         const double xm_all[3] = {xm_least, xm_least, xm_least};
         whole_passes = !caps && xm_sum == xm_sum && passesFromSpread(d2_most, xm_all, world.motion, settings.tolerance);
     }
-    // (The arrays and the tolerance read through locals: the compiler cannot tell that
-    // `candidates`'s stores leave them alone, and would load them again per triangle.)
+    // (The arrays and the tolerance read through locals).
     const std::array<uint32_t, 3>* const tris = world.mesh.triangles.data();
     const std::array<uint32_t, 3>* const tri_edges = world.triangle_edges.data();
     const VTerms* const corner_terms = r_terms.data();
@@ -128,8 +113,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
             if (s0 != Side::Inside && side[t[1]] == s0 && side[t[2]] == s0) continue;  // wholly before or after
             if (s0 != Side::Inside || side[t[1]] != Side::Inside || side[t[2]] != Side::Inside) ++out.clipped_triangles;
         }
-        // The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
-        // chordErrorFromCorners' bit for bit, from the one spread both tests use.
+        // The terms are the corners' own (shapeOfEvent, normMOfEvent).
         if (!displaced) {
             const double xc[3] = {corner_terms[t[0]].xm, corner_terms[t[1]].xm, corner_terms[t[2]].xm};
             double d2;
@@ -145,9 +129,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
         }
         candidates.push_back(uint32_t(f));
     }
-    // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits:
-    // ends in id order), when the candidates are enough to pay for the edge records' reset
-    // (a large mesh with a few candidates computes their edges per triangle instead).
+    // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits).
     const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
     if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
     REdge* const kept = keep_edges ? r_edges.data() : nullptr;
@@ -169,9 +151,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
                 c[k] = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]).c;
             }
         }
-        // The corners' terms in place (the drain's pointsBound on the same record: the same
-        // bits); the sides' |u|_M^2 are the edges' spreads when made (normM2 of the side
-        // either way round: the same bits, chord_error.h chordErrorOfSides).
+        // The corners' terms in place (the drain's pointsBound on the same record).
         const auto& t = world.mesh.triangles[f];
         const VTerms &k0 = terms[t[0]], &k1 = terms[t[1]], &k2 = terms[t[2]];
         ChordError ce;
@@ -206,7 +186,6 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
         return;
     }
     // Room for the pieces and points the refinement is expected to make (growth would copy them).
-    // At most a million: reserving is only a saving, never a bound (max_triangles is).
     size_t expect = size_t(std::min(2 * expected_pieces, 1e6));
     if (settings.max_triangles > 0) expect = std::min(expect, settings.max_triangles);
 
@@ -235,24 +214,19 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
         std::vector<uint32_t>& stack = scratch.stack;
         for (uint32_t f : failing) {
             ensureBase(f);
-            // Still as the mesh has it (only a split changes a record's corners, and it
-            // deepens it; a neighbour's split may have made the record): the first pass's
-            // verdict stands, from the same terms and edge records (edgeOf: the same bits).
+            // Still as the mesh has it (only a split changes a record's corners, and it deepens it).
             if (rt[f].depth == 0 && rt[f].state == kUnknown) rt[f].state = kBoundFailed;
             stack.push_back(f);
             drain(stack);
         }
-        // Step: templates only where they make most of the output: else the few coarse
-        // pieces are bisected on like the rest (the templates' pass over every leaf would
-        // cost more than it saves).
+        // Step: templates only where they make most of the output.
         if (r_templates && !scratch.forms.empty() && !out.over_budget) {
             const uint32_t cap = uint32_t(std::max(settings.max_segments, 2));
             double templated = 0;
             auto share = [&](uint32_t id) {
                 if (rt[id].state == kCoarse) templated += fillEstimate(scratch.form_of[id], cap);
             };
-            // The records still coarse, in id order (as a pass over all records would meet
-            // them), from the list of those marked: no pass over every record.
+            // The records still coarse, in id order (as a pass over all records would meet them).
             std::vector<uint32_t>& coarse = scratch.coarse;
             std::sort(coarse.begin(), coarse.end());
             coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
@@ -270,11 +244,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
             }
         }
     }
-    // Step (no real cap): the output's points, once the splits are done: the visible vertices
-    // (classifyVertices, in input order), then the points the splits (and the templates) made,
-    // in room for all of them made once. Without templates the room is exact: each output
-    // array is allocated once per frame and its points copied once.
-    // Templates fill the leaves when the splits left coarse pieces (no real cap: r_templates).
+    // Step (no real cap): the output's points, once the splits are done.
     const bool filling = r_templates && !failing.empty() && !out.over_budget && !scratch.forms.empty();
     if (!caps) {
         const size_t points = r_nv + (filling ? std::max(r_rest.size(), expect) : r_rest.size());
@@ -284,7 +254,6 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
         classifyVertices(live);
     }
     // Step (no real cap): the leaves filled by their templates.
-    // (Without a coarse piece every leaf is its own output triangle: emitted below as they are.)
     const bool templated = filling && templateLeaves();
     if (!failing.empty()) {
         for (uint8_t l : r_limited) out.limited_triangles += l;
@@ -295,11 +264,9 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
         cutRestLocalBatch(anchor, world.motion, r_rest.data(), n_new, r_pos.data() + r_nv, r_time.data() + r_nv);
     }
 
-    // Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then
-    // the pieces the splits appended.
+    // Step: the leaves in record order.
     if (!caps) {
-        // Nothing clipped: every point a split made is a corner of some leaf, so the points
-        // follow the mesh's visible vertices in id order, copied in bulk.
+        // Nothing clipped: every point a split made is a corner of some leaf.
         const size_t base = out.positions.size(), n_new = r_rest.size();
         out.positions.insert(out.positions.end(), r_pos.begin() + r_nv, r_pos.begin() + r_nv + n_new);
         out.emission_times.insert(out.emission_times.end(), r_time.begin() + r_nv, r_time.begin() + r_nv + n_new);

@@ -33,16 +33,11 @@ bool FrameBuilder::coarseForm(uint32_t id, const Vec3 s[3], bool force) {
     if (!pf.finite) return false;
     const double whole = bubbleMax(pf.c[0], pf.c[1], pf.c[2]);
     const double need = bound_speed * whole / settings.tolerance;
-    // Its shape in the form's metric: area over bound, against the equilateral's (the
-    // template's triangles are the piece's shape, scaled).
+    // Its shape in the form's metric.
     const double cuv = 0.5 * (pf.c[0] + pf.c[2] - pf.c[1]);
     const double area = std::sqrt(std::max(0.0, pf.c[0] * pf.c[2] - cuv * cuv));
     const bool shaped = area >= kShapeShare * kEquilateral * whole;
-    // A piece the grid would fill with stretched triangles, and that needs at most
-    // kAnisoMaxNeed, is filled by the bisection in the form's metric (form_bisect.h) instead:
-    // about kAnisoCost times its need. (Larger ones are bisected on: their halves soon have
-    // a shape the grid fills at a few tens of instructions per triangle, against the local
-    // bisection's few hundred.)
+    // Step: a stretched piece of need at most kAnisoMaxNeed: the form bisection (form_bisect.h).
     const double xa = std::ceil(std::sqrt(need));
     const bool aniso = !shaped && need <= kAnisoMaxNeed;
     if (!force) {
@@ -130,8 +125,7 @@ void FrameBuilder::fillLeaf(uint32_t src, const uint32_t v[3], const uint32_t e[
         tf.limit = settings.tolerance / bound_speed;
     }
     std::vector<std::array<uint32_t, 3>>& local = scratch.local;
-    // A fill's local points 0..2 are the corners, then each side's n[k] - 1 shared points from
-    // side_first(k): both mapped to the frame's point ids (the sides' points in edge order).
+    // A fill's local points 0..2 are the corners, then each side's n[k] - 1 shared points.
     auto mapCornersAndSides = [&](std::vector<uint32_t>& map, auto side_first) {
         for (int k = 0; k < 3; ++k) map[size_t(k)] = v[k];
         for (int k = 0; k < 3; ++k) {
@@ -142,9 +136,7 @@ void FrameBuilder::fillLeaf(uint32_t src, const uint32_t v[3], const uint32_t e[
                 map[side_first(k) + uint32_t(i - 1)] = first + uint32_t(a < b ? i - 1 : n[k] - i - 1);
         }
     };
-    // A piece stretched in its form's metric: the bisection in that metric (form_bisect.h),
-    // unless that fails (past cap^2 triangles, or a fan of slivers along a side held to its
-    // points): then the grid below, on the same side counts.
+    // A piece stretched in its form's metric.
     if (aniso && form) {
         FormBisection& fb = scratch.bisection;
         if (fb.fill(tf, n, size_t(cap) * size_t(cap), local)) {
@@ -209,8 +201,6 @@ bool FrameBuilder::templateLeaves() {
     std::vector<uint32_t>& form_of = scratch.form_of;
     if (form_of.size() < r_tri_size) form_of.resize(r_tri_size, kUnset);
     // Step: each record's level, and each edge's count (the largest level around it).
-    // The estimate bounds the output: a leaf makes at most N^2 + 2 + the extra segments of its
-    // sides (tessellate.h), an edge is on about two leaves.
     double estimate = 0;
     r_level_scale = 1;
     auto levelPass = [&](uint32_t id) {
@@ -224,8 +214,7 @@ bool FrameBuilder::templateLeaves() {
         if (form_of[id] == kUnset) return;
         const PieceForm& pf = scratch.forms[form_of[id]];
         const uint32_t n = formLevel(pf, cap);
-        // A form asking for more than max_segments segments gets that many: the tolerance is
-        // not met there, counted as the depth limit is.
+        // A form asking for more than max_segments segments gets that many.
         if (n == cap && formLevel(pf, kNoCap) > cap) r_limited[t.src] = 1;
         if (scratch.form_aniso[form_of[id]] && !out.over_budget) {
             // The bisection's sides: each cut so that its segments pass alone (form_bisect.h).
