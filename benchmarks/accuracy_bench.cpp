@@ -1,7 +1,7 @@
 // The speed-accuracy trade of the tolerance (issue: accuracy on a dial). For each scene and each
 // tolerance T (vertex mode first, then T = 1e-1 ... 1e-6 times the object size) it times the cut
 // of one frame and reports, as counters, the output triangles and the measured maximum error in
-// both directions (mesh4d/measure.h: output -> exact surface and exact surface -> output).
+// both directions (mesh4d/refine/measure.h: output -> exact surface and exact surface -> output).
 //
 //   flanges: data/scenes/flanges.json, relativistic, frame 100 (the flanges crossing the
 //            centreline); size = the flange's diagonal, sqrt(2^2 + 4^2 + 2^2) light-seconds.
@@ -14,7 +14,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "pipeline/cli.h"
 #include "pipeline/prepared_object.h"
 #include "pipeline/worlds.h"

@@ -18,7 +18,7 @@
 //   sphere:   the 320-face icosphere of radius 1 passing 4 ls away at 0.9c, size = its diameter 2.
 //   plate:    a flange-like plate (2 x 4 ls, 4 triangles about its centre) 18.675 ls away at 0.866c,
 //             seen at closest approach, size = its diagonal sqrt 20: pieces far from the camera,
-//             which the refinement fills with templates (mesh4d/tessellate.h).
+//             which the refinement fills with templates (mesh4d/refine/tessellate.h).
 //
 // Instruction counts (repeatable on a shared machine, unlike times): `refine_bench --count SCENE K`
 // (SCENE: 0 or box, 1 or sphere320, 2 or plate)
@@ -45,7 +45,7 @@
 #include <string>
 
 #include "mesh4d/slice.h"
-#include "mesh4d/subdivide.h"
+#include "mesh4d/refine/subdivide.h"
 #include "test_meshes.h"
 
 namespace {

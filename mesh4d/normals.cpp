@@ -8,7 +8,9 @@
 #include <tbb/parallel_reduce.h>
 
 #include "angles.h"
+#if !defined(APPARENT_NO_LANES)
 #include "lanes.h"
+#endif
 
 namespace mesh4d {
 
@@ -20,12 +22,23 @@ Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
 
 constexpr size_t kGrain = 16384;  // elements per parallel task
 
-// v / norm(v) for two vectors at once, bit for bit what the scalar code gives: norm() is
-// std::hypot(x, y, z), which libstdc++ computes as a * sqrt((x/a)^2 + (y/a)^2 + (z/a)^2) with a
-// the largest magnitude (0 when a is 0), and every step here is the same IEEE operation in the
-// same order on the lanes of lanes.h (no contraction: -ffp-contract=off, CMakeLists.txt).
-// `length` receives the norms.
-void unitPair(Lanes2 x, Lanes2 y, Lanes2 z, Lanes2* ux, Lanes2* uy, Lanes2* uz, Lanes2* length) {
+// v / |v| and |v| (length), |v| as libstdc++'s std::hypot(x, y, z) computes norm(): a sqrt((x/a)^2 +
+// (y/a)^2 + (z/a)^2) with a the largest magnitude (0 when a is 0; v / 1 then).
+Vec3 unitOf(const Vec3& v, double* length) {
+    const double ax = std::fabs(v.x), ay = std::fabs(v.y), az = std::fabs(v.z);
+    const double a = ax < ay ? (ay < az ? az : ay) : (ax < az ? az : ax);
+    const bool is_zero = a == 0;
+    const double safe = is_zero ? 1 : a;
+    const double qx = ax / safe, qy = ay / safe, qz = az / safe;
+    const double len = safe * std::sqrt(qx * qx + qy * qy + qz * qz);
+    *length = is_zero ? 0 : len;
+    const double d = is_zero ? 1 : len;
+    return {v.x / d, v.y / d, v.z / d};
+}
+
+#if !defined(APPARENT_NO_LANES)
+// unitOf for two vectors at once, each lane unitOf's operations in its order (lanes.h).
+void unitOfLanes(Lanes2 x, Lanes2 y, Lanes2 z, Lanes2* ux, Lanes2* uy, Lanes2* uz, Lanes2* length) {
     const Lanes2Mask sign = {(long long)0x8000000000000000ull, (long long)0x8000000000000000ull};
     auto abs = [&](Lanes2 v) { return (Lanes2)((Lanes2Mask)v & ~sign); };
     const Lanes2 ax = abs(x), ay = abs(y), az = abs(z);
@@ -42,6 +55,7 @@ void unitPair(Lanes2 x, Lanes2 y, Lanes2 z, Lanes2* ux, Lanes2* uy, Lanes2* uz, 
     *uy = y / d;
     *uz = z / d;
 }
+#endif
 
 // The per-vertex step of creaseSplitMap: whether a vertex's faces are all within the crease
 // angle of one another (the vertex then has one normal), and the sum of their area vectors in CSR
@@ -106,11 +120,21 @@ struct VertexPass {
             uniform[v] = 1;
             normal[i] = sum;  // normalized below
         }
+#if defined(APPARENT_NO_LANES)
+        for (size_t i = lo; i < hi; ++i) {
+            const uint32_t v = order ? order[i] : uint32_t(i);
+            if (!uniform[v]) continue;
+            double len;
+            const Vec3 u = unitOf(normal[i], &len);
+            if (!(len > 0)) uniform[v] = 0;  // a zero sum: each corner falls back to its own face
+            else normal[i] = u;
+        }
+#else
         for (size_t i = lo; i < hi; i += 2) {
             const size_t j = std::min(i + 1, hi - 1);  // an odd end repeats its last vertex
             const Vec3 s0 = normal[i], s1 = normal[j];
             Lanes2 x = {s0.x, s1.x}, y = {s0.y, s1.y}, z = {s0.z, s1.z}, ux, uy, uz, len;
-            unitPair(x, y, z, &ux, &uy, &uz, &len);
+            unitOfLanes(x, y, z, &ux, &uy, &uz, &len);
             for (int k = 0; k < 2; ++k) {
                 const size_t at = k == 0 ? i : j;
                 const uint32_t v = order ? order[at] : uint32_t(at);
@@ -119,6 +143,7 @@ struct VertexPass {
                 else normal[at] = {ux[k], uy[k], uz[k]};
             }
         }
+#endif
     }
 };
 }  // namespace

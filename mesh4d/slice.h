@@ -68,16 +68,10 @@
 // order (each input triangle, or the piece of it that kept its record, then the pieces the splits
 // appended; a templated piece gives its template's triangles in its place).
 // Cost: per output triangle of the bisection about two edge bounds, one and a fifth triangle
-// bounds, half a split (its point's square root and the slot bookkeeping) and the output; about
-// 1230 to 1350 instructions against about 65 in vertex mode (callgrind, docs/ACCURACY.md, "Cost
-// per output triangle", "Coarse tolerances near the camera"), of which the two bounds are about
-// 400 and the records and the loop about 700. A templated piece costs one form and its grid: a
-// few tens of instructions per output triangle besides its share of the batched cut (200 to 350
-// per output triangle where templates make most of the output, the box 2 ls from the camera at
-// T = 1e-4, 1e-5 x size included). A piece filled by the bisection in its form's metric costs a
-// few hundred instructions per output triangle; the stretched pieces it stops early also let the
-// other pieces keep their templates (the 320-face sphere 4 ls away at T = 1e-4 x size: 423
-// instructions per output triangle in all, against 1319 when every piece was bisected).
+// bounds, half a split (its point's square root and the slot bookkeeping) and the output; a
+// templated piece one form and its grid besides its share of the batched cut; a piece filled by
+// the bisection in its form's metric in between (figures: docs/PERFORMANCE.md, "The refinement's
+// costs").
 // The working arrays (a few hundred bytes per output triangle) are kept by each thread from frame to
 // frame, so a frame reuses the memory of the one before; a thread frees them after a frame that
 // grew them past 256 MiB.

@@ -37,7 +37,7 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     return m;
 }
 
-// A tolerance is bounded for the motions beyond uniform (mesh4d/worldline_refine.h), but not the
+// A tolerance is bounded for the motions beyond uniform (mesh4d/refine/worldline_refine.h), but not the
 // clip curve where the object begins or ends existing within the frames (a real cap of its world),
 // nor the reflections of such an object (pipeline/mirror.h: their worlds may have real caps where
 // the object's own has none, and would be cut in vertex mode). `field` names the object's field,

@@ -23,7 +23,7 @@ mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
 
 // What an object's motion beyond uniform (angular_velocity or acceleration, mesh4d/motion/worldline.h)
 // needs, one line naming file, field and problem when refused: not both; a camera at rest; a
-// tolerance (mesh4d/worldline_refine.h) only for an object that exists throughout the frames (no
+// tolerance (mesh4d/refine/worldline_refine.h) only for an object that exists throughout the frames (no
 // real cap) and in a scene without a mirror, else vertex mode (tolerance 0). Spin: |w| <= 1e12 rad/s, every vertex slower than light, |w x q| < 1 in the centre frame
 // (relativistic, contracted), |velocity + w x q| < 1 in the lab at every angle (finite); instant
 // has no limit. Acceleration: |a| in [1e-12, 1e12], every vertex ahead of the Born-rigid horizon

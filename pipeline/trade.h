@@ -5,11 +5,11 @@
 //   vertex     exact vertices joined by straight edges (--tolerance vertex, what per-vertex
 //              engines do);
 //   uniform k  every input triangle split 4-to-1 at its edge midpoints k times, then vertex mode
-//              (mesh4d/subdivide.h: OpenRelativity's ObjectMeshDensity), k = 1 .. --levels;
+//              (mesh4d/refine/subdivide.h: OpenRelativity's ObjectMeshDensity), k = 1 .. --levels;
 //   T          the adaptive refinement at tolerance T (slice.h), a ladder of T = 1e-1, 3e-2,
 //              1e-2, ... 1e-4 x the largest moving object's size (its bounding-box diagonal;
 //              objects at rest are never refined).
-// Each row reports the measured two-sided error (mesh4d/measure.h: sampled output points against
+// Each row reports the measured two-sided error (mesh4d/refine/measure.h: sampled output points against
 // the exact surface and exact-surface lattice points against the output, the largest over the
 // objects and frames), output triangles per frame, the time of the cut per frame (all objects,
 // refinement included, repeated until at least 2 ms are timed; CPU time of the thread, so that

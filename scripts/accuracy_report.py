@@ -96,12 +96,12 @@ def method_block(trade_dir):
             when = f" ({text})"
     return ["Measured by `scripts/accuracy_report.sh`" + when + ": `apparent trade` on each scene (5 frames spread "
             "over the sequence, one thread, times in CPU time of the thread), tables in `docs/trade/<scene>/table.txt` "
-            "and `trade.csv`. Each row: the measured two-sided error (`mesh4d/measure.h`: 12 samples of every output "
+            "and `trade.csv`. Each row: the measured two-sided error (`mesh4d/refine/measure.h`: 12 samples of every output "
             "triangle against the exact surface, and 45 exact-surface points of every input triangle against the "
             "output; the largest over objects and frames), triangles per frame (mean), the cut (refinement included) "
             "and the .glb conversion per frame (normals, float32: the writer's per-frame work), and .glb bytes per "
             "frame. *Uniform k* splits every input triangle 4-to-1 k times, then vertex mode: what per-vertex engines "
-            "do. *T* is `--tolerance T`, the adaptive refinement (`mesh4d/slice.h`, bound in `mesh4d/chord_error.h`). "
+            "do. *T* is `--tolerance T`, the adaptive refinement (`mesh4d/slice.h`, bound in `mesh4d/refine/chord_error.h`). "
             "Size = the largest moving object's bounding-box diagonal."]
 
 

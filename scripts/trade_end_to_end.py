@@ -3,7 +3,7 @@
 trade scene (every frame, one thread, .glb) with the input subdivided uniformly k times (--tolerance vertex,
 what per-vertex engines do) against the original input at --tolerance = the error uniform level k measured
 (docs/trade/<scene>/trade.csv, written by scripts/accuracy_report.sh). The subdivided meshes go to a temporary
-folder (4-to-1 splits at edge midpoints, as mesh4d/subdivide.h).
+folder (4-to-1 splits at edge midpoints, as mesh4d/refine/subdivide.h).
 
 Timing on a shared machine: the CPU time (user + system) of the child process, so time spent waiting for a
 core is left out; every run of a row is alternated with the others of the row (uniform, tolerance, and each

@@ -415,7 +415,7 @@ TEST(Keyframes, ShippedSceneRenders) {
     }
 }
 
-// A tolerance for a keyframed object is taken (mesh4d/worldline_refine.h, key_split.h): the scene's
+// A tolerance for a keyframed object is taken (mesh4d/refine/worldline_refine.h, key_split.h): the scene's
 // "1e-2x" loads, and the frames where the emission times cross the corner key at t = 1 s are refined
 // (more triangles than the box's 12, each on one of them), the box's output closed in every frame.
 TEST(Keyframes, ToleranceModeRefinesAcrossTheCorner) {

@@ -1,4 +1,4 @@
-// Tolerance mode for motions that are not uniform (issue 18; mesh4d/worldline_refine.h): the
+// Tolerance mode for motions that are not uniform (issue 18; mesh4d/refine/worldline_refine.h): the
 // two-sided distance between the refined output and the exact apparent surface stays within T,
 // the exact surface computed here from the true worldlines with kinematics of this file's own (a
 // rotation written out, a Lorentz boost as a matrix, Born-rigid hyperbolas, the crossing by plain
@@ -14,10 +14,10 @@
 
 #include "mesh4d/extrude.h"
 #include "mesh4d/motion/keyed.h"
-#include "mesh4d/measure.h"
-#include "mesh4d/slice.h"
-#include "mesh4d/worldline_bound.h"
 #include "mesh4d/motion/worldline.h"
+#include "mesh4d/refine/measure.h"
+#include "mesh4d/refine/worldline_bound.h"
+#include "mesh4d/slice.h"
 #include "test_meshes.h"
 
 using mesh4d::Event;
@@ -656,7 +656,7 @@ TEST(MotionTolerance, RigidBoundAboveSecondDerivative) {
     std::printf("[ tolerance ] launched rocket: largest |F..| / K on the sampled lines %.3f\n", tight);
 }
 
-// ---- The measure of `apparent trade` on motions beyond uniform (mesh4d/measure.h) ----
+// ---- The measure of `apparent trade` on motions beyond uniform (mesh4d/refine/measure.h) ----
 
 // measure.h's own root search (crossingBySearch) against the retarded event of hyperbolic motion in
 // closed form: a Born-rigid body accelerated along x from rest at t0 = 0, camera on the x axis.

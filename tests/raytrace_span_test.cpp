@@ -3,7 +3,7 @@
 // rocket of data/scenes/rocket.json (a Born-rigid box 2 ls long at 0.5 ls/s^2, whose frames
 // see interior points of its faces emit after every vertex) and a turned torus, boosted and
 // accelerated obliquely.
-// Crossings come from mesh4d/measure.h crossingBySearch (its own bisection on the true worldline),
+// Crossings come from mesh4d/refine/measure.h crossingBySearch (its own bisection on the true worldline),
 // their object time s from the test's inverse of the motion.
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 #include "mesh4d/box.h"
 #include "mesh4d/motion/latest_crossing.h"
 #include "mesh4d/motion/seen.h"
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/motion/worldline.h"
 #include "pipeline/physics.h"

@@ -2,7 +2,7 @@
 // directions and use it (the measured error is at least half of it), refine only where the surface
 // is curved and only there, beat uniform subdivision at equal error, stay watertight, and
 // reproduce Penrose's circular outline of a relativistic sphere. The bound itself
-// (mesh4d/chord_error.h) is checked against brute-force maxima.
+// (mesh4d/refine/chord_error.h) is checked against brute-force maxima.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -12,14 +12,14 @@
 #include <random>
 #include <thread>
 
-#include "mesh4d/chord_error.h"
-#include "mesh4d/form_bisect.h"
-#include "mesh4d/tessellate.h"
+#include "mesh4d/refine/chord_error.h"
+#include "mesh4d/refine/form_bisect.h"
+#include "mesh4d/refine/tessellate.h"
 #include "mesh4d/robust.h"
-#include "mesh4d/subdivide.h"
+#include "mesh4d/refine/subdivide.h"
 #include "mesh4d/slice.h"
 #include "pipeline/mesh_check.h"
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "test_meshes.h"
 
 using namespace mesh4d;
@@ -681,7 +681,7 @@ TEST(Refine, FramesDoNotDependOnTheFramesBefore) {
     EXPECT_GE(clipped, 1u);
 }
 
-// The template (mesh4d/tessellate.h) is a triangulation of its piece for any side counts and
+// The template (mesh4d/refine/tessellate.h) is a triangulation of its piece for any side counts and
 // level: every triangle counter-clockwise, areas summing to the piece's, every side point and
 // inner point used; with every count equal to the level it is the regular grid (N^2 triangles,
 // each the piece scaled by 1/N or its point reflection: the same bound).
@@ -753,7 +753,7 @@ TEST(Refine, TemplateRingIsCheckedAgainstTheLimit) {
     EXPECT_GT(refused, 10);
 }
 
-// The anisotropic fill (mesh4d/form_bisect.h): on random stretched forms and side counts it
+// The anisotropic fill (mesh4d/refine/form_bisect.h): on random stretched forms and side counts it
 // tiles its piece (positive areas summing to the piece's), every triangle is within the limit by
 // the form (computed here from the params, not by the fill), every side point is used, and each
 // side is covered by exactly its n[k] equal segments (what the neighbour piece has: no
@@ -1141,7 +1141,7 @@ TEST(Refine, KeptTemplatesNearTheCameraStayClosedAndWithinTolerance) {
     }
 }
 
-// The pieces filled by bisection in their form's metric (mesh4d/form_bisect.h, slice.cpp
+// The pieces filled by bisection in their form's metric (mesh4d/refine/form_bisect.h, slice.cpp
 // kAnisoMaxNeed): the 320-face sphere passing 4 ls from the camera at 0.9c, at closest approach,
 // T = 1e-4 and 2e-4 x size (size 2: refine_bench's sphere; at 1e-4 the fill makes 5604 triangles
 // where the global bisection made 5490, docs/ACCURACY.md). The output stays closed, genus 0, one
@@ -1222,7 +1222,7 @@ TEST(Refine, FarPlateNoMoreTrianglesThanUniformAtEqualError) {
 // the box's pieces near the camera are templated instead of bisected (6540 triangles instead of
 // 7490; before 0xc0a5ec92a4c91812 and 0x4f58d9c69d32b2f0, the sphere's count unchanged). Pinned
 // again on branch aniso (issue 13): a piece stretched in its form's metric that needs at most
-// 16 (slice.cpp kAnisoMaxNeed) is filled by the bisection in that metric (mesh4d/form_bisect.h)
+// 16 (slice.cpp kAnisoMaxNeed) is filled by the bisection in that metric (mesh4d/refine/form_bisect.h)
 // instead of the global bisection (the sphere: 5604 triangles instead of 5490, the box 6548
 // instead of 6540; before 0x1ca0664b8e71d7c8 and 0x0276f2fd7b6f9f8a). A change meant to alter
 // the output pins them again and says why.
@@ -1557,12 +1557,18 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
         }
         int winner, candidates;
         const PieceForm want = form_reference::pieceForm(m, E, s, &winner, &candidates);
-        const PieceForm got = pieceForm(m, E, s);
-        for (int e = 0; e < 3; ++e) {
-            EXPECT_TRUE(form_reference::sameDouble(got.c[e], want.c[e])) << "trial " << trial << " c[" << e << "] " << got.c[e] << " " << want.c[e];
-            EXPECT_TRUE(form_reference::sameDouble(got.centre[e], want.centre[e])) << "trial " << trial << " centre[" << e << "]";
+#if defined(APPARENT_NO_LANES)
+        const PieceForm forms[1] = {pieceForm(m, E, s)};
+#else
+        const PieceForm forms[2] = {pieceForm(m, E, s), pieceFormLanes(m, E, s)};
+#endif
+        for (const PieceForm& got : forms) {
+            for (int e = 0; e < 3; ++e) {
+                EXPECT_TRUE(form_reference::sameDouble(got.c[e], want.c[e])) << "trial " << trial << " c[" << e << "] " << got.c[e] << " " << want.c[e];
+                EXPECT_TRUE(form_reference::sameDouble(got.centre[e], want.centre[e])) << "trial " << trial << " centre[" << e << "]";
+            }
+            EXPECT_EQ(got.finite, want.finite) << "trial " << trial;
         }
-        EXPECT_EQ(got.finite, want.finite) << "trial " << trial;
         finite += want.finite;
         // The reference offers 0, 1 or 4 direct candidates, then the Taylor form when it is bounded.
         const bool taylor = candidates == 2 || candidates == 5;
@@ -1577,6 +1583,9 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
             for (double speed : {m.beta, 0.0, m.beta * (0.5 + w(rng)), -m.beta, double(NAN)}) {
                 const bool expected = form_reference::pieceFormWithin(m, E, s, speed, T);
                 EXPECT_EQ(pieceFormWithin(m, E, s, speed, T), expected) << "trial " << trial << " T " << T << " speed " << speed;
+#if !defined(APPARENT_NO_LANES)
+                EXPECT_EQ(pieceFormWithinLanes(m, E, s, speed, T), expected) << "trial " << trial << " T " << T << " speed " << speed;
+#endif
                 (expected ? within_true : within_false)++;
                 ++checked;
             }
@@ -1594,11 +1603,12 @@ TEST(Refine, PieceFormsMatchTheReferenceBitForBit) {
     EXPECT_EQ(checked, 6000 * 7 * 5);
 }
 
-// (helper "pairs") edgeBubblePair, the refinement's split making two edges' bounds at once, is
+#if !defined(APPARENT_NO_LANES)
+// edgeBubbleLanes, the refinement's split making two edges' bounds at once, is
 // edgeBubble on each lane bit for bit: random edges near the camera (m_e <= 0, m_e < l) and far,
 // at rest (b = 0) and moving in both kinematics, with NaN and infinite offsets; the scalar
 // edgeBubble is the reference. Each lane's edge is paired with an unrelated one, both orders.
-TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
+TEST(RefinePairs, EdgeBubbleLanesIsEdgeBubbleBitForBit) {
     std::mt19937_64 rng(1313);
     std::uniform_real_distribution<double> unit(-1, 1), w(0, 1);
     auto same = [](double a, double b) { return (a != a && b != b) || std::memcmp(&a, &b, sizeof(double)) == 0; };
@@ -1628,8 +1638,8 @@ TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
         const Vec3 E_used = kind == 6 && (trial / 24) % 5 == 4 ? Vec3{E.x, double(NAN), E.z} : E;
         const EdgeBubble want[2] = {edgeBubble(m, E_used, p[0], p[1]), edgeBubble(m, E_used, p[2], p[3])};
         EdgeBubble got[2], swapped[2];
-        edgeBubblePair(m, E_used, p[0], p[1], p[2], p[3], got);
-        edgeBubblePair(m, E_used, p[2], p[3], p[0], p[1], swapped);
+        edgeBubbleLanes(m, E_used, p[0], p[1], p[2], p[3], got);
+        edgeBubbleLanes(m, E_used, p[2], p[3], p[0], p[1], swapped);
         for (int e = 0; e < 2; ++e) {
             for (const EdgeBubble* g : {&got[e], &swapped[1 - e]}) {
                 EXPECT_TRUE(same(g->c, want[e].c)) << "trial " << trial << " edge " << e << " c " << g->c << " " << want[e].c;
@@ -1655,3 +1665,4 @@ TEST(RefinePairs, EdgeBubblePairIsEdgeBubbleBitForBit) {
     EXPECT_GT(odd_input, 4000);
     EXPECT_EQ(checked, 20000 * 4);
 }
+#endif

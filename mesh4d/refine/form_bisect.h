@@ -33,9 +33,8 @@
 // Cost: per output triangle about one split (one form evaluation for the new inner edge, a
 // quarter for the halves, bubbleMax and the choice of edge for the triangles it touches, the
 // neighbour links), no square root, no cut: the new points are cut by the caller in its batch.
-// Callgrind puts it at a few hundred instructions per output triangle: below the global
-// bisection's (about 1100: bounds and split records per piece), far above a grid template's few
-// tens, so the caller uses it for small needs only (slice.cpp, kAnisoMaxNeed).
+// Between the global bisection and a grid template per output triangle, so the caller uses it
+// for small needs only (refine/templates.cpp, kAnisoMaxNeed; docs/PERFORMANCE.md).
 #pragma once
 
 #include <array>

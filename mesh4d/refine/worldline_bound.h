@@ -194,9 +194,9 @@
 // error at a sub-grid of exact points and uses K only for what lies between them.
 #pragma once
 
-#include "event.h"
-#include "lightcone.h"
-#include "motion/worldline.h"
+#include "mesh4d/event.h"
+#include "mesh4d/lightcone.h"
+#include "mesh4d/motion/worldline.h"
 
 namespace mesh4d {
 

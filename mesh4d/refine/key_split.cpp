@@ -4,7 +4,7 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "motion/keyed.h"
+#include "mesh4d/motion/keyed.h"
 #include "worldline_bound.h"
 
 namespace mesh4d {

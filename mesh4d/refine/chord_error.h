@@ -47,9 +47,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "motion/motion.h"
-#include "event.h"
-#include "lightcone.h"
+#include "mesh4d/event.h"
+#include "mesh4d/lightcone.h"
+#include "mesh4d/motion/motion.h"
 
 namespace mesh4d {
 
@@ -266,13 +266,13 @@ inline EdgeBubble edgeBubble(const Motion& m, const Vec3& E, const PointTerms& a
     r.length = std::max(0.0, r.length);
     return r;
 }
-// edgeBubble of two edges at once (a0 -> b0 into out[0], a1 -> b1 into out[1]), bit for bit: each
-// of two SSE2 lanes (chord_error.cpp) makes the same IEEE operations in the same order, both sides
-// of edgeBubble's branches made and the lane's own selected, so the two edges' square roots and
-// divisions overlap instead of waiting on each other. For a caller that needs two edges' bounds at
-// the same point (the refinement's split: the edge's halves, the new interior edges).
-void edgeBubblePair(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
-                    const PointTerms& b1, EdgeBubble out[2]);
+// edgeBubbleLanes: edgeBubble of two edges at once (a0 -> b0 into out[0], a1 -> b1 into out[1]),
+// bit for bit, on the lanes of lanes.h (see "Scalar and lanes" below). For a caller that needs two
+// edges' bounds at the same point (the refinement's split: the edge's halves, the new interior edges).
+#if !defined(APPARENT_NO_LANES)
+void edgeBubbleLanes(const Motion& m, const Vec3& E, const PointTerms& a0, const PointTerms& b0, const PointTerms& a1,
+                     const PointTerms& b1, EdgeBubble out[2]);
+#endif
 
 // The bound of chordErrorOfTerms from the three edges' coefficients c (c[e] on corners e, e + 1)
 // instead of the measured bubbles, and the corners' shape offsets and |x|_M.
@@ -284,8 +284,8 @@ void edgeBubblePair(const Motion& m, const Vec3& E, const PointTerms& a0, const 
 // |x_i|_M, which terms(side2) makes only when the bubbles pass (R is needed); chordErrorOfPoints
 // makes them from its corners' terms. A caller that has the lengths already (the refinement's first
 // pass keeps |u|_M^2 per mesh edge, slice.cpp refineFrame) passes them: side2[e] of side e
-// (corners e, e + 1) is normM2 of either direction, the same bits. (Always inlined: left to the
-// compiler, refine_bench --count rows counted 0.1 to 1 % more instructions.)
+// (corners e, e + 1) is normM2 of either direction, the same bits. (Always inlined: the refinement
+// calls it per piece; docs/PERFORMANCE.md, "The refinement's costs".)
 template <class Terms>
 [[gnu::always_inline]] inline ChordError chordErrorOfSides(const Motion& m, double speed, const double c[3],
                                                            Terms terms, double tolerance = INFINITY) {
@@ -305,8 +305,7 @@ template <class Terms>
     return r;
 }
 // (chordErrorOfPoints always inline too: the refinement's drain and first pass call it per piece,
-// and GCC's size budget for the large drain otherwise flips with unrelated edits to it: a call per
-// piece, about 2 % of refine_bench --count 1 3's instructions.)
+// and GCC's size budget for the large drain otherwise flips with unrelated edits to it.)
 [[gnu::always_inline]] inline ChordError chordErrorOfPoints(const Motion& m, double speed, const double c[3],
                                                             const PointTerms& p0, const PointTerms& p1,
                                                             const PointTerms& p2, double tolerance = INFINITY) {
@@ -383,12 +382,13 @@ struct PieceForm {
 // (2) in order (the direct form's mu for each side, then for their sums; the Taylor form), the first
 // with the least bubbleMax on the piece's sides kept; `centre` always made. Not finite when no
 // candidate is bounded (a piece reaching the camera) or a kept coefficient is NaN or +infinity.
-// How (chord_error.cpp): the terms every candidate shares, the direct candidates two at a time in
-// the lanes of an SSE2 register (each lane the scalar arithmetic's operations in its order: the
-// same bits), and a candidate's bubbleMax skipped where its first term (0.25 max c, which
-// bubbleMax never falls below) already loses. Refine.PieceFormsMatchTheReferenceBitForBit
-// compares it with the scalar code of one candidate after the other it replaced.
+// pieceFormLanes is the same, bit for bit, with the direct candidates two at a time on the lanes
+// of lanes.h. Either passes a candidate without its bubbleMax where its first term (bubbleFirst,
+// which bubbleMax never falls below) already loses.
 PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]);
+#if !defined(APPARENT_NO_LANES)
+PieceForm pieceFormLanes(const Motion& m, const Vec3& E, const Vec3 s[3]);
+#endif
 
 // Whether pieceForm(m, E, s) is finite and speed bubbleMax(its c) <= tolerance, without the
 // candidates after the first that passes: the least candidate passes when any does (the product
@@ -396,5 +396,45 @@ PieceForm pieceForm(const Motion& m, const Vec3& E, const Vec3 s[3]);
 // A candidate with speed times its least value over the tolerance fails without its bubbleMax
 // (speed >= 0: rounding is monotonic, and bubbleMax is not below its least).
 bool pieceFormWithin(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance);
+#if !defined(APPARENT_NO_LANES)
+bool pieceFormWithinLanes(const Motion& m, const Vec3& E, const Vec3 s[3], double speed, double tolerance);
+#endif
+
+// ---- Scalar and lanes ----
+// Each bound above with a two-lane form has its scalar form beside it, named X and XLanes
+// (edgeBubble / edgeBubbleLanes, pieceForm / pieceFormLanes, pieceFormWithin / pieceFormWithinLanes;
+// in chord_error.cpp also bubbleMax / bubbleMaxLanes, bubbleFirst / bubbleFirstLanes, directForm /
+// directFormLanes, pieceFormTerms / pieceFormTermsLanes). A lane makes the scalar form's IEEE
+// operations in the same order (both sides of a branch made and the lane's own selected), so the
+// two give the same bits: +, -, *, / and sqrt are correctly rounded, and nothing is contracted
+// (the mesh4d library is compiled with -ffp-contract=off, CMakeLists.txt: a fused multiply-add
+// rounds once where the scalar code rounds twice, and a compiler may fuse in one form and not the
+// other). The refinement calls the lanes forms; the CMake option APPARENT_NO_LANES (a compile
+// definition) removes them and it calls the scalar forms: CI builds both and compares their bytes
+// (scripts/compare_builds.sh), Refine.PieceFormsMatchTheReferenceBitForBit and
+// RefinePairs.EdgeBubbleLanesIsEdgeBubbleBitForBit compare them directly.
+
+// ---- Why the steps hold: the reasoning behind the step headings of the .cpp files ----
+// refine/chord_error.cpp:
+//   - The terms all of a piece's candidate forms are made from (the quantities of chord_error.h's
+//     "The whole-piece bound"): the centroid's |x_c|_M, r_M^2, per side (s[e] -> s[e + 1]) its parts
+//     across and along y_c^ (|e_perp|^2 and alpha^2) and H(x_c)'s coefficient; the direct form's m,
+//     sin^2 theta bound and factor.
+//   - The direct form's candidates: the four balances mu when the along-parts' sum is positive, else
+//     one (mu = 1e-6 and no along term).
+//   - Candidate j's sides' coefficients c[e] and the least value bubbleMax can give them
+//     (bubbleFirst, which bubbleMax returns or exceeds, NaNs alike): a candidate whose least value
+//     already loses is never chosen, so its bubbleMax need not be made.
+//   - The Taylor form's coefficients from H(x_c)'s (t.centre) and its least value (as directForm's);
+//     false when it is unbounded (m_r <= 0).
+//   - pieceFormTerms on the lanes of lanes.h: the six steps u two at a time, lanes (d0, d1), (d2,
+//     e0), (e1, e2) (d_i = s_i - centre, e = s[e + 1] - s[e]), each lane pieceFormTerms' operations
+//     in its order.
+//   - bubbleMax lane by lane (the interior value made in both lanes and selected where the point is
+//     inside), from its first term `first` = bubbleFirstLanes(c01, c12, c20), made by the caller.
+//   - Step: the candidates in order, the first with the least bubbleMax kept; a candidate whose
+//     least value is not below the best so far is passed without its bubbleMax (the same choice).
+//   - edgeBubble per lane: both branches made and each lane's own selected (me > 0, then me >= l; a
+//     NaN compares false in both, as there), the closing min and max as std::min and std::max.
 
 }  // namespace mesh4d

@@ -39,9 +39,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "extrude.h"
-#include "lightcone.h"
-#include "slice.h"
+#include "mesh4d/extrude.h"
+#include "mesh4d/lightcone.h"
+#include "mesh4d/slice.h"
 
 namespace mesh4d {
 

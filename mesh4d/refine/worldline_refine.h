@@ -46,8 +46,8 @@
 // Newton search each) plus one per output point; levels are tried from 1 up.
 #pragma once
 
-#include "extrude.h"
-#include "slice.h"
+#include "mesh4d/extrude.h"
+#include "mesh4d/slice.h"
 
 namespace mesh4d {
 

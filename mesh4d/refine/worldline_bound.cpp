@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "motion/keyed.h"
+#include "mesh4d/motion/keyed.h"
 
 namespace mesh4d {
 

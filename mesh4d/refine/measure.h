@@ -12,8 +12,8 @@
 
 #include <vector>
 
-#include "slice.h"
-#include "motion/worldline.h"
+#include "mesh4d/motion/worldline.h"
+#include "mesh4d/slice.h"
 
 namespace mesh4d::measure {
 

@@ -7,7 +7,7 @@
 // 4^k times the triangles. Midpoints are (a + b) / 2 of the rest points, in double.
 #pragma once
 
-#include "extrude.h"
+#include "mesh4d/extrude.h"
 
 namespace mesh4d {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "key_split.h"
-#include "motion/worldline.h"
+#include "mesh4d/motion/worldline.h"
 #include "worldline_bound.h"
 
 namespace mesh4d {

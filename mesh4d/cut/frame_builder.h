@@ -1,0 +1,871 @@
+// The state of one frame's cut (internal to mesh4d/cut and mesh4d/refine): FrameBuilder holds
+// the frame's inputs, its output and the refinement's working arrays; its stages live in one file
+// each (mesh4d/refine/refine.h lists them). Not a public header: include mesh4d/slice.h.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <set>
+#include <unordered_map>
+
+#include "mesh4d/slice.h"
+#include "mesh4d/refine/chord_error.h"
+#include "mesh4d/exact_side.h"
+#include "mesh4d/refine/form_bisect.h"
+#include "mesh4d/robust.h"
+#include "mesh4d/refine/tessellate.h"
+#include "mesh4d/motion/worldline.h"
+#include "mesh4d/refine/worldline_refine.h"
+
+namespace mesh4d {
+namespace slicing {
+
+// Where a vertex's worldline crossing falls relative to the extruded span.
+enum class Side : uint8_t { NotYet, Inside, Gone };
+
+constexpr uint32_t kUnset = 0xffffffffu;
+
+// The rest clip (restPlan): a chord of a cap's clip circle through a piece must lie within this
+// fraction of the tolerance of the circle.
+constexpr double kMidpointShare = 0.25;
+
+// Sutherland-Hodgman over the span between the caps, for a convex polygon of n corners whose
+// sides are s[i]: the corners inside the span, and on each side i -> i + 1 whose ends lie on
+// different sides of a cap, that cap's crossing (both caps' crossings, in order along the side,
+// when it runs from before existing to after). corner(i) and crossing(i, j, cap) give output ids.
+// Writes at most 2 n ids to `out` and returns their count (a triangle gives at most 5).
+template <class Corner, class Crossing>
+int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t* out) {
+    int k = 0;
+    for (int i = 0; i < n; ++i) {
+        const int j = (i + 1) % n;
+        const Side si = s[i], sj = s[j];
+        if (si == Side::Inside) out[k++] = corner(i);
+        if (si == sj) continue;
+        const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
+        const bool cross_b = si == Side::Gone || sj == Side::Gone;
+        const bool a_first = si == Side::NotYet || sj == Side::Gone;
+        if (cross_a && cross_b) {
+            out[k++] = crossing(i, j, a_first ? 0 : 1);
+            out[k++] = crossing(i, j, a_first ? 1 : 0);
+        } else {
+            out[k++] = crossing(i, j, cross_a ? 0 : 1);
+        }
+    }
+    return k;
+}
+
+// The terms of the a-priori bound of one point (chord_error.h PointTerms), side by side: what a
+// corner or an edge's end contributes is read from one place.
+using VTerms = PointTerms;
+
+struct REdge {
+    uint32_t mid;   // midpoint vertex once made, else kUnset
+    double len;     // EdgeBubble::length once known, else NaN
+    double c;       // EdgeBubble::c, known with len
+    double xm_mid;  // EdgeBubble::xm_mid, known with len (the midpoint's |x|_M, for its split)
+};
+// Triangles of the refinement, the leaves only: ids below r_nt are the mesh's triangles (records
+// made when first touched), later ids pieces made by splits. A split keeps one half in the
+// record it halves (the one with the slot that does not move) and appends the other. Each slot c
+// is the edge from v[c] to v[c + 1]; the slots on one edge form a cycle (the next slot of each,
+// kept apart from the records in an array indexed by the slot itself), as World4D::slot_next
+// does for the mesh, so that an edge is split in every triangle that has it: no T-junctions,
+// however the splits go.
+// kCoarse: its bound fails, but its whole-piece form (chord_error.h pieceForm) is tight enough
+// that a template fills it (tessellate.h) instead of further bisection.
+// kBoundFailed: a mesh triangle as the mesh has it whose bound and whole-piece form refineFrame's
+// first pass found to fail (the drain's verdict on it, from the same terms, bit for bit): the
+// drain goes on from its coarseForm test without judging it again.
+enum : uint8_t { kUnknown = 0, kPassed = 1, kFailed = 2, kCoarse = 3, kBoundFailed = 4 };
+struct RTri {
+    uint32_t v[3];
+    uint32_t edge[3];  // the edge record of each slot
+    uint32_t src;      // the mesh triangle it lies on
+    uint8_t depth;     // bisections since the mesh triangle (at most 2 log2(max_segments) <= 60)
+    uint8_t state;     // kUnknown, or its bound is known to pass or to fail (it waits for a neighbour's split)
+    int16_t longest;   // the slot of its longest edge once known, else -1
+};
+// A slot (triangle record, side) as one number: id << 2 | side (the mesh's World4D::slot_next
+// counts 3 id + side; meshSlot converts). At most 2^30 records. The slot after slot p on its
+// edge is next[p] (4 entries per record, the fourth unused); itself on a boundary edge.
+inline uint32_t slotOf(uint32_t id, int side) { return id << 2 | uint32_t(side); }
+inline uint32_t slotTri(uint32_t slot) { return slot >> 2; }
+inline uint32_t slotSide(uint32_t slot) { return slot & 3; }
+inline uint32_t meshSlot(uint32_t slot3) { return slotOf(slot3 / 3, int(slot3 % 3)); }
+constexpr int kSucc[3] = {1, 2, 0};  // the next corner
+
+// The refinement's working arrays, kept per thread from frame to frame: a frame reuses the pages the
+// previous one touched instead of faulting fresh ones in (the arrays are several times the size of
+// the output). Cleared, not freed, by each frame; freed after a frame that made them larger than
+// kScratchKeep bytes, so a single huge frame does not hold its memory for the program's life.
+struct RefineScratch {
+    std::vector<Vec3> pos, rest;
+    std::vector<double> time;
+    std::vector<VTerms> terms;
+    std::vector<Event> cap;
+    std::vector<uint8_t> init, limited;
+    std::vector<REdge> edges;
+    std::unique_ptr<RTri[]> tri;
+    std::unique_ptr<uint32_t[]> next;  // 4 per record (slotOf)
+    size_t tri_cap = 0;
+    std::vector<uint32_t> members, stack;
+    std::vector<Side> side;
+    std::vector<uint32_t> vertex_out;
+    std::vector<double> spread;  // per mesh edge: its |u|_M^2 (refineFrame's first pass)
+    // The templates (refineFrame without a real cap): the coarse pieces' forms, each record's
+    // form (index, or kUnset), each edge record's segment count and first point, one piece's
+    // local triangles and its local-to-global point map.
+    std::vector<PieceForm> forms;
+    std::vector<uint8_t> form_aniso;  // per form: filled by FormBisection (form_bisect.h), not a grid
+    FormBisection bisection;
+    std::vector<uint32_t> form_of, edge_count, edge_first, local_map;
+    std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
+    std::vector<uint32_t> candidates, failing;  // refineFrame's first pass: triangles its corners' bound fails, and its a-priori bound
+    std::vector<double> quadratic;              // per mesh triangle in `failing`: its bound's quadratic part (kBoundFailed)
+    std::vector<std::array<uint32_t, 3>> local;
+
+    size_t bytes() const {
+        return (pos.capacity() + rest.capacity()) * sizeof(Vec3) + time.capacity() * sizeof(double) +
+               terms.capacity() * sizeof(VTerms) + (spread.capacity() + quadratic.capacity()) * sizeof(double) +
+               cap.capacity() * sizeof(Event) +
+               edges.capacity() * sizeof(REdge) + tri_cap * (sizeof(RTri) + 4 * sizeof(uint32_t)) +
+               (vertex_out.capacity() + members.capacity() + stack.capacity()) * sizeof(uint32_t) +
+               init.capacity() + limited.capacity() + side.capacity() + forms.capacity() * sizeof(PieceForm) +
+               form_aniso.capacity() +
+               (form_of.capacity() + edge_count.capacity() + edge_first.capacity() + local_map.capacity() +
+                coarse.capacity() + candidates.capacity() + failing.capacity()) *
+                   sizeof(uint32_t) +
+               local.capacity() * sizeof(std::array<uint32_t, 3>);
+    }
+};
+constexpr size_t kScratchKeep = size_t(256) << 20;
+
+inline RefineScratch& threadScratch() {
+    static thread_local RefineScratch scratch;
+    return scratch;
+}
+
+struct FrameBuilder {
+    const World4D& world;
+    const ViewSurface& view;
+    const SliceSettings& settings;
+    const ViewAnchor anchor;  // the frame's local coordinates (positions relative to the object's apparent origin)
+    ApparentMesh out;
+    RefineScratch& scratch;               // this thread's working arrays (threadScratch)
+    std::vector<Side>& side;
+    std::vector<uint32_t>& vertex_out;    // rest vertex -> output vertex
+    std::vector<uint32_t> crossing_out;   // 2 * edge + cap -> output vertex
+    uint32_t cur_edges[3] = {0, 0, 0};  // mesh edges of the triangle being clipped (rest clip)
+    bool rest_clip = false;             // at rest, past cone, real caps, tolerance > 0: restPlan
+    double rest_tolerance = 0;          // the tolerance restPlan keeps (settings.tolerance is 0 at rest)
+    double bound_speed = 0;             // boundSpeed(), once per frame
+
+    FrameBuilder(const World4D& w, const ViewSurface& v, const SliceSettings& s)
+        : world(w), view(v), settings(s), anchor(viewAnchor(v, w.motion)), scratch(threadScratch()),
+          side(scratch.side), vertex_out(scratch.vertex_out), r_pos(scratch.pos), r_time(scratch.time),
+          r_terms(scratch.terms), r_rest(scratch.rest), r_cap(scratch.cap), scratch_members(scratch.members),
+          r_edges(scratch.edges),
+          r_tri(scratch.tri), r_next(scratch.next), rn(scratch.next.get()), r_tri_cap(scratch.tri_cap),
+          r_init(scratch.init), r_limited(scratch.limited) {
+        for (auto* a : {&r_pos, &r_rest}) a->clear();
+        r_time.clear();
+        r_terms.clear();
+        for (auto* a : {&r_init, &r_limited}) a->clear();
+        side.clear();
+        vertex_out.clear();
+        r_cap.clear();
+        r_edges.clear();
+        scratch_members.clear();
+        scratch.stack.clear();
+        out.origin = anchor.origin;
+        out.time_origin = anchor.time_origin;
+        bound_speed = boundSpeed();
+    }
+    ~FrameBuilder() {
+        if (scratch.bytes() > kScratchKeep) scratch = RefineScratch();
+    }
+    FrameBuilder(const FrameBuilder&) = delete;
+    FrameBuilder& operator=(const FrameBuilder&) = delete;
+
+    // The factor a piece's bound multiplies the light delay's error by (chord_error.h
+    // chordErrorOfBubbles): the object's speed |u|; |w| = |u - shear| when the view shears its
+    // outputs (the finite model with a moving camera); settings.displacement when that is given
+    // (outputs mapped afterwards: reflections seen by a moving camera, pipeline/mirror.h).
+    double boundSpeed() const {
+        if (settings.displacement >= 0) return settings.displacement;
+        if (view.sheared()) return norm(world.motion.velocity - view.shear);
+        return world.motion.beta;
+    }
+    ChordError pointsBound(const double c[3], const VTerms& a, const VTerms& b, const VTerms& d) const {
+        return chordErrorOfPoints(world.motion, bound_speed, c, a, b, d, settings.tolerance);
+    }
+
+    void addOutput(size_t f, const std::array<uint32_t, 3>& t) {
+        // A clip point that fell on a visible corner is that corner (see crossingPoint): the
+        // triangle has no area then and is not emitted.
+        if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) return;
+        out.triangles.push_back(t);
+        out.source_triangles.push_back(uint32_t(f));
+    }
+
+
+    uint32_t emit(const Event& e, const Vec3& rest) {
+        out.positions.push_back(e.x);
+        out.emission_times.push_back(e.t);
+        out.rest_points.push_back(rest);
+        return uint32_t(out.positions.size() - 1);
+    }
+
+    // The exact cut (local coordinates) of the worldline of the rest point with barycentrics `l` on vertices `v`.
+    Event surfaceAt(const uint32_t v[3], const double l[3]) const {
+        return cutRestLocal(anchor, world.motion, restAt(v, l));
+    }
+
+    Vec3 restAt(const uint32_t v[3], const double l[3]) const {
+        return world.mesh.positions[v[0]] * l[0] + world.mesh.positions[v[1]] * l[1] + world.mesh.positions[v[2]] * l[2];
+    }
+
+    // Step: classify every vertex against the real caps, and cut the worldlines of the rest.
+    // With `live` (one flag per chunk), only the vertices of live chunks are looked at.
+    void classifyVertices(const std::vector<uint8_t>* live);
+
+    uint32_t vertexPoint(uint32_t i) {
+        if (vertex_out[i] == kUnset) {
+            vertex_out[i] = emit(vertexEvent(i), world.mesh.positions[i]);
+        }
+        return vertex_out[i];
+    }
+
+    // The crossing of edge `edge` at cap `cap` (0 = a, 1 = b), always parametrised from the
+    // lower vertex id so both triangles of the edge compute the same point.
+    uint32_t crossingPoint(uint32_t edge, int cap);
+
+    // The output point of a cap crossing at parameter s along a segment whose ends lie on sides
+    // s0 and s1. The cap passing exactly through a visible end (a frame at the instant the object
+    // begins or ends) gives that end itself (end(0) or end(1)), not a copy of it. Otherwise the
+    // crossing event lies on the worldline of the rest point at s (a worldline meets the view
+    // surface once), so its image is the anchored cut of that point, rest(): relative accuracy
+    // however far the object is; only the parameter s carries the absolute events' rounding.
+    template <class End, class Rest>
+    uint32_t crossingAt(double s, Side s0, Side s1, End end, Rest rest) {
+        if (s == 0 && s0 == Side::Inside) return end(0);
+        if (s == 1 && s1 == Side::Inside) return end(1);
+        const Vec3 q = rest();
+        return emit(cutRestLocal(anchor, world.motion, q), q);
+    }
+
+    // The exact image of vertex i (local coordinates), without emitting it.
+    Event vertexEvent(uint32_t i) const {
+        if (i < r_pos.size()) return {r_time[i], r_pos[i]};  // the refinement's batch cut (bit-identical)
+        return cutRestLocal(anchor, world.motion, world.mesh.positions[i]);
+    }
+
+    // Which side of the real caps a rest point falls on, from its events on both caps.
+    Side sideOf(const Event& on_a, const Event& on_b) const {
+        if (world.cap_a_real && viewSideSign(view, on_a) < 0) return Side::NotYet;
+        if (world.cap_b_real && viewSideSign(view, on_b) > 0) return Side::Gone;
+        return Side::Inside;
+    }
+
+    // Clip curves on the past cone (objects at rest, see restPlan). On a cap, events are affine in the rest
+    // point, and h = viewSide = (t_c - t) - |x - C| is concave along them: negative at every corner
+    // of a segment or triangle, it may still be positive inside (a cap curve poking in between
+    // samples: the middle of a large triangle seen first). Its excess over the corners' largest
+    // value is at most L^2 / (8 d) on a segment and L^2 / (6 d) on a triangle (L: longest side of
+    // the cap events, d: their least distance from the camera). This returns how much finer the
+    // piece must get, as a ratio of squared sizes (<= 1: it cannot hide a crossing). A poke
+    // whose h stays below limit^2 / (2 dmin) is ignored: about its top (at distance r0 <= dmin
+    // from the camera) h falls off as rho^2 / (2 r0) with the distance rho, so it is narrower
+    // than `limit`.
+    double hiddenCrossingRatio(const Event* e, const double* h, int n, double limit) const;
+
+    bool capReal(int cap) const { return cap == 0 ? world.cap_a_real : world.cap_b_real; }
+
+    // The cap event of the rest point with barycentrics `l` on vertices `v` (affine in l).
+    Event capAt(const uint32_t v[3], const double l[3], int cap) const {
+        Event r{0, {0, 0, 0}};
+        for (int c = 0; c < 3; ++c) {
+            const Event& e = world.events[2 * v[c] + cap];
+            r.t += l[c] * e.t;
+            r.x += e.x * l[c];
+        }
+        return r;
+    }
+
+    // How much finer the domain must get around the piece (a, b, c) (barycentrics on `v`) for its
+    // clip to hold: a real cap's curve may not hide in it or its sides, and where the curve
+    // crosses it the straight output edge between the two exact crossings must lie within `limit`
+    // of the curve's image (measured at the chord's middle, against the curve point found on the
+    // line across the chord there). A ratio of squared sizes; <= 1 when the piece passes.
+    double clipRatio(const uint32_t v[3], const double* la, const double* lb, const double* lc, double limit) const;
+
+
+    // ---- Step (refinement, tolerance > 0, moving, past cone): conforming bisection ----
+    // Flat records, no allocation per piece: vertices as arrays indexed by id, edges and pieces as
+    // records in one array each. Every decision is made from the a-priori bound (chord_error.h
+    // edgeBubble, chordErrorOfBubbles): per point its terms (affine in the rest point but for one
+    // square root), per edge its coefficient, once each. No exact cut is made for a decision: the
+    // points the splits make are cut once, in one batch, after the last split.
+    // Vertices of the refinement share one id space: ids below r_nv are the mesh's vertices, later
+    // ids edge midpoints made when an edge is split. `side` and `vertex_out` grow with them.
+    uint32_t r_nv = 0, r_nt = 0, r_ne = 0;
+    bool r_caps = false;          // a cap is real: points are classified and pieces clipped
+    bool r_templates = false;     // no real cap: pieces whose form is tight are filled by templates
+    Vec3 r_now{0, 0, 0};          // the object's origin now, relative to the camera (nowBase)
+    std::vector<Vec3>& r_pos;     // exact local image of every id (the batch cuts: mesh vertices first,
+    std::vector<double>& r_time;  // the splits' points after the last split); its local emission time, -delta
+    std::vector<VTerms>& r_terms; // its terms of the bound (for mesh vertices: w only where a triangle needs it)
+    std::vector<Vec3>& r_rest;    // rest point of ids >= r_nv
+    std::vector<Event>& r_cap;    // cap events (2 per id >= r_nv) when a cap is real
+    std::vector<uint32_t>& scratch_members;
+
+    // Edges of the refinement: records below r_ne are the mesh's edges, later ones the halves and
+    // inner edges that splits make. Every slot on an edge refers to the edge's record, so its
+    // midpoint and length are made once and seen from every triangle around it.
+    std::vector<REdge>& r_edges;
+    // The data of r_edges, r_terms and r_init while the splits run (set where they are sized): the
+    // hot loops index them without going through the vectors.
+    REdge* r_edge_data = nullptr;
+    VTerms* r_term_data = nullptr;
+    const uint8_t* r_init_data = nullptr;
+
+    // Triangles (RTri): one array for all ids, left uninitialised (RTri is trivial): a large mesh
+    // of which few triangles need refining touches only their pages (r_init says which base
+    // records are made).
+    std::unique_ptr<RTri[]>& r_tri;
+    RTri* rt = nullptr;  // r_tri.get(), kept in step by reserveTris
+    std::unique_ptr<uint32_t[]>& r_next;  // each slot's next slot on its edge (slotOf)
+    uint32_t* rn;                         // r_next.get(), kept in step by reserveTris
+    size_t& r_tri_cap;
+    size_t r_tri_size = 0;
+    std::vector<uint8_t>& r_init;
+    std::vector<uint8_t>& r_limited;  // per mesh triangle: a piece reached the depth limit first
+    uint32_t r_max_depth = 0;
+    size_t r_leaves = 0;  // pieces so far (an upper bound of the output triangles before clipping)
+    std::unordered_map<uint64_t, uint32_t> r_crossings[2];  // (lo << 32 | hi) -> clip point, per cap
+
+    Vec3 restOfId(uint32_t id) const { return id < r_nv ? world.mesh.positions[id] : r_rest[id - r_nv]; }
+    Event capOfId(uint32_t id, int cap) const { return id < r_nv ? world.events[2 * id + cap] : r_cap[2 * (id - r_nv) + cap]; }
+    Event eventOfId(uint32_t id) const { return {r_time[id], r_pos[id]}; }
+
+    // Room for n more triangle records (growth copies them: they are trivial).
+    void reserveTris(size_t n) {
+        if (r_tri_size + n <= r_tri_cap) return;
+        const size_t cap = std::max(r_tri_size + n, 2 * r_tri_cap);
+        std::unique_ptr<RTri[]> grown(new RTri[cap]);
+        std::unique_ptr<uint32_t[]> grown_next(new uint32_t[4 * cap]);
+        if (r_tri_size > 0) {
+            std::memcpy(static_cast<void*>(grown.get()), r_tri.get(), r_tri_size * sizeof(RTri));
+            std::memcpy(grown_next.get(), r_next.get(), 4 * r_tri_size * sizeof(uint32_t));
+        }
+        r_tri = std::move(grown);
+        rt = r_tri.get();
+        r_next = std::move(grown_next);
+        rn = r_next.get();
+        r_tri_cap = cap;
+    }
+
+    void ensureBase(uint32_t id) {
+        if (id >= r_nt || r_init_data[id]) return;
+        r_init[id] = 1;
+        RTri& t = rt[id];
+        for (int c = 0; c < 3; ++c) {
+            t.v[c] = world.mesh.triangles[id][c];
+            rn[slotOf(id, c)] = meshSlot(world.slot_next[3 * id + c]);
+            t.edge[c] = world.triangle_edges[id][c];
+        }
+        t.src = id;
+        t.depth = 0;
+        t.state = kUnknown;
+        t.longest = -1;
+    }
+    // The next slot around p's edge; an untouched mesh triangle still has the mesh's cycle.
+    uint32_t nextOf(uint32_t p) const {
+        const uint32_t id = slotTri(p);
+        if (id < r_nt && !r_init_data[id]) return meshSlot(world.slot_next[3 * id + slotSide(p)]);
+        return rn[p];
+    }
+    void setNext(uint32_t p, uint32_t to) {
+        ensureBase(slotTri(p));
+        rn[p] = to;
+    }
+
+    // A split's point: its terms now, its exact image in the batch after the last split.
+    // xm: its |x|_M (edgeBubble made it, bit for bit normMOfShape of this shape offset).
+    uint32_t newVertex(const Vec3& rest, uint32_t a, uint32_t b, double xm) {
+        const uint32_t id = uint32_t(r_terms.size());
+        r_terms.push_back({(r_terms[a].s + r_terms[b].s) * 0.5, xm});  // shapeOffset is affine
+        r_term_data = r_terms.data();
+        r_rest.push_back(rest);
+        // Without a real cap every point is inside and is given its output place in bulk.
+        if (r_caps) {
+            Event cap[2];
+            for (int k = 0; k < 2; ++k) {
+                const Event ea = capOfId(a, k), eb = capOfId(b, k);
+                cap[k] = {0.5 * (ea.t + eb.t), (ea.x + eb.x) * 0.5};  // symmetric in a, b
+                r_cap.push_back(cap[k]);
+            }
+            side.push_back(sideOf(cap[0], cap[1]));
+            vertex_out.push_back(kUnset);
+        }
+        return id;
+    }
+
+    // The edge record of slot c of triangle id (ensureBase'd), with its coefficient and length
+    // (chord_error.h edgeBubble) made once per edge, from its ends in id order.
+    // (The look-up inline, the bound made out of line: the hot loops stay small.)
+    [[gnu::always_inline]] const REdge& edgeOf(uint32_t id, int c) {
+        REdge& e = r_edge_data[rt[id].edge[c]];
+        if (e.len != e.len) makeEdge(e, rt[id].v[c], rt[id].v[kSucc[c]]);
+        return e;
+    }
+    [[gnu::noinline]] void makeEdge(REdge& e, uint32_t a, uint32_t b) const;
+    // Two edges' records at once (chord_error.h edgeBubbleLanes, the same bits as makeEdge's;
+    // makeEdge twice with APPARENT_NO_LANES).
+    void makeEdgePair(REdge& e0, uint32_t a0, uint32_t b0, REdge& e1, uint32_t a1, uint32_t b1) const {
+    #if defined(APPARENT_NO_LANES)
+        makeEdge(e0, a0, b0);
+        makeEdge(e1, a1, b1);
+    #else
+        EdgeBubble eb[2];
+        edgeBubbleLanes(world.motion, r_now, r_term_data[std::min(a0, b0)], r_term_data[std::max(a0, b0)],
+                        r_term_data[std::min(a1, b1)], r_term_data[std::max(a1, b1)], eb);
+        storeEdge(e0, eb[0]);
+        storeEdge(e1, eb[1]);
+    #endif
+    }
+    static void storeEdge(REdge& e, const EdgeBubble& eb) {
+        e.len = eb.length;
+        e.c = eb.c;
+        e.xm_mid = eb.xm_mid;
+    }
+
+    // The midpoint vertex of slot c of triangle id (made once per edge, when the edge is split).
+    uint32_t midVertex(uint32_t id, int c) {
+        const uint32_t rec = rt[id].edge[c];
+        if (r_edges[rec].mid != kUnset) return r_edges[rec].mid;
+        const uint32_t a = rt[id].v[c], b = rt[id].v[kSucc[c]];
+        // A mesh edge's midpoint from its lo end, as the edge's other triangles would make it.
+        const uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        const Vec3 rest = (restOfId(lo) + restOfId(hi)) * 0.5;
+        const double xm = edgeOf(id, c).xm_mid;  // made with the edge's bound
+        return r_edges[rec].mid = newVertex(rest, lo, hi, xm);
+    }
+
+    // Moves slot `from` of a triangle being split (its record made) to slot `to` of its half:
+    // same edge, same place in the edge's cycle. The common edge, on two triangles, is a 2-cycle:
+    // the slot after `from` is the one before it, found without a walk.
+    void moveSlot(uint32_t from, uint32_t to) {
+        const uint32_t nx = rn[from];
+        if (nx == from) {
+            rn[to] = to;
+            return;
+        }
+        rn[to] = nx;
+        uint32_t p = nx;
+        for (uint32_t q = nextOf(p); q != from; q = nextOf(p)) p = q;
+        setNext(p, to);
+    }
+
+    // Halves the edge of slot c of triangle id at its midpoint, in every triangle around the edge:
+    // each (a, b, o) becomes A = (a, m, o), kept in its record (slot c + 2 stays in place), and
+    // B = (m, b, o), appended. The halves' slots on the edge form two new cycles, on two new edge
+    // records; each triangle's new inner edge (m, o) gets its own record.
+    // members: the edge's cycle from slot c of id, n slots (the walk that chose the edge collected
+    // it; their records are made).
+    // The new edges' bounds are made here, two at a time (makeEdgePair): every new piece is judged
+    // on all three of its edges when popped, and these are its unmade ones.
+    void splitEdge(uint32_t id, int c, const uint32_t* members, uint32_t n, std::vector<uint32_t>& stack);
+
+    // Refines until every piece's bound (chord_error.h) is within the tolerance, or the piece is
+    // wholly before or after existing (it shows nothing), or it reached the depth limit.
+    void drain(std::vector<uint32_t>& stack);
+
+    // Edge lengths in the map's metric (chord_error.h edgeLength), ordered totally: ties go by the
+    // edge's vertex ids, so every triangle of an edge ranks it the same.
+    struct Rank {
+        double length;
+        uint32_t lo, hi;
+        bool operator<(const Rank& o) const {
+            if (length != o.length) return length < o.length;
+            return lo != o.lo ? lo < o.lo : hi < o.hi;
+        }
+    };
+    // The slot of the longest of the three edges e[c] (lengths known) of the triangle on v.
+    // (The ids are looked at only on a tie of lengths, as Rank orders them.)
+    static int longestOf(const uint32_t v[3], const REdge* const e[3]) {
+        int best = 0;
+        double len = e[0]->len;
+        for (int c = 1; c < 3; ++c) {
+            const double lc = e[c]->len;
+            if (!(lc > len)) {  // (a NaN length is never the longest, as in Rank)
+                if (!(lc == len)) continue;
+                const Rank r{len, std::min(v[best], v[kSucc[best]]), std::max(v[best], v[kSucc[best]])};
+                const Rank rc{lc, std::min(v[c], v[kSucc[c]]), std::max(v[c], v[kSucc[c]])};
+                if (!(r < rc)) continue;
+            }
+            len = lc;
+            best = c;
+        }
+        return best;
+    }
+    [[gnu::always_inline]] int longestSlot(uint32_t id) {
+        ensureBase(id);
+        if (rt[id].longest >= 0) return rt[id].longest;
+        return findLongest(id);
+    }
+    [[gnu::noinline]] int findLongest(uint32_t id);
+
+    // Longest-edge bisection (Rivara): a triangle's longest edge is halved only once it is the
+    // longest edge of every triangle around it; until then the neighbour whose longest edge is
+    // another is refined first, along the path of ever longer edges (it ends: lengths grow
+    // strictly along it in the total order). One split per call. Angles stay bounded in the
+    // map's metric, so the pieces follow the stretch (long across the motion where the map
+    // bends along it) without slivers.
+    // True when the edge halved is id's own (along the path lengths grow strictly, so no edge
+    // after the first is id's).
+    // With `guard` (templates on), a split that would halve a piece marked kCoarse whose level
+    // is kKeptLevel or more is not made: kSplitBlocked (the caller templates id instead).
+    static constexpr int kSplitOther = 0, kSplitOwn = 1, kSplitBlocked = 2;
+    // The edge's cycle is collected as it is walked (splitEdge needs it all): an edge on one or
+    // two triangles (every edge of a closed manifold mesh and of its pieces) in a local pair, a
+    // longer cycle in scratch_members. Every record the walk passes is made (longestSlot).
+    [[gnu::noinline]] int splitLongestPath(uint32_t id, std::vector<uint32_t>& stack, bool guard = true);
+
+    // ---- Templates (no real cap): the pieces the bisection leaves, each filled at once ----
+    // The bisection above stops at a piece whose bound passes (kPassed) or that a template fills
+    // better (kCoarse, coarseForm): its whole-piece form (chord_error.h pieceForm: one quadratic
+    // form A >= the delay's Hessian all over the piece) asks for a level n >= kMinLevel,
+    //     n = the least integer with speed bubbleMax(A's sides) / n^2 <= T,
+    // the piece is not much worse shaped in A's metric than an equilateral triangle (area over
+    // bound at least kShapeShare of the equilateral's: the template's triangles have the piece's
+    // shape), and A is nearly the form at its centroid (within kCoarseSlack) or the n^2
+    // triangles of the template are fewer than the two halves are expected to need (each half
+    // asks for half the centroid's need, its excess of A over the centroid's form shrunk by
+    // sqrt 2, its level rounded up by kRounding on average). With the form of chord_error.h
+    // (second-order slack along the line of sight) this holds near the camera too. For a mesh
+    // triangle (depth 0) whose A is within kNearlyUniform of its centroid's form, each half's
+    // need is taken from the centroid's form on that half's own sides instead (halvesEstimate):
+    // a well-shaped piece's halves keep about 3/4 of its need each, not 1/2, so the halves were
+    // expected to be cheaper than they are, and a mesh triangle far from the camera (the plate
+    // of docs/ACCURACY.md) was halved, its halves' grids rounding up to more triangles than its
+    // own, or halved on down to pieces below kMinLevel and bisected to the end (the templates
+    // then too small a share of the frame's leaves). Its level is now decided at once. On the
+    // pieces the bisection made (near the camera, where the halves gain by adapting to the
+    // varying form) the first estimate is kept: the new one on every piece made the box's
+    // closest frame more triangles (Refine.FewerTrianglesThanUniformSubdivisionAtEqualError;
+    // docs/PERFORMANCE.md, "The refinement's costs").
+    // A split that would halve a piece marked kCoarse at a level of kKeptLevel or more (the
+    // longest-edge path of a neighbour reaching it) is not made: the neighbour is filled by its
+    // own template instead (splitLongestPath's guard), so a template, once chosen, stays whole
+    // (near the camera the bisection would otherwise cut every template its neighbours reach,
+    // and each piece cut so pays the bisection's records instead of the template's). The neighbour's forced template rounds its level up, and the
+    // neighbour may be stretched in the form's metric (no shape rule): where that template
+    // would make more than kForceRatio times the triangles its bisection is expected to make
+    // (its bubbles' bound over T, about the pieces halving down to T leaves), the split is made
+    // after all and the template's halves are judged again (forcedTemplatePays). Guarding every
+    // level without that rule templated the box's closest frame at T = 1e-3 x size into more
+    // triangles than uniform subdivision's; guarding level 8 and more only left the box at
+    // T = 1e-4 x size mostly bisected (docs/ACCURACY.md, "Templates").
+    // The grid triangles of a piece at level n (the piece scaled by 1/n) are within T
+    // (chord_error.h PieceForm). Each edge record gets the largest level of the pieces around
+    // it, and both sides cut it into that many equal segments: no T-junctions, and the counts
+    // depend on the pieces alone (deterministic). The template (tessellate.h) fills the piece:
+    // grid triangles inside, a stitched ring along sides cut more finely than its level, every
+    // ring triangle checked against A (the piece's level is raised until they pass: in the limit
+    // the ring's triangles shrink to the sides' segments, each shorter than a grid edge of the
+    // piece's first level). A piece that passed as a whole (and the mesh's triangles that needed
+    // nothing) keeps level 1: its sides' extra points are fanned and, the delay being convex,
+    // every triangle inside it is within its own bound.
+    // A piece whose shape fails that rule and whose need is at most kAnisoMaxNeed is filled by
+    // bisection in its form's metric instead (form_bisect.h: the grid would round its stretched
+    // triangles up; the global bisection would pay its bounds and records per piece); its sides
+    // get the counts FormBisection::sideSegments gives (each segment within 3 T / speed by the
+    // form), in the same largest-count-around-each-edge rule, so its neighbours conform. Larger
+    // needs are bisected on: their halves soon get grids, far cheaper per triangle (the limit's
+    // choice: docs/PERFORMANCE.md, "The refinement's costs").
+    // The template makes no record per output triangle; where it is not used (a level below
+    // kMinLevel, or more triangles than the halves') the bisection goes on to pieces that
+    // pass, which adapts more finely (docs/ACCURACY.md: the constants keep every trade ratio
+    // within the targets).
+    static constexpr double kMinLevel = 2;
+    static constexpr double kShapeShare = 0.3;
+    static constexpr double kEquilateral = 2.598076211353316;  // 3 sqrt(3) / 2: area / bubbleMax of an equilateral triangle
+    static constexpr double kCoarseSlack = 1.1;
+    static constexpr double kRounding = 0.3;
+    static constexpr double kTemplateShare = 0.5;  // least share of the leaves the templates' triangles must make (refineFrame)
+    static constexpr uint32_t kKeptLevel = 2;      // least level of a template the guard keeps whole
+    static constexpr double kForceRatio = 2;       // a forced template's triangles over its bisection's expected count, at most
+    static constexpr double kAnisoCost = 2;        // FormBisection's triangles over the form's need (bubbleMax speed / T), about
+    static constexpr double kAnisoMaxNeed = 16;    // the largest need (bubbleMax speed / T) FormBisection fills
+    static constexpr uint32_t kNoCap = 1u << 20;   // formLevel without the max_segments cap
+    static constexpr double kNearlyUniform = 1.2;  // a mesh triangle's A within this of its centroid's form: halvesEstimate
+
+    // True when the whole-piece form of the piece with corners' shape offsets a, b, c (chord_error.h
+    // pieceForm: A >= the delay's Hessian on the whole piece) bounds the piece itself within the
+    // tolerance: speed bubbleMax(A's sides) <= T. A sound bound of the piece as chordErrorOfPoints'
+    // is; tighter than its third-order term near the camera (the form's slack there is second
+    // order along the line of sight), so a piece it passes needs no further split.
+    bool passesByForm(const Vec3& a, const Vec3& b, const Vec3& c) const;
+
+    // Whether piece id's forced template (its form made by coarseForm(id, s, true)) makes at
+    // most kForceRatio times the triangles its bisection is expected to: n^2 against its
+    // bubbles' bound over T (at least 1).
+    bool forcedTemplatePays(uint32_t id);
+
+    // The form of piece id (its corners' shape offsets s) when it is finite and (unless `force`:
+    // the depth limit stopped the piece) the piece is better filled by a template (above); kept
+    // in scratch.forms, indexed by scratch.form_of[id].
+    bool coarseForm(uint32_t id, const Vec3 s[3], bool force);
+
+    // The triangles the two halves of a piece are expected to make (coarseForm): each half's need
+    // from the centroid's form on its own sides (the piece halved on its longest side in that
+    // form: a half-side, the median, a whole side; the median's value by the parallelogram law,
+    // which holds for any quadratic form), its excess of A over the centroid's form shrunk by
+    // sqrt 2, its level rounded up by kRounding on average. per: need per unit of bubbleMax.
+    static double halvesEstimate(const PieceForm& pf, double per, double infl);
+    // A half's excess of A over the centroid's form: the piece's (infl - 1) shrunk by sqrt 2.
+    static double halfGrowth(double infl) { return 1 + (infl - 1) / 1.4142135623730951; }
+    // The triangles a half of need `child` is expected to make: its level rounded up by kRounding
+    // on average, squared; at least one.
+    static double halfCost(double child);
+
+    // The triangles the fill of form f is expected to make: n^2 for a grid of level n (at most
+    // cap), kAnisoCost times the form's need for the bisection in its metric.
+    double fillEstimate(uint32_t f, uint32_t cap) const;
+
+    // The least level n >= 1 with speed bubbleMax(c) / n^2 <= T, at most `cap`.
+    uint32_t formLevel(const PieceForm& pf, uint32_t cap) const;
+
+    // The first id of the count - 1 points that cut edge record e (ends a, b) into equal
+    // segments, made once, from the lower id end: point i of the edge is lo + (hi - lo) i / count.
+    uint32_t edgePoints(uint32_t e, uint32_t a, uint32_t b, uint32_t count);
+
+    // Fills one leaf (corners v, edge records e, on mesh triangle src) with its template at
+    // level N (form: the piece's form, or null for a piece within the bound as a whole) and
+    // appends the triangles. base: the output index of the first new point.
+    void fillLeaf(uint32_t src, const uint32_t v[3], const uint32_t e[3], uint32_t N, const PieceForm* form,
+                  bool unsplit, size_t base, uint32_t cap, bool aniso = false);
+
+    // Every leaf in record order filled by its template. When the templates would pass
+    // settings.max_triangles, every level is scaled down until they fit and over_budget is set
+    // (the tolerance is not met then, and the rings are not checked); false (nothing emitted)
+    // when even the leaves alone do not fit: they are emitted as they are.
+    double r_level_scale = 1;
+    bool templateLeaves();
+
+    uint32_t outId(uint32_t id);
+
+    // The clip point of the leaf side a -> b at cap `cap`: keyed by the two ends, parametrised
+    // from the smaller id, so both leaves on the side share it (on a whole mesh edge it is the
+    // point crossingPoint makes in vertex mode).
+    uint32_t leafCrossing(uint32_t a, uint32_t b, int cap);
+
+    void emitLeaf(uint32_t src, const uint32_t v[3]);
+
+    // The whole frame with the tolerance: bounds of every live mesh triangle from its corners and
+    // edge midpoints (cut in batches), splits where a bound exceeds the tolerance, then the leaves
+    // in mesh order. `live`: one flag per chunk (the cull), or null.
+    void refineFrame(const std::vector<uint8_t>* live);
+
+    // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).
+    void clipWhole(size_t f);
+
+    // Step (objects at rest on the past cone, with a real cap, tolerance > 0). The surface is the
+    // input itself (the cut is affine), but a cap meets the cone in a sphere, so the clip curves
+    // are circles. A triangle a cap may cut is split in four, recursively, where a cap's curve could
+    // hide in a piece or its chord through the piece lies farther than T/4 from the circle
+    // (clipRatio), at most to 2^-depth of the triangle with 2^depth <= max_segments. Each leaf
+    // piece is then a convex polygon: its corners and the corners of finer neighbours on its sides
+    // (so the pieces of a triangle meet edge to edge), clipped at exact crossings as in vertex mode.
+    // Points and crossings on a mesh edge are keyed by the edge and their place along it, so the
+    // two triangles of the edge share those they both make; where the two split the edge
+    // differently they meet at T-junctions (the edge is straight: no gap). A whole mesh edge keeps
+    // its vertex-mode crossing (crossingPoint).
+    static constexpr int kRestDepth = 20;                          // deepest split the keys can hold
+    static constexpr int64_t kRestOne = int64_t(1) << kRestDepth;  // barycentric 1 in piece keys
+    using Key = std::pair<int64_t, int64_t>;                       // barycentrics on corners 1, 2 (x 2^-20)
+
+    struct RestPiece {
+        Key k[3];
+    };
+
+    // Points on mesh edges (per frame): (edge, place from lo in 2^-20) -> output vertex, and crossings
+    // on a stretch of a mesh edge: (edge, from, to, cap) -> output vertex.
+    std::map<std::pair<uint32_t, int64_t>, uint32_t> rest_edge_points;
+    std::map<std::pair<std::pair<uint32_t, int64_t>, std::pair<int64_t, int>>, uint32_t> rest_edge_crossings;
+
+    static void barycentrics(const Key& k, double l[3]);
+
+    double pieceRatio(const uint32_t v[3], const RestPiece& p, double limit) const;
+
+    // The triangle corner a key is, or -1.
+    static int cornerOf(const Key& k);
+
+    // Whether a key lies on triangle side s (0: corners 0-1, 1: 1-2, 2: 2-0), and its place along
+    // the side from the side's first corner.
+    static bool onSide(const Key& k, int s, int64_t* place);
+    // A place along triangle f's side s (from the side's first corner), counted from its mesh
+    // edge's lo end instead: the same number for both triangles of the edge.
+    int64_t placeFromLo(const uint32_t v[3], int s, uint32_t edge, int64_t place) const;
+    // The side a point that is no corner lies on, or -1.
+    static int sideOfKey(const Key& k, int64_t* place);
+
+    // Pass 1 (restPlan, every triangle): the leaf pieces, and their places along the mesh edges;
+    // pass 2 (restEmit, once all triangles are planned): the polygons, with the corners of finer
+    // neighbours on every side, also across mesh edges, so the pieces meet edge to edge.
+    struct RestPlan {
+        size_t f = 0;
+        std::vector<RestPiece> leaves;
+        std::set<Key> corners;
+    };
+    std::vector<RestPlan> rest_plans;
+    std::map<uint32_t, std::set<int64_t>> rest_edge_places;  // mesh edge -> leaf corners on it (place from lo)
+
+    void restPlan(size_t f);
+
+    void restEmit(const RestPlan& plan);
+
+    // The key of the point at `place` along triangle side s from its first corner.
+    static Key keyOnSide(int s, int64_t place);
+
+    void splitPiece(const uint32_t v[3], const RestPiece& p, double ratio, int depth, int max_depth, double limit,
+                    std::vector<RestPiece>* leaves, std::set<Key>* corners, bool* limited) const;
+
+    // Corners of other leaves strictly inside the side a -> b, in order: on a mesh edge, those of
+    // both triangles of the edge; inside the triangle, those of its finer leaves (which halve the
+    // side dyadically).
+    void hangingCorners(const uint32_t v[3], const Key& a, const Key& b, const std::set<Key>& corners,
+                        std::vector<Key>* out_keys) const;
+
+    static void innerHanging(const Key& a, const Key& b, const std::set<Key>& corners, std::vector<Key>* out_keys);
+
+    // Output vertex of a piece corner: a mesh vertex, a point on a mesh edge (shared by the edge's
+    // triangles), or an inner point of this triangle.
+    uint32_t restPoint(const uint32_t v[3], const Key& k, std::map<Key, uint32_t>& points);
+
+    Side restSide(const uint32_t v[3], const Key& k) const;
+
+    // The crossing of the stretch a -> b of a piece's boundary with cap `cap`.
+    uint32_t restCrossing(const uint32_t v[3], const Key& a, const Key& b, Side sa, Side sb, int cap,
+                          std::map<Key, uint32_t>& points, std::map<std::pair<std::pair<Key, Key>, int>, uint32_t>& crossings);
+
+    // One leaf polygon (convex, possibly with straight runs of corners) clipped to the span and
+    // emitted: as a fan from its first kept corner when no three consecutive corners are in line,
+    // else as a fan about the centre of its corners (no zero-area triangles).
+    void clipRestPolygon(size_t f, const uint32_t v[3], const std::vector<Key>& poly, std::map<Key, uint32_t>& points,
+                         std::map<std::pair<std::pair<Key, Key>, int>, uint32_t>& crossings);
+
+    // Step: one triangle: whole, refined, or clipped to the span.
+    void addTriangle(size_t f);
+};
+
+// ---- Why the steps hold: the reasoning behind the step headings of the .cpp files ----
+// cut/slice.cpp:
+//   - No real cap, nothing culled, every vertex used, the refinement's batch cut made: output vertex
+//     i is the image of vertex i, copied in bulk (the same points vertexPoint emits).
+//   - Visible vertices first, in input order: when nothing is clipped or refined, output vertex i is
+//     the image of input vertex i (unreferenced input vertices aside).
+//   - The camera among the events: h <= t_c - t there; the light has not left any of them yet, or so
+//     little time ago that whatever shows is narrower than the limit.
+//   - The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
+//     may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box)
+//     and at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms
+//     remain. The margin covers the rounding of these bounds (a few ulps of the largest term).
+//   - Model only what the cut requires: on a hyperplane, or at rest, the map from the rest surface
+//     to the apparent one is affine, so straight edges are exact and nothing is refined (at rest
+//     under a shear it is not: chord_error.h displacedChordError).
+//   - At rest on the past cone with a real cap, the caps' clip curves are circles: those alone are
+//     refined (FrameBuilder::restPlan). A motion that is not uniform (worldline.h) is otherwise cut
+//     in vertex mode: exact points on the true worldlines (lightcone.h sends each cut to
+//     crossWorldline).
+//   - A motion that is not uniform, with a tolerance: worldline_refine.h (no real cap; the callers
+//     refuse a tolerance for such an object that begins or ends existing, and a moving camera).
+//   - Step: the fast path of vertex mode when nothing is clipped: output vertex i is the image of
+//     input vertex i and the triangles are the input's (the same result as below, made in one pass).
+//   - Step: the Galilean map into the output frame, origin and local parts apart (each local point
+//     moves by -shear times its local time, a term of the object's size).
+// refine/first_pass.cpp:
+//   - Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
+//     refinement; the others get the a-priori bound (chordErrorOfBubbles).
+//   - The corners' spread (chord_error.h cornerSpread: the largest |u|_M^2 of a triangle's sides)
+//     from each mesh edge's |u|_M^2, made once per edge instead of once per side of each triangle:
+//     |u|_M^2 is even in u (negating u negates its terms exactly), and the largest of three does not
+//     depend on their order, so each triangle's spread is cornerSpread's bit for bit. (With a cull,
+//     per triangle: most edges may be culled.)
+//   - Every triangle passes when the whole mesh does: its largest spread D with the least |x|_M of
+//     all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at most D (both the
+//     same std::max chain from 0 over the same spreads, which skips a NaN) and its xmin at least X
+//     (no xm is NaN), and passesFromSpread is monotone in both as rounded (chord_error.h): fl(4 d2),
+//     fl(xmin xmin) and fl(beta d2) grow with their operand, and fl(3 (1 - beta^2) T) >= 0 is one
+//     factor of xmin. So the verdict is the triangles' own (no candidates), without the pass over
+//     the triangles (with real caps that pass also counts the clipped triangles: it is made then).
+//   - The least |x|_M of all vertices, and their sum: NaN when one is (an infinity of each sign
+//     makes NaN too, and the pass below is only skipped then). (Its own loop: the terms' loop above
+//     stays vectorised.)
+//   - (The arrays and the tolerance read through locals: the compiler cannot tell that
+//     `candidates`'s stores leave them alone, and would load them again per triangle.)
+//   - The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
+//     chordErrorFromCorners' bit for bit, from the one spread both tests use.
+//   - Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits: ends in
+//     id order), when the candidates are enough to pay for the edge records' reset (a large mesh
+//     with a few candidates computes their edges per triangle instead).
+//   - The corners' terms in place (the drain's pointsBound on the same record: the same bits); the
+//     sides' |u|_M^2 are the edges' spreads when made (normM2 of the side either way round: the same
+//     bits, chord_error.h chordErrorOfSides).
+//   - Room for the pieces and points the refinement is expected to make (growth would copy them). At
+//     most a million: reserving is only a saving, never a bound (max_triangles is).
+//   - Still as the mesh has it (only a split changes a record's corners, and it deepens it; a
+//     neighbour's split may have made the record): the first pass's verdict stands, from the same
+//     terms and edge records (edgeOf: the same bits).
+//   - Step: templates only where they make most of the output: else the few coarse pieces are
+//     bisected on like the rest (the templates' pass over every leaf would cost more than it saves).
+//   - The records still coarse, in id order (as a pass over all records would meet them), from the
+//     list of those marked: no pass over every record.
+//   - Step (no real cap): the output's points, once the splits are done: the visible vertices
+//     (classifyVertices, in input order), then the points the splits (and the templates) made, in
+//     room for all of them made once. Without templates the room is exact: each output array is
+//     allocated once per frame and its points copied once. Templates fill the leaves when the splits
+//     left coarse pieces (no real cap: r_templates).
+//   - Step (no real cap): the leaves filled by their templates. (Without a coarse piece every leaf
+//     is its own output triangle: emitted below as they are.)
+//   - Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then the
+//     pieces the splits appended.
+//   - Nothing clipped: every point a split made is a corner of some leaf, so the points follow the
+//     mesh's visible vertices in id order, copied in bulk.
+// refine/bisect.cpp:
+//   - Without a real cap every point is inside and is given its output place in bulk (refineFrame):
+//     side and vertex_out stay the mesh's.
+//   - A piece back on the stack unchanged (its record is reset when it is halved) keeps its verdict:
+//     its bound is not evaluated again.
+//   - The bubbles pass but the third-order term does not: the whole-piece form (tighter near the
+//     camera, chord_error.h pieceForm) may pass the piece as it is.
+//   - (The form is worth making only for a piece that needs a level of kMinLevel or more: its
+//     bubbles alone say about how much.)
+//   - A split of a coarser neighbour first (kSplitOther) leaves id as it was (its edges are shorter
+//     than the edge halved): id is judged again at once, as if pushed back and popped.
+//   - The split would halve a piece a template fills: this piece is filled by its own template
+//     instead (any level its form asks for), so the template stays whole, unless that template would
+//     make more than kForceRatio times the triangles its bisection is expected to (then the split is
+//     made: the template's halves are judged again).
+// refine/templates.cpp:
+//   - Its shape in the form's metric: area over bound, against the equilateral's (the template's
+//     triangles are the piece's shape, scaled).
+//   - A fill's local points 0..2 are the corners, then each side's n[k] - 1 shared points from
+//     side_first(k): both mapped to the frame's point ids (the sides' points in edge order).
+//   - A piece stretched in its form's metric: the bisection in that metric (form_bisect.h), unless
+//     that fails (past cap^2 triangles, or a fan of slivers along a side held to its points): then
+//     the grid below, on the same side counts.
+//   - Step: each record's level, and each edge's count (the largest level around it). The estimate
+//     bounds the output: a leaf makes at most N^2 + 2 + the extra segments of its sides
+//     (tessellate.h), an edge is on about two leaves.
+//   - A form asking for more than max_segments segments gets that many: the tolerance is not met
+//     there, counted as the depth limit is.
+
+}  // namespace slicing
+}  // namespace mesh4d
