@@ -14,12 +14,16 @@ from setuptools import Distribution, setup
 from setuptools.command.build_py import build_py
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
+BUILD = os.environ.get("APPARENT_BUILD_DIR") or os.path.join(ROOT, "build")
+# setuptools' own files (egg-info, build/lib) go to BUILD/setuptools, not into the source tree.
+SETUPTOOLS_DIR = os.path.join(BUILD, "setuptools")
+os.makedirs(SETUPTOOLS_DIR, exist_ok=True)
 
 
 class BuildWithCMake(build_py):
     def run(self):
         super().run()
-        build = os.environ.get("APPARENT_BUILD_DIR") or os.path.join(ROOT, "build")
+        build = BUILD
         if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
             subprocess.check_call(["cmake", "-S", ROOT, "-B", build, "-DCMAKE_BUILD_TYPE=RelWithDebInfo",
                                    "-DPython3_EXECUTABLE=" + sys.executable])
@@ -43,4 +47,6 @@ class BinaryDistribution(Distribution):
 
 
 setup(packages=["apparent"], package_dir={"apparent": "python/apparent"}, cmdclass={"build_py": BuildWithCMake},
-      distclass=BinaryDistribution)
+      distclass=BinaryDistribution,
+      options={"egg_info": {"egg_base": os.path.relpath(SETUPTOOLS_DIR, ROOT)},
+               "build": {"build_base": os.path.join(SETUPTOOLS_DIR, "build")}})
