@@ -46,7 +46,7 @@ SCENES = [
 
 
 @pytest.mark.parametrize("scene_path", SCENES)
-@pytest.mark.parametrize("tolerance", ["vertex", None])
+@pytest.mark.parametrize("tolerance", ["vertex", None, "1e-2x"])
 def test_cut_equals_the_commands_ply(scene_path, tolerance, tmp_path):
     scene = apparent.load(ROOT / scene_path)
     out = tmp_path / "out"
