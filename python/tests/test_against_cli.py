@@ -1,6 +1,6 @@
 """Scene.cut against the PLY files `apparent render` writes (issue 34): value for value (double),
-in vertex mode and at the scene's default tolerance, for the default scene, a moving camera, a
-spinning body and a keyed path."""
+in vertex mode, at the scene's default tolerance and at 1e-2x (each motion's refinement), for the
+default scene, a moving camera, a spinning body and a keyed path."""
 import pathlib
 
 import numpy as np
