@@ -1,5 +1,6 @@
 #include "pipeline/frame_loop.h"
 
+#include "pipeline/frame_cut.h"
 #include "pipeline/scene_fields.h"
 
 #include <algorithm>
@@ -14,12 +15,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
 #include "mesh4d/check.h"
-#include "mesh4d/light_factors.h"
 
 namespace apparent {
 
@@ -210,21 +209,8 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     // Frame k cut: every world with the frame's view surface (refined to the tolerance).
     auto cutOne = [&](long long k, ExportFrame* frame) {
         frame->t_c = frameTime(scene.frames, k);
-        const mesh4d::ViewSurface view = viewForFrame(scene, model, k);
-        // Objects in parallel too (a short range of frames of a many-object scene), each into its
-        // own slot: the result does not depend on the scheduling.
-        frame->objects.resize(worlds.size());
-        tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
-            const mesh4d::World4D& world = worlds[o];
-            // --cull-view: an object wholly outside the camera's view is left empty.
-            if (settings.cull_view && !inCameraView(scene.camera, mesh4d::apparentBound(world, view))) return;
-            mesh4d::SliceSettings own = slice_settings;
-            own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
-            frame->objects[o] = mesh4d::sliceWorld(world, view, own);
-            if (light_factors) mesh4d::addLightFactors(world, view, &frame->objects[o]);
-        });
-        // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-        reflections.append(view, slice_settings, &frame->objects, &stage.tolerances, light_factors);
+        cutFrameAt(stage, worlds, reflections, viewForFrame(scene, model, k), slice_settings, settings.cull_view,
+                   light_factors, frame);
         APPARENT_CHECK(frame->objects.size(), ==, info.objects.size());
     };
     // In parallel: cut every world with the frame's view surface, then each sink's conversion.

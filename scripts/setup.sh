@@ -25,12 +25,15 @@ packages=(build-essential cmake pkg-config
   libfreetype-dev fonts-dejavu-core ffmpeg)  # figure labels; raytrace/figure --video (and ffprobe in the tests)
 packages+=(libopenmpi-dev openmpi-bin)  # mpirun -n N apparent render (optional in CMake; the mpi_ranks test needs it)
 packages+=(python3 bc)  # scripts/*_report.sh run Python helpers; mpi_report.sh and measure_gltf_sizes.sh compute ratios with bc
+packages+=(pybind11-dev python3-pybind11 python3-numpy python3-venv python3-pip)  # `import apparent` (python/, docs/PYTHON.md); venv and pip: its install
 if [ "$mode" = test ]; then
   packages+=(chromium)            # three.js viewer test (tests/web), headless
   packages+=(meshlab xvfb xauth)  # MeshLab opens the PLY output (tests/validators/meshlab_ply.sh)
   packages+=(blender python3-numpy)  # Blender imports the .glb (tests/blender); its importer needs numpy
   packages+=(python3 clang-14 libclang-rt-14-dev)  # kill test (tests/kill_test.py); libFuzzer for scripts/fuzz.sh
   packages+=(gltfpack assimp-utils)  # scripts/measure_gltf_sizes.sh: gltfpack -cc beside our codecs; the Duck as OBJ
+  packages+=(python3-pytest)  # ctest python_module runs python/tests
+  packages+=(jupyter-nbconvert python3-ipykernel python3-matplotlib)  # ctest python_notebooks executes examples/*.ipynb
   packages+=(git)  # ctest repository_stands_alone reads the tracked files (tests/repository/stands_alone.sh)
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
