@@ -8,6 +8,7 @@
 #include "mesh4d/check.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/frame_loop.h"
+#include "pipeline/physics.h"
 #include "pipeline/scene_fields.h"
 #include "pipeline/worlds.h"
 
@@ -32,28 +33,70 @@ void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, 
     reflections.append(view, settings, &frame->objects, &stage.tolerances, light_factors);
 }
 
+struct FrameCutter::Histories {
+    std::vector<mesh4d::World4D> worlds;
+    MirrorReflections reflections;
+
+    // As the frame loop builds them for frames [first, last] of `scene` (global numbers).
+    Histories(const Stage& stage, const Scene& scene, Model model, long long first, long long last)
+        : worlds(buildWorlds(stage.objects, model, scene, first, last)),
+          reflections(scene, stage.objects, stage.mirrors, model, first, last) {}
+};
+
 FrameCutter::FrameCutter(const Stage& stage, Model model)
     : stage_(stage), model_(model),
-      worlds_(buildWorlds(stage.objects, model, stage.scene, stage.first, stage.last_excl - 1)),
-      reflections_(stage.scene, stage.objects, stage.mirrors, model, stage.first, stage.last_excl - 1),
+      range_(std::make_shared<const Histories>(stage, stage.scene, model, stage.first, stage.last_excl - 1)),
       info_(sequenceInfo(stage, model)), t_first_(frameTime(stage.scene.frames, stage.first)),
       t_last_(frameTime(stage.scene.frames, stage.last_excl - 1)) {
-    reflections_.describe(&info_);
+    range_->reflections.describe(&info_);
+}
+
+FrameCutter::~FrameCutter() = default;
+
+std::shared_ptr<const FrameCutter::Histories> FrameCutter::historiesFor(double t_c, std::string* error) const {
+    if (t_c >= t_first_ && t_c <= t_last_) return range_;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& kept : spans_)
+            if (kept.first == t_c) return kept.second;
+    }
+    // Step: the scene with its frames moved to one frame at t_c, and the command's checks of it.
+    Scene moved = stage_.scene;
+    moved.frames.start = t_c;
+    moved.frames.end = t_c + 0.5 / moved.frames.fps;
+    if (Status s = checkViewedTime(moved, 0); !s.ok) {
+        *error = s.message;
+        return nullptr;
+    }
+    for (size_t i = 0; i < stage_.objects.size(); ++i)
+        if (Status s = checkObjectMotion(stage_.objects[i], model_, moved, stage_.tolerances[i], 0, 0); !s.ok) {
+            *error = s.message;
+            return nullptr;
+        }
+    // Step: its histories, built outside the lock (two threads may build the same; one is kept).
+    auto built = std::make_shared<const Histories>(stage_, moved, model_, 0, 0);
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& kept : spans_)
+        if (kept.first == t_c) return kept.second;
+    spans_.emplace_back(t_c, built);
+    if (spans_.size() > kSpansKept) spans_.pop_front();
+    return built;
 }
 
 bool FrameCutter::cut(double t_c, long long max_frame_triangles, ExportFrame* frame, std::string* error) const {
     const Scene& scene = stage_.scene;
-    if (!std::isfinite(t_c) || t_c < t_first_ || t_c > t_last_) {
-        *error = scene.path + ": camera time " + formatNumber(t_c) + " is outside the frames' times [" +
-                 formatNumber(t_first_) + ", " + formatNumber(t_last_) + "] s";
+    if (!std::isfinite(t_c)) {
+        *error = scene.path + ": camera time " + formatNumber(t_c) + " is not finite";
         return false;
     }
+    const std::shared_ptr<const Histories> histories = historiesFor(t_c, error);
+    if (!histories) return false;
     const long long budget = max_frame_triangles > 0 ? max_frame_triangles : defaultFrameTriangleBudget(stage_);
     mesh4d::SliceSettings settings;
     settings.tolerance = scene.tolerance;
     settings.max_triangles = size_t(budget);
     frame->t_c = t_c;
-    cutFrameAt(stage_, worlds_, reflections_, viewAt(scene, model_, t_c), settings, false, true, frame);
+    cutFrameAt(stage_, histories->worlds, histories->reflections, viewAt(scene, model_, t_c), settings, false, true, frame);
     APPARENT_CHECK(frame->objects.size(), ==, info_.objects.size());
     // The frame loop's budget: an object's refinement stopped at it, or all objects hold more.
     const bool over = frame->triangleCount() > size_t(budget) ||

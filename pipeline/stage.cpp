@@ -12,6 +12,14 @@
 
 namespace apparent {
 
+Status checkViewedTime(const Scene& scene, long long k) {
+    auto outOfRange = [](double v) { return !(std::fabs(v) <= kMaxCoordinate); };
+    if (outOfRange(frameTime(scene.frames, k)) || outOfRange(frameTime(scene.frames, k) - scene.camera.instant_delay))
+        return Status::failure(scene.path + ": frames, camera.instant_delay: the viewed time of frame " + std::to_string(k) +
+                               " is not finite or beyond " + formatNumber(kMaxCoordinate) + " s");
+    return Status::success();
+}
+
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error) {
     auto fail = [&](const std::string& message) {
         *error = printable(message, 4096);  // one line, whatever a file or key holds
@@ -61,9 +69,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
                     std::to_string(options.max_object_frames) + " object-frames (raise it with --max-object-frames)");
     auto outOfRange = [](double v) { return !(std::fabs(v) <= kMaxCoordinate); };
     for (const long long k : {stage->first, stage->last_excl - 1})
-        if (outOfRange(frameTime(scene.frames, k)) || outOfRange(frameTime(scene.frames, k) - scene.camera.instant_delay))
-            return fail(scene.path + ": frames, camera.instant_delay: the viewed time of frame " + std::to_string(k) +
-                        " is not finite or beyond " + formatNumber(kMaxCoordinate) + " s");
+        if (Status s = checkViewedTime(scene, k); !s.ok) return fail(s.message);
     double largest = 0;
     std::vector<double> sizes;  // each object's bounding-box diagonal
     for (const PreparedObject& o : stage->objects) {

@@ -66,4 +66,9 @@ struct Stage {
 // "error: ") in `error`; the command exits with kExitBadInput. Mesh warnings go to `log`.
 bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std::string* error);
 
+// loadStage's check of one end k of the frame range: the camera time of global frame k, and that
+// less camera.instant_delay (the time the instant models view), finite and within kMaxCoordinate;
+// the line names frame k. FrameCutter applies it to the frames it builds for a cut outside the range.
+Status checkViewedTime(const Scene& scene, long long k);
+
 }  // namespace apparent

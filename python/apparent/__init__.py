@@ -127,8 +127,9 @@ class Scene:
     def cut(self, t, model="relativistic", tolerance=None, max_triangles=0):
         """The frame the camera sees at camera time ``t`` (seconds), as a :class:`Frame`.
 
-        t          any camera time between the scene's first and last frame times
-                   (``frame_times[0]`` .. ``frame_times[-1]``), not only a frame time
+        t          any finite camera time, not only a frame time; outside
+                   ``frame_times[0]`` .. ``frame_times[-1]`` the histories are built for ``t``
+                   (as the command builds them for a scene whose frames are one frame at ``t``)
         model      "instant", "finite", "relativistic" (default) or "contracted" (see the module)
         tolerance  None: the scene's; 0 or "vertex": vertex mode (exact vertices, straight edges);
                    a positive number: light-seconds, the largest distance from the exact apparent
