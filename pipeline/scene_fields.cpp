@@ -300,14 +300,14 @@ const std::vector<ObjectField>& objectFields() {
         {{"mesh"}, true, &readMeshPath},
         {{"position"}, true, &readPosition},
         {{"t0"}, false, &readT0},
-        {{"velocity"}, false, &readVelocity},
-        {{"direction", "gamma", "rapidity"}, false, &readExactSpeed},
+        {{"velocity"}, false, &readVelocity, true},
+        {{"direction", "gamma", "rapidity"}, false, &readExactSpeed, true},
         {{"rotation_deg"}, false, &readRotation},
         {{"scale"}, false, &readScale},
         {{"mirror"}, false, &readMirror},
         {{"exists"}, false, &readExists},
-        {{"angular_velocity"}, false, &readAngularVelocity},
-        {{"acceleration"}, false, &readAcceleration},
+        {{"angular_velocity"}, false, &readAngularVelocity, true},
+        {{"acceleration"}, false, &readAcceleration, true},
     };
     return table;
 }

@@ -23,9 +23,14 @@
 //   paddedSpanSeen (seen.h)       the span of the object's time a range of views sees, padded for
 //                                 the extrusion of its history.
 //   slabSpanSeen (seen.h)         the span a range of views sees on the history's time slabs.
-// Not yet here (they stay with the refinement): the slab step (extrude.h slabSpacing and
-// SlabGrid, a switch over MotionKind) and the rates bound (worldline_bound.h, which still tests
-// the fields).
+//   slabSpacing, SlabGrid (extrude.h) the slab step; pieceBound (worldline_bound.h) the rates bound.
+//
+// Adding a kind: a row of MotionKind and its test in kindOf and mixedKinds (here), its parameters
+// in KindParams (here), its answers as one KindAnswers row in its own file (kinds.h: the own-frame
+// event and rates, the clock, the fastest speed, the rates bound, the slab step and the stage's
+// refusals), named in answersOf (kinds.cpp, the one switch a new kind must join), and its scene
+// field as one row of pipeline/scene_fields.cpp's table (JSON and glTF extras alike). The
+// questions' switches send every kind they do not name to its row (a `default:`).
 //
 // Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
 //
@@ -50,6 +55,11 @@ enum class Kinematics { Galilean, Lorentz };
 
 struct KeyedMotion;  // keyed.h
 
+// The parameters of the kinds answered in their own file (kinds.h), as a scene states them: a scene
+// field's row in pipeline/scene_fields.cpp's table reads them into ObjectSpec::kinds, and motionOf
+// copies them whole into Motion::kinds. Empty: none of these kinds.
+struct KindParams {};
+
 struct Motion {
     Kinematics kinematics = Kinematics::Galilean;
     double t0 = 0;        // lab time of the origin event
@@ -72,6 +82,8 @@ struct Motion {
     // A keyframed path (mesh4d/motion/keyed.h: the centre and the turn interpolated between lab keys,
     // carried rigidly in the frame of `velocity`, the path's mean velocity). Null: none.
     std::shared_ptr<const KeyedMotion> keyed;
+    // The kinds answered in their own file (kinds.h).
+    KindParams kinds;
 };
 
 // The closed list of the kinds of motion (above).
