@@ -2,6 +2,8 @@
 
 namespace mesh4d {
 
+extern const KindAnswers kOrbitAnswers;  // orbit.cpp
+
 const KindAnswers* answersOf(const Motion& m) {
     switch (kindOf(m)) {
         case MotionKind::Uniform:
@@ -9,6 +11,8 @@ const KindAnswers* answersOf(const Motion& m) {
         case MotionKind::Hyperbolic:
         case MotionKind::Keyed:
             return nullptr;
+        case MotionKind::Orbit:
+            return &kOrbitAnswers;
     }
     return nullptr;
 }
