@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "motion/keyed.h"
+#include "motion/kinds.h"
 #include "robust.h"
 #include "motion/worldline.h"
 
@@ -259,6 +260,11 @@ double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, dou
         case MotionKind::Spin:
         case MotionKind::Hyperbolic:
             break;
+        default: {  // a kind answered in its own file (kinds.h): its K and M, for all s
+            double K = 0, M = 0;
+            answersOf(motion)->slab_rates(motion, mesh, &K, &M);
+            return stepWithin(K, M, chord);
+        }
     }
     // M: the largest second derivative of a vertex's own-frame worldline over the span (spin:
     // |w|^2 rho, rho the vertex's distance from the axis); K: the largest difference of the first
@@ -294,6 +300,7 @@ SlabGrid::SlabGrid(const RestMesh& mesh, const Motion& motion, double chord) : c
         }
         case MotionKind::Spin:
         case MotionKind::Hyperbolic:
+        default:  // a kind answered in its own file (kinds.h): one step for all s, as a spin's
             break;
     }
     const double a = norm(motion.acceleration);

@@ -43,10 +43,11 @@ Status readKeyframedPath(const std::string& path, const tinygltf::Model& model, 
     if (node.matrix.size() == 16)
         return fail(where + ".matrix", "an animated node must give translation, rotation and scale, not a matrix (glTF 2.0 section 3.11)");
     // The velocity comes from the path; a spin or acceleration with it is not modelled.
-    for (const char* key : {"velocity", "direction", "gamma", "rapidity", "angular_velocity", "acceleration"})
-        if (ex.contains(key))
-            return fail(where + ".extras." + key, "the node's path is keyframed (" + field + "): its motion comes from the "
-                                                  "animation, remove " + key);
+    for (const ObjectField& f : objectFields())
+        for (const std::string& key : f.keys)
+            if (f.states_motion && ex.contains(key))
+                return fail(where + ".extras." + key, "the node's path is keyframed (" + field + "): its motion comes from "
+                                                      "the animation, remove " + key);
     if (ex.contains("mirror") && ex["mirror"] == true)
         return fail(where + ".extras.mirror", "a mirror must be at rest, and the node's path is keyframed (" + field + ")");
     // Step: STEP keys are a jump, an infinite speed, unless they hold one value.

@@ -12,8 +12,9 @@
 //   CUBICSPLINE channels, gltf_animation.h; a spline through its cubicSamples) follows that path
 //   (mesh4d/motion/keyed.h): the keys, composed with the parent's transform as the static values
 //   are, give ObjectSpec::keys; the pose at t0 is the rest pose (position, linear) and the path's
-//   mean velocity is `velocity`. Refused: velocity, direction, gamma, rapidity, angular_velocity,
-//   acceleration or mirror in its extras, a matrix, a STEP jump, a turn under a parent that shears
+//   mean velocity is `velocity`. Refused: a field that states motion in its extras (scene_fields.h
+//   ObjectField::states_motion: velocity, direction, gamma, rapidity, angular_velocity,
+//   acceleration and the fields of the kinds of mesh4d/motion/kinds.h) or mirror, a matrix, a STEP jump, a turn under a parent that shears
 //   or scales unequally, a rotation spline through 0, the centre at >= c on any segment (the speed
 //   and the lab time). Channels on nodes that are not objects are warnings.
 // - Camera: the first node with a camera (glTF cameras look down local -Z, +Y up; yfov gives

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/worldline.h"
 #include "pipeline/scene_fields.h"
 #include "pipeline/worlds.h"
@@ -34,6 +35,7 @@ mesh4d::Motion motionOf(const ObjectSpec& s, Model model) {
     m.acceleration = s.acceleration;          // worldline.h: Born-rigid, from t0 on
     // keyed.h: the path carried in the frame of its mean velocity (s.velocity, m.velocity).
     if (s.keys) m.keyed = mesh4d::makeKeyedMotion(*s.keys, m.kinematics == mesh4d::Kinematics::Lorentz, m.t0, m.origin, m.velocity);
+    m.kinds = s.kinds;  // mesh4d/motion/kinds.h: the kinds answered in their own file
     return m;
 }
 
@@ -82,6 +84,22 @@ static Status checkKeyedMotion(const PreparedObject& object, const mesh4d::Motio
     return tolerance_ok();
 }
 
+// The needs of a kind answered in its own file (mesh4d/motion/kinds.h): one kind at a time, a camera
+// at rest, the kind's own refusals, the tolerance.
+static Status checkKindMotion(const PreparedObject& object, const mesh4d::Motion& m, const mesh4d::KindAnswers& k,
+                              Model model, const Scene& scene, double tolerance, long long first_frame,
+                              long long last_frame) {
+    const std::string field = scene.path + ": " + object.spec.field_path + "." + k.field + ": ";
+    if (mesh4d::mixedKinds(m))
+        return Status::failure(field + "give " + k.field + " alone: with angular_velocity, acceleration or a keyframed "
+                                                           "path it is not modelled");
+    if (cameraMotionOf(scene).moving())
+        return Status::failure(field + k.what + " needs a camera at rest (camera.velocity is not [0, 0, 0])");
+    const std::string problem = k.problem(m, object.rest.positions);
+    if (!problem.empty()) return Status::failure(field + problem);
+    return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, k.what);
+}
+
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
@@ -95,6 +113,8 @@ Status checkObjectMotion(const PreparedObject& object, Model model, const Scene&
         case mesh4d::MotionKind::Spin:
         case mesh4d::MotionKind::Hyperbolic:
             break;
+        default:  // a kind answered in its own file (mesh4d/motion/kinds.h)
+            return checkKindMotion(object, m, *mesh4d::answersOf(m), model, scene, tolerance, first_frame, last_frame);
     }
     // A spin with an acceleration (two kinds) is named by its spin, and refused below.
     const bool mixed = mesh4d::mixedKinds(m);

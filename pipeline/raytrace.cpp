@@ -20,6 +20,7 @@
 #include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
+#include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/seen.h"
 #include "mesh4d/motion/worldline.h"
 #include "pipeline/worlds.h"
@@ -98,6 +99,8 @@ std::string motionField(const ObjectSpec& spec, const mesh4d::Motion& motion) {
         case mesh4d::MotionKind::Uniform:
         case mesh4d::MotionKind::Hyperbolic:
             break;
+        default:  // a kind answered in its own file (mesh4d/motion/kinds.h)
+            return spec.field_path + "." + mesh4d::answersOf(motion)->field;
     }
     return spec.field_path + ".acceleration";
 }

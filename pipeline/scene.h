@@ -10,6 +10,7 @@
 
 #include "mesh4d/event.h"
 #include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/motion.h"
 #include "pipeline/status.h"
 
 namespace apparent {
@@ -73,6 +74,9 @@ struct ObjectSpec {
     // Constant proper acceleration of the origin from t0 on (1/ls, c = 1: light-seconds per second
     // squared), Born-rigid, in the frame of `velocity` (mesh4d/motion/worldline.h); zero: uniform.
     mesh4d::Vec3 acceleration;
+    // The kinds of motion answered in their own file (mesh4d/motion/kinds.h), read by their rows of
+    // scene_fields.cpp's table; empty: none.
+    mesh4d::KindParams kinds;
     mesh4d::Vec3 rotation_deg;         // rest-frame rotation, degrees, applied X then Y then Z
     mesh4d::Vec3 scale{1, 1, 1};       // rest-frame scale, applied before the rotation
     // Interval of existence on the object's own clock (0 at t0): proper time for the relativistic

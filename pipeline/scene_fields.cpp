@@ -292,6 +292,36 @@ void readAcceleration(FieldReader& r, const json& j, const std::string& path, co
         r.fail(path + ".acceleration", "a mirror must be at rest (acceleration [0, 0, 0])");
 }
 
+// A circular orbit (mesh4d/motion/motion.h Orbit): center and axis in the scene's axes (as
+// angular_velocity), the speed, the orientation. Read after the speed and the mirror: the orbit is
+// the whole motion.
+void readOrbit(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    const json* o = nullptr;
+    const std::string p = path + ".orbit";
+    if (r.failed() || !r.object(j, "orbit", path, &o)) return;
+    r.checkKeys(*o, p, {"center", "axis", "speed", "orientation"});
+    for (const char* key : {"center", "axis", "speed"})
+        if (!r.failed() && !o->contains(key)) r.fail(p + "." + key, "missing (the orbit needs center, axis and speed)");
+    mesh4d::Orbit orbit;
+    Vec3 axis{0, 0, 0};
+    std::string orientation = "fixed";
+    r.axisVec3(*o, "center", p, &orbit.center);
+    r.axisVec3(*o, "axis", p, &axis);
+    r.number(*o, "speed", p, &orbit.speed);
+    r.string(*o, "orientation", p, &orientation);
+    if (r.failed()) return;
+    if (!(mesh4d::norm(axis) > 0)) return r.fail(p + ".axis", "must be non-zero");
+    if (!(orbit.speed > 0 && orbit.speed < 1)) return r.fail(p + ".speed", "must be > 0 and < 1 (the speed of light)");
+    if (orientation != "fixed" && orientation != "locked")
+        return r.fail(p + ".orientation", "expected \"fixed\" or \"locked\", got \"" + orientation + "\"");
+    if (obj->mirror) return r.fail(p, "a mirror must be at rest (remove orbit)");
+    if (obj->speed != ObjectSpec::Speed::Velocity || mesh4d::norm(obj->velocity) != 0)
+        return r.fail(p, "the orbit gives the motion: velocity must be [0, 0, 0] (no gamma or rapidity)");
+    orbit.axis = axis / mesh4d::norm(axis);
+    orbit.locked = orientation == "locked";
+    obj->kinds.orbit = std::make_shared<const mesh4d::Orbit>(orbit);
+}
+
 }  // namespace
 
 const std::vector<ObjectField>& objectFields() {
@@ -300,14 +330,15 @@ const std::vector<ObjectField>& objectFields() {
         {{"mesh"}, true, &readMeshPath},
         {{"position"}, true, &readPosition},
         {{"t0"}, false, &readT0},
-        {{"velocity"}, false, &readVelocity},
-        {{"direction", "gamma", "rapidity"}, false, &readExactSpeed},
+        {{"velocity"}, false, &readVelocity, true},
+        {{"direction", "gamma", "rapidity"}, false, &readExactSpeed, true},
         {{"rotation_deg"}, false, &readRotation},
         {{"scale"}, false, &readScale},
         {{"mirror"}, false, &readMirror},
         {{"exists"}, false, &readExists},
-        {{"angular_velocity"}, false, &readAngularVelocity},
-        {{"acceleration"}, false, &readAcceleration},
+        {{"angular_velocity"}, false, &readAngularVelocity, true},
+        {{"acceleration"}, false, &readAcceleration, true},
+        {{"orbit"}, false, &readOrbit, true},
     };
     return table;
 }

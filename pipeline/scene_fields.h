@@ -87,6 +87,9 @@ struct ObjectField {
     bool given_by_gltf_node;  // name, mesh, position: a glTF node gives them itself
     void (*read)(FieldReader& r, const nlohmann::json& j, const std::string& path, const ObjectContext& context,
                  ObjectSpec* obj);
+    // The field states the object's motion: a keyframed glTF node (its motion from the animation)
+    // refuses it.
+    bool states_motion = false;
 };
 
 // The object fields in the order they are read (errors report the first problem in this order).

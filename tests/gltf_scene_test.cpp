@@ -147,6 +147,7 @@ TEST(GltfScene, EveryObjectFieldInExtrasGivesTheJsonObject) {
         {{"exists", {-1, 2.5}}, {"t0", 1}},
         {{"angular_velocity", {0, 0.5, -0.25}}, {"velocity", {0.3, 0, 0}}},
         {{"acceleration", {0.5, 0, 0.25}}, {"velocity", {0, 0.3, 0}}},
+        {{"orbit", {{"center", {1, 0, 0}}, {"axis", {0, 0, 2}}, {"speed", 0.5}, {"orientation", "locked"}}}},
     };
     // Every key of the table that a node does not give itself is covered by a case above.
     for (const std::string& key : objectMarkerKeys()) {
@@ -181,6 +182,14 @@ TEST(GltfScene, EveryObjectFieldInExtrasGivesTheJsonObject) {
         EXPECT_EQ(g.mirror, j.mirror);
         EXPECT_EQ(g.angular_velocity, j.angular_velocity);
         EXPECT_EQ(g.acceleration, j.acceleration);
+        ASSERT_EQ(bool(g.kinds.orbit), bool(j.kinds.orbit));
+        if (g.kinds.orbit) {
+            EXPECT_EQ(g.kinds.orbit->center, j.kinds.orbit->center);
+            EXPECT_EQ(g.kinds.orbit->axis, j.kinds.orbit->axis);
+            EXPECT_EQ(g.kinds.orbit->speed, j.kinds.orbit->speed);
+            EXPECT_EQ(g.kinds.orbit->locked, j.kinds.orbit->locked);
+            EXPECT_TRUE(g.kinds.orbit->locked);
+        }
         EXPECT_NE(g.mesh_path.find("scene.gltf#thing"), std::string::npos) << g.mesh_path;
     }
     // Independently of the JSON reader: gamma = 1e7 along +z is b = sqrt(1 - 1e-14), and

@@ -5,6 +5,7 @@
 
 #include "mesh4d/box.h"
 #include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/latest_crossing.h"
 #include "mesh4d/motion/worldline.h"
 
@@ -69,6 +70,15 @@ ProperTimeSpan paddedSpanSeen(const RestMesh& rest, const Motion& motion, const 
             }
             break;
         }
+        default: {
+            // A kind answered in its own file (kinds.h): b is its fastest vertex's speed in its own
+            // frame, as for a keyframed path.
+            const KindAnswers* k = answersOf(motion);
+            for (const Vec3& p : rest.positions) b = std::max(b, k->fastest(motion, p));
+            b = std::min(b, 1 - 1e-9);
+            one_minus_b2 = (1 - b) * (1 + b);
+            break;
+        }
     }
     const double rounding = 1e-9 * std::max(std::fabs(seen.lo), std::fabs(seen.hi));
     const double pad = std::min(diag * (1 + b) / one_minus_b2, speed_cap) + rounding;
@@ -83,6 +93,7 @@ SeenSpan slabSpanSeen(const RestMesh& rest, const Motion& motion, const ViewSurf
         case MotionKind::Uniform:
         case MotionKind::Hyperbolic:
         case MotionKind::Keyed:
+        default:  // a kind answered in its own file (kinds.h): its vertices' crossings
             break;
     }
     return pathSpanSeen(rest, motion, first, last, offset);

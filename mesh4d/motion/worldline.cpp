@@ -1,6 +1,7 @@
 #include "mesh4d/motion/worldline.h"
 
 #include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/local.h"
 
 #include <algorithm>
@@ -36,6 +37,8 @@ Local localEvent(const Motion& m, double s, const Vec3& q) {
         case MotionKind::Uniform:
         case MotionKind::Spin:
             break;
+        default:  // a kind answered in its own file (kinds.h)
+            return answersOf(m)->local(m, s, q);
     }
     return spinLocal(m, s, q);
 }
@@ -66,6 +69,12 @@ Rel relativeEvent(const Motion& m, double s, const Vec3& q, double t_c, const Ve
             case MotionKind::Uniform:
             case MotionKind::Spin:
                 break;
+            default: {  // a kind answered in its own file (kinds.h): its lab carry
+                const Local l = answersOf(m)->local(m, s, q);
+                r.e.x = (m.origin - apex) + l.Y;
+                r.rate.dx = l.dY;
+                return r;
+            }
         }
         const Local l = spinLocal(m, s, q);
         r.e.x = (m.origin - apex) + (l.Y + m.velocity * s);
@@ -114,6 +123,8 @@ double worldlineProperTime(const Motion& m, double s, const Vec3& q) {
         }
         case MotionKind::Spin:
             break;
+        default:  // a kind answered in its own file (kinds.h)
+            return answersOf(m)->proper_time(m, s, q);
     }
     const double u = spinSpeed(m, q);
     return s * std::sqrt((1 - u) * (1 + u));
@@ -140,6 +151,7 @@ WorldlineCrossing crossWorldline(const ViewSurface& view, const Motion& m, const
     plain.angular_velocity = {0, 0, 0};
     plain.acceleration = {0, 0, 0};
     plain.keyed = nullptr;
+    plain.kinds = KindParams{};
     const Event plain_cut = cutRestWorldline(view, plain, nowBase(view, plain), q);
     double s = properTimeAt(plain, q, plain_cut.t);
     if (kindOf(m) == MotionKind::Hyperbolic) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mesh4d/motion/keyed.h"
+#include "mesh4d/motion/kinds.h"
 
 namespace mesh4d {
 
@@ -82,6 +83,12 @@ FrameRates segmentRates(const KeyedMotion& k, size_t j, double rho) {
 // Not for a keyframed path (keyedRates below).
 FrameRates frameRates(const Motion& m, const CornerCrossing c[3], double s_lo, double s_hi) {
     FrameRates r;
+    if (const KindAnswers* k = answersOf(m)) {  // a kind answered in its own file (kinds.h)
+        const Vec3 q[3] = {c[0].q, c[1].q, c[2].q};
+        double o[8];
+        k->rates(m, q, o);
+        return {o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7]};
+    }
     const bool lorentz = m.kinematics == Kinematics::Lorentz;
     if (!accelerated(m)) {  // spin
         const double wn = norm(m.angular_velocity);
