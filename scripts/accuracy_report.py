@@ -70,14 +70,18 @@ def load_trade(path):
                       "export_seconds_per_frame", "glb_bytes_per_frame"):
                 r[k] = number(path, i, r, k)
             field(path, r, "family")
+            # The geometric distance (added after the first reports: absent from older files).
+            if r.get("geometric_error_ls") not in (None, ""):
+                for k in ("geometric_error_ls", "geometric_error_rel"):
+                    r[k] = number(path, i, r, k)
             r["total"] = r["cut_seconds_per_frame"] + r["export_seconds_per_frame"]
             rows.append(r)
     return rows
 
 
-def interpolate(adaptive, error, key):
-    """The adaptive rows' `key` at `error`, log-log between the bracketing rows (None outside)."""
-    pts = sorted((r["error_ls"], r[key]) for r in adaptive if r["error_ls"] > 0)
+def interpolate(adaptive, error, key, by="error_ls"):
+    """The adaptive rows' `key` at `error` (of column `by`), log-log between the bracketing rows (None outside)."""
+    pts = sorted((r[by], r[key]) for r in adaptive if r[by] > 0)
     for (e0, v0), (e1, v1) in zip(pts, pts[1:]):
         if e0 <= error <= e1 and e0 < e1:
             t = (math.log(error) - math.log(e0)) / (math.log(e1) - math.log(e0))
@@ -98,7 +102,9 @@ def method_block(trade_dir):
             "over the sequence, one thread, times in CPU time of the thread), tables in `docs/trade/<scene>/table.txt` "
             "and `trade.csv`. Each row: the measured two-sided error (`mesh4d/measure.h`: 12 samples of every output "
             "triangle against the exact surface, and 45 exact-surface points of every input triangle against the "
-            "output; the largest over objects and frames), triangles per frame (mean), the cut (refinement included) "
+            "output; the largest over objects and frames; parametric: each output point against the exact image of its own "
+            "rest point, and, where trade.csv has it, geometric: against the nearest point of the other surface, "
+            "geometricTwoSided), triangles per frame (mean), the cut (refinement included) "
             "and the .glb conversion per frame (normals, float32: the writer's per-frame work), and .glb bytes per "
             "frame. *Uniform k* splits every input triangle 4-to-1 k times, then vertex mode: what per-vertex engines "
             "do. *T* is `--tolerance T`, the adaptive refinement (`mesh4d/slice.h`, bound in `mesh4d/chord_error.h`). "
@@ -118,6 +124,29 @@ def equal_error_rows(name, rows):
             continue
         out.append(f"| {name} | {int(u['parameter'])}: {rel:.3g} | {u['triangles_per_frame']:.0f} | {n:.0f} | "
                    f"{n / u['triangles_per_frame']:.2f} | {t / u['total']:.2f} |")
+    return out
+
+
+def equal_geometric_error_rows(name, rows):
+    """As equal_error_rows with the geometric distance (rows without it: none), the tolerance rows
+    against uniform subdivision: uniform's triangles and time interpolated to each tolerance row's
+    geometric error."""
+    if not rows or "geometric_error_ls" not in rows[0]:
+        return []
+    uniform = [r for r in rows if r["family"] in ("vertex", "uniform")]  # vertex mode: uniform level 0
+    size = next((r["error_ls"] / r["error_rel"] for r in rows if r["error_rel"] > 0), None)
+    if size is None:
+        return []
+    out = []
+    for a in (r for r in rows if r["family"] == "tolerance"):
+        n = interpolate(uniform, a["geometric_error_ls"], "triangles_per_frame", "geometric_error_ls")
+        t = interpolate(uniform, a["geometric_error_ls"], "total", "geometric_error_ls")
+        if n is None:
+            continue
+        out.append(f"| {name} | {a['parameter'] / size:.2g} | "
+                   f"{a['geometric_error_ls'] / a['parameter']:.2f} | {a['error_ls'] / a['parameter']:.2f} | "
+                   f"{a['triangles_per_frame']:.0f} | {n:.0f} | {a['triangles_per_frame'] / n:.2f} | "
+                   f"{a['total'] / t:.2f} |")
     return out
 
 
@@ -224,6 +253,14 @@ def main(trade_dir, docs):
         scene_rows[name] = load_trade(csv_path)
         summary += equal_error_rows(name, scene_rows[name])
         new[f"trade-{name}"] = ["```"] + open(table).read().rstrip().split("\n") + ["```"]
+    geometric = []
+    for name, rows in scene_rows.items():
+        geometric += equal_geometric_error_rows(name, rows)
+    if geometric:
+        summary += ["", "At equal geometric distance (what `--tolerance` promises; `mesh4d/measure.h` geometricTwoSided): "
+                    "each tolerance row against uniform subdivision interpolated log-log to the row's geometric error.", "",
+                    "| scene | T / size | geometric / T | parametric / T | adaptive triangles | uniform triangles at that "
+                    "geometric error | ratio | time, adaptive / uniform |", "|---|---|---|---|---|---|---|---|"] + geometric
     new["at-equal-error"] = summary + ["", "![error against triangles per frame](accuracy.png)"] if scene_rows else None
     e2e = os.path.join(trade_dir, "end_to_end.md")
     new["end-to-end"] = open(e2e).read().rstrip().split("\n") if os.path.exists(e2e) else None
