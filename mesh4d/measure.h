@@ -128,8 +128,9 @@ inline double exactToOutput(const World4D& w, const ViewSurface& view, const App
 }
 
 
-// The two-sided distance as the tests measure it: the larger of both directions (grid 8 on each
-// input triangle for exact -> output).
+// The two-sided PARAMETRIC distance as the tests measure it: the larger of both directions (grid 8
+// on each input triangle for exact -> output). An upper bound of the geometric one below
+// (geometricTwoSided), which is what --tolerance promises.
 inline double twoSided(const World4D& w, const ViewSurface& view, const ApparentMesh& m, int grid = 8) {
     if (m.triangles.empty()) return 0;
     return std::max(outputToExact(w, view, m), exactToOutput(w, view, m, grid));
