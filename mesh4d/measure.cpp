@@ -370,7 +370,7 @@ GeometricError geometricError(const World4D& w, const ViewSurface& view, const A
                     const Vec3 out = m.positions[ot[0]] * l[0] + m.positions[ot[1]] * l[1] + m.positions[ot[2]] * l[2];
                     radius = std::min(radius, norm(x - out));
                 }
-                lattice.push_back({radius, x});
+                if (radius > r.exact_to_output) lattice.push_back({radius, x});  // others cannot raise it
             }
     }
     std::sort(lattice.begin(), lattice.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
