@@ -11,7 +11,10 @@
 //              objects at rest are never refined).
 // Each row reports the measured two-sided error (mesh4d/refine/measure.h: sampled output points against
 // the exact surface and exact-surface lattice points against the output, the largest over the
-// objects and frames), output triangles per frame, the time of the cut per frame (all objects,
+// objects and frames) in both of measure.h's senses: parametric (twoSided: each output point
+// against the exact image of its own rest point; the column "error") and geometric
+// (geometricTwoSided: against the nearest point of the other surface; the column "geometric",
+// what --tolerance promises), output triangles per frame, the time of the cut per frame (all objects,
 // refinement included, repeated until at least 2 ms are timed; CPU time of the thread, so that
 // other load on the machine does not count), the time to convert a frame for
 // the .glb (the real writer's per-frame work: crease split, normals, float32; timed the same way,
@@ -55,7 +58,8 @@ struct TradeSettings {
 struct TradeRow {
     std::string family;      // "vertex", "uniform", "tolerance"
     double parameter = 0;    // uniform: level; tolerance: T in light-seconds
-    double error = 0;        // measured two-sided error, light-seconds
+    double error = 0;        // measured two-sided parametric error, light-seconds (measure.h twoSided)
+    double geometric_error = 0;  // measured two-sided geometric distance, light-seconds (measure.h geometricTwoSided)
     double triangles = 0;    // output triangles per frame (mean)
     double seconds = 0;      // cut time per frame (mean), refinement included
     double export_seconds = 0;  // .glb conversion per frame (GlbSequenceWriter::prepare)

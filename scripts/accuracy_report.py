@@ -18,6 +18,10 @@ The blocks (NAME: what fills it, from TRADE_DIR):
     per-triangle     per_triangle.json (refine_bench: BM_PerTriangle)
     instructions     instructions.csv (callgrind counts of refine_bench --count)
     trade-<scene>    <scene>/table.txt, one per scene of SCENES
+    motions-method   the other motions' method paragraph (with motions/measured.txt's date and build)
+    motions-at-equal-error  each tolerance row of motions/<scene>/trade.csv against uniform subdivision
+                     at the row's own error, parametric and geometric
+    trade-<scene>    motions/<scene>/table.txt, one per scene of MOTION_SCENES
 The hand-written analysis lives outside the markers. A block whose data file is absent is left as it
 is (said on stderr). A marker missing, doubled, out of order or unknown, or a data file without a field
 it needs: one line on stderr naming the file and the problem, exit 2, and nothing is written.
@@ -33,8 +37,11 @@ import re
 import sys
 
 SCENES = ["flanges", "box_near", "sphere320", "plate", "sphere20480"]
+# The other motions (keyframed, accelerated, spinning, rolling), measured into TRADE_DIR/motions/.
+MOTION_SCENES = ["keyed", "keyed_cubic", "rocket", "spinning_wheel", "rolling_wheel"]
 BLOCKS = ["method", "at-equal-error", "end-to-end", "cheap-path", "per-triangle", "instructions"] + \
-         [f"trade-{name}" for name in SCENES]
+         [f"trade-{name}" for name in SCENES] + ["motions-method", "motions-at-equal-error"] + \
+         [f"trade-{name}" for name in MOTION_SCENES]
 BEGIN = re.compile(r"^<!-- generated: (\S+) -->$")
 END = re.compile(r"^<!-- end generated: (\S+) -->$")
 
@@ -70,14 +77,18 @@ def load_trade(path):
                       "export_seconds_per_frame", "glb_bytes_per_frame"):
                 r[k] = number(path, i, r, k)
             field(path, r, "family")
+            # The geometric distance (added after the first reports: absent from older files).
+            if r.get("geometric_error_ls") not in (None, ""):
+                for k in ("geometric_error_ls", "geometric_error_rel"):
+                    r[k] = number(path, i, r, k)
             r["total"] = r["cut_seconds_per_frame"] + r["export_seconds_per_frame"]
             rows.append(r)
     return rows
 
 
-def interpolate(adaptive, error, key):
-    """The adaptive rows' `key` at `error`, log-log between the bracketing rows (None outside)."""
-    pts = sorted((r["error_ls"], r[key]) for r in adaptive if r["error_ls"] > 0)
+def interpolate(adaptive, error, key, by="error_ls"):
+    """The adaptive rows' `key` at `error` (of column `by`), log-log between the bracketing rows (None outside)."""
+    pts = sorted((r[by], r[key]) for r in adaptive if r[by] > 0)
     for (e0, v0), (e1, v1) in zip(pts, pts[1:]):
         if e0 <= error <= e1 and e0 < e1:
             t = (math.log(error) - math.log(e0)) / (math.log(e1) - math.log(e0))
@@ -98,7 +109,9 @@ def method_block(trade_dir):
             "over the sequence, one thread, times in CPU time of the thread), tables in `docs/trade/<scene>/table.txt` "
             "and `trade.csv`. Each row: the measured two-sided error (`mesh4d/refine/measure.h`: 12 samples of every output "
             "triangle against the exact surface, and 45 exact-surface points of every input triangle against the "
-            "output; the largest over objects and frames), triangles per frame (mean), the cut (refinement included) "
+            "output; the largest over objects and frames; parametric: each output point against the exact image of its own "
+            "rest point, and, where trade.csv has it, geometric: against the nearest point of the other surface, "
+            "geometricTwoSided), triangles per frame (mean), the cut (refinement included) "
             "and the .glb conversion per frame (normals, float32: the writer's per-frame work), and .glb bytes per "
             "frame. *Uniform k* splits every input triangle 4-to-1 k times, then vertex mode: what per-vertex engines "
             "do. *T* is `--tolerance T`, the adaptive refinement (`mesh4d/slice.h`, bound in `mesh4d/refine/chord_error.h`). "
@@ -118,6 +131,95 @@ def equal_error_rows(name, rows):
             continue
         out.append(f"| {name} | {int(u['parameter'])}: {rel:.3g} | {u['triangles_per_frame']:.0f} | {n:.0f} | "
                    f"{n / u['triangles_per_frame']:.2f} | {t / u['total']:.2f} |")
+    return out
+
+
+def equal_geometric_error_rows(name, rows):
+    """As equal_error_rows with the geometric distance (rows without it: none), the tolerance rows
+    against uniform subdivision: uniform's triangles and time interpolated to each tolerance row's
+    geometric error."""
+    if not rows or "geometric_error_ls" not in rows[0]:
+        return []
+    uniform = [r for r in rows if r["family"] in ("vertex", "uniform")]  # vertex mode: uniform level 0
+    size = next((r["error_ls"] / r["error_rel"] for r in rows if r["error_rel"] > 0), None)
+    if size is None:
+        return []
+    out = []
+    for a in (r for r in rows if r["family"] == "tolerance"):
+        n = interpolate(uniform, a["geometric_error_ls"], "triangles_per_frame", "geometric_error_ls")
+        t = interpolate(uniform, a["geometric_error_ls"], "total", "geometric_error_ls")
+        if n is None:
+            continue
+        out.append(f"| {name} | {a['parameter'] / size:.2g} | "
+                   f"{a['geometric_error_ls'] / a['parameter']:.2f} | {a['error_ls'] / a['parameter']:.2f} | "
+                   f"{a['triangles_per_frame']:.0f} | {n:.0f} | {a['triangles_per_frame'] / n:.2f} | "
+                   f"{a['total'] / t:.2f} |")
+    return out
+
+
+def motions_method_block(trade_dir):
+    stamp = os.path.join(trade_dir, "motions", "measured.txt")
+    text = open(stamp).read().strip() if os.path.exists(stamp) else ""
+    return ["Measured by `scripts/accuracy_report.sh`" + (f" ({text})" if text else "") +
+            ": `apparent trade SCENE --levels 4 --tolerances 1e-2,1e-3,1e-4` on each scene (5 frames spread over "
+            "the sequence; the rolling wheel `--frames 8:9 --tolerances 1e-2,3e-3,1e-3`), one thread, CPU time of "
+            "the thread, tables in `docs/trade/motions/<scene>/`. Each tolerance row against uniform subdivision "
+            "(vertex mode as level 0, levels 1 - 4), uniform's triangles and time (cut + .glb conversion) "
+            "interpolated log-log to the row's own measured error: parametric in the first table, geometric in the "
+            "second (the exact surface found by `mesh4d/refine/measure.h`'s root search on the true worldlines). "
+            "\"finer than uniform\": the row's error is below every uniform level's, so no uniform row matches it."]
+
+
+def motions_rows(name, rows, by):
+    """One line per tolerance row of `rows`: against uniform subdivision (vertex mode its level 0)
+    interpolated log-log to the row's own error in column `by` (error_ls or geometric_error_ls)."""
+    if not rows or by not in rows[0]:
+        return []
+    uniform = [r for r in rows if r["family"] in ("vertex", "uniform")]
+    size = next((r["error_ls"] / r["error_rel"] for r in rows if r["error_rel"] > 0), None)
+    if size is None:
+        return []
+    out = []
+    for a in (r for r in rows if r["family"] == "tolerance"):
+        err = a[by]
+        head = f"| {name} | {a['parameter'] / size:.2g} | {err / a['parameter']:.2f} | {a['triangles_per_frame']:.0f} | " \
+               f"{a['total'] * 1e3:.3g} |"
+        n = interpolate(uniform, err, "triangles_per_frame", by)
+        t = interpolate(uniform, err, "total", by)
+        if n is None or t is None:
+            finest = min((u for u in uniform if u[by] > 0), key=lambda u: u[by], default=None)
+            coarsest = max(uniform, key=lambda u: u[by], default=None)
+            if finest is not None and err < finest[by]:
+                what = f"finer than uniform level {finest['parameter']:.0f} (its error {finest[by] / a['parameter']:.2g} T)"
+            elif coarsest is not None and err > coarsest[by]:
+                what = "coarser than vertex mode"
+            else:
+                what = "no uniform row brackets it"
+            out.append(head + f" {what} | | | |")
+            continue
+        out.append(head + f" {n:.0f} | {t * 1e3:.3g} | {a['triangles_per_frame'] / n:.2f} | {a['total'] / t:.3g} |")
+    return out
+
+
+def motions_block(trade_dir):
+    scene_rows = {}
+    for name in MOTION_SCENES:
+        path = os.path.join(trade_dir, "motions", name, "trade.csv")
+        if os.path.exists(path):
+            scene_rows[name] = load_trade(path)
+    if not scene_rows:
+        return None
+    head = ["| scene | T / size | err / T | adaptive triangles | adaptive ms | uniform triangles at that error | "
+            "uniform ms | triangles, adaptive / uniform | time, adaptive / uniform |", "|---|---|---|---|---|---|---|---|---|"]
+    out = ["Parametric error (each output point against the exact image of its own rest point):", ""] + head
+    for name, rows in scene_rows.items():
+        out += motions_rows(name, rows, "error_ls")
+    geometric = []
+    for name, rows in scene_rows.items():
+        geometric += motions_rows(name, rows, "geometric_error_ls")
+    if geometric:
+        out += ["", "Geometric distance (against the nearest point of the other surface: what `--tolerance` promises):",
+                ""] + head + geometric
     return out
 
 
@@ -224,6 +326,14 @@ def main(trade_dir, docs):
         scene_rows[name] = load_trade(csv_path)
         summary += equal_error_rows(name, scene_rows[name])
         new[f"trade-{name}"] = ["```"] + open(table).read().rstrip().split("\n") + ["```"]
+    geometric = []
+    for name, rows in scene_rows.items():
+        geometric += equal_geometric_error_rows(name, rows)
+    if geometric:
+        summary += ["", "At equal geometric distance (what `--tolerance` promises; `mesh4d/refine/measure.h` geometricTwoSided): "
+                    "each tolerance row against uniform subdivision interpolated log-log to the row's geometric error.", "",
+                    "| scene | T / size | geometric / T | parametric / T | adaptive triangles | uniform triangles at that "
+                    "geometric error | ratio | time, adaptive / uniform |", "|---|---|---|---|---|---|---|---|"] + geometric
     new["at-equal-error"] = summary + ["", "![error against triangles per frame](accuracy.png)"] if scene_rows else None
     e2e = os.path.join(trade_dir, "end_to_end.md")
     new["end-to-end"] = open(e2e).read().rstrip().split("\n") if os.path.exists(e2e) else None
@@ -232,6 +342,12 @@ def main(trade_dir, docs):
                              ("instructions", "instructions.csv", instructions_block)):
         path = os.path.join(trade_dir, file)
         new[name] = make(path) if os.path.exists(path) else None
+    new["motions-at-equal-error"] = motions_block(trade_dir)
+    new["motions-method"] = motions_method_block(trade_dir) if new["motions-at-equal-error"] else None
+    for name in MOTION_SCENES:
+        table = os.path.join(trade_dir, "motions", name, "table.txt")
+        new[f"trade-{name}"] = ["```"] + open(table).read().rstrip().split("\n") + ["```"] \
+            if os.path.exists(table) else None
 
     # Replace the blocks from the last to the first, so that earlier spans keep their indices.
     for name, (b, e) in sorted(spans.items(), key=lambda s: -s[1][0]):

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "mesh4d/extrude.h"
-#include "mesh4d/measure.h"
+#include "mesh4d/refine/measure.h"
 #include "mesh4d/motion/worldline.h"
 #include "mesh4d/slice.h"
 #include "pipeline/physics.h"

@@ -44,6 +44,7 @@ TEST(Trade, TableCsvAndPlotOnTheBoxScene) {
                                 "3", "--tolerances", "1e-2,1e-3", "--quiet"});
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("uniform level 3"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("geometric"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("For vertex mode's error"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("For a tenth of it"), std::string::npos) << r.out;
     const auto rows = readCsv(dir / "trade.csv");
@@ -52,6 +53,13 @@ TEST(Trade, TableCsvAndPlotOnTheBoxScene) {
     double previous_uniform = std::stod(rows[0].at("error_ls"));
     for (const auto& row : rows) {
         const double error = std::stod(row.at("error_ls")), parameter = std::stod(row.at("parameter"));
+        // The geometric distance (nearest points) beside the parametric one: never above it (a minimum
+        // over a larger set, the same samples), and not zero on this box (its faces x = const are
+        // across the velocity, where the error is not a slide).
+        const double geometric = std::stod(row.at("geometric_error_ls"));
+        EXPECT_LE(geometric, error * (1 + 1e-12)) << row.at("family") << " " << parameter;
+        EXPECT_GT(geometric, 0.3 * error) << row.at("family") << " " << parameter;
+        EXPECT_NEAR(std::stod(row.at("geometric_error_rel")) * std::sqrt(3.0), geometric, 1e-9 * geometric);
         EXPECT_GT(std::stod(row.at("triangles_per_frame")), 0);
         EXPECT_GT(std::stod(row.at("glb_bytes_per_frame")), 0);
         if (row.at("family") == "tolerance") {
@@ -107,6 +115,11 @@ TEST(Trade, SpinningWheelAllFamiliesErrorFallsWithT) {
     for (const auto& row : rows) {
         ++count[row.at("family")];
         const double error = std::stod(row.at("error_ls")), parameter = std::stod(row.at("parameter"));
+        // The geometric distance of a spinning body (exact points by measure.h's root search): never
+        // above the parametric one.
+        const double geometric = std::stod(row.at("geometric_error_ls"));
+        EXPECT_LE(geometric, error * (1 + 1e-12)) << row.at("family") << " " << parameter;
+        EXPECT_GT(geometric, 0) << row.at("family") << " " << parameter;
         EXPECT_GT(error, 0);
         EXPECT_EQ(row.at("skipped"), "0");
         if (row.at("family") == "uniform") {
