@@ -10,7 +10,7 @@
 #include <random>
 
 #include "mesh4d/refine/measure.h"
-#include "mesh4d/subdivide.h"
+#include "mesh4d/refine/subdivide.h"
 #include "test_meshes.h"
 
 using namespace mesh4d;
