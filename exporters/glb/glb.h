@@ -148,8 +148,8 @@ constexpr size_t kMorphVertexTargets = size_t(1) << 22;
 
 // One object's vertex-cache and vertex-fetch orders for an index list, kept for the next frame:
 // both depend on the index list alone, so an equal list (vertex mode, or the same refinement)
-// takes them from here instead of optimizing again (meshopt_optimizeVertexCache costs about
-// 100 ms at 1M triangles).
+// takes them from here instead of optimizing again (meshopt_optimizeVertexCache is the costly
+// step of a large frame's packing).
 struct MeshoptOrder {
     std::vector<uint32_t> indices;   // the index list they were computed for
     size_t vertices = 0;             // and its vertex count

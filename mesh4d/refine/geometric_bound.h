@@ -145,7 +145,7 @@ inline GeometricBound geometricBound(const ViewAnchor& anchor, const Motion& m, 
         const double straight = norm(cross(u, chord)) / norm(chord);
         edge_factor[e] = std::max(curve, straight);
     }
-    // Step: the second-order term K (checked: the remainder stays below 5 % of E).
+    // Step: the second-order term K.
     const double m_low = xm_min - side - 3 * parametric;
     if (!(m_low > 0)) return r;
     const double H = 1 / (m.one_minus_beta2 * m_low);            // ||H|| on the slid region

@@ -26,14 +26,14 @@ void BoxTree::build(std::vector<Vec3> lo, std::vector<Vec3> hi) {
     std::iota(order_.begin(), order_.end(), 0u);
     if (lo.empty()) return;
     // Step: split the longest side of the centres' box at the median, down to 4 boxes a leaf.
-    struct Todo {
+    struct Pending {
         uint32_t node, first, count;
     };
-    std::vector<Todo> todo{{0, 0, uint32_t(lo.size())}};
+    std::vector<Pending> pending{{0, 0, uint32_t(lo.size())}};
     nodes_.push_back({});
-    while (!todo.empty()) {
-        const Todo t = todo.back();
-        todo.pop_back();
+    while (!pending.empty()) {
+        const Pending t = pending.back();
+        pending.pop_back();
         Node n;
         n.lo = lo[order_[t.first]];
         n.hi = hi[order_[t.first]];
@@ -61,8 +61,8 @@ void BoxTree::build(std::vector<Vec3> lo, std::vector<Vec3> hi) {
         nodes_[t.node] = n;
         nodes_.push_back({});
         nodes_.push_back({});
-        todo.push_back({n.first, t.first, half});
-        todo.push_back({n.first + 1, t.first + half, t.count - half});
+        pending.push_back({n.first, t.first, half});
+        pending.push_back({n.first + 1, t.first + half, t.count - half});
     }
     // The leaves keep the boxes themselves for the final test.
     leaf_lo_ = std::move(lo);
