@@ -141,6 +141,12 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "Largest distance between output and exact apparent surface (overrides the scene's): "
                            "T light-seconds; Fx, F times each object's bounding-box diagonal (default 1e-3x); "
                            "or 'vertex': exact vertices joined by straight edges, no refinement");
+    std::string attribute_tolerance_text;
+    render_cmd->add_option("--attribute-tolerance", attribute_tolerance_text,
+                           "Also bound the parametric error, each output point against the exact image of its own "
+                           "rest point (where a texture or an emission time lands): A light-seconds or Fx; default: "
+                           "none, only the distance --tolerance is bounded (faces that contain the velocity stay "
+                           "coarse inside)");
     render_cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
     std::string compress_text;
     render_cmd->add_option("--compress", compress_text,
@@ -434,6 +440,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                          "1e-3x, nor 'vertex'");
         rs.stage.has_tolerance = true;
     }
+    if (!attribute_tolerance_text.empty() &&
+        (!parseTolerance(attribute_tolerance_text, &rs.stage.attribute_tolerance, &rs.stage.attribute_tolerance_relative) ||
+         (rs.stage.attribute_tolerance <= 0 && rs.stage.attribute_tolerance_relative <= 0)))
+        return usage("--attribute-tolerance: '" + attribute_tolerance_text +
+                     "' is neither a positive number of light-seconds nor a fraction of each object's size such as 1e-3x");
     if (!frames_text.empty() && !parseFrames(frames_text, &rs.stage.frame_from, &rs.stage.frame_to))
         return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
     if (!compress_text.empty()) {

@@ -35,6 +35,11 @@ std::string outputSettings(const RenderSettings& s, const Stage& stage) {
     for (const std::string& f : s.formats) os << " " << f;
     os << "\nframes " << stage.first << " " << stage.last_excl << "\ntolerance " << stage.scene.tolerance;
     for (double t : stage.tolerances) os << " " << t;
+    if (std::any_of(stage.attribute_tolerances.begin(), stage.attribute_tolerances.end(),
+                    [](double t) { return t < INFINITY; })) {
+        os << "\nattribute-tolerance";
+        for (double t : stage.attribute_tolerances) os << " " << t;
+    }
     const GlbOptions& g = s.glb;
     os << "\nglb " << g.draco << " " << g.position_bits << " " << g.normal_bits << " " << g.meshopt << " "
        << g.meshopt_bits << " " << g.doppler << " " << g.proper_time << " " << g.shade_doppler << "\ncull "

@@ -282,7 +282,11 @@ Vec3 shearedOrigin(const ViewSurface& view, const ViewAnchor& anchor) {
 
 }  // namespace
 
-ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings) {
+ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& given) {
+    // Step: an attribute tolerance below the distance's bounds the parametric error everywhere.
+    SliceSettings settings = given;
+    if (settings.tolerance > 0 && settings.attribute_tolerance < settings.tolerance)
+        settings.tolerance = settings.attribute_tolerance;
     ApparentMesh out = sliceUnsheared(world, view, settings);
     if (!view.sheared()) return out;
     // Step: the Galilean map into the output frame, origin and local parts apart.
