@@ -358,6 +358,22 @@ Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int
     return d / mesh4d::norm(d);
 }
 
+PixelRay pixelRay(const CameraSpec& camera, int width, int height, int px, int py) {
+    if (!camera.orthographic()) return {camera.position, pixelDirection(camera, width, height, px, py)};
+    // Step: the camera basis, as pixelDirection's.
+    const Vec3 f0 = camera.look_at - camera.position;
+    const Vec3 f = f0 / mesh4d::norm(f0);
+    const Vec3 r0 = mesh4d::cross(f, camera.up);
+    const Vec3 r = r0 / mesh4d::norm(r0);
+    const Vec3 u = mesh4d::cross(r, f);
+    // Step: the pixel centre on the image plane through the camera, width scene units wide.
+    const double half_w = 0.5 * camera.width;
+    const double half_h = half_w * double(height) / double(width);
+    const double x = (2 * (px + 0.5) / width - 1) * half_w;
+    const double y = (1 - 2 * (py + 0.5) / height) * half_h;
+    return {camera.position + x * r + y * u, f};
+}
+
 SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects,
                          const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
                          long long last_frame, TracerOptions options)
@@ -602,16 +618,26 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
             // Step: the primary ray, back along the past cone (or along t = t_c). A sheared view
             // (finite, moving camera) is traced in the lab from the camera's lab position, along
             // the lab direction the pixel's camera-frame direction sees (camera_frame.h).
+            // An orthographic camera's ray leaves its pixel on the image plane along the view
+            // direction, at t_c: along the tilted hyperplane's null rays in finite and relativistic.
             mesh4d::Ray4D ray;
             ray.origin = {view.t_c, view.apex};
-            ray.direction = pixelDirection(scene_.camera, width, height, px, py);
+            if (scene_.camera.orthographic()) {
+                const PixelRay p = pixelRay(scene_.camera, width, height, px, py);
+                ray.origin = {view.t_c, p.origin};
+                ray.direction = p.direction;
+            } else {
+                ray.direction = pixelDirection(scene_.camera, width, height, px, py);
+            }
             if (view.sheared()) ray.direction = mesh4d::labRayDirection(camera, ray.direction);
-            ray.along_cone = view.kind == mesh4d::ViewKind::PastCone;
+            const bool tilted = view.kind == mesh4d::ViewKind::Hyperplane && view.tilted();
+            ray.along_cone = view.kind == mesh4d::ViewKind::PastCone || tilted;
+            const mesh4d::ViewKind light_kind = tilted ? mesh4d::ViewKind::PastCone : view.kind;
             const Hit hit = nearest(ray, false);
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
                 frame.object[idx] = hit.object;
-                color = shade(hit, view.kind, ray.origin.x, view.shear);
+                color = shade(hit, light_kind, ray.origin.x, view.shear);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,

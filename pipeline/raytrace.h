@@ -38,6 +38,15 @@ namespace apparent {
 // width x height image (row 0 at the top); fov_deg is the vertical field of view.
 mesh4d::Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int py);
 
+// The ray of pixel (px, py): from the camera position along pixelDirection (perspective), or, for
+// an orthographic camera, from the pixel centre on the image plane through the camera (normal to
+// the view direction, camera.width wide, the height in the picture's proportion) along the view
+// direction.
+struct PixelRay {
+    mesh4d::Vec3 origin, direction;
+};
+PixelRay pixelRay(const CameraSpec& camera, int width, int height, int px, int py);
+
 // One traced frame: the picture and, per pixel (row-major), the index of the object the ray hits
 // first (-1: none) and of the object seen in it by a mirror bounce (-1: none or not a mirror).
 struct TracedFrame {
