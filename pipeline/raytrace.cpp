@@ -23,6 +23,7 @@
 #include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/seen.h"
 #include "mesh4d/motion/worldline.h"
+#include "pipeline/view_hints.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -731,6 +732,9 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
             err << "error: " << message << "\n";
             return c;
         };
+        // Hints instead of blanks: an object no frame shows in the camera's view (view_hints.h).
+        if (!settings.quiet)
+            for (const std::string& w : outOfViewWarnings(stage, model, frameRange(first, last_excl))) err << "warning: " << w << "\n";
         // Step: the folder, then the static worlds once per model, then every frame.
         const std::string dir = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
         if (settings.write_png) {
@@ -1014,6 +1018,9 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     // Panel i = r * columns + c: row r's model at column c's frame.
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
+        // Hints instead of an empty row: an object no column shows in the camera's view (view_hints.h).
+        if (!settings.quiet && !fg.sender)
+            for (const std::string& w : outOfViewWarnings(stage, rows[r], frames)) err << "warning: " << w << "\n";
         TracerOptions options;
         options.window_prisms = slabPrismLimit(settings.max_slab_memory);
         SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi, options);
