@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pipeline/measure.h"
 #include "pipeline/raytrace.h"
 #include "pipeline/render.h"
 #include "pipeline/scene_fields.h"
@@ -273,6 +274,24 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
         "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
 
+    // `measure`: what the pictures show, as numbers (pipeline/measure.h).
+    MeasureSettings mss;
+    std::string measure_model_text, measure_frames_text;
+    CLI::App* measure_cmd = app.add_subcommand(
+        "measure", "Measure the apparent shapes: extent, the rotation of faces about the view's up axis, outline roundness");
+    measure_cmd->add_option("scene", mss.stage.scene_path, "Scene file (JSON or glTF)")->required();
+    measure_cmd->add_option("--model", measure_model_text, "Model, comma list or all (default: the scene's model)");
+    measure_cmd->add_option("--frames", measure_frames_text, "A:B measures frames A..B-1 (default: 5 frames spread over the scene)");
+    measure_cmd->add_option("--marker", mss.marker, "An object whose apparent position is given relative to the others' outlines");
+    measure_cmd->add_flag("--quiet,-q", mss.quiet, "Only the table");
+    addStageLimits(measure_cmd, &mss.stage);
+    measure_cmd->footer(
+        "Prints per model, frame and object (tab-separated): apparent points, the image extent (orthographic: scene\n"
+        "units on the image plane; perspective: the tangent plane at distance 1), the lab bounding box, the rotation\n"
+        "about the view's up axis fitted to the projected areas of the faces (degrees; residual; scale, 1 for a pure\n"
+        "turn), the outline's largest radius (rim) and roundness (largest over smallest radius). With --marker NAME,\n"
+        "NAME's position as a fraction of each other object's rim radius. docs/PICTURES.md, \"Measuring a picture\".");
+
     // `merge`: the .glb of every model from the job-array shards in DIR/shards (pipeline/shards.h).
     MergeSettings ms;
     CLI::App* merge_cmd = app.add_subcommand(
@@ -401,6 +420,14 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
             trs.tolerances_rel.push_back(t);
         }
         return guarded([&] { return trade(trs, out, err); }, err);
+    }
+    if (measure_cmd->parsed()) {
+        if (std::string message; !parseModelList(measure_model_text, &mss.stage, &message)) return usage(message);
+        if (!measure_frames_text.empty() && !parseFrames(measure_frames_text, &mss.stage.frame_from, &mss.stage.frame_to))
+            return usage("--frames: '" + measure_frames_text + "' is not A:B with 0 <= A < B");
+        mss.has_frames = !measure_frames_text.empty();
+        mss.stage.quiet = mss.quiet;
+        return guarded([&] { return measure(mss, out, err); }, err);
     }
     if (merge_cmd->parsed()) {
         if (ms.max_output_bytes < 0) return usage("--max-output-bytes: must be positive, or 0 for no limit");
