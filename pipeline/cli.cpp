@@ -209,6 +209,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     raytrace_cmd->add_option("--shade", trace_shade_text,
                              "plain (default) or doppler: colours shifted by the Doppler factor and scaled by the "
                              "searchlight factor, as render --shade doppler bakes them");
+    raytrace_cmd->add_option("--gate", ts.gate,
+                             "The Vienna experiment's gated camera (finite, relativistic): exposures of light-path slices "
+                             "DEPTH deep (scene units), each showing the objects at its own time");
     raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary, no progress");
     addStageLimits(raytrace_cmd, &ts.stage);
     raytrace_cmd->add_option("--max-slab-memory", ts.max_slab_memory,
@@ -234,6 +237,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--video", fs.video_path, "Instead of the sheet: an H.264 MP4, the models side by side, every frame; needs ffmpeg");
     figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
+    figure_cmd->add_option("--gate", fs.gate, "As raytrace --gate: the gated camera's light-path slices, DEPTH deep");
     figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary, no progress");
     addStageLimits(figure_cmd, &fs.stage);
     figure_cmd->add_option("--max-slab-memory", fs.max_slab_memory,
