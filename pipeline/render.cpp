@@ -12,6 +12,7 @@
 #include "pipeline/json_limits.h"
 #include "pipeline/mesh_check.h"
 #include "pipeline/shards.h"
+#include "pipeline/view_hints.h"
 
 namespace apparent {
 
@@ -245,6 +246,10 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
             if (!settings.quiet)
                 for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
         }
+        // Hints instead of blanks: an object no frame shows in the camera's view (view_hints.h).
+        if (!settings.quiet && !settings.sharded)
+            for (const std::string& w : outOfViewWarnings(stage, model, frameRange(stage.first, stage.last_excl)))
+                err << "warning: " << w << "\n";
         if (result.limited_triangles > 0 && !settings.quiet)
             err << "warning: " << name << ": " << result.limited_triangles
                 << " triangle-frames reached the refinement limit of " << result.max_segments

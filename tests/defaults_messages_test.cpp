@@ -196,7 +196,7 @@ TEST(Messages, MeshGivenAsTheScene) {
 TEST(Messages, UnknownCommandSuggestsTheNearest) {
     CommandResult r = apparentRun({"rendr", "scene.json"});
     EXPECT_EQ(r.code, 2);
-    EXPECT_EQ(r.err, "error: unknown command 'rendr'; did you mean render? (commands: render, raytrace, figure, trade, merge; "
+    EXPECT_EQ(r.err, "error: unknown command 'rendr'; did you mean render? (commands: render, raytrace, figure, trade, measure, merge; "
                      "run 'apparent --help')\n");
     r = apparentRun({"fgure"});
     EXPECT_NE(r.err.find("did you mean figure?"), std::string::npos) << r.err;

@@ -795,7 +795,8 @@ struct FrameBuilder {
 //   - The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
 //     may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box)
 //     and at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms
-//     remain. The margin covers the rounding of these bounds (a few ulps of the largest term).
+//     remain, and on the tilted one (lightcone.h) the least and greatest (x - C).k over the box take
+//     the distances' place. The margin covers the rounding of these bounds (a few ulps of the largest term).
 //   - Model only what the cut requires: on a hyperplane, or at rest, the map from the rest surface
 //     to the apparent one is affine, so straight edges are exact and nothing is refined (at rest
 //     under a shear it is not: chord_error.h displacedChordError).
