@@ -101,11 +101,12 @@ public:
         return ok;
     }
 
-    FrameData cut(double t, const std::string& model, const std::string& tolerance, long long max_triangles) {
+    FrameData cut(double t, const std::string& model, const std::string& tolerance, long long max_triangles,
+                  const std::string& attribute_tolerance) {
         FrameData data;
         {
             py::gil_scoped_release release;
-            std::shared_ptr<Cutting> c = get(model, tolerance);
+            std::shared_ptr<Cutting> c = get(model, tolerance, attribute_tolerance);
             apparent::ExportFrame frame;
             std::string error;
             if (!c->cutter->cut(t, max_triangles, &frame, &error)) throw BadInput(error);
@@ -115,9 +116,11 @@ public:
     }
 
 private:
-    // The cutting for `model` ("" : the scene's) at `tolerance` ("": the scene's; as --tolerance).
-    std::shared_ptr<Cutting> get(const std::string& model, const std::string& tolerance) {
-        const std::string key = model + "|" + tolerance;
+    // The cutting for `model` ("" : the scene's) at `tolerance` ("": the scene's; as --tolerance)
+    // and `attribute_tolerance` ("": none; as --attribute-tolerance).
+    std::shared_ptr<Cutting> get(const std::string& model, const std::string& tolerance,
+                                 const std::string& attribute_tolerance = "") {
+        const std::string key = model + "|" + tolerance + "|" + attribute_tolerance;
         std::lock_guard<std::mutex> lock(mutex_);
         auto found = cache_.find(key);
         if (found != cache_.end()) return found->second;
@@ -136,6 +139,11 @@ private:
                                "such as 1e-3x, nor 'vertex'");
             options.has_tolerance = true;
         }
+        if (!attribute_tolerance.empty() &&
+            (!apparent::parseTolerance(attribute_tolerance, &options.attribute_tolerance, &options.attribute_tolerance_relative) ||
+             (options.attribute_tolerance <= 0 && options.attribute_tolerance_relative <= 0)))
+            throw BadInput("--attribute-tolerance: '" + attribute_tolerance +
+                           "' is neither a positive number of light-seconds nor a fraction of each object's size such as 1e-3x");
         auto c = std::make_shared<Cutting>();
         std::ostringstream log;
         std::string error;
@@ -228,7 +236,8 @@ PYBIND11_MODULE(_apparent, m) {
         .def_property_readonly("default_model", &SceneHandle::defaultModel)
         .def_property_readonly("default_tolerance", &SceneHandle::defaultTolerance)
         .def("models", &SceneHandle::models)
-        .def("cut", &SceneHandle::cut, py::arg("t"), py::arg("model"), py::arg("tolerance"), py::arg("max_triangles"));
+        .def("cut", &SceneHandle::cut, py::arg("t"), py::arg("model"), py::arg("tolerance"), py::arg("max_triangles"),
+             py::arg("attribute_tolerance") = "");
 
     m.def("run_command", &runCommand, py::arg("args"),
           "Runs `apparent ARGS...` in-process: (exit code, standard output, error line).");

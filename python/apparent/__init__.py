@@ -124,7 +124,7 @@ class Scene:
             self._models = tuple(self._handle.models())
         return self._models
 
-    def cut(self, t, model="relativistic", tolerance=None, max_triangles=0):
+    def cut(self, t, model="relativistic", tolerance=None, max_triangles=0, attribute_tolerance=None):
         """The frame the camera sees at camera time ``t`` (seconds), as a :class:`Frame`.
 
         t          any finite camera time, not only a frame time; outside
@@ -135,12 +135,21 @@ class Scene:
                    a positive number: light-seconds, the largest distance from the exact apparent
                    surface; "1e-3x": that fraction of each object's size
         max_triangles  per frame (0: the command's default, 4 x the scene's input triangles)
+        attribute_tolerance  None: only the distance is bounded (faces that contain the velocity stay
+                   coarse inside: their points slide within them); a positive number or "1e-3x": also
+                   each point's distance from the exact image of its own rest point (as
+                   --attribute-tolerance), where textures and emission times land
 
         The cut at ``frame_times[k]`` holds the values of frame k of ``apparent render``.
         The GIL is released while cutting: several threads may cut at once. Bad input raises
         apparent.Error with the command line's message."""
         t = float(t)
-        return Frame(self._handle.cut(t, str(model), _tolerance_text(tolerance), int(max_triangles)))
+        if attribute_tolerance is not None and (isinstance(attribute_tolerance, bool) or attribute_tolerance == 0 or
+                                                attribute_tolerance == "vertex"):
+            raise Error("--attribute-tolerance: %r is neither a positive number of light-seconds nor a fraction of "
+                        "each object's size such as 1e-3x" % (attribute_tolerance,))
+        attribute = "" if attribute_tolerance is None else _tolerance_text(attribute_tolerance)
+        return Frame(self._handle.cut(t, str(model), _tolerance_text(tolerance), int(max_triangles), attribute))
 
     def frames(self, model="relativistic", tolerance=None, frames=None, threads=None):
         """Iterates the frames in order as :class:`Frame`, cut in parallel behind the iterator.
