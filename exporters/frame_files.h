@@ -57,6 +57,7 @@ public:
     void beforeSending(long long index, EncodedOutput* frame) override;
     void dropEncoded(long long first, long long last_excl) override;
     bool readsLightFactors() const override { return light_factors_; }
+    bool readsRestPoints() const override { return false; }  // PLY and OBJ write neither
     ~FrameFileSink() override;
 
 private:

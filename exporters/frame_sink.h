@@ -78,6 +78,11 @@ public:
     // mesh4d/light_factors.h): the loop computes them only when some sink does. The default: yes,
     // so a sink that does not say stays correct.
     virtual bool readsLightFactors() const { return true; }
+    // Whether this sink reads the frames' rest points and source triangles (ApparentMesh::rest_points
+    // and source_triangles) after prepare(): when none does, the loop releases them from a frame
+    // once prepared, so the frames it holds at once (the first ones, for the output estimate) do
+    // not keep them. The default: yes.
+    virtual bool readsRestPoints() const { return true; }
 
     // Frames across processes. On the process that cuts frames without writing: what begin() sets
     // up for prepare() and encode(), nothing written (the default: nothing).

@@ -195,6 +195,7 @@ public:
     void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
     // Only --attributes doppler/proper_time and --shade doppler read them.
     bool readsLightFactors() const override { return options_.doppler || options_.proper_time || options_.shade_doppler; }
+    bool readsRestPoints() const override { return false; }
     // Frames across processes: GlbSequenceWriter::encode and addEncoded.
     bool beginEncoding(const SequenceInfo& info, std::string* error) override { return begin(info, error); }
     EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const override;

@@ -166,6 +166,8 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     // so every rank or shard computes what the writing one needs).
     bool light_factors = false;
     for (const FrameSink* sink : sinks) light_factors = light_factors || sink->readsLightFactors();
+    bool rest_points = false;
+    for (const FrameSink* sink : sinks) rest_points = rest_points || sink->readsRestPoints();
     mesh4d::SliceSettings slice_settings;
     slice_settings.tolerance = scene.tolerance;
     slice_settings.max_triangles = size_t(settings.max_frame_triangles);
@@ -225,6 +227,12 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         w->over_budget = overBudget(frame, settings.max_frame_triangles);
         if (!w->over_budget)
             for (const FrameSink* sink : sinks) w->prepared.push_back(sink->prepare(frame));
+        // What no sink reads is released here, before the frame waits for its turn (FrameSink::readsRestPoints).
+        if (!rest_points)
+            for (mesh4d::ApparentMesh& o : frame.objects) {
+                std::vector<mesh4d::Vec3>().swap(o.rest_points);
+                std::vector<uint32_t>().swap(o.source_triangles);
+            }
         if (settings.distributed) {
             // The frame as it travels; the cut mesh and the conversions are released here.
             auto e = std::make_unique<EncodedFrame>();

@@ -80,6 +80,7 @@ public:
     }
     void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
     bool readsLightFactors() const override { return glb_.readsLightFactors(); }
+    bool readsRestPoints() const override { return glb_.readsRestPoints(); }
 
 private:
     bool write(const std::string& bytes, std::string* error) {

@@ -259,10 +259,13 @@ public:
             const bool both = o.doppler.size() == o.positions.size() && o.proper_time.size() == o.positions.size();
             with_factors += both;
             without_factors += o.doppler.empty() && o.proper_time.empty();
+            with_rest += o.rest_points.size() == o.positions.size() && o.source_triangles.size() == o.triangles.size();
+            without_rest += o.rest_points.empty() && o.source_triangles.empty();
         }
         return true;
     }
     bool readsLightFactors() const override { return reads; }
+    bool readsRestPoints() const override { return reads_rest; }
     bool finish(SinkSummary* summary, std::string*) override {
         summary->text = ", recorded";
         ++finished;
@@ -272,10 +275,12 @@ public:
     struct Prepared : PreparedFrame {
         long long index = -1;
     };
-    bool reads = true;  // readsLightFactors()
+    bool reads = true;       // readsLightFactors()
+    bool reads_rest = true;  // readsRestPoints()
     size_t objects = 0, triangles = 0;
     size_t non_empty = 0, reflections_seen = 0;    // objects delivered with points; of them reflections
     size_t with_factors = 0, without_factors = 0;  // of them with both light factors or neither
+    size_t with_rest = 0, without_rest = 0;        // with rest points and source triangles, or neither
     int begun = 0, finished = 0;
     long long prepared_for_it = 0;
     std::vector<long long> order;
@@ -355,6 +360,48 @@ TEST(Stage, LightFactorsOnlyWhenASinkReadsThem) {
             }
         }
     }
+}
+
+// The loop releases the rest points and source triangles once the frame is prepared when no sink
+// reads them (the frames held for the output estimate then do not keep them); one sink that reads
+// them keeps them for every sink. The default scene with its mirror (reflections), frames held for
+// the estimate and delivered after it.
+TEST(Stage, RestPointsReleasedWhenNoSinkReadsThem) {
+    StageOptions options;
+    options.scene_path = source("data/scenes/flanges.json");
+    options.frame_from = 8;
+    options.frame_to = 16;
+    options.quiet = true;
+    Stage stage;
+    std::ostringstream log, progress;
+    std::string error;
+    ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+    for (bool second_reads : {false, true}) {
+        RecordingSink a, b;
+        a.reads_rest = false;
+        b.reads_rest = second_reads;
+        OutputBudget budget(1LL << 40);  // a limit: the first frames are held for the estimate
+        FrameLoopSettings settings;
+        settings.progress = false;
+        FrameLoopResult result;
+        ASSERT_TRUE(runFrameLoop(stage, Model::Relativistic, settings, {&a, &b}, &budget, progress, &result, &error))
+            << error;
+        for (const RecordingSink* s : {&a, &b}) {
+            EXPECT_EQ(s->order.size(), 8u);
+            EXPECT_GT(s->reflections_seen, 0u);
+            EXPECT_GT(s->non_empty, 0u);
+            EXPECT_EQ(second_reads ? s->with_rest : s->without_rest, s->non_empty) << second_reads;
+        }
+    }
+}
+
+// The file sinks and the .glb read neither rest points nor source triangles.
+TEST(Stage, SinksSayWhetherTheyReadRestPoints) {
+    const fs::path dir = freshDir("reads_rest");
+    EXPECT_FALSE(plySink((dir / "p").string())->readsRestPoints());
+    EXPECT_FALSE(objSink((dir / "o").string())->readsRestPoints());
+    EXPECT_FALSE(GlbSink((dir / "a.glb").string(), GlbOptions(), false).readsRestPoints());
+    fs::remove_all(dir);
 }
 
 // The sinks' answers: the PLY writes doppler and proper_time, the OBJ nothing of them, the .glb
