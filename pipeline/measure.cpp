@@ -160,14 +160,7 @@ int measure(const MeasureSettings& settings, std::ostream& out, std::ostream& er
             return kExitBadInput;
         }
     }
-    std::vector<long long> frames;
-    if (settings.has_frames) {
-        for (long long k = stage.first; k < stage.last_excl; ++k) frames.push_back(k);
-    } else {
-        const long long total = stage.last_excl - stage.first;
-        const long long n = std::min<long long>(5, total);
-        for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
-    }
+    const std::vector<long long> frames = sampledFrames(stage, settings.has_frames);
     const ImageAxes axes = imageAxes(scene.camera);
     if (!settings.quiet)
         out << "Image coordinates: " << (axes.orthographic ? "scene units on the image plane (orthographic camera)"

@@ -134,4 +134,16 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     return true;
 }
 
+std::vector<long long> sampledFrames(const Stage& stage, bool all) {
+    std::vector<long long> frames;
+    if (all) {
+        for (long long k = stage.first; k < stage.last_excl; ++k) frames.push_back(k);
+        return frames;
+    }
+    const long long total = stage.last_excl - stage.first;
+    const long long n = std::min<long long>(5, total);
+    for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
+    return frames;
+}
+
 }  // namespace apparent

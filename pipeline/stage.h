@@ -78,4 +78,8 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
 // the line names frame k. FrameCutter applies it to the frames it builds for a cut outside the range.
 Status checkViewedTime(const Scene& scene, long long k);
 
+// The frames a measuring command (trade, measure) takes: every frame of the stage's range when
+// `all` (--frames given), else at most five spread over it, its first and last included.
+std::vector<long long> sampledFrames(const Stage& stage, bool all);
+
 }  // namespace apparent

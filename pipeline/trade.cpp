@@ -200,14 +200,7 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
             err << "error: " << s.message << " (`apparent trade` sweeps the tolerance)\n";
             return kExitBadInput;
         }
-    std::vector<long long> frames;
-    if (settings.has_frames) {
-        for (long long k = stage.first; k < stage.last_excl; ++k) frames.push_back(k);
-    } else {
-        const long long total = stage.last_excl - stage.first;
-        const long long n = std::min<long long>(5, total);
-        for (long long i = 0; i < n; ++i) frames.push_back(stage.first + (n == 1 ? 0 : i * (total - 1) / (n - 1)));
-    }
+    const std::vector<long long> frames = sampledFrames(stage, settings.has_frames);
     const std::vector<PreparedObject>& objects = stage.objects;
     // Non-uniform: spinning, accelerated or keyframed (mesh4d/motion/motion.h).
     auto beyondUniform = [&](const ObjectSpec& s) { return !mesh4d::isUniform(motionOf(s, model)); };

@@ -13,6 +13,18 @@ using mesh4d::RestMesh;
 using mesh4d::Vec3;
 
 // Icosahedron subdivided `levels` times, projected on a sphere of radius r (closed, genus 0).
+// The cube of edge 1 centred at the origin, each face two triangles, outward.
+inline RestMesh unitBox() {
+    RestMesh box;
+    for (int i = 0; i < 8; ++i) box.positions.push_back({i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5});
+    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads) {
+        box.triangles.push_back({q[0], q[1], q[2]});
+        box.triangles.push_back({q[0], q[2], q[3]});
+    }
+    return box;
+}
+
 inline RestMesh icosphere(int levels, double r) {
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
     RestMesh m;
