@@ -20,6 +20,7 @@
 #include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
+#include "pipeline/framing.h"
 #include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/seen.h"
 #include "mesh4d/motion/worldline.h"
@@ -342,6 +343,12 @@ Status checkTracedMotions(const Stage& stage, long long slab_memory) {
 
 }  // namespace
 
+int samplesSide(int samples) {
+    for (int side = 1; side <= 16; ++side)
+        if (side * side == samples) return side;
+    return 0;
+}
+
 Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int py) {
     // Step: the camera basis: forward f, right r, up u (right-handed, u = r x f).
     const Vec3 f0 = camera.look_at - camera.position;
@@ -585,20 +592,25 @@ std::array<double, 3> SceneTracer::shadeReflected(const Hit& h, const mesh4d::Vi
                      reflectDirection(m, camera.velocity));
 }
 
-TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) {
+TracedFrame SceneTracer::traceFrame(long long k, int out_width, int out_height, TraceProgress* progress) {
     if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) {
         buildWindow(k);
         listTraces();
     }
     TracedFrame frame;
-    frame.image = RgbImage(width, height);
-    frame.object.assign(size_t(width) * size_t(height), -1);
-    frame.reflected.assign(size_t(width) * size_t(height), -1);
+    frame.image = RgbImage(out_width, out_height);
+    frame.object.assign(size_t(out_width) * size_t(out_height), -1);
+    frame.reflected.assign(size_t(out_width) * size_t(out_height), -1);
     const mesh4d::ViewSurface view = viewForFrame(scene_, model_, k);
     const mesh4d::CameraMotion camera = cameraMotionOf(scene_);
-    tbb::parallel_for(0, height, [&](int py) {
+    // Step: the samples: the pixels of the picture s times as wide and high (s x s per pixel, their
+    // centres the strata's), summed per pixel in linear light; row py of it is pass py mod s.
+    const int s = samples_side_, width = out_width * s, height = out_height * s;
+    std::vector<std::array<double, 3>> sum(size_t(out_width) * size_t(out_height), {0, 0, 0});
+    const auto trace_row = [&](int py) {
         for (int px = 0; px < width; ++px) {
-            const size_t idx = size_t(py) * size_t(width) + size_t(px);
+            const size_t idx = size_t(py / s) * size_t(out_width) + size_t(px / s);
+            const bool centre = px % s == s / 2 && py % s == s / 2;  // the sample the object buffers hold
             // Step: the primary ray, back along the past cone (or along t = t_c). A sheared view
             // (finite, moving camera) is traced in the lab from the camera's lab position, along
             // the lab direction the pixel's camera-frame direction sees (camera_frame.h).
@@ -610,7 +622,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
             const Hit hit = nearest(ray, false);
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
-                frame.object[idx] = hit.object;
+                if (centre) frame.object[idx] = hit.object;
                 color = shade(hit, view.kind, ray.origin.x, view.shear);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
@@ -626,7 +638,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                     const Hit second = nearest(bounce, true);
                     std::array<double, 3> reflected = kBackground;
                     if (second.object >= 0) {
-                        frame.reflected[idx] = second.object;
+                        if (centre) frame.reflected[idx] = second.object;
                         reflected = camera.moving() ? shadeReflected(second, view, plane, camera)
                                                     : shade(second, view.kind, bounce.origin.x);
                     }
@@ -634,11 +646,19 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                         color[size_t(c)] = (1 - kMirrorReflectance) * color[size_t(c)] + kMirrorReflectance * reflected[size_t(c)];
                 }
             }
-            uint8_t* p = frame.image.pixel(px, py);
-            for (int c = 0; c < 3; ++c) p[c] = toSrgb8(color[size_t(c)]);
+            for (size_t c = 0; c < 3; ++c) sum[idx][c] += color[c];
         }
         if (progress) progress->rowDone();
-    });
+    };
+    for (int pass = 0; pass < s; ++pass) tbb::parallel_for(0, out_height, [&](int row) { trace_row(row * s + pass); });
+    // Step: each pixel the mean of its samples, to 8-bit sRGB.
+    const double n = double(s) * double(s);
+    for (int py = 0; py < out_height; ++py)
+        for (int px = 0; px < out_width; ++px) {
+            uint8_t* p = frame.image.pixel(px, py);
+            const std::array<double, 3>& c = sum[size_t(py) * size_t(out_width) + size_t(px)];
+            for (size_t i = 0; i < 3; ++i) p[i] = toSrgb8(c[i] / n);
+        }
     return frame;
 }
 
@@ -681,14 +701,16 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     const FrameSplit split{group.rank(), group.size()};
 
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    const int side = samplesSide(settings.samples);
     TraceProgress progress(err, !settings.quiet && !sender,
-                           (long long)stage.models.size() * (last_excl - first) * settings.height);
+                           (long long)stage.models.size() * (last_excl - first) * settings.height * side);
     for (Model model : stage.models) {
         const auto start = std::chrono::steady_clock::now();
         TracerOptions options;
         options.window_prisms = slabPrismLimit(settings.max_slab_memory);
         SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1, options);
         tracer.setShadeDoppler(settings.shade_doppler);
+        tracer.setSamplesSide(side);
         if (sender) {
             // Step (rank r > 0): trace this rank's frames and send each picture, until rank 0 says END.
             for (long long k = first + split.part; k < last_excl && !group.stopRequested(); k += split.parts) {
@@ -730,7 +752,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
                     return fail(1, "internal: rank " + std::to_string(split.partOf(k, first)) + " sent a picture of " +
                                        std::to_string(bytes.size()) + " bytes for frame " + std::to_string(k));
                 std::copy(bytes.begin(), bytes.end(), frame.image.rgb.begin());
-                for (int row = 0; row < settings.height; ++row) progress.rowDone();
+                for (int row = 0; row < settings.height * side; ++row) progress.rowDone();
             }
             if (settings.write_png &&
                 !writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error))
@@ -743,7 +765,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!settings.quiet) {
             log << modelName(model) << ": " << (last_excl - first) << " frames of " << settings.width << "x"
-                << settings.height << " in " << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat
+                << settings.height << (side > 1 ? ", " + std::to_string(side * side) + " samples a pixel," : "") << " in " << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat
                 << std::setprecision(6);
             if (settings.write_png) log << ", " << dir << "/";
             if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
@@ -852,9 +874,21 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     std::string error;
     SheetText base_text;
     if (painter)
-        for (Model m : stage.models) base_text.column_labels.push_back(modelName(m));
+        for (size_t m = 0; m < stage.models.size(); ++m)
+            base_text.column_labels.push_back(settings.row_labels.empty() ? modelName(stage.models[m]) : settings.row_labels[m]);
     base_text.title = "t";  // a title band for the time, filled per frame
-    const SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, base_text, painter != nullptr);
+    const auto title_at = [&](long long k) {
+        return (settings.title.empty() ? "" : settings.title + "   ") + cameraTimeLabel(scene, k);
+    };
+    SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, base_text, painter != nullptr);
+    // Step: the title band as high as the longest title of any frame wraps to (one size for the video).
+    if (painter)
+        for (long long k = stage.first; k < stage.last_excl; ++k)
+            base.min_title_lines = std::max(base.min_title_lines,
+                                            int(wrapText(*painter, title_at(k), base.title_px, base.width - 2 * base.pad).size()));
+    const int extra_lines = painter ? base.min_title_lines - 1 : 0;
+    const int sheet_width = base.width, sheet_height = base.height + extra_lines * base.titleStep();
+    const int side = samplesSide(settings.samples > 0 ? settings.samples : kDefaultRaytraceSamples);
     std::vector<std::unique_ptr<SceneTracer>> tracers;
     for (Model m : stage.models) {
         TracerOptions options;  // the models' tracers at once share the budget
@@ -862,13 +896,14 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
         tracers.push_back(
             std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1, options));
         tracers.back()->setShadeDoppler(settings.shade_doppler);
+        tracers.back()->setSamplesSide(side);
     }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     // Video frame k: the title band with its time, then every model's panel.
     long long k = stage.first;
     auto make = [&](TraceProgress* progress) {
         SheetText text = base_text;
-        text.title = (settings.title.empty() ? "" : settings.title + "   ") + cameraTimeLabel(scene, k);
+        text.title = title_at(k);
         SheetLayout layout = base;
         RgbImage sheet = drawSheet(text, painter, &layout);
         for (size_t m = 0; m < tracers.size(); ++m) {
@@ -884,14 +919,14 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
         return fg.group.finishSending();
     }
     VideoWriter writer;
-    if (!writer.open(settings.video_path, base.width, base.height, scene.frames.fps, &error))
+    if (!writer.open(settings.video_path, sheet_width, sheet_height, scene.frames.fps, &error))
         return fg.fail(kExitOutputError, error);
     TraceProgress progress(err, !settings.quiet,
-                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height);
+                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height * side);
     for (; k < stage.last_excl; ++k) {
         RgbImage sheet;
-        if (const int code = fg.picture(k - stage.first, base.width, base.height,
-                                        (long long)stage.models.size() * settings.height, &progress, &sheet, make))
+        if (const int code = fg.picture(k - stage.first, sheet_width, sheet_height,
+                                        (long long)stage.models.size() * settings.height * side, &progress, &sheet, make))
             return code;
         if (!writer.addFrame(sheet, &error)) return fg.fail(kExitOutputError, error);
     }
@@ -899,7 +934,7 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     if (fg.receiver) fg.group.endFrames(0);
     progress.finish();
     if (!settings.quiet) {
-        log << settings.video_path << ": " << writer.frames() << " frames of " << base.width << "x" << base.height
+        log << settings.video_path << ": " << writer.frames() << " frames of " << sheet_width << "x" << sheet_height
             << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1;
         if (fg.receiver) log << ", " << fg.group.size() << " processes shared the frames";
         log << "\n";
@@ -960,6 +995,26 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
             frames = figureFrames(scene, settings.columns);
         }
     }
+    // Step: the labels given for the rows and columns, one each.
+    if (!code && !settings.row_labels.empty() && settings.row_labels.size() != rows.size()) {
+        error = "--row-labels: " + std::to_string(settings.row_labels.size()) + " labels for " +
+                std::to_string(rows.size()) + " models";
+        code = kExitBadInput;
+    }
+    if (!code && !settings.column_labels.empty() && settings.column_labels.size() != frames.size()) {
+        error = "--column-labels: " + std::to_string(settings.column_labels.size()) + " labels for " +
+                std::to_string(frames.size()) + " columns";
+        code = kExitBadInput;
+    }
+    // Step: --frame-objects: the camera aimed and its view fitted to the objects in these frames.
+    if (!code && settings.frame_objects) {
+        std::vector<long long> framed = frames;
+        for (long long k = stage.first; video && k < stage.last_excl; ++k) framed.push_back(k);
+        if (Status s = frameObjects(stage, rows, framed, settings.width, settings.height, &stage.scene.camera); !s.ok) {
+            error = s.message;
+            code = kExitBadInput;
+        }
+    }
     // Step: the font (labels and title) and ffmpeg (video), before any tracing.
     TextPainter painter;
     const bool with_text = settings.labels || !settings.title.empty();
@@ -977,14 +1032,18 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     SheetText text;
     text.title = settings.title;
     if (settings.labels) {
-        for (Model m : rows) text.row_labels.push_back(modelName(m));
-        for (long long k : frames) text.column_labels.push_back(cameraTimeLabel(scene, k));
+        text.row_labels = settings.row_labels;
+        text.column_labels = settings.column_labels;
+        for (size_t r = 0; settings.row_labels.empty() && r < rows.size(); ++r) text.row_labels.push_back(modelName(rows[r]));
+        for (size_t c = 0; settings.column_labels.empty() && c < frames.size(); ++c)
+            text.column_labels.push_back(cameraTimeLabel(scene, frames[c]));
     }
     SheetLayout layout(int(rows.size()), int(frames.size()), settings.width, settings.height, text, with_text);
     RgbImage sheet = fg.sender ? RgbImage() : drawSheet(text, with_text ? &painter : nullptr, &layout);
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    const int side = samplesSide(settings.samples > 0 ? settings.samples : kDefaultFigureSamples);
     TraceProgress progress(err, !settings.quiet && !fg.sender,
-                           (long long)rows.size() * (long long)frames.size() * settings.height);
+                           (long long)rows.size() * (long long)frames.size() * settings.height * side);
     // Panel i = r * columns + c: row r's model at column c's frame.
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
@@ -992,6 +1051,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         options.window_prisms = slabPrismLimit(settings.max_slab_memory);
         SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi, options);
         tracer.setShadeDoppler(settings.shade_doppler);
+        tracer.setSamplesSide(side);
         for (size_t c = 0; c < frames.size(); ++c) {
             auto make = [&](TraceProgress* p) {
                 if (p) p->setLabel(std::string(modelName(rows[r])) + " frame " + std::to_string(frames[c]));
@@ -1005,7 +1065,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
                 continue;
             }
             RgbImage panel;
-            if (const int failed = fg.picture(i, settings.width, settings.height, settings.height, &progress, &panel, make))
+            if (const int failed = fg.picture(i, settings.width, settings.height, (long long)settings.height * side, &progress, &panel, make))
                 return failed;
             placePanel(&sheet, layout, int(r), int(c), panel);
         }
@@ -1023,6 +1083,10 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         for (Model m : rows) log << " " << modelName(m);
         log << "; frames";
         for (long long k : frames) log << " " << k << " (t = " << frameTime(scene.frames, k) << " s)";
+        if (side > 1) log << "; " << side * side << " samples a pixel";
+        if (settings.frame_objects)
+            log << "; framed: camera.look_at [" << scene.camera.look_at.x << ", " << scene.camera.look_at.y << ", "
+                << scene.camera.look_at.z << "], camera.fov_deg " << scene.camera.fov_deg;
         if (fg.receiver) log << "; " << fg.group.size() << " processes shared the frames";
         log << "\n";
     }
