@@ -2,6 +2,8 @@
 // from the scene camera, several models side by side in one WebGL canvas.
 //
 // URL parameters: ?dir=/out  ?models=instant,finite,relativistic  ?t=SECONDS  ?paused=1  ?shade=plain|doppler
+// ?t is camera time, as the labels show it (the scene extras' frame_times); a t outside the files' camera times
+// but inside the animation is read as animation time (from the first frame written), as links before issue 38 meant.
 // Colours: files rendered with `--shade doppler` carry COLOR_0 (the Doppler-shifted colour) with a white
 // material whose extras.base_color is the plain colour; the "Doppler" toggle switches between the two.
 // Test hook: window.apparentViewer (see the end of this file and README.md).
@@ -21,10 +23,11 @@ const params = new URLSearchParams(location.search);
 const dir = (params.get('dir') || '/out').replace(/\/+$/, '');
 const modelNames = (params.get('models') || 'instant,finite,relativistic')
   .split(',').map((s) => s.trim()).filter(Boolean);
-const initialTime = Math.max(0, Number(params.get('t')) || 0);
+const initialTime = Number(params.get('t')) || 0;
 const startPaused = ['1', 'true', 'yes'].includes((params.get('paused') || '').toLowerCase());
 let shade = (params.get('shade') || 'doppler').toLowerCase() === 'plain' ? 'plain' : 'doppler';
-// ?aspect=16:9 or 1.6: aspect ratio of every viewport (default: the file camera's aspectRatio, else 16:9)
+// ?aspect=16:9 or 1.6: aspect ratio of every viewport (default: the viewports fill the window, each showing at
+// least the file camera's view, of its aspectRatio, else 16:9)
 function parseAspect(v) {
   if (!v) return null;
   const m = /^\s*([\d.]+)\s*[:/x]\s*([\d.]+)\s*$/.exec(v);
@@ -87,7 +90,8 @@ const models = modelNames.map((name) => {
   };
 });
 
-let time = initialTime;
+let time = 0;            // animation time: 0 at the first frame written
+let cameraStart = 0;     // the camera time of animation time 0 (frame_times[0]; 0 without frame_times)
 let zoom = 1;            // view zoom: fov' = 2 atan(tan(fov / 2) / zoom); the camera itself never moves
 let aspect = aspectParam || DEFAULT_ASPECT;
 let playing = !startPaused;
@@ -359,12 +363,13 @@ function updateLabels() {
     m.sub.textContent = `${shown}${camT}`;
     m.label.title = `${m.url}\n${m.cameraNote || ''}${zoom !== 1 ? `\nzoom ${zoom.toFixed(2)}×` : ''}`;
   }
-  timeEl.textContent = `t = ${time.toFixed(3)} s / ${maxDuration.toFixed(3)} s` +
+  timeEl.textContent = `t = ${(time + cameraStart).toFixed(3)} s · ${time.toFixed(3)} / ${maxDuration.toFixed(3)} s` +
     (zoom !== 1 ? ` · zoom ${zoom.toFixed(2)}×` : '');
   slider.value = String(time);
 }
 
-// Lay the viewports out side by side, all with the same aspect ratio, as large as the stage allows.
+// Lay the viewports out side by side, filling the stage (with ?aspect: all of that aspect ratio, as large as the
+// stage allows).
 function layout() {
   const n = models.length;
   if (!n) return;
@@ -374,9 +379,9 @@ function layout() {
   const gap = parseFloat(cs.columnGap) || 0;
   const labelH = models[0].label.offsetHeight;
   let w = Math.floor((viewsEl.clientWidth - padX - gap * (n - 1)) / n);
-  let h = Math.floor(w / aspect);
-  const maxH = Math.floor(viewsEl.clientHeight - padY - labelH);
-  if (h > maxH) { h = Math.max(1, maxH); w = Math.max(1, Math.floor(h * aspect)); }
+  const maxH = Math.max(1, Math.floor(viewsEl.clientHeight - padY - labelH));
+  let h = aspectParam ? Math.floor(w / aspect) : maxH;
+  if (h > maxH) { h = maxH; w = Math.max(1, Math.floor(h * aspect)); }
   for (const m of models) {
     m.view.style.width = `${w}px`;
     m.slot.style.height = `${h}px`;
@@ -419,8 +424,11 @@ function render() {
       cam.near = m.cameraObject.near;
       cam.far = m.cameraObject.far;
     }
+    // A viewport narrower than the file camera's aspect widens the vertical field so that the file's whole
+    // horizontal field stays in view.
     const base = THREE.MathUtils.degToRad(m.baseFov || DEFAULT_FOV);
-    cam.fov = THREE.MathUtils.radToDeg(2 * Math.atan(Math.tan(base / 2) / zoom));
+    const widen = Math.max(1, aspect / (r.width / r.height));
+    cam.fov = THREE.MathUtils.radToDeg(2 * Math.atan(Math.tan(base / 2) * widen / zoom));
     cam.aspect = r.width / r.height;
     cam.updateProjectionMatrix();
     renderer.render(m.scene, cam);
@@ -498,7 +506,7 @@ function info() {
   return Object.fromEntries(models.map((m) => [m.name, {
     url: m.url, loaded: m.loaded, fps: m.fps, duration: m.duration, frames: m.frames.length,
     firstFrame: m.firstFrame, frameTimes: m.frameTimes.length, camera: m.cameraSource,
-    fov: m.baseFov ?? null, aspect, zoom, cameraNote: m.cameraNote || null,
+    fov: m.baseFov ?? null, aspect, zoom, cameraNote: m.cameraNote || null, cameraStart,
     dopplerColours: (m.shaded || []).length, shade,
   }]));
 }
@@ -527,7 +535,13 @@ const ready = (async () => {
   dopplerBox.disabled = !ok.some((m) => m.shaded.length);
   dopplerBox.checked = shade === 'doppler';
   applyShade();
-  setTime(Math.min(initialTime, maxDuration));
+  // ?t: camera time; outside the files' camera times but inside the animation, the old animation time.
+  const timed = ok.find((m) => m.frameTimes.length);
+  if (timed) cameraStart = Number(timed.frameTimes[0]);
+  const cameraEnd = cameraStart + maxDuration;
+  const oldLink = timed && (initialTime < cameraStart || initialTime > cameraEnd) && initialTime >= 0 &&
+    initialTime <= maxDuration;
+  setTime(Math.min(Math.max(0, oldLink ? initialTime : initialTime - cameraStart), maxDuration));
   setPlaying(playing);
   requestAnimationFrame(tick);
   if (failed.length) {
@@ -554,6 +568,8 @@ window.apparentViewer = {
   // 'plain' or 'doppler' (files with COLOR_0 from --shade doppler); returns the shade now in use
   setShade,
   getTime: () => time,
+  // camera time of the current animation time (?t reads it)
+  getCameraTime: () => time + cameraStart,
   play: () => setPlaying(true),
   pause: () => setPlaying(false),
   isPlaying: () => playing,
