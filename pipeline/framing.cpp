@@ -29,7 +29,7 @@ Status frameObjects(const Stage& stage, const std::vector<Model>& models, const 
                     int width, int height, CameraSpec* camera) {
     // Step: the unit directions from the camera to every point of the framed objects' shapes.
     const std::vector<size_t> framed = framedObjects(stage);
-    const Vec3 eye = camera->position;
+    const Vec3 eye = camera->position * unitsPerLightSecond(stage.scene.units);  // where the cut's outputs have it
     std::vector<Vec3> dirs;
     Vec3 sum{0, 0, 0};
     for (Model model : models) {
@@ -88,8 +88,8 @@ Status frameObjects(const Stage& stage, const std::vector<Model>& models, const 
             << kMaxFramingFovDeg << ")";
         return Status::failure(msg.str());
     }
-    const double dist = mesh4d::norm(camera->look_at - eye);
-    camera->look_at = eye + (dist > 0 ? dist : 1) * f;
+    const double dist = mesh4d::norm(camera->look_at - camera->position);
+    camera->look_at = camera->position + (dist > 0 ? dist : 1) * f;
     camera->fov_deg = std::max(fov, 1e-6);
     return Status::success();
 }

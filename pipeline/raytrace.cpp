@@ -807,12 +807,18 @@ bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::ve
     return true;
 }
 
+TimePrefix cameraTimePrefix(const Scene& scene) {
+    const double last = frameTime(scene.frames, std::max(0LL, frameCount(scene.frames) - 1));
+    return timePrefixFor(std::max(std::fabs(scene.frames.start), std::fabs(last)));
+}
+
 std::string cameraTimeLabel(const Scene& scene, long long k) {
-    // As many decimals as the frame rate needs (10 fps: one), so labels keep their width in a video.
-    const int decimals = scene.frames.fps <= 1 ? 0 : std::min(6, int(std::ceil(std::log10(scene.frames.fps) - 1e-9)));
-    std::ostringstream s;
-    s << "t = " << std::fixed << std::setprecision(decimals) << frameTime(scene.frames, k) << " s";
-    return s.str();
+    // As many decimals as the frame rate needs in the prefix's unit (10 fps: one), so labels keep
+    // their width in a video.
+    const TimePrefix prefix = cameraTimePrefix(scene);
+    const double rate = scene.frames.fps * prefix.seconds;
+    const int decimals = rate <= 1 ? 0 : std::min(6, int(std::ceil(std::log10(rate) - 1e-9)));
+    return "t = " + timeText(frameTime(scene.frames, k), prefix, decimals);
 }
 
 namespace {
@@ -1082,11 +1088,15 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         log << settings.out_path << ": " << sheet.width << "x" << sheet.height << ", rows";
         for (Model m : rows) log << " " << modelName(m);
         log << "; frames";
-        for (long long k : frames) log << " " << k << " (t = " << frameTime(scene.frames, k) << " s)";
+        const TimePrefix prefix = cameraTimePrefix(scene);
+        for (long long k : frames)
+            log << " " << k << " (t = " << frameTime(scene.frames, k) / prefix.seconds << " " << prefix.name << ")";
         if (side > 1) log << "; " << side * side << " samples a pixel";
-        if (settings.frame_objects)
-            log << "; framed: camera.look_at [" << scene.camera.look_at.x << ", " << scene.camera.look_at.y << ", "
-                << scene.camera.look_at.z << "], camera.fov_deg " << scene.camera.fov_deg;
+        if (settings.frame_objects) {
+            const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
+            log << "; framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
+                << scene.camera.fov_deg;
+        }
         if (fg.receiver) log << "; " << fg.group.size() << " processes shared the frames";
         log << "\n";
     }

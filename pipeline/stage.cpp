@@ -36,7 +36,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     if (!options.quiet)
         for (const std::string& w : scene.warnings) log << "warning: " << w << "\n";
     if (options.has_tolerance) {
-        scene.tolerance = options.tolerance;
+        scene.tolerance = options.tolerance * lightSecondsPer(scene.units);  // --tolerance T: in the scene's units
         scene.tolerance_relative = options.tolerance_relative;
     }
     stage->models = options.models;

@@ -92,6 +92,10 @@ const models = modelNames.map((name) => {
 
 let time = 0;            // animation time: 0 at the first frame written
 let cameraStart = 0;     // the camera time of animation time 0 (frame_times[0]; 0 without frame_times)
+// Times shown in ns, us or ms when all the files' frame times are below 1 us, 1 ms or 1 s (a scene in metres
+// lasts nanoseconds), as apparent figure labels them (pipeline/units.h).
+let timeUnit = { name: 's', seconds: 1 };
+function timeText(t, digits = 3) { return `${(t / timeUnit.seconds).toFixed(digits)} ${timeUnit.name}`; }
 let zoom = 1;            // view zoom: fov' = 2 atan(tan(fov / 2) / zoom); the camera itself never moves
 let aspect = aspectParam || DEFAULT_ASPECT;
 let playing = !startPaused;
@@ -357,13 +361,13 @@ function updateLabels() {
     if (!m.loaded) continue;
     const vis = visibleOf(m);
     const k = frameIndexAt(m, time);
-    const camT = k >= 0 && m.frameTimes[k] !== undefined ? ` · camera t ${Number(m.frameTimes[k]).toFixed(3)} s` : '';
+    const camT = k >= 0 && m.frameTimes[k] !== undefined ? ` · camera t ${timeText(Number(m.frameTimes[k]))}` : '';
     const shown = vis.length ? vis.map((v) => `${v.name} · ${v.vertices} vertices` +
       (v.reflected ? ` + ${v.reflected} in mirrors` : '')).join(', ') : 'empty frame';
     m.sub.textContent = `${shown}${camT}`;
     m.label.title = `${m.url}\n${m.cameraNote || ''}${zoom !== 1 ? `\nzoom ${zoom.toFixed(2)}×` : ''}`;
   }
-  timeEl.textContent = `t = ${(time + cameraStart).toFixed(3)} s · ${time.toFixed(3)} / ${maxDuration.toFixed(3)} s` +
+  timeEl.textContent = `t = ${timeText(time + cameraStart)} · ${timeText(time)} / ${timeText(maxDuration)}` +
     (zoom !== 1 ? ` · zoom ${zoom.toFixed(2)}×` : '');
   slider.value = String(time);
 }
@@ -538,6 +542,11 @@ const ready = (async () => {
   // ?t: camera time; outside the files' camera times but inside the animation, the old animation time.
   const timed = ok.find((m) => m.frameTimes.length);
   if (timed) cameraStart = Number(timed.frameTimes[0]);
+  const largest = ok.reduce((a, m) => m.frameTimes.reduce((b, x) => Math.max(b, Math.abs(Number(x))), a), 0);
+  if (largest > 0 && largest < 1) {
+    timeUnit = largest >= 1e-3 ? { name: 'ms', seconds: 1e-3 } : largest >= 1e-6 ? { name: 'us', seconds: 1e-6 }
+      : { name: 'ns', seconds: 1e-9 };
+  }
   const cameraEnd = cameraStart + maxDuration;
   const oldLink = timed && (initialTime < cameraStart || initialTime > cameraEnd) && initialTime >= 0 &&
     initialTime <= maxDuration;
@@ -553,7 +562,7 @@ const ready = (async () => {
   const dbg = gl.getExtension('WEBGL_debug_renderer_info');
   const glName = dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
   setStatus(`${dir}: ${ok.map((m) => `${m.name} (${m.frames.length} frames @ ${+m.fps.toFixed(3)} fps)`).join(', ')}` +
-    ` · duration ${maxDuration.toFixed(3)} s · ${models[0].cameraNote || ''}\n` +
+    ` · duration ${timeText(maxDuration)} · ${models[0].cameraNote || ''}\n` +
     `Space play/pause · ←/→ step · wheel or +/- zoom, 0 or double-click reset · ${glName}`);
   return info();
 })();

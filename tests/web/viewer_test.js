@@ -3,7 +3,7 @@
 //
 //   node tests/web/viewer_test.js OUTDIR [--screenshot PATH] [--models a,b,c] [--frames 0,50,100,199]
 //                                        [--shot-time SECONDS] [--chromium PATH] [--keep-profile] [--plain DIR]
-//                                        [--open-time T --expect-camera-time C]
+//                                        [--open-time T --expect-camera-time C] [--expect-time-unit ns]
 //
 // OUTDIR holds <model>.glb for every model (plain or KHR_draco_mesh_compression). The test serves the repository
 // root and OUTDIR (as /out/) on 127.0.0.1, opens the viewer in Debian Chromium (headless, SwiftShader WebGL) via
@@ -53,7 +53,7 @@ function setupFail(msg) {
 // ------------------------------------------------------------------ arguments
 const opts = { outdir: null, screenshot: null, models: ['instant', 'finite', 'relativistic'], frames: null,
   shotTime: 10, chromium: process.env.CHROMIUM || '/usr/bin/chromium', keepProfile: false, plain: null,
-  openTime: 0, expectCameraTime: null };
+  openTime: 0, expectCameraTime: null, expectTimeUnit: null };
 {
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; ++i) {
@@ -65,6 +65,7 @@ const opts = { outdir: null, screenshot: null, models: ['instant', 'finite', 're
     else if (a === '--shot-time') opts.shotTime = Number(val());
     else if (a === '--open-time') opts.openTime = Number(val());
     else if (a === '--expect-camera-time') opts.expectCameraTime = Number(val());
+    else if (a === '--expect-time-unit') opts.expectTimeUnit = val();
     else if (a === '--chromium') opts.chromium = val();
     else if (a === '--keep-profile') opts.keepProfile = true;
     else if (a === '--plain') opts.plain = path.resolve(val());
@@ -259,6 +260,12 @@ async function main() {
       const cameraTime = await page.evaluate(() => window.apparentViewer.getCameraTime());
       check(Math.abs(cameraTime - opts.expectCameraTime) < 1e-6, `?t=${opts.openTime} opens at camera time ` +
         `${opts.expectCameraTime}`, `camera time ${cameraTime}`);
+    }
+
+    // 3c. times shown in the unit that fits the files' frame times (a scene in metres: ns)
+    if (opts.expectTimeUnit !== null) {
+      const shown = await page.evaluate(() => document.getElementById('time').textContent);
+      check(new RegExp(`^t = -?[0-9.]+ ${opts.expectTimeUnit} `).test(shown), `times read in ${opts.expectTimeUnit}`, shown);
     }
 
     // 4. visibility and vertex counts at several times
