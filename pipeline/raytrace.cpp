@@ -765,8 +765,8 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!settings.quiet) {
             log << modelName(model) << ": " << (last_excl - first) << " frames of " << settings.width << "x"
-                << settings.height << (side > 1 ? ", " + std::to_string(side * side) + " samples a pixel," : "") << " in " << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat
-                << std::setprecision(6);
+                << settings.height << (side > 1 ? ", " + std::to_string(side * side) + " samples a pixel," : "") << " in "
+                << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat << std::setprecision(6);
             if (settings.write_png) log << ", " << dir << "/";
             if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
             if (receiver) log << ", " << group.size() << " processes shared the frames";
@@ -942,6 +942,12 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     if (!settings.quiet) {
         log << settings.video_path << ": " << writer.frames() << " frames of " << sheet_width << "x" << sheet_height
             << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1;
+        if (side > 1) log << ", " << side * side << " samples a pixel";
+        if (settings.frame_objects) {
+            const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
+            log << ", framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
+                << scene.camera.fov_deg;
+        }
         if (fg.receiver) log << ", " << fg.group.size() << " processes shared the frames";
         log << "\n";
     }
