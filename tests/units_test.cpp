@@ -117,6 +117,14 @@ TEST(Units, OutputsAndMessagesUseTheScenesUnits) {
     EXPECT_NE(obj.find("\n# units: metres, seconds, speeds as fractions of c\n"), std::string::npos);
     EXPECT_NE(read(dir / "out/relativistic.glb").find(R"("units":"metres, seconds, speeds as fractions of c")"),
               std::string::npos);
+    // --tolerance T is in the scene's units too: the .glb's extras give it back in metres.
+    r = testcli::apparentRun({"render", metres, "--out", (dir / "tol").string(), "--frames", "3:4", "--tolerance", "0.01",
+                              "--quiet"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string glb = read(dir / "tol/relativistic.glb");
+    const size_t at = glb.find("\"tolerance\":");
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_NEAR(std::stod(glb.substr(at + 12, 30)), 0.01, 1e-15);
     r = testcli::apparentRun({"figure", metres, "--out", (dir / "sheet.png").string(), "--frames", "3:5", "--size",
                               "64x36", "--samples", "1"});
     ASSERT_EQ(r.code, 0) << r.err;
