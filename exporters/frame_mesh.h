@@ -39,6 +39,8 @@ struct ExportCamera {
     mesh4d::Vec3 look_at{0, 0, -1};
     mesh4d::Vec3 up{0, 1, 0};
     double fov_deg = 60;  // vertical field of view
+    double width = 0;     // > 0: an orthographic camera this wide (scene camera.width); 0: perspective
+    bool orthographic() const { return width > 0; }
 };
 
 struct SequenceInfo {

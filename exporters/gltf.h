@@ -1,7 +1,8 @@
 // One animated binary glTF (.glb) per model, holding every frame of the sequence.
 //
 // Layout (glTF 2.0):
-// - node 0 "camera": a perspective camera placed and aimed like the scene camera;
+// - node 0 "camera": a perspective camera placed and aimed like the scene camera (orthographic,
+//   xmag half its width, for camera.projection "orthographic");
 // - node 1 + k "frame_NNNNN": mesh k (with meshopt the mesh of its run, see frame coherence
 //   below), frame k, one primitive per visible object with that
 //   object's material; its translation is the frame's local origin (the centre of its bounding

@@ -22,6 +22,21 @@ int viewSideSign(const ViewSurface& view, const Event& e) {
     // the sum of squares within 4u, the root within 3u more and the final difference within u:
     // |h - fl(h)| <= 8u (|dt| + |dx|) generously; 1e-15 > 8u covers it.
     const double dt = view.t_c - e.t;
+    if (view.kind == ViewKind::Hyperplane && view.tilted()) {
+        // The null hyperplane: h = dt - (x - C).k, filtered as the cone's (|k| = 1), then exact.
+        const Vec3 dx = e.x - view.apex;
+        const double along = dot(dx, view.tilt);
+        const double h = dt - along;
+        const double bound = 1e-15 * (std::fabs(dt) + std::fabs(dx.x) + std::fabs(dx.y) + std::fabs(dx.z));
+        if (h > bound) return 1;
+        if (h < -bound) return -1;
+        if (!std::isfinite(h)) return h > 0 ? 1 : -1;
+        ++fallbacks;
+        using MP = CGAL::MP_Float;
+        const MP exact = (MP(view.t_c) - MP(e.t)) - (MP(e.x.x) - MP(view.apex.x)) * MP(view.tilt.x) -
+                         (MP(e.x.y) - MP(view.apex.y)) * MP(view.tilt.y) - (MP(e.x.z) - MP(view.apex.z)) * MP(view.tilt.z);
+        return signOf(exact);
+    }
     if (view.kind == ViewKind::Hyperplane) {
         // One subtraction of doubles: its sign is exact (Sterbenz; the rounded difference is zero
         // only if the exact one is).

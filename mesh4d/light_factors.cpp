@@ -45,7 +45,11 @@ void addLightFactors(const World4D& world, const ViewSurface& view, ApparentMesh
     for (size_t i = 0; i < n; ++i) {
         // Under a shear the outputs are in the camera's frame: back to the view's own (the lab).
         const Vec3 x = view.sheared() ? m->absolutePosition(i) + view.shear * m->absoluteTime(i) : m->absolutePosition(i);
-        m->doppler[i] = dopplerFactor(world.motion, view.kind, view.apex, x, view.shear);
+        // A tilted hyperplane: the light goes along -k, to the foot of x on the image plane.
+        if (view.kind == ViewKind::Hyperplane && view.tilted())
+            m->doppler[i] = dopplerFactor(world.motion, ViewKind::PastCone, x - view.tilt * dot(x - view.apex, view.tilt), x);
+        else
+            m->doppler[i] = dopplerFactor(world.motion, view.kind, view.apex, x, view.shear);
         m->proper_time[i] = properTimeAt(world.motion, m->rest_points[i], m->absoluteTime(i));
     }
 }

@@ -7,7 +7,8 @@
 //     Lorentz (relativistic):   D = 1 / (g (1 - w.n)),   g = 1/sqrt(1 - b^2)
 //     Galilean (finite; light at c in that frame, the camera at rest in it):  D = 1 / (1 - w.n)
 //       (with a moving camera the frame is the lab and D = (1 - v.n) / (1 - u.n): dopplerFactor)
-//     on a hyperplane (instant, contracted: no light travel): D = 1.
+//     on a hyperplane (instant, contracted: no light travel): D = 1; on a tilted one (an
+//     orthographic camera, lightcone.h) the light goes along -k: n = -k (addLightFactors).
 // On the line of sight D = sqrt((1 + b)/(1 - b)) approaching and sqrt((1 - b)/(1 + b)) receding;
 // at right angles to w in the camera's frame D = 1/g (the transverse Doppler effect).
 // 1 - w.n is formed as (1 - b^2)/(1 + b) + b |u - n|^2 / 2 (u = w/b), a sum of two non-negative

@@ -11,7 +11,7 @@ namespace mesh4d {
 
 double viewSide(const ViewSurface& view, const Event& e) {
     const double dt = view.t_c - e.t;
-    if (view.kind == ViewKind::Hyperplane) return dt;
+    if (view.kind == ViewKind::Hyperplane) return view.tilted() ? dt - dot(e.x - view.apex, view.tilt) : dt;
     return dt - norm(e.x - view.apex);
 }
 
@@ -29,11 +29,16 @@ WorldlineCut cutWorldline(const ViewSurface& view, const Event& anchor, const Ve
     // Move to the camera first: e is where the point is at t_c, relative to C.
     const double dt_now = view.t_c - anchor.t;
     WorldlineCut cut;
-    if (view.kind == ViewKind::Hyperplane) {
+    if (view.kind == ViewKind::Hyperplane && !view.tilted()) {
         cut.event = {view.t_c, anchor.x + v * dt_now};
         return cut;
     }
     const Vec3 e = (anchor.x - view.apex) + v * dt_now;
+    if (view.kind == ViewKind::Hyperplane) {
+        const double d = dot(e, view.tilt) / (1 + dot(v, view.tilt));
+        cut.event = {view.t_c - d, view.apex + (e - v * d)};
+        return cut;
+    }
     const double d = retardedDelay(e, v, one_minus_b2);
     cut.event = {view.t_c - d, view.apex + (e - v * d)};
     return cut;
@@ -46,6 +51,10 @@ Vec3 nowBase(const ViewSurface& view, const Motion& m) {
 Event cutRestWorldline(const ViewSurface& view, const Motion& m, const Vec3& now_base, const Vec3& q) {
     if (!isUniform(m)) return crossWorldline(view, m, q).event;
     const Vec3 e = now_base + shapeOffset(m, q);
+    if (view.kind == ViewKind::Hyperplane && view.tilted()) {
+        const double d = dot(e, view.tilt) / (1 + dot(m.velocity, view.tilt));
+        return {view.t_c - d, view.apex + (e - m.velocity * d)};
+    }
     if (view.kind == ViewKind::Hyperplane) return {view.t_c, view.apex + e};
     const double d = retardedDelay(e, m.velocity, m.one_minus_beta2);
     return {view.t_c - d, view.apex + (e - m.velocity * d)};
@@ -63,6 +72,17 @@ ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m) {
         return a;
     }
     const Vec3 E = nowBase(view, m);
+    if (view.kind == ViewKind::Hyperplane && view.tilted()) {
+        // The null hyperplane: the origin's delay D = E.k / (1 + v.k), each point's delta = s.lean.
+        a.cone = false;
+        a.tilted = true;
+        a.lean = view.tilt / (1 + dot(m.velocity, view.tilt));
+        const double D = dot(E, a.lean);
+        a.y0 = E - m.velocity * D;
+        a.origin = view.apex + a.y0;
+        a.time_origin = view.t_c - D;
+        return a;
+    }
     if (view.kind == ViewKind::Hyperplane) {
         a.cone = false;
         a.y0 = E;
@@ -81,6 +101,10 @@ ViewAnchor viewAnchor(const ViewSurface& view, const Motion& m) {
 
 namespace {
 inline Event cutLocal(const ViewAnchor& anchor, const Motion& m, const Vec3& s) {
+    if (anchor.tilted) {
+        const double delta = dot(s, anchor.lean);
+        return {-delta, s - m.velocity * delta};
+    }
     if (!anchor.cone) return {0, s};
     const double K = 2 * dot(s, anchor.y0) + norm2(s);
     const double B = anchor.S + dot(s, m.velocity);
@@ -142,6 +166,12 @@ void cutRestLocalBatch(const ViewAnchor& anchor, const Motion& m, const Vec3* q,
     if (!isUniform(m)) {
         for (size_t i = 0; i < n; ++i) {
             const Event e = cutRestLocal(anchor, m, q[i]);
+            positions[i] = e.x;
+            times[i] = e.t;
+        }
+    } else if (anchor.tilted) {
+        for (size_t i = 0; i < n; ++i) {
+            const Event e = cutLocal(anchor, m, shapeOffset(m, q[i]));
             positions[i] = e.x;
             times[i] = e.t;
         }

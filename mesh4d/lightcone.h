@@ -1,9 +1,11 @@
 // The view hypersurfaces a frame is cut with, and the exact cuts of worldlines and segments.
 //
 // Past lightcone of the camera event (t_c, C): the events with t = t_c - |x - C| (past sheet only,
-// c = 1). Hyperplane: the events with t = t_c (infinite light speed). For both we use the side
-// function
-//     h(E) = (t_c - E.t) - |E.x - C|     (cone)        h(E) = t_c - E.t     (hyperplane)
+// c = 1). Hyperplane: the events with t = t_c (infinite light speed), or, tilted by the unit view
+// direction k of an orthographic camera, the null hyperplane t = t_c - (x - C).k: the emissions of
+// the light that crosses the image plane (through C, normal to k) at t_c travelling along -k, the
+// far-field limit of the cone (Terrell 1959, Penrose 1959). For all three we use the side function
+//     h(E) = (t_c - E.t) - |E.x - C|   (cone)      h(E) = (t_c - E.t) - (E.x - C).k   (hyperplane, k = 0 untilted)
 // h > 0: E is inside the past cone (its light has already passed the camera); h < 0: E is still
 // outside it (in the future of the view surface); h = 0: on the surface.
 //
@@ -14,6 +16,10 @@
 // taken in the cancellation-free form of docs/DESIGN.md section 5:
 //     s = sqrt((e.v)^2 + (1 - b^2)|e|^2);  e.v >= 0: d = |e|^2 / (e.v + s);  else d = (s - e.v)/(1 - b^2).
 // The apparent point is y = C + e - v d. A point at the camera (e = 0) gives d = 0, y = C.
+// On the tilted hyperplane h is affine, and the delay is linear: t_c - d = t_c - (e - v d).k gives
+//     d = e.k / (1 + v.k)      (1 + v.k >= 1 - |v| > 0),     y = C + e - v d,
+// so the cut of a uniformly moving body is an affine image of its rest shape: with v normal to k,
+// its projection along k is that of the body turned by asin|v| about k x v (Terrell's rotation).
 // A spacelike segment whose end events lie on opposite sides (h changes sign) crosses the view
 // surface exactly once, because h is concave along any segment (affine minus a norm); the crossing
 // is the root of a quadratic in the segment parameter, chosen on the past sheet.
@@ -38,6 +44,11 @@ struct ViewSurface {
     // in the cut's own frame (every other case).
     Vec3 shear{0, 0, 0};
     bool sheared() const { return shear.x != 0 || shear.y != 0 || shear.z != 0; }
+    // A Hyperplane's tilt: the orthographic camera's unit view direction k (the null hyperplane
+    // above); zero: the hyperplane t = t_c. Only uniform motion is cut on a tilted hyperplane
+    // (pipeline/scene.cpp checkSceneForModel refuses the rest).
+    Vec3 tilt{0, 0, 0};
+    bool tilted() const { return tilt.x != 0 || tilt.y != 0 || tilt.z != 0; }
 };
 
 // Side function h(E) above.
@@ -83,6 +94,10 @@ struct ViewAnchor {
     Vec3 y0;                 // Y0 (cone) or E (hyperplane), relative to the camera
     double S = 0;
     bool cone = true;
+    // On a tilted hyperplane: k / (1 + v.k), so that the point at s from the origin emits
+    // delta = s.lean before the origin does (its image s - v delta); zero otherwise.
+    Vec3 lean{0, 0, 0};
+    bool tilted = false;
     // A motion that is not uniform (worldline.h) is cut by crossWorldline on this view, its result
     // taken relative to origin and time_origin (the crossing of the origin's worldline).
     ViewSurface view;

@@ -86,6 +86,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -124,6 +125,12 @@ struct SliceSettings {
     // Two-sided distance bound to the exact apparent surface, light-seconds; 0 is vertex mode
     // (exact vertices, straight edges: what real-time engines do). 0 is the safe default.
     double tolerance = 0;
+    // Bound of the parametric error (each output point against the exact image of its own rest
+    // point: where a texture or an attribute lands), light-seconds; infinite: only the distance
+    // above is bounded. Where it is below `tolerance` the refinement bounds the parametric error
+    // by it everywhere; else it limits only the faces whose interior error is a slide within the
+    // face (mesh4d/refine/slide_bound.h), which the distance alone leaves coarse.
+    double attribute_tolerance = INFINITY;
     // Finest refinement, as pieces along an input edge: a piece is halved at most
     // 2 ceil(log2(max_segments)) times; an input triangle whose pieces would need more is counted in
     // ApparentMesh::limited_triangles. The rest clip splits at most to 1/max_segments of a triangle.

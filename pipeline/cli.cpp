@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pipeline/measure.h"
 #include "pipeline/raytrace.h"
 #include "pipeline/render.h"
 #include "pipeline/scene_fields.h"
@@ -164,6 +165,12 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "Largest distance between output and exact apparent surface (overrides the scene's): "
                            "T light-seconds; Fx, F times each object's bounding-box diagonal (default 1e-3x); "
                            "or 'vertex': exact vertices joined by straight edges, no refinement");
+    std::string attribute_tolerance_text;
+    render_cmd->add_option("--attribute-tolerance", attribute_tolerance_text,
+                           "Also bound the parametric error, each output point against the exact image of its own "
+                           "rest point (where a texture or an emission time lands): A light-seconds or Fx; default: "
+                           "none, only the distance --tolerance is bounded (faces that contain the velocity stay "
+                           "coarse inside)");
     render_cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
     std::string compress_text;
     render_cmd->add_option("--compress", compress_text,
@@ -235,6 +242,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                              "Rays per pixel, a square (1, 4, 9, ..., 256): the centres of a grid of equal strata, "
                              "averaged in linear light; 1: one ray through the pixel centre")
         ->capture_default_str();
+    raytrace_cmd->add_option("--gate", ts.gate,
+                             "The Vienna experiment's gated camera (finite, relativistic): exposures of light-path slices "
+                             "DEPTH deep (scene units), each showing the objects at its own time");
     raytrace_cmd->add_flag("--quiet,-q", ts.quiet, "No summary, no progress");
     addStageLimits(raytrace_cmd, &ts.stage);
     raytrace_cmd->add_option("--max-slab-memory", ts.max_slab_memory,
@@ -272,6 +282,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--video", fs.video_path, "Instead of the sheet: an H.264 MP4, the models side by side, every frame; needs ffmpeg");
     figure_cmd->add_option("--size", figure_size_text, "Panel size WxH (default 320x180)");
     figure_cmd->add_option("--threads", fs.threads, "Worker threads (0: all cores)")->capture_default_str();
+    figure_cmd->add_option("--gate", fs.gate, "As raytrace --gate: the gated camera's light-path slices, DEPTH deep");
     figure_cmd->add_flag("--quiet,-q", fs.quiet, "No summary, no progress");
     addStageLimits(figure_cmd, &fs.stage);
     figure_cmd->add_option("--max-slab-memory", fs.max_slab_memory,
@@ -311,6 +322,24 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         "per frame; "
         "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
         "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
+
+    // `measure`: what the pictures show, as numbers (pipeline/measure.h).
+    MeasureSettings mss;
+    std::string measure_model_text, measure_frames_text;
+    CLI::App* measure_cmd = app.add_subcommand(
+        "measure", "Measure the apparent shapes: extent, the rotation of faces about the view's up axis, outline roundness");
+    measure_cmd->add_option("scene", mss.stage.scene_path, "Scene file (JSON or glTF)")->required();
+    measure_cmd->add_option("--model", measure_model_text, "Model, comma list or all (default: the scene's model)");
+    measure_cmd->add_option("--frames", measure_frames_text, "A:B measures frames A..B-1 (default: 5 frames spread over the scene)");
+    measure_cmd->add_option("--marker", mss.marker, "An object whose apparent position is given relative to the others' outlines");
+    measure_cmd->add_flag("--quiet,-q", mss.quiet, "Only the table");
+    addStageLimits(measure_cmd, &mss.stage);
+    measure_cmd->footer(
+        "Prints per model, frame and object (tab-separated): apparent points, the image extent (orthographic: scene\n"
+        "units on the image plane; perspective: the tangent plane at distance 1), the lab bounding box, the rotation\n"
+        "about the view's up axis fitted to the projected areas of the faces (degrees; residual; scale, 1 for a pure\n"
+        "turn), the outline's largest radius (rim) and roundness (largest over smallest radius). With --marker NAME,\n"
+        "NAME's position as a fraction of each other object's rim radius. docs/PICTURES.md, \"Measuring a picture\".");
 
     // `merge`: the .glb of every model from the job-array shards in DIR/shards (pipeline/shards.h).
     MergeSettings ms;
@@ -450,6 +479,14 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         }
         return guarded([&] { return trade(trs, out, err); }, err);
     }
+    if (measure_cmd->parsed()) {
+        if (std::string message; !parseModelList(measure_model_text, &mss.stage, &message)) return usage(message);
+        if (!measure_frames_text.empty() && !parseFrames(measure_frames_text, &mss.stage.frame_from, &mss.stage.frame_to))
+            return usage("--frames: '" + measure_frames_text + "' is not A:B with 0 <= A < B");
+        mss.has_frames = !measure_frames_text.empty();
+        mss.stage.quiet = mss.quiet;
+        return guarded([&] { return measure(mss, out, err); }, err);
+    }
     if (merge_cmd->parsed()) {
         if (ms.max_output_bytes < 0) return usage("--max-output-bytes: must be positive, or 0 for no limit");
         return guarded([&] { return merge(ms, out, err); }, err);
@@ -482,6 +519,11 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                          "1e-3x, nor 'vertex'");
         rs.stage.has_tolerance = true;
     }
+    if (!attribute_tolerance_text.empty() &&
+        (!parseTolerance(attribute_tolerance_text, &rs.stage.attribute_tolerance, &rs.stage.attribute_tolerance_relative) ||
+         (rs.stage.attribute_tolerance <= 0 && rs.stage.attribute_tolerance_relative <= 0)))
+        return usage("--attribute-tolerance: '" + attribute_tolerance_text +
+                     "' is neither a positive number of light-seconds nor a fraction of each object's size such as 1e-3x");
     if (!frames_text.empty() && !parseFrames(frames_text, &rs.stage.frame_from, &rs.stage.frame_to))
         return usage("--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
     if (!compress_text.empty()) {

@@ -26,11 +26,13 @@ void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, 
         if (cull_view && !inCameraView(stage.scene.camera, mesh4d::apparentBound(world, view))) return;
         mesh4d::SliceSettings own = settings;
         own.tolerance = stage.tolerances[o];  // each object's (pipeline/stage.h)
+        if (o < stage.attribute_tolerances.size()) own.attribute_tolerance = stage.attribute_tolerances[o];
         frame->objects[o] = mesh4d::sliceWorld(world, view, own);
         if (light_factors) mesh4d::addLightFactors(world, view, &frame->objects[o]);
     });
     // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
-    reflections.append(view, settings, &frame->objects, &stage.tolerances, light_factors);
+    reflections.append(view, settings, &frame->objects, &stage.tolerances, light_factors,
+                       stage.attribute_tolerances.empty() ? nullptr : &stage.attribute_tolerances);
     // Step: the outputs' lengths in the scene's units (pipeline/units.h).
     frame->units.clear();
     if (const double u = unitsPerLightSecond(stage.scene.units); u != 1) {

@@ -125,6 +125,7 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
     info.camera.look_at = scene.camera.look_at * u;
     info.camera.up = scene.camera.up;
     info.camera.fov_deg = scene.camera.fov_deg;
+    if (scene.camera.orthographic()) info.camera.width = scene.camera.width;
     return info;
 }
 

@@ -27,6 +27,8 @@ std::vector<size_t> framedObjects(const Stage& stage) {
 
 Status frameObjects(const Stage& stage, const std::vector<Model>& models, const std::vector<long long>& frames,
                     int width, int height, CameraSpec* camera) {
+    if (camera->orthographic())
+        return Status::failure("--frame-objects: not with an orthographic camera (set camera.width and its position)");
     // Step: the unit directions from the camera to every point of the framed objects' shapes.
     const std::vector<size_t> framed = framedObjects(stage);
     const Vec3 eye = camera->position * unitsPerLightSecond(stage.scene.units);  // where the cut's outputs have it

@@ -27,7 +27,7 @@ constexpr double kMaxFramingFovDeg = 170;
 std::vector<size_t> framedObjects(const Stage& stage);
 
 // Sets camera->look_at (at the distance it had) and camera->fov_deg as above for a picture of
-// width x height. Failure (one line): nothing of the framed objects is seen in those frames, a
+// width x height (a perspective camera). Failure (one line): an orthographic camera; nothing of the framed objects is seen in those frames, a
 // point lies more than 85 degrees off the centre, or the view would need more than
 // kMaxFramingFovDeg; a frame the mesh pipeline refuses (its message).
 Status frameObjects(const Stage& stage, const std::vector<Model>& models, const std::vector<long long>& frames,

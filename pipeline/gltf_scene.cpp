@@ -215,6 +215,14 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
         c.up = up;
         const auto& cam = model.cameras[size_t(node.camera)];
         if (cam.type == "perspective") c.fov_deg = cam.perspective.yfov * 180.0 / mesh4d::kPi;
+        // An orthographic glTF camera: xmag is half the view's width (glTF 2.0 section 3.10.3).
+        if (cam.type == "orthographic") {
+            c.projection = CameraSpec::Projection::Orthographic;
+            c.width = 2 * cam.orthographic.xmag;
+            if (!(c.width > 0) || !std::isfinite(c.width))
+                r.fail("cameras[" + std::to_string(node.camera) + "].orthographic.xmag",
+                       "must be > 0 (half the view's width), got " + formatNumber(cam.orthographic.xmag));
+        }
     }
 
     // Step: the scene's extras: light, frames, model and tolerance, read as in a JSON scene.

@@ -288,7 +288,7 @@ MirrorReflections::MirrorReflections(const Scene& scene, const std::vector<Prepa
 
 void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                                std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances,
-                               bool light_factors) const {
+                               bool light_factors, const std::vector<double>* object_attribute_tolerances) const {
     // Step: each mirror as the camera sees it in this frame (its own cut, `exists` included):
     // what is seen through it is clipped to these triangles. Slivers give no pyramid.
     APPARENT_CHECK(objects->size(), >=, scene_objects_);  // the frame's scene objects come first
@@ -304,7 +304,7 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         }
     }
     if (camera_motion_.moving()) {
-        appendMoving(view, settings, objects, object_tolerances, seen, light_factors);
+        appendMoving(view, settings, objects, object_tolerances, seen, light_factors, object_attribute_tolerances);
         return;
     }
     for (const Target& target : targets_) {
@@ -317,6 +317,7 @@ void MirrorReflections::append(const mesh4d::ViewSurface& view, const mesh4d::Sl
         image.apex = reflectPoint(m, view.apex);
         mesh4d::SliceSettings own = settings;
         if (object_tolerances) own.tolerance = (*object_tolerances)[target.object];
+        if (object_attribute_tolerances) own.attribute_tolerance = (*object_attribute_tolerances)[target.object];
         mesh4d::ApparentMesh cut = mesh4d::sliceWorld(target.world, image, own);
         // The light factors of the path through the mirror: a mirror at rest changes no frequency,
         // so they are those seen by the image of the camera.
@@ -333,7 +334,7 @@ void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh
                                      std::vector<mesh4d::ApparentMesh>* objects,
                                      const std::vector<double>* object_tolerances,
                                      const std::vector<std::vector<std::array<Vec3, 3>>>& seen,
-                                     bool light_factors) const {
+                                     bool light_factors, const std::vector<double>* object_attribute_tolerances) const {
     const mesh4d::Kinematics kinematics = kinematicsOf(model_);
     const bool cone = view.kind == mesh4d::ViewKind::PastCone;
     // Step (cone models): the camera's lab event at this frame's camera time, and each mirror as
@@ -361,6 +362,7 @@ void MirrorReflections::appendMoving(const mesh4d::ViewSurface& view, const mesh
         }
         mesh4d::SliceSettings own = settings;
         if (object_tolerances) own.tolerance = (*object_tolerances)[target.object];
+        if (object_attribute_tolerances) own.attribute_tolerance = (*object_attribute_tolerances)[target.object];
         if (!cone) {
             // Step (hyperplane models): the mirror's plane at the view's time in the camera's frame:
             // x' with n.(lab position - point) = 0, lab position = A x' + b(t'), A symmetric: normal

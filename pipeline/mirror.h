@@ -94,11 +94,12 @@ public:
     // `objects` must already hold the frame's cut of every scene object, in scene order: each
     // mirror's cut is what its reflections are clipped to (empty cut: empty reflections).
     // `object_tolerances` (one per scene object), when given, replaces settings.tolerance for each
-    // object's reflections (the stage's per-object tolerances). `light_factors`: whether the
+    // object's reflections (the stage's per-object tolerances), and `object_attribute_tolerances`
+    // settings.attribute_tolerance (Stage::attribute_tolerances). `light_factors`: whether the
     // reflections get their Doppler factors and proper times (false: left empty, as no sink reads them).
     void append(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                 std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances = nullptr,
-                bool light_factors = true) const;
+                bool light_factors = true, const std::vector<double>* object_attribute_tolerances = nullptr) const;
     // Appends the reflections' names and colours (the object's, darkened by the mirror's
     // reflectance) to info->objects, and makes the mirrors themselves translucent so that the
     // reflections behind them show from the camera.
@@ -120,7 +121,8 @@ private:
     // append() for a moving camera (the class comment); `seen`: each mirror's cut triangles.
     void appendMoving(const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings,
                       std::vector<mesh4d::ApparentMesh>* objects, const std::vector<double>* object_tolerances,
-                      const std::vector<std::vector<std::array<mesh4d::Vec3, 3>>>& seen, bool light_factors) const;
+                      const std::vector<std::vector<std::array<mesh4d::Vec3, 3>>>& seen, bool light_factors,
+                      const std::vector<double>* object_attribute_tolerances) const;
     size_t scene_objects_ = 0;
     std::vector<Target> targets_;
 };

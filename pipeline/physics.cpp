@@ -100,11 +100,27 @@ static Status checkKindMotion(const PreparedObject& object, const mesh4d::Motion
     return checkMotionTolerance(object, model, scene, tolerance, first_frame, last_frame, field, k.what);
 }
 
+// What the orthographic camera's tilted hyperplane (physics.h viewAt) cuts: uniform motion in the
+// camera's frame, no mirror, and for finite a camera at rest (its light-speed models only).
+static Status checkOrthographicView(const ObjectSpec& s, const mesh4d::Motion& m, Model model, const Scene& scene) {
+    if (!scene.camera.orthographic() || !(model == Model::Finite || model == Model::Relativistic)) return Status::success();
+    const std::string field = scene.path + ": " + s.field_path;
+    const std::string why = " not modelled with camera.projection \"orthographic\" in model " + std::string(modelName(model)) +
+                            " (the orthographic camera sees uniform motion; use a perspective camera far away)";
+    if (s.mirror) return Status::failure(field + ".mirror: a mirror is" + why);
+    if (mesh4d::kindOf(m) != mesh4d::MotionKind::Uniform)
+        return Status::failure(field + ": a motion other than uniform (spin, acceleration, orbit or keyframed path) is" + why);
+    if (model == Model::Finite && cameraMotionOf(scene).moving())
+        return Status::failure(scene.path + ": camera.velocity: a moving camera is" + why);
+    return Status::success();
+}
+
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame) {
     const ObjectSpec& s = object.spec;
     const mesh4d::Motion m = motionOf(s, model);
     const mesh4d::MotionKind kind = mesh4d::kindOf(m);
+    if (Status o = checkOrthographicView(s, m, model, scene); !o.ok) return o;
     switch (kind) {
         case mesh4d::MotionKind::Uniform:
             return Status::success();
@@ -203,6 +219,14 @@ mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c) {
     // The hyperplane models may look back by the stage's light delay (scene camera.instant_delay).
     if (view.kind == mesh4d::ViewKind::Hyperplane) view.t_c -= scene.camera.instant_delay;
     view.apex = scene.camera.position;
+    // The orthographic camera of the light-speed models: the null hyperplane of the light that
+    // crosses its image plane at t_c (lightcone.h).
+    if (scene.camera.orthographic() && view.kind == mesh4d::ViewKind::PastCone) {
+        const mesh4d::Vec3 k = scene.camera.look_at - scene.camera.position;
+        view.kind = mesh4d::ViewKind::Hyperplane;
+        view.tilt = k / mesh4d::norm(k);
+        return view;
+    }
     // The finite model with a moving camera: light moves at c in the lab, so the cone is the lab's,
     // from the camera's lab position at t_c (its proper time, the lab's under Galilean kinematics),
     // and the outputs are sheared into the camera's frame, x' = x - v t (slice.h sliceWorld).

@@ -31,6 +31,8 @@ mesh4d::Motion motionOf(const ObjectSpec& object, Model model);
 // kMaxRapidity (gamma 1e15, as the gamma field). A keyframed path (ObjectSpec::keys): no spin or
 // acceleration with it, a camera at rest, the tolerance as above, and every vertex slower than light
 // over every segment (not checked for instant), refused with the vertex, its speed and the lab time.
+// With an orthographic camera (finite, relativistic): uniform motion only, no mirror, and for
+// finite a camera at rest.
 constexpr double kMaxRapidity = 35.2;
 Status checkObjectMotion(const PreparedObject& object, Model model, const Scene& scene, double tolerance,
                          long long first_frame, long long last_frame);
@@ -58,6 +60,9 @@ const mesh4d::RestMesh& restInCameraFrame(const mesh4d::RestMesh& rest, const me
 // (lightcone.h ViewSurface::shear). In the camera's frame the object moves at w = u - v, and the
 // light delay d of a point now at e relative to the camera solves |e - u d| = d (the lab's quadratic
 // with the lab velocity u), its image being e - w d: the same as cutting in the lab and shearing.
+// The orthographic camera (camera.projection) in finite and relativistic: the hyperplane tilted by
+// the unit view direction k, t = t_c - (x - C).k (lightcone.h); instant and contracted keep t = t_c
+// (their rays are parallel too, but light takes no time).
 mesh4d::ViewSurface viewAt(const Scene& scene, Model model, double t_c);
 mesh4d::ViewSurface viewForFrame(const Scene& scene, Model model, long long k);
 

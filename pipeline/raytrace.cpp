@@ -24,6 +24,8 @@
 #include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/seen.h"
 #include "mesh4d/motion/worldline.h"
+#include "pipeline/scene_fields.h"
+#include "pipeline/view_hints.h"
 #include "pipeline/worlds.h"
 
 namespace apparent {
@@ -365,6 +367,41 @@ Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int
     return d / mesh4d::norm(d);
 }
 
+Status checkGate(const Stage& stage, double depth) {
+    if (depth == 0) return Status::success();
+    if (!(depth > 0) || !std::isfinite(depth)) return Status::failure("--gate: the slice depth must be > 0");
+    for (const PreparedObject& o : stage.objects) {
+        const std::string field = stage.scene.path + ": " + o.spec.field_path;
+        if (o.spec.mirror) return Status::failure(field + ".mirror: --gate does not trace mirrors");
+        for (Model m : stage.models)
+            if (!mesh4d::isUniform(motionOf(o.spec, m)))
+                return Status::failure(field + ": --gate traces uniform motion only (this object spins, accelerates, "
+                                               "orbits or follows keys)");
+        mesh4d::EventBox box;
+        for (const Vec3& q : o.rest.positions) box.addPoint(q);
+        if (depth > box.diagonal())
+            return Status::failure("--gate: the slice depth " + formatNumber(depth) + " is more than " + field + "'s size (" +
+                                   formatNumber(box.diagonal()) + ", its bounding-box diagonal)");
+    }
+    return Status::success();
+}
+
+PixelRay pixelRay(const CameraSpec& camera, int width, int height, int px, int py) {
+    if (!camera.orthographic()) return {camera.position, pixelDirection(camera, width, height, px, py)};
+    // Step: the camera basis, as pixelDirection's.
+    const Vec3 f0 = camera.look_at - camera.position;
+    const Vec3 f = f0 / mesh4d::norm(f0);
+    const Vec3 r0 = mesh4d::cross(f, camera.up);
+    const Vec3 r = r0 / mesh4d::norm(r0);
+    const Vec3 u = mesh4d::cross(r, f);
+    // Step: the pixel centre on the image plane through the camera, width scene units wide.
+    const double half_w = 0.5 * camera.width;
+    const double half_h = half_w * double(height) / double(width);
+    const double x = (2 * (px + 0.5) / width - 1) * half_w;
+    const double y = (1 - 2 * (py + 0.5) / height) * half_h;
+    return {camera.position + x * r + y * u, f};
+}
+
 SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& objects,
                          const std::vector<MirrorPlane>& mirrors, Model model, long long first_frame,
                          long long last_frame, TracerOptions options)
@@ -376,6 +413,9 @@ SceneTracer::SceneTracer(const Scene& scene, const std::vector<PreparedObject>& 
     objects_.resize(objects.size());
     for (size_t i = 0; i < objects.size(); ++i) {
         colors_.push_back(objectBaseColor(objects, i));
+        double radius = 0;
+        for (const Vec3& q : objects[i].rest.positions) radius = std::max(radius, mesh4d::norm(q));
+        rest_radius_.push_back(radius);
         lab_motions_.push_back(motionOf(objects[i].spec, model));
         motions_.push_back(cutMotionOf(objects[i].spec, model, scene).motion);
         if (isSlabbed(lab_motions_.back())) continue;
@@ -519,9 +559,9 @@ void SceneTracer::buildWindow(long long k) {
     slab_counts_.most = std::max(slab_counts_.most, slabs);
 }
 
-SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const {
+SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirrors, double s_limit) const {
     Hit best;
-    double s_max = INFINITY;
+    double s_max = s_limit;
     // Objects in scene order; an object's chunks and traces (its time slabs, when scanned one by
     // one) latest first: the ray runs back in time, so the first slab it hits holds that object's
     // nearest hit, and the earlier slabs then fail their root box at once.
@@ -535,6 +575,26 @@ SceneTracer::Hit SceneTracer::nearest(const mesh4d::Ray4D& ray, bool skip_mirror
         }
     }
     return best;
+}
+
+SceneTracer::Hit SceneTracer::nearestGated(const mesh4d::ViewSurface& view, const PixelRay& pixel, double near,
+                                           double far) const {
+    // Slices j from the first that reaches `near` to the last that starts before `far`, nearest
+    // first; each traced within itself along its middle's lab instant.
+    const long long j0 = std::max(0LL, (long long)std::floor(near / gate_));
+    const long long j1 = (long long)std::floor(far / gate_);
+    for (long long j = j0; j <= j1; ++j) {
+        mesh4d::Ray4D ray;
+        ray.origin = {view.t_c - (double(j) + 0.5) * gate_, pixel.origin + pixel.direction * (double(j) * gate_)};
+        ray.direction = pixel.direction;
+        ray.along_cone = false;
+        Hit h = nearest(ray, false, gate_);
+        if (h.object >= 0) {
+            h.hit.s += double(j) * gate_;  // from the pixel's origin
+            return h;
+        }
+    }
+    return {};
 }
 
 std::array<double, 3> SceneTracer::shade(const Hit& h, mesh4d::ViewKind kind, const Vec3& receiver,
@@ -603,6 +663,19 @@ TracedFrame SceneTracer::traceFrame(long long k, int out_width, int out_height, 
     frame.reflected.assign(size_t(out_width) * size_t(out_height), -1);
     const mesh4d::ViewSurface view = viewForFrame(scene_, model_, k);
     const mesh4d::CameraMotion camera = cameraMotionOf(scene_);
+    // The gated camera (setGate) in the light-speed models: the objects' extent along the rays,
+    // from their apparent bounds widened by the slices' stepped delay (|u| DEPTH at most).
+    const bool gated = gate_ > 0 && (model_ == Model::Finite || model_ == Model::Relativistic);
+    std::vector<mesh4d::BoundingSphere> gate_bounds;
+    if (gated) {
+        for (size_t i = 0; i < motions_.size(); ++i) {
+            mesh4d::World4D w;
+            w.motion = motions_[i];
+            w.shape_radius = rest_radius_[i];
+            gate_bounds.push_back(mesh4d::apparentBound(w, view));
+            gate_bounds.back().radius += gate_;
+        }
+    }
     // Step: the samples: the pixels of the picture s times as wide and high (s x s per pixel, their
     // centres the strata's), summed per pixel in linear light; row py of it is pass py mod s.
     const int s = samples_side_, width = out_width * s, height = out_height * s;
@@ -611,19 +684,51 @@ TracedFrame SceneTracer::traceFrame(long long k, int out_width, int out_height, 
         for (int px = 0; px < width; ++px) {
             const size_t idx = size_t(py / s) * size_t(out_width) + size_t(px / s);
             const bool centre = px % s == s / 2 && py % s == s / 2;  // the sample the object buffers hold
+            if (gated) {
+                // Step: the gated primary ray: the first slice with a hit (nearestGated).
+                const PixelRay pixel = pixelRay(scene_.camera, width, height, px, py);
+                // The part of the ray within the widened bounds: where a slice may hit.
+                double near = INFINITY, far = -INFINITY;
+                for (const mesh4d::BoundingSphere& b : gate_bounds) {
+                    const Vec3 oc = b.center - pixel.origin;
+                    const double mid = mesh4d::dot(oc, pixel.direction);
+                    const double half2 = b.radius * b.radius - (mesh4d::norm2(oc) - mid * mid);
+                    if (!(half2 >= 0)) continue;
+                    near = std::min(near, mid - std::sqrt(half2));
+                    far = std::max(far, mid + std::sqrt(half2));
+                }
+                const Hit hit = far >= 0 ? nearestGated(view, pixel, near, far) : Hit{};
+                std::array<double, 3> color = kBackground;
+                if (hit.object >= 0) {
+                    if (centre) frame.object[idx] = hit.object;
+                    color = shade(hit, mesh4d::ViewKind::PastCone, pixel.origin);
+                }
+                for (size_t c = 0; c < 3; ++c) sum[idx][c] += color[c];
+                continue;
+            }
             // Step: the primary ray, back along the past cone (or along t = t_c). A sheared view
             // (finite, moving camera) is traced in the lab from the camera's lab position, along
             // the lab direction the pixel's camera-frame direction sees (camera_frame.h).
+            // An orthographic camera's ray leaves its pixel on the image plane along the view
+            // direction, at t_c: along the tilted hyperplane's null rays in finite and relativistic.
             mesh4d::Ray4D ray;
             ray.origin = {view.t_c, view.apex};
-            ray.direction = pixelDirection(scene_.camera, width, height, px, py);
+            if (scene_.camera.orthographic()) {
+                const PixelRay p = pixelRay(scene_.camera, width, height, px, py);
+                ray.origin = {view.t_c, p.origin};
+                ray.direction = p.direction;
+            } else {
+                ray.direction = pixelDirection(scene_.camera, width, height, px, py);
+            }
             if (view.sheared()) ray.direction = mesh4d::labRayDirection(camera, ray.direction);
-            ray.along_cone = view.kind == mesh4d::ViewKind::PastCone;
+            const bool tilted = view.kind == mesh4d::ViewKind::Hyperplane && view.tilted();
+            ray.along_cone = view.kind == mesh4d::ViewKind::PastCone || tilted;
+            const mesh4d::ViewKind light_kind = tilted ? mesh4d::ViewKind::PastCone : view.kind;
             const Hit hit = nearest(ray, false);
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
                 if (centre) frame.object[idx] = hit.object;
-                color = shade(hit, view.kind, ray.origin.x, view.shear);
+                color = shade(hit, light_kind, ray.origin.x, view.shear);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
                     // Step: one bounce: restart at the hit event with the reflected direction,
@@ -681,6 +786,13 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
         if (Status s = checkTracedMotions(stage, settings.max_slab_memory); !s.ok) {
             error = s.message;
             code = kExitBadInput;
+        } else if (Status g = checkGate(stage, settings.gate); !g.ok) {
+            error = g.message;
+            code = kExitBadInput;
+        } else if (settings.gate > 0 && !settings.quiet) {
+            for (Model m : stage.models)
+                if (m == Model::Instant || m == Model::Contracted)
+                    err << "warning: --gate: model " << modelName(m) << " has no light delay to gate; drawn ungated\n";
         }
     }
     const bool video = !settings.video_path.empty();
@@ -711,6 +823,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
         SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1, options);
         tracer.setShadeDoppler(settings.shade_doppler);
         tracer.setSamplesSide(side);
+        tracer.setGate(settings.gate);
         if (sender) {
             // Step (rank r > 0): trace this rank's frames and send each picture, until rank 0 says END.
             for (long long k = first + split.part; k < last_excl && !group.stopRequested(); k += split.parts) {
@@ -727,6 +840,9 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
             err << "error: " << message << "\n";
             return c;
         };
+        // Hints instead of blanks: an object no frame shows in the camera's view (view_hints.h).
+        if (!settings.quiet)
+            for (const std::string& w : outOfViewWarnings(stage, model, frameRange(first, last_excl))) err << "warning: " << w << "\n";
         // Step: the folder, then the static worlds once per model, then every frame.
         const std::string dir = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
         if (settings.write_png) {
@@ -903,6 +1019,7 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
             std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1, options));
         tracers.back()->setShadeDoppler(settings.shade_doppler);
         tracers.back()->setSamplesSide(side);
+        tracers.back()->setGate(settings.gate);
     }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     // Video frame k: the title band with its time, then every model's panel.
@@ -981,6 +1098,13 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         if (Status s = checkTracedMotions(stage, memory); !s.ok) {
             error = s.message;
             code = kExitBadInput;
+        } else if (Status g = checkGate(stage, settings.gate); !g.ok) {
+            error = g.message;
+            code = kExitBadInput;
+        } else if (settings.gate > 0 && !settings.quiet) {
+            for (Model m : stage.models)
+                if (m == Model::Instant || m == Model::Contracted)
+                    err << "warning: --gate: model " << modelName(m) << " has no light delay to gate; drawn ungated\n";
         }
     }
     const Scene& scene = stage.scene;
@@ -1059,11 +1183,15 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     // Panel i = r * columns + c: row r's model at column c's frame.
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
+        // Hints instead of an empty row: an object no column shows in the camera's view (view_hints.h).
+        if (!settings.quiet && !fg.sender)
+            for (const std::string& w : outOfViewWarnings(stage, rows[r], frames)) err << "warning: " << w << "\n";
         TracerOptions options;
         options.window_prisms = slabPrismLimit(settings.max_slab_memory);
         SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi, options);
         tracer.setShadeDoppler(settings.shade_doppler);
         tracer.setSamplesSide(side);
+        tracer.setGate(settings.gate);
         for (size_t c = 0; c < frames.size(); ++c) {
             auto make = [&](TraceProgress* p) {
                 if (p) p->setLabel(std::string(modelName(rows[r])) + " frame " + std::to_string(frames[c]));

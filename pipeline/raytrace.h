@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <iosfwd>
 #include <memory>
@@ -38,6 +39,15 @@ namespace apparent {
 // Unit direction of the ray from the camera through the centre of pixel (px, py) of a
 // width x height image (row 0 at the top); fov_deg is the vertical field of view.
 mesh4d::Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int py);
+
+// The ray of pixel (px, py): from the camera position along pixelDirection (perspective), or, for
+// an orthographic camera, from the pixel centre on the image plane through the camera (normal to
+// the view direction, camera.width wide, the height in the picture's proportion) along the view
+// direction.
+struct PixelRay {
+    mesh4d::Vec3 origin, direction;
+};
+PixelRay pixelRay(const CameraSpec& camera, int width, int height, int px, int py);
 
 // One traced frame: the picture and, per pixel (row-major), the index of the object the ray hits
 // first (-1: none) and of the object seen in it by a mirror bounce (-1: none or not a mirror).
@@ -107,6 +117,23 @@ public:
     // below it (side even).
     void setSamplesSide(int side) { samples_side_ = std::max(1, side); }
 
+    // --gate DEPTH (0: off), the gated camera of the Vienna experiment (Hornof et al. 2025), in
+    // finite and relativistic: the picture is composed of exposures of the light-path slices
+    // [j DEPTH, (j + 1) DEPTH) along each ray from the camera (its image plane, orthographic), each
+    // showing the scene as it is at the slice's middle time t_j = t_c - (j + 1/2) DEPTH: the ray
+    // runs through slice j along that lab instant (ray4d.h, along t = const), and the nearest slice
+    // with a hit wins (nearer slices hide farther ones, as along the continuous light path). The
+    // delay steps by DEPTH at each slice boundary, so a surface crossed by boundaries steps there
+    // (the photographs' doubled edges). A surface that moves within itself (its normal across the
+    // velocity u) is hit in its own slice: its picture goes to the ungated one as DEPTH goes to 0
+    // (an edge within u DEPTH / 2; tests/gated_test.cpp). A face moving through the rays is not:
+    // a ray advancing across it at lateral rate a meets it in its own slice only where the
+    // continuous crossing lies within DEPTH a / (2 (|u| + a)) of the slice's middle, so it shows as
+    // stripes covering a / (|u| + a) of it at every DEPTH (the trailing face of a cube; edge-on, an
+    // orthographic camera's side faces vanish). Preconditions (raytrace and figure check them:
+    // checkGate): uniform motion, no mirror, DEPTH at most the objects' size.
+    void setGate(double depth) { gate_ = depth; }
+
     // The traced worlds of the current window: one per object, or one per time slab of an object
     // whose motion is not uniform.
     size_t worldCount() const;
@@ -151,7 +178,10 @@ private:
                                                 bool slabs) const;
     // The window of time slabs that holds frame k.
     void buildWindow(long long k);
-    Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors) const;
+    Hit nearest(const mesh4d::Ray4D& ray, bool skip_mirrors, double s_limit = INFINITY) const;
+    // The gated primary ray of a pixel (setGate): the first slice's hit, slices from depth `near`
+    // to `far` (the objects' extent along the rays this frame).
+    Hit nearestGated(const mesh4d::ViewSurface& view, const PixelRay& pixel, double near, double far) const;
     // `receiver`: where the light goes from the hit (the camera or the mirror point), for D, and its
     // velocity (light_factors.h dopplerFactor: nonzero only for finite with a moving camera).
     std::array<double, 3> shade(const Hit& h, mesh4d::ViewKind kind, const mesh4d::Vec3& receiver,
@@ -181,6 +211,8 @@ private:
     SlabCounts slab_counts_;
     bool shade_doppler_ = false;
     int samples_side_ = 1;
+    double gate_ = 0;
+    std::vector<double> rest_radius_;  // per object, max |q| of its rest points (the gate's slice range)
 };
 
 // --samples N: the side of the square grid of N samples per pixel (N = side x side, side 1..16);
@@ -201,6 +233,7 @@ struct RaytraceSettings {
     int threads = 0;
     bool quiet = false;            // no summary, no progress
     bool shade_doppler = false;    // --shade doppler (SceneTracer::setShadeDoppler)
+    double gate = 0;               // --gate DEPTH (SceneTracer::setGate; 0: off)
     long long max_slab_memory = kDefaultSlabMemory;  // --max-slab-memory: one window's time slabs
     int samples = kDefaultRaytraceSamples;  // --samples: rays per pixel, a square (SceneTracer::setSamplesSide)
 };
@@ -209,6 +242,11 @@ struct RaytraceSettings {
 // Progress on stderr (trace_progress.h) unless quiet. Exit codes as `render`; --video with several
 // models or without ffmpeg in PATH: 2.
 int raytrace(const RaytraceSettings& settings, std::ostream& log, std::ostream& err);
+
+// --gate's needs: every object moving uniformly, no mirror, the depth > 0 and at most the
+// smallest object's size (the histories are extruded over the span the ungated view sees, padded
+// by each object's light-crossing time). One line naming the problem otherwise.
+Status checkGate(const Stage& stage, double depth);
 
 constexpr int kMaxFigureColumns = 64;
 
@@ -231,6 +269,7 @@ struct FigureSettings {
     int threads = 0;
     bool quiet = false;
     bool shade_doppler = false;    // --shade doppler, as raytrace's (SceneTracer::setShadeDoppler)
+    double gate = 0;               // --gate DEPTH, as raytrace's (SceneTracer::setGate)
     long long max_slab_memory = kDefaultSlabMemory;  // --max-slab-memory, as raytrace's (the video's models share it)
 };
 

@@ -12,6 +12,7 @@
 #include "pipeline/json_limits.h"
 #include "pipeline/mesh_check.h"
 #include "pipeline/shards.h"
+#include "pipeline/view_hints.h"
 
 namespace apparent {
 
@@ -35,6 +36,11 @@ std::string outputSettings(const RenderSettings& s, const Stage& stage) {
     for (const std::string& f : s.formats) os << " " << f;
     os << "\nframes " << stage.first << " " << stage.last_excl << "\ntolerance " << stage.scene.tolerance;
     for (double t : stage.tolerances) os << " " << t;
+    if (std::any_of(stage.attribute_tolerances.begin(), stage.attribute_tolerances.end(),
+                    [](double t) { return t < INFINITY; })) {
+        os << "\nattribute-tolerance";
+        for (double t : stage.attribute_tolerances) os << " " << t;
+    }
     const GlbOptions& g = s.glb;
     os << "\nglb " << g.draco << " " << g.position_bits << " " << g.normal_bits << " " << g.meshopt << " "
        << g.meshopt_bits << " " << g.doppler << " " << g.proper_time << " " << g.shade_doppler << "\ncull "
@@ -240,6 +246,10 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
             if (!settings.quiet)
                 for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
         }
+        // Hints instead of blanks: an object no frame shows in the camera's view (view_hints.h).
+        if (!settings.quiet && !settings.sharded)
+            for (const std::string& w : outOfViewWarnings(stage, model, frameRange(stage.first, stage.last_excl)))
+                err << "warning: " << w << "\n";
         if (result.limited_triangles > 0 && !settings.quiet)
             err << "warning: " << name << ": " << result.limited_triangles
                 << " triangle-frames reached the refinement limit of " << result.max_segments

@@ -26,6 +26,14 @@ struct CameraSpec {
     mesh4d::Vec3 look_at{0, 0, -1};
     mesh4d::Vec3 up{0, 1, 0};
     double fov_deg = 60;
+    // The projection: perspective (rays from `position`, fov_deg) or orthographic (parallel rays
+    // along the view direction k from the image plane through `position` normal to k, `width`
+    // scene units wide). The orthographic camera of the light-speed models (finite, relativistic)
+    // sees the light that crosses that plane at the frame's time (mesh4d/lightcone.h, the tilted
+    // hyperplane): the far-field view of Terrell's and Penrose's analyses.
+    enum class Projection { Perspective, Orthographic } projection = Projection::Perspective;
+    double width = 0;  // orthographic: the view's width in scene units (> 0); 0 unset
+    bool orthographic() const { return projection == Projection::Orthographic; }
     // Seconds by which the hyperplane models (instant, contracted) look into the past: they view
     // t = t_k - instant_delay, so that with the light delay of the stage centre they show the
     // objects where the light-speed models do (Black et al. 2007 advance their camera so).

@@ -386,14 +386,35 @@ void readObjectFields(FieldReader& r, const json& j, const std::string& path, co
 // Step: the scene-level sections.
 
 void readCamera(FieldReader& r, const json& cam, const std::string& path, CameraSpec* camera) {
-    r.checkKeys(cam, path, {"position", "look_at", "up", "fov_deg", "instant_delay", "velocity"});
+    r.checkKeys(cam, path, {"position", "look_at", "up", "fov_deg", "instant_delay", "velocity", "projection", "width"});
     r.number(cam, "instant_delay", path, &camera->instant_delay);
     r.vec3(cam, "velocity", path, &camera->velocity);
     r.vec3(cam, "position", path, &camera->position);
     r.vec3(cam, "look_at", path, &camera->look_at);
     r.vec3(cam, "up", path, &camera->up);
     r.number(cam, "fov_deg", path, &camera->fov_deg);
+    readProjection(r, cam, path, camera);
     checkCamera(r, path, *camera);
+}
+
+void readProjection(FieldReader& r, const json& cam, const std::string& path, CameraSpec* camera) {
+    std::string projection = "perspective";
+    r.string(cam, "projection", path, &projection);
+    if (r.failed()) return;
+    if (projection != "perspective" && projection != "orthographic")
+        return r.fail(path + ".projection", "expected \"perspective\" (the default) or \"orthographic\", got \"" + projection + "\"");
+    camera->projection = projection == "orthographic" ? CameraSpec::Projection::Orthographic : CameraSpec::Projection::Perspective;
+    if (camera->orthographic() && !cam.contains("width"))
+        return r.fail(path + ".width", "missing: an orthographic camera needs the view's width (scene units > 0)");
+    r.number(cam, "width", path, &camera->width);
+    if (r.failed()) return;
+    if (camera->orthographic() && !(camera->width > 0))
+        return r.fail(path + ".width", "must be > 0 (the orthographic view's width in scene units), got " + formatNumber(camera->width));
+    if (!camera->orthographic() && cam.contains("width"))
+        r.warn(path + ".width", "ignored: the view's width is read only with \"projection\": \"orthographic\" "
+                                "(a perspective camera's view is set by fov_deg)");
+    if (camera->orthographic() && cam.contains("fov_deg"))
+        r.warn(path + ".fov_deg", "ignored: an orthographic camera's view is set by width");
 }
 
 void checkCamera(FieldReader& r, const std::string& path, const CameraSpec& c) {

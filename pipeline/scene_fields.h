@@ -111,6 +111,9 @@ void readObjectFields(FieldReader& r, const nlohmann::json& j, const std::string
 // readCamera reads the JSON camera object at `path`; checkCamera checks a camera from any source.
 void readCamera(FieldReader& r, const nlohmann::json& cam, const std::string& path, CameraSpec* camera);
 void checkCamera(FieldReader& r, const std::string& path, const CameraSpec& camera);
+// camera.projection ("perspective", the default, or "orthographic") and camera.width (required and
+// > 0 for orthographic; a warning with perspective), from the JSON camera object at `path`.
+void readProjection(FieldReader& r, const nlohmann::json& cam, const std::string& path, CameraSpec* camera);
 // The light's default direction follows camera.up: read the camera first.
 void readLight(FieldReader& r, const nlohmann::json& parent, const std::string& top, Scene* scene);
 void readFrames(FieldReader& r, const nlohmann::json& parent, const std::string& top, FrameSpec* frames);

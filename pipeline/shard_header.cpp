@@ -93,6 +93,11 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
         v->z = in->real();
     }
     c.fov_deg = in->real();
+    if (c.fov_deg < 0) {  // an orthographic camera, written as minus its width
+        c.width = -c.fov_deg;
+        c.fov_deg = 60;
+        if (in->ok && !(std::isfinite(c.width))) fail("camera.width", formatNumber(c.width) + " is not finite");
+    }
     const mesh4d::Vec3 dir = c.look_at - c.position;
     if (in->ok && !finite({c.position.x, c.position.y, c.position.z, c.look_at.x, c.look_at.y, c.look_at.z, c.up.x,
                            c.up.y, c.up.z}))
@@ -139,7 +144,8 @@ void putShardSequence(std::string* out, const SequenceInfo& info, const GlbOptio
     }
     for (const mesh4d::Vec3& v : {info.camera.position, info.camera.look_at, info.camera.up})
         for (double c : {v.x, v.y, v.z}) putDouble(out, c);
-    putDouble(out, info.camera.fov_deg);
+    // An orthographic camera as minus its width, in the field of the field of view (which is > 0).
+    putDouble(out, info.camera.orthographic() ? -info.camera.width : info.camera.fov_deg);
     for (int v : {int(o.draco), o.position_bits, o.normal_bits, int(o.meshopt), o.meshopt_bits, int(o.doppler),
                   int(o.proper_time), int(o.shade_doppler)})
         putU64(out, uint64_t(int64_t(v)));

@@ -106,6 +106,15 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
             return fail(scene.path + ": tolerance: every object has size 0, so a tolerance relative to the size is 0; "
                         "give one in light-seconds (--tolerance T) or 'vertex'");
     }
+    // Step: each object's attribute tolerance (--attribute-tolerance), as its tolerance is made.
+    stage->attribute_tolerances.assign(stage->objects.size(), INFINITY);
+    for (size_t i = 0; i < sizes.size(); ++i) {
+        if (options.attribute_tolerance_relative > 0)
+            stage->attribute_tolerances[i] = std::max(options.attribute_tolerance_relative * (sizes[i] > 0 ? sizes[i] : largest),
+                                                      kToleranceFloorRelative * largest);
+        else if (options.attribute_tolerance > 0)
+            stage->attribute_tolerances[i] = options.attribute_tolerance * lightSecondsPer(scene.units);  // in the scene's units
+    }
     const double floor = kToleranceFloorRelative * largest;
     if (scene.tolerance_relative > 0 && scene.tolerance_relative < kToleranceFloorRelative)
         return fail(scene.path + ": tolerance (or --tolerance): " + formatNumber(scene.tolerance_relative) +

@@ -37,6 +37,11 @@ struct StageOptions {
     bool has_tolerance = false;        // --tolerance given: overrides the scene's
     double tolerance = 1e-3;           // light-seconds; 0: vertex mode (with tolerance_relative 0)
     double tolerance_relative = 0;     // > 0: --tolerance Fx, this fraction of each object's size
+    // --attribute-tolerance: the bound of the parametric error (mesh4d/slice.h
+    // SliceSettings::attribute_tolerance), light-seconds or (relative > 0) a fraction of each
+    // object's size; both 0: none (only the distance is bounded).
+    double attribute_tolerance = 0;
+    double attribute_tolerance_relative = 0;
     long long frame_from = 0;          // --frames A:B, global frame numbers, B exclusive
     long long frame_to = -1;           // -1: to the last frame of the scene
     long long max_frames = kDefaultMaxFrames;  // --max-frames: scenes with more frames are refused
@@ -55,6 +60,8 @@ struct Stage {
     // Each object's tolerance, light-seconds (0: vertex mode): the scene's absolute one, or its
     // relative one times the object's bounding-box diagonal (docs/ACCURACY.md).
     std::vector<double> tolerances;
+    // Each object's attribute tolerance, light-seconds (INFINITY: none; StageOptions).
+    std::vector<double> attribute_tolerances;
     std::vector<MirrorPlane> mirrors;  // the planes of the mirror objects (findMirrors)
 };
 

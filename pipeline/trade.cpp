@@ -215,7 +215,9 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
     // The instant model cuts at one lab time, where every motion of worldline.h places the rest
     // mesh affinely (one object time s for all its points); the contracted model too for uniform
     // motion, but not for the others (s then varies over the body).
-    if (model == Model::Instant || (model == Model::Contracted && !any_beyond)) {
+    // The orthographic camera's tilted hyperplane (physics.h viewAt) maps uniform motion, the
+    // only motion it takes, affinely too.
+    if (model == Model::Instant || (model == Model::Contracted && !any_beyond) || scene.camera.orthographic()) {
         out << "The " << modelName(model) << " model cuts the histories with a hyperplane: the map from the rest "
             << "mesh is affine, so vertex mode is exact (error 0) and no tolerance or subdivision changes it.\n";
         return kExitOk;

@@ -90,6 +90,18 @@ std::vector<mesh4d::World4D> takeWorlds(std::vector<PreparedObject>* objects, Mo
 }
 
 bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound) {
+    if (camera.orthographic()) {
+        // The orthographic view: a cylinder along the view axis from the image plane on, as wide
+        // as the view's corners in a frame no narrower than 1:kCullAspect (portrait).
+        const Vec3 f0 = camera.look_at - camera.position;
+        const Vec3 f = f0 / mesh4d::norm(f0);
+        const Vec3 d = bound.center - camera.position;
+        const double depth = mesh4d::dot(d, f);
+        const double off_axis = mesh4d::norm(d - f * depth);
+        const double half_w = 0.5 * camera.width, half_h = half_w * kCullAspect;
+        if (!(depth >= -bound.radius) && std::isfinite(depth)) return false;  // behind the image plane
+        return !(off_axis - bound.radius > std::sqrt(half_w * half_w + half_h * half_h));
+    }
     const Vec3 d = bound.center - camera.position;
     const double dist = mesh4d::norm(d);
     if (!(dist > bound.radius)) return true;  // the camera is inside the sphere (or NaN: keep it)

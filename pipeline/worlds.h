@@ -43,6 +43,8 @@ std::vector<mesh4d::World4D> takeWorlds(std::vector<PreparedObject>* objects, Mo
 // around the view axis whose half-angle reaches the corners of a kCullAspect:1 frame with the
 // camera's vertical field of view (wider than 16:9 and 21:9 screens; a 32:9 screen at the same
 // vertical field of view could miss parts at its far left and right).
+// An orthographic camera's view (camera.width wide): a cylinder along the view axis in front of
+// its image plane, reaching the corners of a frame up to kCullAspect times as tall as wide.
 constexpr double kCullAspect = 2.4;
 bool inCameraView(const CameraSpec& camera, const mesh4d::BoundingSphere& bound);
 

@@ -135,7 +135,7 @@ TEST(Defaults, ToleranceFollowsTheObjectsSize) {
 // budget and 0 removes it.
 TEST(Defaults, SizeEstimateStopsTheRunBeforeItWrites) {
     Folder dir;
-    // 10 000 frames of the box at 1e-4 of its size: about 2.4 GiB by the first frames' count, more
+    // 10 000 frames of the box at 1e-5 of its size: more by the first frames' count, more
     // than the default budget of 2 GiB.
     const std::string big = writeBoxScene(dir, "big.json", 1);
     {
@@ -144,7 +144,7 @@ TEST(Defaults, SizeEstimateStopsTheRunBeforeItWrites) {
         text.replace(text.find(R"("fps": 10 })"), 11, R"("fps": 2500 })");
         std::ofstream(big) << text;
     }
-    CommandResult r = apparentRun({"render", big, "--out", (dir / "big").string(), "--tolerance", "1e-4x"});
+    CommandResult r = apparentRun({"render", big, "--out", (dir / "big").string(), "--tolerance", "1e-5x"});
     EXPECT_EQ(r.code, 3) << r.err;
     EXPECT_EQ(lines(r.err), 1u) << r.err;
     for (const char* way : {"--tolerance", "--frames", "--compress", "--max-output-bytes", "nothing was written",
@@ -196,7 +196,7 @@ TEST(Messages, MeshGivenAsTheScene) {
 TEST(Messages, UnknownCommandSuggestsTheNearest) {
     CommandResult r = apparentRun({"rendr", "scene.json"});
     EXPECT_EQ(r.code, 2);
-    EXPECT_EQ(r.err, "error: unknown command 'rendr'; did you mean render? (commands: render, raytrace, figure, trade, merge; "
+    EXPECT_EQ(r.err, "error: unknown command 'rendr'; did you mean render? (commands: render, raytrace, figure, trade, measure, merge; "
                      "run 'apparent --help')\n");
     r = apparentRun({"fgure"});
     EXPECT_NE(r.err.find("did you mean figure?"), std::string::npos) << r.err;

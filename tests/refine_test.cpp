@@ -65,6 +65,7 @@ TEST(Refine, ErrorWithinToleranceBothDirections) {
         for (double rel : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6}) {
             SliceSettings s;
             s.tolerance = rel * size;
+            s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
             s.max_segments = 4096;
             const World4D& wt = rel >= 1e-4 ? w : w_face;
             const ApparentMesh out = testmesh::sliceAbsolute(wt, view, s);
@@ -74,6 +75,13 @@ TEST(Refine, ErrorWithinToleranceBothDirections) {
             if (rel >= 1e-3 || &wt == &w_face) {  // the backward search is quadratic in the triangle count
                 const double backward = exactToOutput(wt, view, out, rel >= 1e-5 ? 6 : 3);
                 EXPECT_LE(backward, s.tolerance) << "T = " << rel << " x size";
+            }
+            if (rel >= 1e-4) {  // the default, no attribute tolerance: the geometric distance within T
+                SliceSettings g;
+                g.tolerance = s.tolerance;
+                g.max_segments = 4096;
+                const ApparentMesh geo = sliceWorld(w, view, g);
+                EXPECT_LE(measure::geometricTwoSided(w, view, geo), g.tolerance) << "T = " << rel << " x size, geometric";
             }
         }
     }
@@ -463,6 +471,7 @@ TEST(Refine, MeasuredErrorIsBetweenHalfTheToleranceAndIt) {
         for (double rel : {1e-2, 3e-3, 1e-3, 3e-4, 1e-4}) {
             SliceSettings s;
             s.tolerance = rel * sc.size;
+            s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
             if (vertex_error <= s.tolerance) continue;
             const ApparentMesh out = sliceWorld(w, sc.view, s);
             const double measured = measure::twoSided(w, sc.view, out, 6);
@@ -485,6 +494,7 @@ TEST(Refine, FewerTrianglesThanUniformSubdivisionAtEqualError) {
         const World4D w = extrude(sc.mesh, sc.motion, -100, 100, false, false);
         SliceSettings s;
         s.tolerance = uniform_error;
+        s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
         const ApparentMesh adaptive = sliceWorld(w, sc.view, s);
         EXPECT_LE(measure::twoSided(w, sc.view, adaptive, 6), uniform_error);
         EXPECT_LT(double(adaptive.triangles.size()), 0.8 * double(uniform.triangles.size())) << "level " << level;
@@ -557,6 +567,7 @@ TEST(Refine, EdgeOnThreeTrianglesIsHalvedInAll) {
     SliceSettings s;
     s.max_segments = 4096;
     s.tolerance = 1e-3 * restSize(fins);
+    s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
     const ApparentMesh out = sliceWorld(w, {ViewKind::PastCone, 2.0, {0, 0, 0}}, s);
     ASSERT_GT(out.triangles.size(), 30u);
     // Whether rest point p lies on the segment from a to b (to rounding).
@@ -1096,6 +1107,7 @@ TEST(Refine, TemplatedPiecesStayWatertightAndWithinTolerance) {
     for (double T : {1e-3, 3e-4, 1e-4}) {
         SliceSettings s;
         s.tolerance = T;
+        s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
         const ApparentMesh out = testmesh::sliceAbsolute(w, view, s);
         ASSERT_GT(out.triangles.size(), 50u);
         const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
@@ -1125,6 +1137,7 @@ TEST(Refine, KeptTemplatesNearTheCameraStayClosedAndWithinTolerance) {
         SliceSettings s;
         s.max_segments = 4096;
         s.tolerance = rel * sc.size;
+        s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
         const ApparentMesh out = testmesh::sliceAbsolute(w, sc.view, s);
         ASSERT_GT(out.triangles.size(), 1000u);
         const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
@@ -1154,6 +1167,7 @@ TEST(Refine, FormMetricBisectionStaysClosedAndWithinTolerance) {
         SliceSettings s;
         s.max_segments = 4096;
         s.tolerance = rel * 2.0;
+        s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
         const ApparentMesh out = testmesh::sliceAbsolute(w, view, s);
         ASSERT_GT(out.triangles.size(), 1000u);
         const apparent::Topology t = apparent::analyzeTopology(out.positions, out.triangles);
@@ -1197,6 +1211,7 @@ TEST(Refine, FarPlateNoMoreTrianglesThanUniformAtEqualError) {
         }
         SliceSettings s;
         s.tolerance = error;
+        s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
         for (double t_c : frames) {
             const ViewSurface view{ViewKind::PastCone, t_c, {0, 0, 0}};
             const ApparentMesh a = sliceWorld(w, view, s);
@@ -1263,6 +1278,7 @@ TEST(Refine, NearCameraBisectionBytesPinned) {
         SliceSettings s;
         s.max_segments = 4096;
         s.tolerance = 1e-4 * c.size;
+        s.attribute_tolerance = s.tolerance;  // the parametric bound (slice.h): this test's subject
         const ApparentMesh m = sliceWorld(w, {ViewKind::PastCone, c.distance, {0, 0, 0}}, s);
         EXPECT_EQ(m.triangles.size(), c.triangles) << "distance " << c.distance;
         EXPECT_EQ(fnv(m), c.hash) << "distance " << c.distance << ": the refined output's bytes changed";

@@ -201,10 +201,30 @@ void writeBuffers(gltfjson::Text* t, const GlbBuilder& b) {
 }
 
 // Clip planes in light-seconds: 1e-3 of, and 10 times, `far`.
+// An orthographic camera (scene camera.projection): xmag and ymag are half the view's width and
+// height, the height for a 16:9 screen (the raytracer's default picture), znear 0 at the image plane.
 void writeCamera(gltfjson::Text* t, const SequenceInfo& info, double far) {
     t->key("cameras");
     t->open('[');
     t->open('{');
+    if (info.camera.orthographic()) {
+        t->key("orthographic");
+        t->open('{');
+        t->key("xmag");
+        t->value(0.5 * info.camera.width);
+        t->key("ymag");
+        t->value(0.5 * info.camera.width * 9.0 / 16.0);
+        t->key("zfar");
+        t->value(10 * far);
+        t->key("znear");
+        t->value(0.0);
+        t->close('}');
+        t->key("type");
+        t->value("orthographic");
+        t->close('}');
+        t->close(']');
+        return;
+    }
     t->key("perspective");
     t->open('{');
     const double yfov = info.camera.fov_deg * mesh4d::kPi / 180.0;

@@ -200,7 +200,16 @@ async function loadModel(m) {
   m.camera = new THREE.PerspectiveCamera(DEFAULT_FOV, 1, 0.01, 1000);
   m.cameraObject = findFileCamera(m);
   m.cameraSource = m.cameraObject ? 'file' : 'default';
-  if (m.cameraObject) {
+  if (m.cameraObject?.isOrthographicCamera) {
+    // An orthographic file camera (scene camera.projection): xmag is half the view's width; the
+    // height follows each viewport's aspect.
+    const ci = m.gltf.parser.associations.get(m.cameraObject)?.cameras;
+    const cdef = ci !== undefined ? json.cameras[ci] : (json.cameras || []).find((c) => c.type === 'orthographic');
+    m.orthoHalfWidth = Number(cdef?.orthographic?.xmag) || m.cameraObject.right;
+    m.camera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1000);
+    m.cameraNote = `file camera "${json.nodes.find((n) => n.camera !== undefined)?.name || ''}", ` +
+      `orthographic, width ${(2 * m.orthoHalfWidth).toPrecision(4)}`;
+  } else if (m.cameraObject) {
     const ci = m.gltf.parser.associations.get(m.cameraObject)?.cameras;
     const cdef = ci !== undefined ? json.cameras[ci] : (json.cameras || []).find((c) => c.type === 'perspective');
     m.fileAspect = Number(cdef?.perspective?.aspectRatio) || null;
@@ -428,12 +437,17 @@ function render() {
       cam.near = m.cameraObject.near;
       cam.far = m.cameraObject.far;
     }
-    // A viewport narrower than the file camera's aspect widens the vertical field so that the file's whole
-    // horizontal field stays in view.
-    const base = THREE.MathUtils.degToRad(m.baseFov || DEFAULT_FOV);
-    const widen = Math.max(1, aspect / (r.width / r.height));
-    cam.fov = THREE.MathUtils.radToDeg(2 * Math.atan(Math.tan(base / 2) * widen / zoom));
-    cam.aspect = r.width / r.height;
+    if (cam.isOrthographicCamera) {
+      const hw = m.orthoHalfWidth / zoom, hh = hw * r.height / r.width;
+      cam.left = -hw; cam.right = hw; cam.top = hh; cam.bottom = -hh;
+    } else {
+      // A viewport narrower than the file camera's aspect widens the vertical field so that the file's whole
+      // horizontal field stays in view.
+      const base = THREE.MathUtils.degToRad(m.baseFov || DEFAULT_FOV);
+      const widen = Math.max(1, aspect / (r.width / r.height));
+      cam.fov = THREE.MathUtils.radToDeg(2 * Math.atan(Math.tan(base / 2) * widen / zoom));
+      cam.aspect = r.width / r.height;
+    }
     cam.updateProjectionMatrix();
     renderer.render(m.scene, cam);
   }

@@ -16,6 +16,7 @@
 #include "mesh4d/refine/chord_error.h"
 #include "mesh4d/exact_side.h"
 #include "mesh4d/refine/form_bisect.h"
+#include "mesh4d/refine/slide_bound.h"
 #include "mesh4d/robust.h"
 #include "mesh4d/refine/tessellate.h"
 #include "mesh4d/motion/worldline.h"
@@ -65,6 +66,7 @@ using VTerms = PointTerms;
 
 struct REdge {
     uint32_t mid;   // midpoint vertex once made, else kUnset
+    uint32_t on;    // a record past the mesh's edges: the mesh edge it is a part of, else kUnset (an inner edge)
     double len;     // EdgeBubble::length once known, else NaN
     double c;       // EdgeBubble::c, known with len
     double xm_mid;  // EdgeBubble::xm_mid, known with len (the midpoint's |x|_M, for its split)
@@ -127,6 +129,10 @@ struct RefineScratch {
     std::vector<uint32_t> coarse;  // every record marked kCoarse, as marked (repeats, stale ones included)
     std::vector<uint32_t> candidates, failing;  // refineFrame's first pass: triangles its corners' bound fails, and its a-priori bound
     std::vector<double> quadratic;              // per mesh triangle in `failing`: its bound's quadratic part (kBoundFailed)
+    // Faces containing the velocity (slide_bound.h), asked per frame, made once each: per mesh
+    // triangle whether its plane contains v, per mesh edge whether it is inner to such a face
+    // (-1 not yet asked).
+    std::vector<int8_t> tri_slides, edge_inner;
     std::vector<std::array<uint32_t, 3>> local;
 
     size_t bytes() const {
@@ -182,6 +188,8 @@ struct FrameBuilder {
         r_edges.clear();
         scratch_members.clear();
         scratch.stack.clear();
+        scratch.tri_slides.clear();
+        scratch.edge_inner.clear();
         out.origin = anchor.origin;
         out.time_origin = anchor.time_origin;
         bound_speed = boundSpeed();
@@ -612,6 +620,17 @@ struct FrameBuilder {
     // is; tighter than its third-order term near the camera (the form's slack there is second
     // order along the line of sight), so a piece it passes needs no further split.
     bool passesByForm(const Vec3& a, const Vec3& b, const Vec3& c) const;
+    // Faces containing the velocity (slide_bound.h): on this frame (uniform motion, no real cap,
+    // outputs not displaced), whether mesh triangle f's plane contains v, whether mesh edge e of
+    // f is inner to its face (shared with exactly one triangle, coplanar, whose plane contains v
+    // too), and whether piece id of such a triangle passes on its rim: each of its sides on a rim
+    // edge within the tolerance (edge records e; a side's mesh edge is its record below r_ne,
+    // else REdge::on).
+    bool r_slide = false;
+    bool slides(uint32_t f);
+    bool innerEdge(uint32_t e, uint32_t f);
+    bool rimPasses(uint32_t f, const uint32_t v[3], const uint32_t rec[3], const double c[3], const double len[3],
+                   const double xm_mid[3]);
 
     // Whether piece id's forced template (its form made by coarseForm(id, s, true)) makes at
     // most kForceRatio times the triangles its bisection is expected to: n^2 against its
@@ -776,7 +795,8 @@ struct FrameBuilder {
 //   - The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
 //     may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box)
 //     and at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms
-//     remain. The margin covers the rounding of these bounds (a few ulps of the largest term).
+//     remain, and on the tilted one (lightcone.h) the least and greatest (x - C).k over the box take
+//     the distances' place. The margin covers the rounding of these bounds (a few ulps of the largest term).
 //   - Model only what the cut requires: on a hyperplane, or at rest, the map from the rest surface
 //     to the apparent one is affine, so straight edges are exact and nothing is refined (at rest
 //     under a shear it is not: chord_error.h displacedChordError).

@@ -189,16 +189,30 @@ bool chunkMayShow(const World4D& world, const ViewSurface& view, const TriangleC
                              std::max(norm(b.lo), norm(b.hi));
         return 1e-12 * scale;
     };
+    // On a tilted hyperplane the least and greatest (x - C).k over the box take the distances' place.
+    auto along = [&](const EventBox& b, double* nearest, double* farthest) {
+        double lo = 0, hi = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double a0 = (b.lo[k] - view.apex[k]) * view.tilt[k], a1 = (b.hi[k] - view.apex[k]) * view.tilt[k];
+            lo += std::min(a0, a1);
+            hi += std::max(a0, a1);
+        }
+        *nearest = lo;
+        *farthest = hi;
+    };
+    const bool tilted = view.kind == ViewKind::Hyperplane && view.tilted();
     if (world.cap_a_real) {
         const EventBox& a = c.cap[0];
         double nearest = 0, farthest = 0;
         if (cone) distances(a, &nearest, &farthest);
+        if (tilted) along(a, &nearest, &farthest);
         if ((view.t_c - a.t_lo) - nearest < -margin(a)) return false;  // none has begun existing
     }
     if (world.cap_b_real) {
         const EventBox& b = c.cap[1];
         double nearest = 0, farthest = 0;
         if (cone) distances(b, &nearest, &farthest);
+        if (tilted) along(b, &nearest, &farthest);
         if ((view.t_c - b.t_hi) - farthest > margin(b)) return false;  // all have ended existing
     }
     return true;
@@ -282,7 +296,11 @@ Vec3 shearedOrigin(const ViewSurface& view, const ViewAnchor& anchor) {
 
 }  // namespace
 
-ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& settings) {
+ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const SliceSettings& given) {
+    // Step: an attribute tolerance below the distance's bounds the parametric error everywhere.
+    SliceSettings settings = given;
+    if (settings.tolerance > 0 && settings.attribute_tolerance < settings.tolerance)
+        settings.tolerance = settings.attribute_tolerance;
     ApparentMesh out = sliceUnsheared(world, view, settings);
     if (!view.sheared()) return out;
     // Step: the Galilean map into the output frame, origin and local parts apart.
@@ -302,6 +320,8 @@ BoundingSphere apparentBound(const World4D& world, const ViewSurface& view) {
     if (!isUniform(world.motion)) return {anchor.origin, INFINITY};  // no bound derived: never culled
     const double b = world.motion.beta;
     double stretch = view.kind == ViewKind::PastCone ? (1 + b) / world.motion.one_minus_beta2 : 1.0;
+    // A tilted hyperplane: local points s - v delta with |delta| = |s.k| / (1 + v.k) <= R / (1 - b).
+    if (view.kind == ViewKind::Hyperplane && view.tilted()) stretch = 1 / (1 - b);
     // Sheared, local points are s - w delta, w = u - shear, with |s| <= R and |delta| <= R / (1 - b).
     if (view.sheared() && view.kind == ViewKind::PastCone)
         stretch = 1 + norm(world.motion.velocity - view.shear) * (1 + b) / world.motion.one_minus_beta2;

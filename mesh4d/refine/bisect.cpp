@@ -14,8 +14,11 @@ void FrameBuilder::splitEdge(uint32_t id, int c, const uint32_t* members, uint32
     const uint32_t hi = std::max(rt[id].v[c], rt[id].v[kSucc[c]]);
     uint32_t pending = kUnset, pending_o = 0;  // an inner edge (m, pending_o) waiting for its pair
     const uint32_t lo_rec = uint32_t(r_edges.size()), hi_rec = lo_rec + 1;
-    r_edges.resize(r_edges.size() + 2 + n, REdge{kUnset, NAN, NAN, NAN});
+    const uint32_t parent = rt[id].edge[c];
+    const uint32_t on = parent < r_ne ? parent : r_edge_data[parent].on;  // the halves lie on the parent's mesh edge
+    r_edges.resize(r_edges.size() + 2 + n, REdge{kUnset, kUnset, NAN, NAN, NAN});
     r_edge_data = r_edges.data();
+    r_edge_data[lo_rec].on = r_edge_data[hi_rec].on = on;
     reserveTris(n);
     uint32_t lo_first = kUnset, lo_prev = kUnset, hi_first = kUnset, hi_prev = kUnset;
     auto link = [&](uint32_t slot, uint32_t& first, uint32_t& prev) {
@@ -82,6 +85,8 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
         }
         // A piece back on the stack unchanged (its record is reset when it is halved).
         if (state == kPassed || state == kCoarse) continue;
+        // A face containing v (slide_bound.h): judged on its rim, never filled by a template.
+        const bool slide = r_slide && slides(rt[id].src);
         if (state == kUnknown || state == kBoundFailed) {
             const uint32_t v[3] = {rt[id].v[0], rt[id].v[1], rt[id].v[2]};
             const REdge* e[3] = {&edgeOf(id, 0), &edgeOf(id, 1), &edgeOf(id, 2)};
@@ -96,6 +101,14 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
                     rt[id].state = kPassed;
                     continue;
                 }
+                if (slide && ce.bound <= settings.attribute_tolerance) {
+                    const double len[3] = {e[0]->len, e[1]->len, e[2]->len};
+                    const double xm_mid[3] = {e[0]->xm_mid, e[1]->xm_mid, e[2]->xm_mid};
+                    if (rimPasses(rt[id].src, v, rt[id].edge, c, len, xm_mid)) {
+                        rt[id].state = kPassed;
+                        continue;
+                    }
+                }
                 // The bubbles pass but the third-order term does not.
                 if (ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s)) {
                     rt[id].state = kPassed;
@@ -104,7 +117,7 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
                 quadratic = ce.quadratic;
             }
             // (The form is worth making only for a piece that needs a level of kMinLevel or more).
-            if (r_templates && quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
+            if (r_templates && !slide && quadratic >= 0.5 * kMinLevel * kMinLevel * settings.tolerance &&
                 coarseForm(id, std::array<Vec3, 3>{k0.s, k1.s, k2.s}.data(), false)) {
                 rt[id].state = kCoarse;
                 scratch.coarse.push_back(id);
@@ -126,7 +139,9 @@ void FrameBuilder::drain(std::vector<uint32_t>& stack) {
             }
             const int split = splitLongestPath(id, stack);
             again = split == kSplitOther;
-            if (split == kSplitBlocked) {
+            if (split == kSplitBlocked && slide) {
+                again = splitLongestPath(id, stack, false) == kSplitOther;
+            } else if (split == kSplitBlocked) {
                 // The split would halve a piece a template fills.
                 const uint32_t* v = rt[id].v;
                 const Vec3 s[3] = {r_term_data[v[0]].s, r_term_data[v[1]].s, r_term_data[v[2]].s};

@@ -71,6 +71,8 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
     }
     // (The corners' bounds have the factor |u|: a displaced bound takes the full one.)
     const bool displaced = view.sheared() || settings.displacement >= 0;
+    // Faces containing v are judged on their rim (slide_bound.h), unless their parametric error is bounded too.
+    r_slide = !caps && !displaced && world.motion.beta > 0 && settings.attribute_tolerance > settings.tolerance;
     // The corners' spread (chord_error.h cornerSpread).
     std::vector<double>& spread = scratch.spread;
     const bool edge_spread = !displaced && !live;
@@ -131,12 +133,12 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
     }
     // Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits).
     const bool keep_edges = !candidates.empty() && 4 * candidates.size() >= ne;
-    if (keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
+    if (keep_edges) r_edges.assign(ne, REdge{kUnset, kUnset, NAN, NAN, NAN});
     REdge* const kept = keep_edges ? r_edges.data() : nullptr;
     const VTerms* const terms = r_terms.data();
     for (uint32_t f : candidates) {
         const auto& te = world.triangle_edges[f];
-        double c[3];
+        double c[3], len[3], xm_mid[3];
         for (int k = 0; k < 3; ++k) {
             const uint32_t e = te[k];
             if (kept) {
@@ -146,9 +148,14 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
                     storeEdge(re, edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]));
                 }
                 c[k] = re.c;
+                len[k] = re.len;
+                xm_mid[k] = re.xm_mid;
             } else {
                 const Edge& ed = world.edges[e];
-                c[k] = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]).c;
+                const EdgeBubble eb = edgeBubble(world.motion, r_now, terms[ed.lo], terms[ed.hi]);
+                c[k] = eb.c;
+                len[k] = eb.length;
+                xm_mid[k] = eb.xm_mid;
             }
         }
         // The corners' terms in place (the drain's pointsBound on the same record).
@@ -165,7 +172,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
             ce = pointsBound(c, k0, k1, k2);
         }
         const double bound = ce.bound;
-        if (bound > settings.tolerance &&
+        if (bound > settings.tolerance && !(r_slide && bound <= settings.attribute_tolerance && slides(f) && rimPasses(f, t.data(), te.data(), c, len, xm_mid)) &&
             !(ce.quadratic <= settings.tolerance && passesByForm(k0.s, k1.s, k2.s))) {
             // (Room for every mesh triangle's, made when the first one fails: set for the failing only.)
             if (failing.empty() && scratch.quadratic.size() < r_nt) scratch.quadratic.resize(r_nt);
@@ -191,7 +198,7 @@ void FrameBuilder::refineFrame(const std::vector<uint8_t>* live) {
 
     // Step: split until every piece passes.
     if (!failing.empty()) {
-        if (!keep_edges) r_edges.assign(ne, REdge{kUnset, NAN, NAN, NAN});
+        if (!keep_edges) r_edges.assign(ne, REdge{kUnset, kUnset, NAN, NAN, NAN});
         reserveTris(r_nt + expect);  // records made on first touch (ensureBase)
         r_tri_size = r_nt;
         r_edges.reserve(ne + 2 * expect);

@@ -1,7 +1,8 @@
 // The geometric distance between a straight output triangle and the exact apparent surface patch
 // it stands for, bounded from the parametric bound (chord_error.h) and the direction of the
 // motion; uniform motion, the past cone. Stated and tested (tests/geometric_bound_test.cpp); the
-// refinement does not use it yet (it bounds the parametric error, chord_error.h).
+// refinement uses only its exact case, faces that contain the velocity (slide_bound.h), and
+// bounds every other piece's parametric error (chord_error.h).
 //
 // Setting (chord_error.h). In the local coordinates the exact map is F(s) = s - v delta(s) over
 // the shape triangle (s the shape offset, affine in the rest point), and the straight triangle T

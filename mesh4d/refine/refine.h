@@ -23,6 +23,11 @@
 //  6. cut/slice.cpp       vertex mode (no refinement): each triangle whole or clipped to the span
 //     cut/rest_clip.cpp   (clipWhole); objects at rest on the past cone with a real cap and a
 //                         tolerance: restPlan refines only where a cap's curve crosses a triangle.
+// What T bounds: the geometric distance (SliceSettings::tolerance). A piece whose face contains
+// the velocity is judged on its rim alone (slide.cpp, bound in slide_bound.h: inside such a face
+// the error is a slide within it), in the first pass and the drain, never filled by a template;
+// every other piece by the parametric bound, which is also the geometric one up to the factors of
+// geometric_bound.h (not used yet). SliceSettings::attribute_tolerance at T turns the rim rule off.
 // Non-uniform motions refine per triangle on grids instead (worldline_refine.h, bound in
 // worldline_bound.h; keyframed paths split at their keys first, key_split.h); measure.h measures
 // any output against the exact surface; subdivide.h is the uniform subdivision the benchmarks

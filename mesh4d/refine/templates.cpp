@@ -206,6 +206,7 @@ bool FrameBuilder::templateLeaves() {
     auto levelPass = [&](uint32_t id) {
         RTri& t = rt[id];
         if (t.state == kFailed) {  // the depth limit stopped it: its template is what it gets
+            if (r_slide && slides(t.src)) return;  // a face containing v: no form (slide_bound.h)
             const Vec3 s[3] = {r_terms[t.v[0]].s, r_terms[t.v[1]].s, r_terms[t.v[2]].s};
             coarseForm(id, s, true);
         } else if (t.state != kCoarse) {

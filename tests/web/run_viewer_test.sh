@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Renders the default scene (plain, Draco, meshopt, and Draco with --shade doppler) and checks each with three.js in headless
 # Chromium (tests/web/viewer_test.js); then the 20480-face icosphere in vertex mode with --compress meshopt, whose frames
-# are morph targets (exporters/gltf.h), against its plain export (--plain: the shown frame's bounds as three.js draws it).
+# are morph targets (exporters/gltf.h), against its plain export (--plain: the shown frame's bounds as three.js draws it);
+# then the Vienna cube through its orthographic camera (docs/PICTURES.md, "The orthographic camera").
 # Usage: run_viewer_test.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
 apparent=$1
@@ -30,3 +31,6 @@ sphere="$src/data/scenes/trade/sphere20480.json"
 "$apparent" render "$sphere" --out "$out/sphere-meshopt" --model relativistic --compress meshopt --quiet
 grep -q '"targets"' "$out/sphere-meshopt/relativistic.glb" || { echo "run_viewer_test: $sphere: no morph targets" >&2; exit 1; }
 node tests/web/viewer_test.js "$out/sphere-meshopt" --models relativistic --frames 0,1,2,20,39 --shot-time 4 --plain "$out/sphere-plain"
+"$apparent" render "$src/data/scenes/vienna_cube.json" --out "$out/ortho" --model relativistic --quiet
+grep -q '"orthographic"' "$out/ortho/relativistic.glb" || { echo "run_viewer_test: vienna_cube: no orthographic camera" >&2; exit 1; }
+node tests/web/viewer_test.js "$out/ortho" --models relativistic --frames 0,10,20,39 --shot-time 2
