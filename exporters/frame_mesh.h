@@ -14,6 +14,9 @@ struct ExportFrame {
     long long index = 0;                        // global frame number (file names use it)
     double t_c = 0;                             // camera time of the frame
     std::vector<mesh4d::ApparentMesh> objects;  // one per scene object, in scene order
+    // The units of the positions when they are not light-seconds (a scene in metres: "metres,
+    // seconds, ...", pipeline/units.h), for the PLY and OBJ comments; empty: light-seconds.
+    std::string units;
 
     size_t triangleCount() const {
         size_t n = 0;
@@ -42,7 +45,8 @@ struct ExportCamera {
 
 struct SequenceInfo {
     std::string model;            // instant, finite, relativistic, contracted
-    double tolerance = 0;         // requested tolerance (light-seconds)
+    double tolerance = 0;         // requested tolerance (in the scene's units of length)
+    std::string units = "light-seconds, seconds, c = 1";  // the scene's (pipeline/units.h unitsText)
     double fps = 1;
     std::string scene_path;
     std::vector<ExportObject> objects;  // parallel to ExportFrame::objects

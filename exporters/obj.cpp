@@ -96,6 +96,7 @@ void serializeObj(const ExportFrame& frame, std::string* out) {
     }
     std::string& all = *out;
     all = "# " + std::to_string(vertices) + " vertices, " + std::to_string(faces) + " faces\n";
+    if (!frame.units.empty()) all += "# units: " + frame.units + "\n";
     all.reserve(all.size() + size);
     for (size_t i = 0; i < blocks.size(); ++i) all += texts[i];
 }

@@ -84,6 +84,7 @@ void serializePly(const ExportFrame& frame, std::string* out) {
     const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
                                "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n" +
                                (factors ? "property double doppler\nproperty double proper_time\n" : "") +
+                               (frame.units.empty() ? "" : "comment units: " + frame.units + "\n") +
                                "element face " + std::to_string(faces) +
                                "\nproperty list uchar int vertex_indices\nend_header\n";
     std::string& bytes = *out;

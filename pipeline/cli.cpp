@@ -68,6 +68,29 @@ bool parseSize(const std::string& text, int* width, int* height) {
     }
 }
 
+// --samples N refused: N is not a square of 1..16.
+std::string samplesProblem(int samples) {
+    return "--samples: " + std::to_string(samples) + " is not a square from 1 to 256 (1, 4, 9, 16, ...)";
+}
+
+// --row-labels, --column-labels: a comma list; "\," is a comma within a label.
+std::vector<std::string> splitLabels(const std::string& text) {
+    std::vector<std::string> labels;
+    if (text.empty()) return labels;
+    labels.emplace_back();
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (text[i] == '\\' && i + 1 < text.size() && text[i + 1] == ',') {
+            labels.back() += ',';
+            ++i;
+        } else if (text[i] == ',') {
+            labels.emplace_back();
+        } else {
+            labels.back() += text[i];
+        }
+    }
+    return labels;
+}
+
 // --model: a comma list of models ("relativistic", "finite,instant", "all"), for every command
 // that takes one; false with the message for an unknown name.
 bool parseModelList(const std::string& text, StageOptions* options, std::string* error) {
@@ -215,6 +238,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     raytrace_cmd->add_option("--shade", trace_shade_text,
                              "plain (default) or doppler: colours shifted by the Doppler factor and scaled by the "
                              "searchlight factor, as render --shade doppler bakes them");
+    raytrace_cmd->add_option("--samples", ts.samples,
+                             "Rays per pixel, a square (1, 4, 9, ..., 256): the centres of a grid of equal strata, "
+                             "averaged in linear light; 1: one ray through the pixel centre")
+        ->capture_default_str();
     raytrace_cmd->add_option("--gate", ts.gate,
                              "The Vienna experiment's gated camera (finite, relativistic): exposures of light-path slices "
                              "DEPTH deep (scene units), each showing the objects at its own time");
@@ -236,8 +263,20 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     figure_cmd->add_option("--times", figure_times_text, "Comma list of camera times, one column each (nearest frame)");
     figure_cmd->add_option("--frames", figure_frames_text, "A:B: columns are frames A..B-1 (with --video: the video's frames)");
     figure_cmd->add_option("--models", figure_models_text, "Comma list of models, one row each (default instant,finite,relativistic)");
-    figure_cmd->add_option("--title", fs.title, "A title line above the sheet");
+    figure_cmd->add_option("--title", fs.title, "A title above the sheet (wrapped onto more lines when wider than the sheet)");
     figure_cmd->add_flag("--no-labels", figure_no_labels, "No model names and camera times around the panels");
+    std::string figure_row_labels_text, figure_column_labels_text;
+    figure_cmd->add_option("--row-labels", figure_row_labels_text,
+                           "Comma list, one label per model instead of its name (the rows; with --video the columns); "
+                           "\\, for a comma in a label");
+    figure_cmd->add_option("--column-labels", figure_column_labels_text,
+                           "Comma list, one label per column instead of its camera time (not with --video)");
+    figure_cmd->add_flag("--frame-objects", fs.frame_objects,
+                         "Aim the camera and fit its field of view to the moving objects' apparent shapes over the "
+                         "figure's frames and models (every object when none moves)");
+    figure_cmd->add_option("--samples", fs.samples,
+                           "Rays per pixel, a square, as raytrace's (default " + std::to_string(kDefaultFigureSamples) +
+                               "; with --video " + std::to_string(kDefaultRaytraceSamples) + ")");
     std::string figure_shade_text;
     figure_cmd->add_option("--shade", figure_shade_text, "plain (default) or doppler, as raytrace --shade");
     figure_cmd->add_option("--video", fs.video_path, "Instead of the sheet: an H.264 MP4, the models side by side, every frame; needs ffmpeg");
@@ -358,6 +397,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (!trace_shade_text.empty() && trace_shade_text != "plain" && trace_shade_text != "doppler")
             return usage("--shade: unknown shading '" + trace_shade_text + "' (plain, doppler)");
         ts.shade_doppler = trace_shade_text == "doppler";
+        if (samplesSide(ts.samples) == 0) return usage(samplesProblem(ts.samples));
         if (ts.threads < 0 || ts.threads > kMaxThreads) return usage(threadsProblem(ts.threads));
         if (ts.stage.max_frames <= 0) return usage("--max-frames: must be positive");
         if (ts.max_slab_memory < kTraceBytesPerPrism)
@@ -399,6 +439,14 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         if (figure_models.all_models) fs.models = {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted};
         for (Model m : figure_models.models) fs.models.push_back(m);
         fs.labels = !figure_no_labels;
+        if (fs.samples != 0 && samplesSide(fs.samples) == 0) return usage(samplesProblem(fs.samples));
+        if (figure_cmd->count("--samples") > 0 && fs.samples == 0) return usage(samplesProblem(0));
+        fs.row_labels = splitLabels(figure_row_labels_text);
+        fs.column_labels = splitLabels(figure_column_labels_text);
+        if (figure_no_labels && !(fs.row_labels.empty() && fs.column_labels.empty()))
+            return usage("--no-labels: not with --row-labels or --column-labels");
+        if (!fs.video_path.empty() && !fs.column_labels.empty())
+            return usage("--column-labels: not with --video (its columns are the models: --row-labels)");
         if (!figure_shade_text.empty() && figure_shade_text != "plain" && figure_shade_text != "doppler")
             return usage("--shade: unknown shading '" + figure_shade_text + "' (plain, doppler)");
         fs.shade_doppler = figure_shade_text == "doppler";

@@ -33,6 +33,15 @@ void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, 
     // Mirrors add their retarded reflections as further objects (pipeline/mirror.h).
     reflections.append(view, settings, &frame->objects, &stage.tolerances, light_factors,
                        stage.attribute_tolerances.empty() ? nullptr : &stage.attribute_tolerances);
+    // Step: the outputs' lengths in the scene's units (pipeline/units.h).
+    frame->units.clear();
+    if (const double u = unitsPerLightSecond(stage.scene.units); u != 1) {
+        frame->units = unitsText(stage.scene.units);
+        for (mesh4d::ApparentMesh& m : frame->objects) {
+            m.origin = m.origin * u;
+            for (mesh4d::Vec3& p : m.positions) p = p * u;
+        }
+    }
 }
 
 struct FrameCutter::Histories {

@@ -110,7 +110,9 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
     const Scene& scene = stage.scene;
     SequenceInfo info;
     info.model = modelName(model);
-    info.tolerance = scene.tolerance;
+    const double u = unitsPerLightSecond(scene.units);  // the outputs' lengths (cutFrameAt)
+    info.tolerance = scene.tolerance * u;
+    info.units = unitsText(scene.units);
     info.fps = scene.frames.fps;
     info.scene_path = scene.path;
     for (size_t i = 0; i < stage.objects.size(); ++i) {
@@ -119,8 +121,8 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
         o.base_color = objectBaseColor(stage.objects, i);
         info.objects.push_back(o);
     }
-    info.camera.position = scene.camera.position;
-    info.camera.look_at = scene.camera.look_at;
+    info.camera.position = scene.camera.position * u;
+    info.camera.look_at = scene.camera.look_at * u;
     info.camera.up = scene.camera.up;
     info.camera.fov_deg = scene.camera.fov_deg;
     if (scene.camera.orthographic()) info.camera.width = scene.camera.width;

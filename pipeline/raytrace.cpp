@@ -20,6 +20,7 @@
 #include "mesh4d/box.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/distribute.h"
+#include "pipeline/framing.h"
 #include "mesh4d/motion/kinds.h"
 #include "mesh4d/motion/seen.h"
 #include "mesh4d/motion/worldline.h"
@@ -344,6 +345,12 @@ Status checkTracedMotions(const Stage& stage, long long slab_memory) {
 
 }  // namespace
 
+int samplesSide(int samples) {
+    for (int side = 1; side <= 16; ++side)
+        if (side * side == samples) return side;
+    return 0;
+}
+
 Vec3 pixelDirection(const CameraSpec& camera, int width, int height, int px, int py) {
     // Step: the camera basis: forward f, right r, up u (right-handed, u = r x f).
     const Vec3 f0 = camera.look_at - camera.position;
@@ -645,15 +652,15 @@ std::array<double, 3> SceneTracer::shadeReflected(const Hit& h, const mesh4d::Vi
                      reflectDirection(m, camera.velocity));
 }
 
-TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TraceProgress* progress) {
+TracedFrame SceneTracer::traceFrame(long long k, int out_width, int out_height, TraceProgress* progress) {
     if (!planner_->objects().empty() && (k < window_first_ || k > window_last_)) {
         buildWindow(k);
         listTraces();
     }
     TracedFrame frame;
-    frame.image = RgbImage(width, height);
-    frame.object.assign(size_t(width) * size_t(height), -1);
-    frame.reflected.assign(size_t(width) * size_t(height), -1);
+    frame.image = RgbImage(out_width, out_height);
+    frame.object.assign(size_t(out_width) * size_t(out_height), -1);
+    frame.reflected.assign(size_t(out_width) * size_t(out_height), -1);
     const mesh4d::ViewSurface view = viewForFrame(scene_, model_, k);
     const mesh4d::CameraMotion camera = cameraMotionOf(scene_);
     // The gated camera (setGate) in the light-speed models: the objects' extent along the rays,
@@ -669,9 +676,14 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
             gate_bounds.back().radius += gate_;
         }
     }
-    tbb::parallel_for(0, height, [&](int py) {
+    // Step: the samples: the pixels of the picture s times as wide and high (s x s per pixel, their
+    // centres the strata's), summed per pixel in linear light; row py of it is pass py mod s.
+    const int s = samples_side_, width = out_width * s, height = out_height * s;
+    std::vector<std::array<double, 3>> sum(size_t(out_width) * size_t(out_height), {0, 0, 0});
+    const auto trace_row = [&](int py) {
         for (int px = 0; px < width; ++px) {
-            const size_t idx = size_t(py) * size_t(width) + size_t(px);
+            const size_t idx = size_t(py / s) * size_t(out_width) + size_t(px / s);
+            const bool centre = px % s == s / 2 && py % s == s / 2;  // the sample the object buffers hold
             if (gated) {
                 // Step: the gated primary ray: the first slice with a hit (nearestGated).
                 const PixelRay pixel = pixelRay(scene_.camera, width, height, px, py);
@@ -688,11 +700,10 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                 const Hit hit = far >= 0 ? nearestGated(view, pixel, near, far) : Hit{};
                 std::array<double, 3> color = kBackground;
                 if (hit.object >= 0) {
-                    frame.object[idx] = hit.object;
+                    if (centre) frame.object[idx] = hit.object;
                     color = shade(hit, mesh4d::ViewKind::PastCone, pixel.origin);
                 }
-                uint8_t* p = frame.image.pixel(px, py);
-                for (int c = 0; c < 3; ++c) p[c] = toSrgb8(color[size_t(c)]);
+                for (size_t c = 0; c < 3; ++c) sum[idx][c] += color[c];
                 continue;
             }
             // Step: the primary ray, back along the past cone (or along t = t_c). A sheared view
@@ -716,7 +727,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
             const Hit hit = nearest(ray, false);
             std::array<double, 3> color = kBackground;
             if (hit.object >= 0) {
-                frame.object[idx] = hit.object;
+                if (centre) frame.object[idx] = hit.object;
                 color = shade(hit, light_kind, ray.origin.x, view.shear);
                 const int32_t mirror = mirror_of_object_[size_t(hit.object)];
                 if (mirror >= 0) {
@@ -732,7 +743,7 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                     const Hit second = nearest(bounce, true);
                     std::array<double, 3> reflected = kBackground;
                     if (second.object >= 0) {
-                        frame.reflected[idx] = second.object;
+                        if (centre) frame.reflected[idx] = second.object;
                         reflected = camera.moving() ? shadeReflected(second, view, plane, camera)
                                                     : shade(second, view.kind, bounce.origin.x);
                     }
@@ -740,11 +751,19 @@ TracedFrame SceneTracer::traceFrame(long long k, int width, int height, TracePro
                         color[size_t(c)] = (1 - kMirrorReflectance) * color[size_t(c)] + kMirrorReflectance * reflected[size_t(c)];
                 }
             }
-            uint8_t* p = frame.image.pixel(px, py);
-            for (int c = 0; c < 3; ++c) p[c] = toSrgb8(color[size_t(c)]);
+            for (size_t c = 0; c < 3; ++c) sum[idx][c] += color[c];
         }
         if (progress) progress->rowDone();
-    });
+    };
+    for (int pass = 0; pass < s; ++pass) tbb::parallel_for(0, out_height, [&](int row) { trace_row(row * s + pass); });
+    // Step: each pixel the mean of its samples, to 8-bit sRGB.
+    const double n = double(s) * double(s);
+    for (int py = 0; py < out_height; ++py)
+        for (int px = 0; px < out_width; ++px) {
+            uint8_t* p = frame.image.pixel(px, py);
+            const std::array<double, 3>& c = sum[size_t(py) * size_t(out_width) + size_t(px)];
+            for (size_t i = 0; i < 3; ++i) p[i] = toSrgb8(c[i] / n);
+        }
     return frame;
 }
 
@@ -794,14 +813,16 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     const FrameSplit split{group.rank(), group.size()};
 
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    const int side = samplesSide(settings.samples);
     TraceProgress progress(err, !settings.quiet && !sender,
-                           (long long)stage.models.size() * (last_excl - first) * settings.height);
+                           (long long)stage.models.size() * (last_excl - first) * settings.height * side);
     for (Model model : stage.models) {
         const auto start = std::chrono::steady_clock::now();
         TracerOptions options;
         options.window_prisms = slabPrismLimit(settings.max_slab_memory);
         SceneTracer tracer(stage.scene, stage.objects, stage.mirrors, model, first, last_excl - 1, options);
         tracer.setShadeDoppler(settings.shade_doppler);
+        tracer.setSamplesSide(side);
         tracer.setGate(settings.gate);
         if (sender) {
             // Step (rank r > 0): trace this rank's frames and send each picture, until rank 0 says END.
@@ -847,7 +868,7 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
                     return fail(1, "internal: rank " + std::to_string(split.partOf(k, first)) + " sent a picture of " +
                                        std::to_string(bytes.size()) + " bytes for frame " + std::to_string(k));
                 std::copy(bytes.begin(), bytes.end(), frame.image.rgb.begin());
-                for (int row = 0; row < settings.height; ++row) progress.rowDone();
+                for (int row = 0; row < settings.height * side; ++row) progress.rowDone();
             }
             if (settings.write_png &&
                 !writePng((std::filesystem::path(dir) / (frameName(k) + ".png")).string(), frame.image, &error))
@@ -860,8 +881,8 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!settings.quiet) {
             log << modelName(model) << ": " << (last_excl - first) << " frames of " << settings.width << "x"
-                << settings.height << " in " << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat
-                << std::setprecision(6);
+                << settings.height << (side > 1 ? ", " + std::to_string(side * side) + " samples a pixel," : "") << " in "
+                << std::fixed << std::setprecision(2) << seconds << " s" << std::defaultfloat << std::setprecision(6);
             if (settings.write_png) log << ", " << dir << "/";
             if (video) log << ", " << settings.video_path << " (H.264, " << stage.scene.frames.fps << " fps)";
             if (receiver) log << ", " << group.size() << " processes shared the frames";
@@ -902,12 +923,18 @@ bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::ve
     return true;
 }
 
+TimePrefix cameraTimePrefix(const Scene& scene) {
+    const double last = frameTime(scene.frames, std::max(0LL, frameCount(scene.frames) - 1));
+    return timePrefixFor(std::max(std::fabs(scene.frames.start), std::fabs(last)));
+}
+
 std::string cameraTimeLabel(const Scene& scene, long long k) {
-    // As many decimals as the frame rate needs (10 fps: one), so labels keep their width in a video.
-    const int decimals = scene.frames.fps <= 1 ? 0 : std::min(6, int(std::ceil(std::log10(scene.frames.fps) - 1e-9)));
-    std::ostringstream s;
-    s << "t = " << std::fixed << std::setprecision(decimals) << frameTime(scene.frames, k) << " s";
-    return s.str();
+    // As many decimals as the frame rate needs in the prefix's unit (10 fps: one), so labels keep
+    // their width in a video.
+    const TimePrefix prefix = cameraTimePrefix(scene);
+    const double rate = scene.frames.fps * prefix.seconds;
+    const int decimals = rate <= 1 ? 0 : std::min(6, int(std::ceil(std::log10(rate) - 1e-9)));
+    return "t = " + timeText(frameTime(scene.frames, k), prefix, decimals);
 }
 
 namespace {
@@ -969,9 +996,21 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     std::string error;
     SheetText base_text;
     if (painter)
-        for (Model m : stage.models) base_text.column_labels.push_back(modelName(m));
+        for (size_t m = 0; m < stage.models.size(); ++m)
+            base_text.column_labels.push_back(settings.row_labels.empty() ? modelName(stage.models[m]) : settings.row_labels[m]);
     base_text.title = "t";  // a title band for the time, filled per frame
-    const SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, base_text, painter != nullptr);
+    const auto title_at = [&](long long k) {
+        return (settings.title.empty() ? "" : settings.title + "   ") + cameraTimeLabel(scene, k);
+    };
+    SheetLayout base(1, int(stage.models.size()), settings.width, settings.height, base_text, painter != nullptr);
+    // Step: the title band as high as the longest title of any frame wraps to (one size for the video).
+    if (painter)
+        for (long long k = stage.first; k < stage.last_excl; ++k)
+            base.min_title_lines = std::max(base.min_title_lines,
+                                            int(wrapText(*painter, title_at(k), base.title_px, base.width - 2 * base.pad).size()));
+    const int extra_lines = painter ? base.min_title_lines - 1 : 0;
+    const int sheet_width = base.width, sheet_height = base.height + extra_lines * base.titleStep();
+    const int side = samplesSide(settings.samples > 0 ? settings.samples : kDefaultRaytraceSamples);
     std::vector<std::unique_ptr<SceneTracer>> tracers;
     for (Model m : stage.models) {
         TracerOptions options;  // the models' tracers at once share the budget
@@ -979,6 +1018,7 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
         tracers.push_back(
             std::make_unique<SceneTracer>(scene, stage.objects, stage.mirrors, m, stage.first, stage.last_excl - 1, options));
         tracers.back()->setShadeDoppler(settings.shade_doppler);
+        tracers.back()->setSamplesSide(side);
         tracers.back()->setGate(settings.gate);
     }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
@@ -986,7 +1026,7 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     long long k = stage.first;
     auto make = [&](TraceProgress* progress) {
         SheetText text = base_text;
-        text.title = (settings.title.empty() ? "" : settings.title + "   ") + cameraTimeLabel(scene, k);
+        text.title = title_at(k);
         SheetLayout layout = base;
         RgbImage sheet = drawSheet(text, painter, &layout);
         for (size_t m = 0; m < tracers.size(); ++m) {
@@ -1002,14 +1042,14 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
         return fg.group.finishSending();
     }
     VideoWriter writer;
-    if (!writer.open(settings.video_path, base.width, base.height, scene.frames.fps, &error))
+    if (!writer.open(settings.video_path, sheet_width, sheet_height, scene.frames.fps, &error))
         return fg.fail(kExitOutputError, error);
     TraceProgress progress(err, !settings.quiet,
-                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height);
+                           (long long)stage.models.size() * (stage.last_excl - stage.first) * settings.height * side);
     for (; k < stage.last_excl; ++k) {
         RgbImage sheet;
-        if (const int code = fg.picture(k - stage.first, base.width, base.height,
-                                        (long long)stage.models.size() * settings.height, &progress, &sheet, make))
+        if (const int code = fg.picture(k - stage.first, sheet_width, sheet_height,
+                                        (long long)stage.models.size() * settings.height * side, &progress, &sheet, make))
             return code;
         if (!writer.addFrame(sheet, &error)) return fg.fail(kExitOutputError, error);
     }
@@ -1017,8 +1057,14 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     if (fg.receiver) fg.group.endFrames(0);
     progress.finish();
     if (!settings.quiet) {
-        log << settings.video_path << ": " << writer.frames() << " frames of " << base.width << "x" << base.height
+        log << settings.video_path << ": " << writer.frames() << " frames of " << sheet_width << "x" << sheet_height
             << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1;
+        if (side > 1) log << ", " << side * side << " samples a pixel";
+        if (settings.frame_objects) {
+            const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
+            log << ", framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
+                << scene.camera.fov_deg;
+        }
         if (fg.receiver) log << ", " << fg.group.size() << " processes shared the frames";
         log << "\n";
     }
@@ -1085,6 +1131,26 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
             frames = figureFrames(scene, settings.columns);
         }
     }
+    // Step: the labels given for the rows and columns, one each.
+    if (!code && !settings.row_labels.empty() && settings.row_labels.size() != rows.size()) {
+        error = "--row-labels: " + std::to_string(settings.row_labels.size()) + " labels for " +
+                std::to_string(rows.size()) + " models";
+        code = kExitBadInput;
+    }
+    if (!code && !settings.column_labels.empty() && settings.column_labels.size() != frames.size()) {
+        error = "--column-labels: " + std::to_string(settings.column_labels.size()) + " labels for " +
+                std::to_string(frames.size()) + " columns";
+        code = kExitBadInput;
+    }
+    // Step: --frame-objects: the camera aimed and its view fitted to the objects in these frames.
+    if (!code && settings.frame_objects) {
+        std::vector<long long> framed = frames;
+        for (long long k = stage.first; video && k < stage.last_excl; ++k) framed.push_back(k);
+        if (Status s = frameObjects(stage, rows, framed, settings.width, settings.height, &stage.scene.camera); !s.ok) {
+            error = s.message;
+            code = kExitBadInput;
+        }
+    }
     // Step: the font (labels and title) and ffmpeg (video), before any tracing.
     TextPainter painter;
     const bool with_text = settings.labels || !settings.title.empty();
@@ -1102,14 +1168,18 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     SheetText text;
     text.title = settings.title;
     if (settings.labels) {
-        for (Model m : rows) text.row_labels.push_back(modelName(m));
-        for (long long k : frames) text.column_labels.push_back(cameraTimeLabel(scene, k));
+        text.row_labels = settings.row_labels;
+        text.column_labels = settings.column_labels;
+        for (size_t r = 0; settings.row_labels.empty() && r < rows.size(); ++r) text.row_labels.push_back(modelName(rows[r]));
+        for (size_t c = 0; settings.column_labels.empty() && c < frames.size(); ++c)
+            text.column_labels.push_back(cameraTimeLabel(scene, frames[c]));
     }
     SheetLayout layout(int(rows.size()), int(frames.size()), settings.width, settings.height, text, with_text);
     RgbImage sheet = fg.sender ? RgbImage() : drawSheet(text, with_text ? &painter : nullptr, &layout);
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    const int side = samplesSide(settings.samples > 0 ? settings.samples : kDefaultFigureSamples);
     TraceProgress progress(err, !settings.quiet && !fg.sender,
-                           (long long)rows.size() * (long long)frames.size() * settings.height);
+                           (long long)rows.size() * (long long)frames.size() * settings.height * side);
     // Panel i = r * columns + c: row r's model at column c's frame.
     const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
     for (size_t r = 0; r < rows.size(); ++r) {
@@ -1120,6 +1190,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         options.window_prisms = slabPrismLimit(settings.max_slab_memory);
         SceneTracer tracer(scene, stage.objects, stage.mirrors, rows[r], *lo, *hi, options);
         tracer.setShadeDoppler(settings.shade_doppler);
+        tracer.setSamplesSide(side);
         tracer.setGate(settings.gate);
         for (size_t c = 0; c < frames.size(); ++c) {
             auto make = [&](TraceProgress* p) {
@@ -1134,7 +1205,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
                 continue;
             }
             RgbImage panel;
-            if (const int failed = fg.picture(i, settings.width, settings.height, settings.height, &progress, &panel, make))
+            if (const int failed = fg.picture(i, settings.width, settings.height, (long long)settings.height * side, &progress, &panel, make))
                 return failed;
             placePanel(&sheet, layout, int(r), int(c), panel);
         }
@@ -1151,7 +1222,15 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         log << settings.out_path << ": " << sheet.width << "x" << sheet.height << ", rows";
         for (Model m : rows) log << " " << modelName(m);
         log << "; frames";
-        for (long long k : frames) log << " " << k << " (t = " << frameTime(scene.frames, k) << " s)";
+        const TimePrefix prefix = cameraTimePrefix(scene);
+        for (long long k : frames)
+            log << " " << k << " (t = " << frameTime(scene.frames, k) / prefix.seconds << " " << prefix.name << ")";
+        if (side > 1) log << "; " << side * side << " samples a pixel";
+        if (settings.frame_objects) {
+            const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
+            log << "; framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
+                << scene.camera.fov_deg;
+        }
         if (fg.receiver) log << "; " << fg.group.size() << " processes shared the frames";
         log << "\n";
     }

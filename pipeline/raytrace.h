@@ -1,5 +1,6 @@
 // The paper's 4D raytracer as a reference renderer: `apparent raytrace` and `apparent figure`.
-// Rays leave the camera through each pixel centre and run back along the past lightcone (or along
+// Rays leave the camera through each pixel centre (or through the centres of a grid of cells of
+// the pixel, SceneTracer::setSamplesSide) and run back along the past lightcone (or along
 // the hyperplane t = t_c for the instant and contracted models), meet the 4D tetrahedra of every
 // object's history by the barycentric method (mesh4d/ray4d.h), the nearest event wins, and the hit
 // is shaded by Lambert's law from the scene's light with the lab-frame normal of the object's
@@ -104,11 +105,17 @@ public:
 
     // Traces global frame k (first..last) at width x height (rows in parallel with TBB;
     // deterministic), building the window of time slabs that holds it first when needed. Each row
-    // done is counted in `progress` when given.
+    // of samples done (height x the samples' side of them) is counted in `progress` when given.
     TracedFrame traceFrame(long long k, int width, int height, TraceProgress* progress = nullptr);
 
     // --shade doppler (off by default): colours shifted by each hit's Doppler factor.
     void setShadeDoppler(bool on) { shade_doppler_ = on; }
+    // --samples: side x side rays per pixel (1, the default: one through the pixel centre), at the
+    // centres of a side x side grid of equal strata of the pixel; the pixel is their mean colour in
+    // linear light (then sRGB). With one sample the picture is the one-ray picture, byte for byte.
+    // The object buffers hold the sample at the pixel centre (side odd) or the one right of and
+    // below it (side even).
+    void setSamplesSide(int side) { samples_side_ = std::max(1, side); }
 
     // --gate DEPTH (0: off), the gated camera of the Vienna experiment (Hornof et al. 2025), in
     // finite and relativistic: the picture is composed of exposures of the light-path slices
@@ -203,9 +210,19 @@ private:
     std::unique_ptr<SlabPlanner> planner_;      // the objects whose motion is not uniform
     SlabCounts slab_counts_;
     bool shade_doppler_ = false;
+    int samples_side_ = 1;
     double gate_ = 0;
     std::vector<double> rest_radius_;  // per object, max |q| of its rest points (the gate's slice range)
 };
+
+// --samples N: the side of the square grid of N samples per pixel (N = side x side, side 1..16);
+// 0 when N is not such a square.
+int samplesSide(int samples);
+
+// Rays per pixel by default (--samples; docs/PICTURES.md "Anti-aliasing" says why): a frame of
+// `raytrace` or of a video 2 x 2, a figure's sheet, a picture for a slide, 3 x 3.
+constexpr int kDefaultRaytraceSamples = 4;
+constexpr int kDefaultFigureSamples = 9;
 
 struct RaytraceSettings {
     StageOptions stage;            // scene, --model (empty: the scene's), --frames, --max-frames, limits
@@ -218,6 +235,7 @@ struct RaytraceSettings {
     bool shade_doppler = false;    // --shade doppler (SceneTracer::setShadeDoppler)
     double gate = 0;               // --gate DEPTH (SceneTracer::setGate; 0: off)
     long long max_slab_memory = kDefaultSlabMemory;  // --max-slab-memory: one window's time slabs
+    int samples = kDefaultRaytraceSamples;  // --samples: rays per pixel, a square (SceneTracer::setSamplesSide)
 };
 
 // `apparent raytrace`: DIR/<model>/frame_NNNNN.png per frame and/or one video (exporters/video.h).
@@ -239,8 +257,13 @@ struct FigureSettings {
     int columns = 6;               // --columns: evenly spaced frames (figureFrames)
     std::vector<double> times;     // --times: the columns' camera times (nearest frame each)
     long long frame_from = -1, frame_to = -1;  // --frames A:B: columns A..B-1 (-1: unset; B -1: to the end)
-    std::string title;             // --title: one line above the sheet
+    std::string title;             // --title: above the sheet, wrapped onto more lines when wider than it
     bool labels = true;            // row labels (model names) and column labels (camera times)
+    // --row-labels, --column-labels: the labels instead of the model names (one per model, the
+    // rows; a video's columns) and the camera times (one per column); empty: those.
+    std::vector<std::string> row_labels, column_labels;
+    bool frame_objects = false;    // --frame-objects: the camera aimed and its view fitted (framing.h)
+    int samples = 0;               // --samples: rays per pixel (0: kDefaultFigureSamples, a video kDefaultRaytraceSamples)
     std::string video_path;        // --video: an MP4 of every frame in --frames, the models side by side
     int width = 320, height = 180;  // one panel
     int threads = 0;
@@ -258,8 +281,10 @@ bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::ve
                    std::string* error);
 
 // "t = 10.0 s": frame k's camera time with as many decimals as the frame rate needs (10 fps: 1,
-// 12 or 30 fps: 2), as the figure labels its columns and video frames.
+// 12 or 30 fps: 2), as the figure labels its columns and video frames; in ms, us or ns when the
+// scene's frame times are all below 1 s, 1 ms or 1 us (cameraTimePrefix: "t = 32.0 ns").
 std::string cameraTimeLabel(const Scene& scene, long long k);
+TimePrefix cameraTimePrefix(const Scene& scene);
 
 // `apparent figure`: the paper's comparison sheet, a row per model, a column per frame, labelled
 // with model names and camera times, panels separated by 4-pixel grey lines; or with --video the

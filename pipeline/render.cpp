@@ -253,8 +253,8 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
         if (result.limited_triangles > 0 && !settings.quiet)
             err << "warning: " << name << ": " << result.limited_triangles
                 << " triangle-frames reached the refinement limit of " << result.max_segments
-                << " segments; the tolerance " << stage.scene.tolerance
-                << " ls is not met there (a coarser tolerance or a finer input mesh helps)\n";
+                << " segments; the tolerance " << stage.scene.tolerance * unitsPerLightSecond(stage.scene.units) << " "
+                << lengthName(stage.scene.units) << " is not met there (a coarser tolerance or a finer input mesh helps)\n";
         if (distributed) summary += ", " + std::to_string(group.size()) + " processes shared the frames";
         if (settings.verbose && !settings.quiet) {
             // Where the time went (FrameLoopResult): what decides how far more processes help.

@@ -52,6 +52,27 @@ bool isGltfPath(const std::string& path) {
 
 namespace {
 
+// A scene written in `units` into light-seconds (pipeline/units.h): every length times
+// lightSecondsPer(units); times, speeds, angles and angular velocities stay.
+void toLightSeconds(Scene* scene) {
+    const double k = lightSecondsPer(scene->units);
+    if (k == 1) return;
+    scene->camera.position = scene->camera.position * k;
+    scene->camera.look_at = scene->camera.look_at * k;
+    scene->light.position = scene->light.position * k;
+    if (scene->tolerance_relative == 0) scene->tolerance *= k;
+    for (ObjectSpec& o : scene->objects) {
+        o.position = o.position * k;
+        o.scale = o.scale * k;  // the mesh's own lengths
+        o.acceleration = o.acceleration * k;
+        if (o.kinds.orbit) {
+            mesh4d::Orbit orbit = *o.kinds.orbit;
+            orbit.center = orbit.center * k;
+            o.kinds.orbit = std::make_shared<const mesh4d::Orbit>(orbit);
+        }
+    }
+}
+
 // The JSON scene file's fields (docs/SCENES.md), read by the shared field readers.
 Status readJsonScene(const json& root, const std::string& path, Scene* scene) {
     *scene = Scene{};
@@ -62,7 +83,14 @@ Status readJsonScene(const json& root, const std::string& path, Scene* scene) {
         r.fail("(top level)", "expected a JSON object, got " + FieldReader::typeName(root));
         return status;
     }
-    r.checkKeys(root, "", {"camera", "light", "frames", "model", "tolerance", "objects"});
+    r.checkKeys(root, "", {"camera", "light", "frames", "model", "tolerance", "objects", "units"});
+    if (root.contains("units")) {
+        std::string units;
+        r.string(root, "units", "", &units);
+        if (units == "m") scene->units = LengthUnit::Metre;
+        else if (!r.failed() && units != "ls")
+            r.fail("units", "unknown units '" + units + "' (ls: light-seconds and seconds, the default; m: metres and seconds)");
+    }
     // Step: camera, light (whose default follows camera.up), frames, model and tolerance.
     if (const json* cam = nullptr; r.object(root, "camera", "", &cam)) readCamera(r, *cam, "camera", &scene->camera);
     readLight(r, root, "", scene);
@@ -89,6 +117,7 @@ Status readJsonScene(const json& root, const std::string& path, Scene* scene) {
             scene->objects.push_back(obj);
         }
     }
+    if (status.ok) toLightSeconds(scene);
     scene->warnings = r.warnings();
     return status;
 }

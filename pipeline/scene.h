@@ -11,6 +11,7 @@
 #include "mesh4d/event.h"
 #include "mesh4d/motion/keyed.h"
 #include "mesh4d/motion/motion.h"
+#include "pipeline/units.h"
 #include "pipeline/status.h"
 
 namespace apparent {
@@ -111,6 +112,9 @@ constexpr double kDefaultToleranceRelative = 1e-3;
 
 struct Scene {
     std::string path;                  // the scene file, as given
+    // `units` (pipeline/units.h): the scene's lengths as written. Every length below is in
+    // light-seconds whatever it is (loadScene converts); the outputs are in these units.
+    LengthUnit units = LengthUnit::LightSecond;
     CameraSpec camera;
     LightSpec light;                   // default: overhead (camera.up) plus a key light from the camera
     FrameSpec frames;

@@ -38,7 +38,9 @@ bool isComment(const std::string& key) { return key.rfind('_', 0) == 0; }
 void FieldReader::checkKeys(const json& obj, const std::string& path, const std::vector<std::string>& known) {
     for (auto it = obj.begin(); it != obj.end(); ++it) {
         if (isComment(it.key()) || std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
-        fail(join(path, it.key()), "unknown field (known: " + fieldList(known) + ")");
+        const std::string near = nearestField(it.key(), known);
+        fail(join(path, it.key()), "unknown field (" + (near.empty() ? std::string() : "did you mean " + near + "?; ") +
+                                       "known: " + fieldList(known) + ")");
         return;
     }
 }
@@ -154,6 +156,8 @@ std::string nearestField(const std::string& key, const std::vector<std::string>&
         size_t d = distance(k, lf);
         // A truncated or extended name ("rotation" for "rotation_deg", "velocity_x") counts as near.
         if (k.size() >= 4 && lf.size() >= 4 && (lf.rfind(k, 0) == 0 || k.rfind(lf, 0) == 0)) d = std::min<size_t>(d, 1);
+        // So does the first word of a name with a unit ("fov" for "fov_deg").
+        if (k.size() >= 2 && lf.rfind(k + "_", 0) == 0) d = std::min<size_t>(d, 1);
         if (d < best_d) { best_d = d; best = f; }
     }
     // At most 2 edits, and fewer than half the key's length: "t1" is not a misspelt "t0".

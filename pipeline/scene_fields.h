@@ -65,7 +65,8 @@ std::string fieldList(const std::vector<std::string>& keys);
 std::string formatNumber(double v);
 
 // The known field closest to `key` by edit distance when the key looks like a misspelling of it
-// (at most 2 edits, and fewer than half the key's length); empty otherwise.
+// (at most 2 edits, and fewer than half the key's length; a name cut short, or the first word of
+// a name with a unit, "fov" for "fov_deg", counts as one edit); empty otherwise.
 std::string nearestField(const std::string& key, const std::vector<std::string>& known);
 
 // Where an object comes from, which decides who gives the fields name, mesh and position.

@@ -36,7 +36,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
     if (!options.quiet)
         for (const std::string& w : scene.warnings) log << "warning: " << w << "\n";
     if (options.has_tolerance) {
-        scene.tolerance = options.tolerance;
+        scene.tolerance = options.tolerance * lightSecondsPer(scene.units);  // --tolerance T: in the scene's units
         scene.tolerance_relative = options.tolerance_relative;
     }
     stage->models = options.models;
@@ -113,7 +113,7 @@ bool loadStage(const StageOptions& options, Stage* stage, std::ostream& log, std
             stage->attribute_tolerances[i] = std::max(options.attribute_tolerance_relative * (sizes[i] > 0 ? sizes[i] : largest),
                                                       kToleranceFloorRelative * largest);
         else if (options.attribute_tolerance > 0)
-            stage->attribute_tolerances[i] = options.attribute_tolerance;
+            stage->attribute_tolerances[i] = options.attribute_tolerance * lightSecondsPer(scene.units);  // in the scene's units
     }
     const double floor = kToleranceFloorRelative * largest;
     if (scene.tolerance_relative > 0 && scene.tolerance_relative < kToleranceFloorRelative)

@@ -263,11 +263,13 @@ TEST(GltfScene, UnknownAndMisspeltExtrasKeysAreWarnings) {
     EXPECT_TRUE(contains(s.warnings, "scenes[0].extras.modle: unknown field, ignored (did you mean model?)",
                          "known fields: frames, light, model, tolerance"))
         << w;
-    // A JSON scene refuses the same typo (unchanged).
+    // A JSON scene refuses the same typo, with the same suggestion (issue 38).
     Scene js;
     const Status jst = loadScene(jsonTwin(dir, {{"velocty", {0.5, 0, 0}}}, {0, 0, 0}), &js);
     ASSERT_FALSE(jst.ok);
-    EXPECT_NE(jst.message.find("objects[0].velocty: unknown field"), std::string::npos) << jst.message;
+    EXPECT_NE(jst.message.find("objects[0].velocty: unknown field (did you mean velocity?; known: name, mesh,"),
+              std::string::npos)
+        << jst.message;
 }
 
 // A node whose extras hold only near-misses of object fields is not an object, and says so; a

@@ -248,6 +248,8 @@ TEST(RaytraceScene, BadLightAndMirrorFields) {
         {R"("light": {"direction": [0, 0, 0]})", "light.direction: must be non-zero"},
         {R"("light": {"colour": [1, 1, 1], "direction": [0, 1, 0]})", "light.colour: unknown field"},
         {R"("camera": {"instant_delay": "soon"})", "camera.instant_delay: expected a number"},
+        {R"("camera": {"fov": 40})", "camera.fov: unknown field (did you mean fov_deg?; known: position, look_at"},
+        {R"("light": {"ambiant": 0.2, "direction": [0, 1, 0]})", "light.ambiant: unknown field (did you mean ambient?;"},
     };
     for (const auto& [field, expected] : cases) {
         const auto path = dir / "scene.json";

@@ -315,7 +315,7 @@ void writeScenes(gltfjson::Text* t, const SequenceModel& model) {
     t->key("tolerance");
     t->value(info.tolerance);
     t->key("units");
-    t->value("light-seconds, seconds, c = 1");
+    t->value(info.units);
     t->close('}');
     if (!info.model.empty()) {
         t->key("name");

@@ -2,6 +2,8 @@
 // from the scene camera, several models side by side in one WebGL canvas.
 //
 // URL parameters: ?dir=/out  ?models=instant,finite,relativistic  ?t=SECONDS  ?paused=1  ?shade=plain|doppler
+// ?t is camera time, as the labels show it (the scene extras' frame_times); a t outside the files' camera times
+// but inside the animation is read as animation time (from the first frame written), as links before issue 38 meant.
 // Colours: files rendered with `--shade doppler` carry COLOR_0 (the Doppler-shifted colour) with a white
 // material whose extras.base_color is the plain colour; the "Doppler" toggle switches between the two.
 // Test hook: window.apparentViewer (see the end of this file and README.md).
@@ -21,10 +23,11 @@ const params = new URLSearchParams(location.search);
 const dir = (params.get('dir') || '/out').replace(/\/+$/, '');
 const modelNames = (params.get('models') || 'instant,finite,relativistic')
   .split(',').map((s) => s.trim()).filter(Boolean);
-const initialTime = Math.max(0, Number(params.get('t')) || 0);
+const initialTime = Number(params.get('t')) || 0;
 const startPaused = ['1', 'true', 'yes'].includes((params.get('paused') || '').toLowerCase());
 let shade = (params.get('shade') || 'doppler').toLowerCase() === 'plain' ? 'plain' : 'doppler';
-// ?aspect=16:9 or 1.6: aspect ratio of every viewport (default: the file camera's aspectRatio, else 16:9)
+// ?aspect=16:9 or 1.6: aspect ratio of every viewport (default: the viewports fill the window, each showing at
+// least the file camera's view, of its aspectRatio, else 16:9)
 function parseAspect(v) {
   if (!v) return null;
   const m = /^\s*([\d.]+)\s*[:/x]\s*([\d.]+)\s*$/.exec(v);
@@ -87,7 +90,12 @@ const models = modelNames.map((name) => {
   };
 });
 
-let time = initialTime;
+let time = 0;            // animation time: 0 at the first frame written
+let cameraStart = 0;     // the camera time of animation time 0 (frame_times[0]; 0 without frame_times)
+// Times shown in ns, us or ms when all the files' frame times are below 1 us, 1 ms or 1 s (a scene in metres
+// lasts nanoseconds), as apparent figure labels them (pipeline/units.h).
+let timeUnit = { name: 's', seconds: 1 };
+function timeText(t, digits = 3) { return `${(t / timeUnit.seconds).toFixed(digits)} ${timeUnit.name}`; }
 let zoom = 1;            // view zoom: fov' = 2 atan(tan(fov / 2) / zoom); the camera itself never moves
 let aspect = aspectParam || DEFAULT_ASPECT;
 let playing = !startPaused;
@@ -362,18 +370,19 @@ function updateLabels() {
     if (!m.loaded) continue;
     const vis = visibleOf(m);
     const k = frameIndexAt(m, time);
-    const camT = k >= 0 && m.frameTimes[k] !== undefined ? ` · camera t ${Number(m.frameTimes[k]).toFixed(3)} s` : '';
+    const camT = k >= 0 && m.frameTimes[k] !== undefined ? ` · camera t ${timeText(Number(m.frameTimes[k]))}` : '';
     const shown = vis.length ? vis.map((v) => `${v.name} · ${v.vertices} vertices` +
       (v.reflected ? ` + ${v.reflected} in mirrors` : '')).join(', ') : 'empty frame';
     m.sub.textContent = `${shown}${camT}`;
     m.label.title = `${m.url}\n${m.cameraNote || ''}${zoom !== 1 ? `\nzoom ${zoom.toFixed(2)}×` : ''}`;
   }
-  timeEl.textContent = `t = ${time.toFixed(3)} s / ${maxDuration.toFixed(3)} s` +
+  timeEl.textContent = `t = ${timeText(time + cameraStart)} · ${timeText(time)} / ${timeText(maxDuration)}` +
     (zoom !== 1 ? ` · zoom ${zoom.toFixed(2)}×` : '');
   slider.value = String(time);
 }
 
-// Lay the viewports out side by side, all with the same aspect ratio, as large as the stage allows.
+// Lay the viewports out side by side, filling the stage (with ?aspect: all of that aspect ratio, as large as the
+// stage allows).
 function layout() {
   const n = models.length;
   if (!n) return;
@@ -383,9 +392,9 @@ function layout() {
   const gap = parseFloat(cs.columnGap) || 0;
   const labelH = models[0].label.offsetHeight;
   let w = Math.floor((viewsEl.clientWidth - padX - gap * (n - 1)) / n);
-  let h = Math.floor(w / aspect);
-  const maxH = Math.floor(viewsEl.clientHeight - padY - labelH);
-  if (h > maxH) { h = Math.max(1, maxH); w = Math.max(1, Math.floor(h * aspect)); }
+  const maxH = Math.max(1, Math.floor(viewsEl.clientHeight - padY - labelH));
+  let h = aspectParam ? Math.floor(w / aspect) : maxH;
+  if (h > maxH) { h = maxH; w = Math.max(1, Math.floor(h * aspect)); }
   for (const m of models) {
     m.view.style.width = `${w}px`;
     m.slot.style.height = `${h}px`;
@@ -432,8 +441,11 @@ function render() {
       const hw = m.orthoHalfWidth / zoom, hh = hw * r.height / r.width;
       cam.left = -hw; cam.right = hw; cam.top = hh; cam.bottom = -hh;
     } else {
+      // A viewport narrower than the file camera's aspect widens the vertical field so that the file's whole
+      // horizontal field stays in view.
       const base = THREE.MathUtils.degToRad(m.baseFov || DEFAULT_FOV);
-      cam.fov = THREE.MathUtils.radToDeg(2 * Math.atan(Math.tan(base / 2) / zoom));
+      const widen = Math.max(1, aspect / (r.width / r.height));
+      cam.fov = THREE.MathUtils.radToDeg(2 * Math.atan(Math.tan(base / 2) * widen / zoom));
       cam.aspect = r.width / r.height;
     }
     cam.updateProjectionMatrix();
@@ -512,7 +524,7 @@ function info() {
   return Object.fromEntries(models.map((m) => [m.name, {
     url: m.url, loaded: m.loaded, fps: m.fps, duration: m.duration, frames: m.frames.length,
     firstFrame: m.firstFrame, frameTimes: m.frameTimes.length, camera: m.cameraSource,
-    fov: m.baseFov ?? null, aspect, zoom, cameraNote: m.cameraNote || null,
+    fov: m.baseFov ?? null, aspect, zoom, cameraNote: m.cameraNote || null, cameraStart,
     dopplerColours: (m.shaded || []).length, shade,
   }]));
 }
@@ -541,7 +553,18 @@ const ready = (async () => {
   dopplerBox.disabled = !ok.some((m) => m.shaded.length);
   dopplerBox.checked = shade === 'doppler';
   applyShade();
-  setTime(Math.min(initialTime, maxDuration));
+  // ?t: camera time; outside the files' camera times but inside the animation, the old animation time.
+  const timed = ok.find((m) => m.frameTimes.length);
+  if (timed) cameraStart = Number(timed.frameTimes[0]);
+  const largest = ok.reduce((a, m) => m.frameTimes.reduce((b, x) => Math.max(b, Math.abs(Number(x))), a), 0);
+  if (largest > 0 && largest < 1) {
+    timeUnit = largest >= 1e-3 ? { name: 'ms', seconds: 1e-3 } : largest >= 1e-6 ? { name: 'us', seconds: 1e-6 }
+      : { name: 'ns', seconds: 1e-9 };
+  }
+  const cameraEnd = cameraStart + maxDuration;
+  const oldLink = timed && (initialTime < cameraStart || initialTime > cameraEnd) && initialTime >= 0 &&
+    initialTime <= maxDuration;
+  setTime(Math.min(Math.max(0, oldLink ? initialTime : initialTime - cameraStart), maxDuration));
   setPlaying(playing);
   requestAnimationFrame(tick);
   if (failed.length) {
@@ -553,7 +576,7 @@ const ready = (async () => {
   const dbg = gl.getExtension('WEBGL_debug_renderer_info');
   const glName = dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
   setStatus(`${dir}: ${ok.map((m) => `${m.name} (${m.frames.length} frames @ ${+m.fps.toFixed(3)} fps)`).join(', ')}` +
-    ` · duration ${maxDuration.toFixed(3)} s · ${models[0].cameraNote || ''}\n` +
+    ` · duration ${timeText(maxDuration)} · ${models[0].cameraNote || ''}\n` +
     `Space play/pause · ←/→ step · wheel or +/- zoom, 0 or double-click reset · ${glName}`);
   return info();
 })();
@@ -568,6 +591,8 @@ window.apparentViewer = {
   // 'plain' or 'doppler' (files with COLOR_0 from --shade doppler); returns the shade now in use
   setShade,
   getTime: () => time,
+  // camera time of the current animation time (?t reads it)
+  getCameraTime: () => time + cameraStart,
   play: () => setPlaying(true),
   pause: () => setPlaying(false),
   isPlaying: () => playing,

@@ -18,6 +18,14 @@ node tests/web/viewer_test.js "$out/plain"
 node tests/web/viewer_test.js "$out/draco"
 node tests/web/viewer_test.js "$out/meshopt"
 node tests/web/viewer_test.js "$out/doppler"
+# ?t is camera time: frames 50..119 are camera times 5.0 .. 11.9 s; t=8 opens at camera time 8, and t=2, outside
+# them, is an older link's animation time (camera time 5 + 2).
+"$apparent" render "$src/data/scenes/flanges.json" --out "$out/late" --model relativistic --frames 50:120 --quiet
+node tests/web/viewer_test.js "$out/late" --models relativistic --frames 0,30,69 --shot-time 3 --open-time 8 --expect-camera-time 8
+node tests/web/viewer_test.js "$out/late" --models relativistic --frames 0,69 --shot-time 3 --open-time 2 --expect-camera-time 7
+# A scene in metres (units: m) lasts 300 ns: its times read in ns.
+"$apparent" render "$src/data/fixtures/scene_metres.json" --out "$out/metres" --model relativistic --quiet
+node tests/web/viewer_test.js "$out/metres" --models relativistic --frames 0,15,29 --shot-time 2e-7 --expect-time-unit ns
 sphere="$src/data/scenes/trade/sphere20480.json"
 "$apparent" render "$sphere" --out "$out/sphere-plain" --model relativistic --quiet
 "$apparent" render "$sphere" --out "$out/sphere-meshopt" --model relativistic --compress meshopt --quiet

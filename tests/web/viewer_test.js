@@ -3,6 +3,7 @@
 //
 //   node tests/web/viewer_test.js OUTDIR [--screenshot PATH] [--models a,b,c] [--frames 0,50,100,199]
 //                                        [--shot-time SECONDS] [--chromium PATH] [--keep-profile] [--plain DIR]
+//                                        [--open-time T --expect-camera-time C] [--expect-time-unit ns]
 //
 // OUTDIR holds <model>.glb for every model (plain or KHR_draco_mesh_compression). The test serves the repository
 // root and OUTDIR (as /out/) on 127.0.0.1, opens the viewer in Debian Chromium (headless, SwiftShader WebGL) via
@@ -14,7 +15,10 @@
 //     that of its reflection child nodes ("frame_NNNNN mirror M", issue #7) shown with it (a child that three.js
 //     did not attach to its frame, or shows at another time, changes the count);
 //   - a screenshot at t = --shot-time (default 10 s) has a meaningful number of non-background pixels in every
-//     model's viewport;
+//     model's viewport, and the viewports fill the window (their widths and gaps its width, their heights its
+//     height less the labels);
+//   - with --open-time T: the viewer opened with ?t=T shows camera time C (--expect-camera-time: T for a camera
+//     time of the files, the first frame's time plus T for an older link's animation time);
 //   - for files with COLOR_0 (render --shade doppler): the viewer found the Doppler colours, and switching to
 //     plain colours changes the picture where objects move (relativistic) but not where D = 1 (instant);
 //   - with --plain DIR (the plain export of the same render; OUTDIR a --compress meshopt one, whose frames may be
@@ -48,7 +52,8 @@ function setupFail(msg) {
 
 // ------------------------------------------------------------------ arguments
 const opts = { outdir: null, screenshot: null, models: ['instant', 'finite', 'relativistic'], frames: null,
-  shotTime: 10, chromium: process.env.CHROMIUM || '/usr/bin/chromium', keepProfile: false, plain: null };
+  shotTime: 10, chromium: process.env.CHROMIUM || '/usr/bin/chromium', keepProfile: false, plain: null,
+  openTime: 0, expectCameraTime: null, expectTimeUnit: null };
 {
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; ++i) {
@@ -58,6 +63,9 @@ const opts = { outdir: null, screenshot: null, models: ['instant', 'finite', 're
     else if (a === '--models') opts.models = val().split(',').map((s) => s.trim()).filter(Boolean);
     else if (a === '--frames') opts.frames = val().split(',').map((s) => Number(s.trim()));
     else if (a === '--shot-time') opts.shotTime = Number(val());
+    else if (a === '--open-time') opts.openTime = Number(val());
+    else if (a === '--expect-camera-time') opts.expectCameraTime = Number(val());
+    else if (a === '--expect-time-unit') opts.expectTimeUnit = val();
     else if (a === '--chromium') opts.chromium = val();
     else if (a === '--keep-profile') opts.keepProfile = true;
     else if (a === '--plain') opts.plain = path.resolve(val());
@@ -221,7 +229,7 @@ async function main() {
       else delivered.add(res.url());
     });
 
-    const viewerUrl = `${url}/exporters/web/?dir=/out&models=${opts.models.join(',')}&paused=1&t=0`;
+    const viewerUrl = `${url}/exporters/web/?dir=/out&models=${opts.models.join(',')}&paused=1&t=${opts.openTime}`;
     console.log(`  browser: ${await ctx.browser()?.version() ?? 'chromium'}; opening ${viewerUrl}`);
     await page.goto(viewerUrl, { waitUntil: 'load', timeout: 20000 });
     await page.waitForFunction(() => !!window.apparentViewer, null, { timeout: 20000 });
@@ -245,6 +253,19 @@ async function main() {
         `viewer uses ${vi.camera}, file ${d.hasCamera ? 'has' : 'has no'} camera node`);
       console.log(`  ${m}: viewer sees ${vi.frames} frames @ ${vi.fps} fps, ${vi.duration} s, ${vi.camera} camera ` +
         `(fov ${vi.fov})`);
+    }
+
+    // 3b. ?t is camera time (an older link's animation time when outside the files' camera times)
+    if (opts.expectCameraTime !== null) {
+      const cameraTime = await page.evaluate(() => window.apparentViewer.getCameraTime());
+      check(Math.abs(cameraTime - opts.expectCameraTime) < 1e-6, `?t=${opts.openTime} opens at camera time ` +
+        `${opts.expectCameraTime}`, `camera time ${cameraTime}`);
+    }
+
+    // 3c. times shown in the unit that fits the files' frame times (a scene in metres: ns)
+    if (opts.expectTimeUnit !== null) {
+      const shown = await page.evaluate(() => document.getElementById('time').textContent);
+      check(new RegExp(`^t = -?[0-9.]+ ${opts.expectTimeUnit} `).test(shown), `times read in ${opts.expectTimeUnit}`, shown);
     }
 
     // 4. visibility and vertex counts at several times
@@ -307,6 +328,18 @@ async function main() {
     const png = await page.screenshot({ path: opts.screenshot, type: 'png' });
     const img = decodePNG(png);
     const bgRGB = [1, 3, 5].map((i) => parseInt(bg.slice(i, i + 2), 16));
+    const room = await page.evaluate(() => {
+      const v = document.getElementById('views'), cs = getComputedStyle(v);
+      return { w: v.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight),
+        h: v.clientHeight - parseFloat(cs.paddingTop) - parseFloat(cs.paddingBottom),
+        gap: parseFloat(cs.columnGap) || 0, label: document.querySelector('.label').offsetHeight };
+    });
+    const widths = opts.models.reduce((a, m) => a + (vps[m]?.width || 0), 0) + room.gap * (opts.models.length - 1);
+    check(widths >= room.w - opts.models.length - 1, 'viewports fill the window\'s width', `${widths} of ${room.w} px`);
+    for (const m of opts.models) {
+      check((vps[m]?.height || 0) >= room.h - room.label - 1, `${m}: viewport fills the window's height`,
+        `${vps[m]?.height} of ${room.h - room.label} px`);
+    }
     console.log(`  screenshot at t = ${shotT} s: ${opts.screenshot} (${img.width}x${img.height})`);
     for (const m of opts.models) {
       const r = vps[m];
