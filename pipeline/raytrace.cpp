@@ -386,6 +386,22 @@ Status checkGate(const Stage& stage, double depth) {
     return Status::success();
 }
 
+namespace {
+
+// The checks of a traced stage (raytrace, figure): the slabs' memory, the gate, and the gate's
+// warning for the models without light delay.
+Status checkTracedStage(const Stage& stage, long long slab_memory, double gate, bool quiet, std::ostream& err) {
+    if (Status s = checkTracedMotions(stage, slab_memory); !s.ok) return s;
+    if (Status g = checkGate(stage, gate); !g.ok) return g;
+    if (gate > 0 && !quiet)
+        for (Model m : stage.models)
+            if (m == Model::Instant || m == Model::Contracted)
+                err << "warning: --gate: model " << modelName(m) << " has no light delay to gate; drawn ungated\n";
+    return Status::success();
+}
+
+}  // namespace
+
 PixelRay pixelRay(const CameraSpec& camera, int width, int height, int px, int py) {
     if (!camera.orthographic()) return {camera.position, pixelDirection(camera, width, height, px, py)};
     // Step: the camera basis, as pixelDirection's.
@@ -782,19 +798,11 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     stage_options.quiet = settings.quiet || sender;
     std::string error;
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
-    if (!code) {
-        if (Status s = checkTracedMotions(stage, settings.max_slab_memory); !s.ok) {
+    if (!code)
+        if (Status s = checkTracedStage(stage, settings.max_slab_memory, settings.gate, settings.quiet, err); !s.ok) {
             error = s.message;
             code = kExitBadInput;
-        } else if (Status g = checkGate(stage, settings.gate); !g.ok) {
-            error = g.message;
-            code = kExitBadInput;
-        } else if (settings.gate > 0 && !settings.quiet) {
-            for (Model m : stage.models)
-                if (m == Model::Instant || m == Model::Contracted)
-                    err << "warning: --gate: model " << modelName(m) << " has no light delay to gate; drawn ungated\n";
         }
-    }
     const bool video = !settings.video_path.empty();
     if (!code && !sender && video && stage.models.size() != 1) {
         error = "--video: a video shows one model (" + std::to_string(stage.models.size()) +
@@ -1095,16 +1103,9 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
     int code = loadStage(stage_options, &stage, err, &error) ? kExitOk : kExitBadInput;
     if (!code) {
         const long long memory = video ? settings.max_slab_memory / (long long)stage.models.size() : settings.max_slab_memory;
-        if (Status s = checkTracedMotions(stage, memory); !s.ok) {
+        if (Status s = checkTracedStage(stage, memory, settings.gate, settings.quiet, err); !s.ok) {
             error = s.message;
             code = kExitBadInput;
-        } else if (Status g = checkGate(stage, settings.gate); !g.ok) {
-            error = g.message;
-            code = kExitBadInput;
-        } else if (settings.gate > 0 && !settings.quiet) {
-            for (Model m : stage.models)
-                if (m == Model::Instant || m == Model::Contracted)
-                    err << "warning: --gate: model " << modelName(m) << " has no light delay to gate; drawn ungated\n";
         }
     }
     const Scene& scene = stage.scene;

@@ -1250,13 +1250,7 @@ TEST(Refine, NearCameraBisectionBytesPinned) {
         mix(counters, sizeof(counters));
         return h;
     };
-    RestMesh box;
-    for (int i = 0; i < 8; ++i) box.positions.push_back({i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5});
-    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& q : quads) {
-        box.triangles.push_back({q[0], q[1], q[2]});
-        box.triangles.push_back({q[0], q[2], q[3]});
-    }
+    const RestMesh box = testmesh::unitBox();
     struct Case {
         RestMesh mesh;
         double distance, size;
