@@ -20,22 +20,13 @@ peer=${PEER:+$(realpath "$PEER")}
 rounds=${ROUNDS:-3}
 command -v gltfpack >/dev/null || { echo "frames_churn.sh: needs gltfpack (scripts/setup.sh installs it)" >&2; exit 2; }
 [ -x /usr/bin/time ] || { echo "frames_churn.sh: needs GNU time as /usr/bin/time (Debian package time)" >&2; exit 2; }
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
 
 # Step: the torus, 1000 x 500 vertices, two triangles per quad (1,000,000 triangles), and its scene.
-awk 'BEGIN {
-    n = 1000; m = 500; R = 2; r = 0.5; pi = atan2(0, -1);
-    for (i = 0; i < n; ++i) for (j = 0; j < m; ++j) {
-        u = 2 * pi * i / n; v = 2 * pi * j / m;
-        printf "v %.12g %.12g %.12g\n", (R + r * cos(v)) * cos(u), r * sin(v), (R + r * cos(v)) * sin(u);
-    }
-    for (i = 0; i < n; ++i) for (j = 0; j < m; ++j) {
-        a = i * m + j + 1; b = ((i + 1) % n) * m + j + 1; c = ((i + 1) % n) * m + (j + 1) % m + 1; d = i * m + (j + 1) % m + 1;
-        printf "f %d %d %d\nf %d %d %d\n", a, b, c, a, c, d;
-    }
-}' > torus.obj
+bash "$root/scripts/torus_obj.sh" 1000 500 torus.obj
 cat > torus.json <<'JSON'
 {
   "camera": { "position": [0, 0, 0], "look_at": [0, 0, -10], "up": [0, 1, 0], "fov_deg": 60 },

@@ -16,22 +16,13 @@ apparent=$(realpath "${1:-build/apparent}")
 peer=${PEER:+$(realpath "$PEER")}
 shift || true
 options="$*"
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 # Step: the torus, 500 x 200 vertices, two triangles per quad (200,000 triangles).
-awk 'BEGIN {
-    n = 500; m = 200; R = 2; r = 0.5; pi = atan2(0, -1);
-    for (i = 0; i < n; ++i) for (j = 0; j < m; ++j) {
-        u = 2 * pi * i / n; v = 2 * pi * j / m;
-        printf "v %.12g %.12g %.12g\n", (R + r * cos(v)) * cos(u), r * sin(v), (R + r * cos(v)) * sin(u);
-    }
-    for (i = 0; i < n; ++i) for (j = 0; j < m; ++j) {
-        a = i * m + j + 1; b = ((i + 1) % n) * m + j + 1; c = ((i + 1) % n) * m + (j + 1) % m + 1; d = i * m + (j + 1) % m + 1;
-        printf "f %d %d %d\nf %d %d %d\n", a, b, c, a, c, d;
-    }
-}' > "$work/torus.obj"
+bash "$root/scripts/torus_obj.sh" 500 200 "$work/torus.obj"
 cat > "$work/torus.json" <<'JSON'
 {
   "camera": { "position": [0, 0, 0], "look_at": [0, 0, -10], "up": [0, 1, 0], "fov_deg": 60 },
