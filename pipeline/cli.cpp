@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pipeline/figure.h"
 #include "pipeline/measure.h"
 #include "pipeline/raytrace.h"
 #include "pipeline/render.h"
@@ -222,7 +223,7 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     render_cmd->footer(kRenderFooter);
 
 
-    // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h).
+    // `raytrace` and `figure`: the paper's 4D raytracer as a reference (pipeline/raytrace.h, pipeline/figure.h).
     RaytraceSettings ts;
     std::string trace_model_text, trace_size_text, trace_frames_text;
     CLI::App* raytrace_cmd = app.add_subcommand("raytrace", "Ray-trace the 4D histories into PNG frames DIR/<model>/frame_NNNNN.png and/or an MP4 video");

@@ -1,5 +1,5 @@
 // A sheet of equal panels in a grid with optional text around it: the layout `apparent figure`
-// uses for its comparison sheet and its side-by-side video frames (raytrace.h). Bands: a title on
+// uses for its comparison sheet and its side-by-side video frames (figure.h). Bands: a title on
 // top (wrapped onto more lines when it is wider than the sheet), column labels under it, row
 // labels on the left; panels separated by kGap grey pixels. Text through exporters/text.h (FreeType).
 #pragma once

@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "exporters/png.h"
+#include "exporters/text.h"
 #include "mesh4d/angles.h"
 #include "mesh4d/doppler_colour.h"
 #include "mesh4d/ray4d.h"

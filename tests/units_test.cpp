@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "pipeline/figure.h"
 #include "pipeline/frame_cut.h"
-#include "pipeline/raytrace.h"
 #include "quiet_stage.h"
 #include "run_command.h"
 #include "temp_dir.h"
