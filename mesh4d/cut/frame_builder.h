@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "mesh4d/slice.h"
+#include "mesh4d/cut/rest_clip.h"
 #include "mesh4d/refine/chord_error.h"
 #include "mesh4d/exact_side.h"
 #include "mesh4d/refine/form_bisect.h"
@@ -29,10 +30,6 @@ namespace slicing {
 enum class Side : uint8_t { NotYet, Inside, Gone };
 
 constexpr uint32_t kUnset = 0xffffffffu;
-
-// The rest clip (restPlan): a chord of a cap's clip circle through a piece must lie within this
-// fraction of the tolerance of the circle.
-constexpr double kMidpointShare = 0.25;
 
 // Sutherland-Hodgman over the span between the caps, for a convex polygon of n corners whose
 // sides are s[i]: the corners inside the span, and on each side i -> i + 1 whose ends lie on
@@ -695,63 +692,26 @@ struct FrameBuilder {
     // Step: a whole triangle clipped to the span in vertex mode (Sutherland-Hodgman over the caps).
     void clipWhole(size_t f);
 
-    // Step (objects at rest on the past cone, with a real cap, tolerance > 0). The surface is the
-    // input itself (the cut is affine), but a cap meets the cone in a sphere, so the clip curves
-    // are circles. A triangle a cap may cut is split in four, recursively, where a cap's curve could
-    // hide in a piece or its chord through the piece lies farther than T/4 from the circle
-    // (clipRatio), at most to 2^-depth of the triangle with 2^depth <= max_segments. Each leaf
-    // piece is then a convex polygon: its corners and the corners of finer neighbours on its sides
-    // (so the pieces of a triangle meet edge to edge), clipped at exact crossings as in vertex mode.
-    // Points and crossings on a mesh edge are keyed by the edge and their place along it, so the
-    // two triangles of the edge share those they both make; where the two split the edge
-    // differently they meet at T-junctions (the edge is straight: no gap). A whole mesh edge keeps
-    // its vertex-mode crossing (crossingPoint).
-    static constexpr int kRestDepth = 20;                          // deepest split the keys can hold
-    static constexpr int64_t kRestOne = int64_t(1) << kRestDepth;  // barycentric 1 in piece keys
-    using Key = std::pair<int64_t, int64_t>;                       // barycentrics on corners 1, 2 (x 2^-20)
-
-    struct RestPiece {
-        Key k[3];
-    };
+    // Step (objects at rest on the past cone, with a real cap, tolerance > 0): the rest clip
+    // (mesh4d/cut/rest_clip.h: why it holds, its keys and pieces).
 
     // Points on mesh edges (per frame): (edge, place from lo in 2^-20) -> output vertex, and crossings
     // on a stretch of a mesh edge: (edge, from, to, cap) -> output vertex.
     std::map<std::pair<uint32_t, int64_t>, uint32_t> rest_edge_points;
     std::map<std::pair<std::pair<uint32_t, int64_t>, std::pair<int64_t, int>>, uint32_t> rest_edge_crossings;
 
-    static void barycentrics(const Key& k, double l[3]);
-
     double pieceRatio(const uint32_t v[3], const RestPiece& p, double limit) const;
 
-    // The triangle corner a key is, or -1.
-    static int cornerOf(const Key& k);
-
-    // Whether a key lies on triangle side s (0: corners 0-1, 1: 1-2, 2: 2-0), and its place along
-    // the side from the side's first corner.
-    static bool onSide(const Key& k, int s, int64_t* place);
     // A place along triangle f's side s (from the side's first corner), counted from its mesh
     // edge's lo end instead: the same number for both triangles of the edge.
     int64_t placeFromLo(const uint32_t v[3], int s, uint32_t edge, int64_t place) const;
-    // The side a point that is no corner lies on, or -1.
-    static int sideOfKey(const Key& k, int64_t* place);
 
-    // Pass 1 (restPlan, every triangle): the leaf pieces, and their places along the mesh edges;
-    // pass 2 (restEmit, once all triangles are planned): the polygons, with the corners of finer
-    // neighbours on every side, also across mesh edges, so the pieces meet edge to edge.
-    struct RestPlan {
-        size_t f = 0;
-        std::vector<RestPiece> leaves;
-        std::set<Key> corners;
-    };
     std::vector<RestPlan> rest_plans;
     std::map<uint32_t, std::set<int64_t>> rest_edge_places;  // mesh edge -> leaf corners on it (place from lo)
 
     void restPlan(size_t f);
 
     void restEmit(const RestPlan& plan);
-
-    // The key of the point at `place` along triangle side s from its first corner.
-    static Key keyOnSide(int s, int64_t place);
 
     void splitPiece(const uint32_t v[3], const RestPiece& p, double ratio, int depth, int max_depth, double limit,
                     std::vector<RestPiece>* leaves, std::set<Key>* corners, bool* limited) const;
@@ -761,8 +721,6 @@ struct FrameBuilder {
     // side dyadically).
     void hangingCorners(const uint32_t v[3], const Key& a, const Key& b, const std::set<Key>& corners,
                         std::vector<Key>* out_keys) const;
-
-    static void innerHanging(const Key& a, const Key& b, const std::set<Key>& corners, std::vector<Key>* out_keys);
 
     // Output vertex of a piece corner: a mesh vertex, a point on a mesh edge (shared by the edge's
     // triangles), or an inner point of this triangle.

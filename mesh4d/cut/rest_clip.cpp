@@ -1,10 +1,12 @@
 // The rest clip (restPlan): objects at rest on the past cone with a real cap and a tolerance.
+#include "mesh4d/cut/rest_clip.h"
+
 #include "mesh4d/cut/frame_builder.h"
 
 namespace mesh4d {
 namespace slicing {
 
-void FrameBuilder::barycentrics(const Key& k, double l[3]) {
+void barycentrics(const Key& k, double l[3]) {
     l[1] = double(k.first) / double(kRestOne);
     l[2] = double(k.second) / double(kRestOne);
     l[0] = double(kRestOne - k.first - k.second) / double(kRestOne);
@@ -16,14 +18,14 @@ double FrameBuilder::pieceRatio(const uint32_t v[3], const RestPiece& p, double 
     return clipRatio(v, l[0], l[1], l[2], limit);
 }
 
-int FrameBuilder::cornerOf(const Key& k) {
+int cornerOf(const Key& k) {
     if (k.first == 0 && k.second == 0) return 0;
     if (k.first == kRestOne && k.second == 0) return 1;
     if (k.first == 0 && k.second == kRestOne) return 2;
     return -1;
 }
 
-bool FrameBuilder::onSide(const Key& k, int s, int64_t* place) {
+bool onSide(const Key& k, int s, int64_t* place) {
     if (s == 0 && k.second == 0) { *place = k.first; return true; }
     if (s == 1 && k.first + k.second == kRestOne) { *place = k.second; return true; }
     if (s == 2 && k.first == 0) { *place = kRestOne - k.second; return true; }
@@ -34,7 +36,7 @@ int64_t FrameBuilder::placeFromLo(const uint32_t v[3], int s, uint32_t edge, int
     return world.edges[edge].lo == v[s] ? place : kRestOne - place;
 }
 
-int FrameBuilder::sideOfKey(const Key& k, int64_t* place) {
+int sideOfKey(const Key& k, int64_t* place) {
     for (int s = 0; s < 3; ++s)
         if (onSide(k, s, place)) return s;
     return -1;
@@ -86,7 +88,7 @@ void FrameBuilder::restEmit(const RestPlan& plan) {
     }
 }
 
-FrameBuilder::Key FrameBuilder::keyOnSide(int s, int64_t place) {
+Key keyOnSide(int s, int64_t place) {
     if (s == 0) return {place, 0};
     if (s == 1) return {kRestOne - place, place};
     return {0, kRestOne - place};
@@ -126,7 +128,7 @@ void FrameBuilder::hangingCorners(const uint32_t v[3], const Key& a, const Key& 
     innerHanging(a, b, corners, out_keys);
 }
 
-void FrameBuilder::innerHanging(const Key& a, const Key& b, const std::set<Key>& corners, std::vector<Key>* out_keys) {
+void innerHanging(const Key& a, const Key& b, const std::set<Key>& corners, std::vector<Key>* out_keys) {
     if ((a.first + b.first) % 2 != 0 || (a.second + b.second) % 2 != 0) return;
     const Key m{(a.first + b.first) / 2, (a.second + b.second) / 2};
     if (!corners.count(m)) return;
