@@ -1,5 +1,5 @@
 // The bisection: conforming longest-edge splits of the pieces whose bound fails (the drain).
-#include "mesh4d/cut/frame_builder.h"
+#include "mesh4d/refine/bisect.h"
 #include "mesh4d/refine/templates.h"
 
 namespace mesh4d {

@@ -1,5 +1,5 @@
 // refineFrame: the first pass over the mesh, the drain, the batch cut and the leaves' assembly.
-#include "mesh4d/cut/frame_builder.h"
+#include "mesh4d/refine/bisect.h"
 #include "mesh4d/refine/templates.h"
 
 namespace mesh4d {

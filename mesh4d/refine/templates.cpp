@@ -1,5 +1,5 @@
 // The templates: pieces the bisection leaves, each filled at once by a grid or a form bisection.
-#include "mesh4d/cut/frame_builder.h"
+#include "mesh4d/refine/bisect.h"
 #include "mesh4d/refine/templates.h"
 
 namespace mesh4d {
