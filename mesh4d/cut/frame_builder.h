@@ -1,6 +1,9 @@
 // The state of one frame's cut (internal to mesh4d/cut and mesh4d/refine): FrameBuilder holds
 // the frame's inputs, its output and the refinement's working arrays; its stages live in one file
 // each (mesh4d/refine/refine.h lists them). Not a public header: include mesh4d/slice.h.
+// What is an algorithm's own lives beside it, with the reasons its .cpp steps hold: the vertex
+// clip (cut/vertex_clip.h), the rest clip (cut/rest_clip.h), the bisection's inline parts
+// (refine/bisect.h), the templates (refine/templates.h); the first pass's in refine/refine.h.
 #pragma once
 
 #include <algorithm>
@@ -14,6 +17,7 @@
 
 #include "mesh4d/slice.h"
 #include "mesh4d/cut/rest_clip.h"
+#include "mesh4d/cut/vertex_clip.h"
 #include "mesh4d/refine/chord_error.h"
 #include "mesh4d/exact_side.h"
 #include "mesh4d/refine/form_bisect.h"
@@ -26,36 +30,7 @@
 namespace mesh4d {
 namespace slicing {
 
-// Where a vertex's worldline crossing falls relative to the extruded span.
-enum class Side : uint8_t { NotYet, Inside, Gone };
-
 constexpr uint32_t kUnset = 0xffffffffu;
-
-// Sutherland-Hodgman over the span between the caps, for a convex polygon of n corners whose
-// sides are s[i]: the corners inside the span, and on each side i -> i + 1 whose ends lie on
-// different sides of a cap, that cap's crossing (both caps' crossings, in order along the side,
-// when it runs from before existing to after). corner(i) and crossing(i, j, cap) give output ids.
-// Writes at most 2 n ids to `out` and returns their count (a triangle gives at most 5).
-template <class Corner, class Crossing>
-int clipToSpan(int n, const Side* s, Corner corner, Crossing crossing, uint32_t* out) {
-    int k = 0;
-    for (int i = 0; i < n; ++i) {
-        const int j = (i + 1) % n;
-        const Side si = s[i], sj = s[j];
-        if (si == Side::Inside) out[k++] = corner(i);
-        if (si == sj) continue;
-        const bool cross_a = si == Side::NotYet || sj == Side::NotYet;
-        const bool cross_b = si == Side::Gone || sj == Side::Gone;
-        const bool a_first = si == Side::NotYet || sj == Side::Gone;
-        if (cross_a && cross_b) {
-            out[k++] = crossing(i, j, a_first ? 0 : 1);
-            out[k++] = crossing(i, j, a_first ? 1 : 0);
-        } else {
-            out[k++] = crossing(i, j, cross_a ? 0 : 1);
-        }
-    }
-    return k;
-}
 
 // The terms of the a-priori bound of one point (chord_error.h PointTerms), side by side: what a
 // corner or an edge's end contributes is read from one place.
@@ -568,81 +543,6 @@ struct FrameBuilder {
     // Step: one triangle: whole, refined, or clipped to the span.
     void addTriangle(size_t f);
 };
-
-// ---- Why the steps hold: the reasoning behind the step headings of the .cpp files ----
-// cut/slice.cpp:
-//   - No real cap, nothing culled, every vertex used, the refinement's batch cut made: output vertex
-//     i is the image of vertex i, copied in bulk (the same points vertexPoint emits).
-//   - Visible vertices first, in input order: when nothing is clipped or refined, output vertex i is
-//     the image of input vertex i (unreferenced input vertices aside).
-//   - The camera among the events: h <= t_c - t there; the light has not left any of them yet, or so
-//     little time ago that whatever shows is narrower than the limit.
-//   - The 4D-box cull of one run of triangles (SliceSettings::cull): true when some event of the run
-//     may be visible. On the cone, h = (t_c - t) - |x - C| is at most (t_c - t_lo) - dist(C, box)
-//     and at least (t_c - t_hi) - maxdist(C, box) over a box; on the hyperplane only the t terms
-//     remain, and on the tilted one (lightcone.h) the least and greatest (x - C).k over the box take
-//     the distances' place. The margin covers the rounding of these bounds (a few ulps of the largest term).
-//   - Model only what the cut requires: on a hyperplane, or at rest, the map from the rest surface
-//     to the apparent one is affine, so straight edges are exact and nothing is refined (at rest
-//     under a shear it is not: chord_error.h displacedChordError).
-//   - At rest on the past cone with a real cap, the caps' clip curves are circles: those alone are
-//     refined (FrameBuilder::restPlan). A motion that is not uniform (worldline.h) is otherwise cut
-//     in vertex mode: exact points on the true worldlines (lightcone.h sends each cut to
-//     crossWorldline).
-//   - A motion that is not uniform, with a tolerance: worldline_refine.h (no real cap; the callers
-//     refuse a tolerance for such an object that begins or ends existing, and a moving camera).
-//   - Step: the fast path of vertex mode when nothing is clipped: output vertex i is the image of
-//     input vertex i and the triangles are the input's (the same result as below, made in one pass).
-//   - Step: the Galilean map into the output frame, origin and local parts apart (each local point
-//     moves by -shear times its local time, a term of the object's size).
-// refine/first_pass.cpp:
-//   - Step: the corners' bound (chordErrorFromCorners) passes most triangles that need no
-//     refinement; the others get the a-priori bound (chordErrorOfBubbles).
-//   - The corners' spread (chord_error.h cornerSpread: the largest |u|_M^2 of a triangle's sides)
-//     from each mesh edge's |u|_M^2, made once per edge instead of once per side of each triangle:
-//     |u|_M^2 is even in u (negating u negates its terms exactly), and the largest of three does not
-//     depend on their order, so each triangle's spread is cornerSpread's bit for bit. (With a cull,
-//     per triangle: most edges may be culled.)
-//   - Every triangle passes when the whole mesh does: its largest spread D with the least |x|_M of
-//     all its vertices X (passesFromSpread(D, {X, X, X})). Each triangle's d2 is at most D (both the
-//     same std::max chain from 0 over the same spreads, which skips a NaN) and its xmin at least X
-//     (no xm is NaN), and passesFromSpread is monotone in both as rounded (chord_error.h): fl(4 d2),
-//     fl(xmin xmin) and fl(beta d2) grow with their operand, and fl(3 (1 - beta^2) T) >= 0 is one
-//     factor of xmin. So the verdict is the triangles' own (no candidates), without the pass over
-//     the triangles (with real caps that pass also counts the clipped triangles: it is made then).
-//   - The least |x|_M of all vertices, and their sum: NaN when one is (an infinity of each sign
-//     makes NaN too, and the pass below is only skipped then). (Its own loop: the terms' loop above
-//     stays vectorised.)
-//   - (The arrays and the tolerance read through locals: the compiler cannot tell that
-//     `candidates`'s stores leave them alone, and would load them again per triangle.)
-//   - The terms are the corners' own (shapeOfEvent, normMOfEvent): the corners' bound is
-//     chordErrorFromCorners' bit for bit, from the one spread both tests use.
-//   - Each mesh edge's bound made once and kept for the splits (edgeOf makes the same bits: ends in
-//     id order), when the candidates are enough to pay for the edge records' reset (a large mesh
-//     with a few candidates computes their edges per triangle instead).
-//   - The corners' terms in place (the drain's pointsBound on the same record: the same bits); the
-//     sides' |u|_M^2 are the edges' spreads when made (normM2 of the side either way round: the same
-//     bits, chord_error.h chordErrorOfSides).
-//   - Room for the pieces and points the refinement is expected to make (growth would copy them). At
-//     most a million: reserving is only a saving, never a bound (max_triangles is).
-//   - Still as the mesh has it (only a split changes a record's corners, and it deepens it; a
-//     neighbour's split may have made the record): the first pass's verdict stands, from the same
-//     terms and edge records (edgeOf: the same bits).
-//   - Step: templates only where they make most of the output: else the few coarse pieces are
-//     bisected on like the rest (the templates' pass over every leaf would cost more than it saves).
-//   - The records still coarse, in id order (as a pass over all records would meet them), from the
-//     list of those marked: no pass over every record.
-//   - Step (no real cap): the output's points, once the splits are done: the visible vertices
-//     (classifyVertices, in input order), then the points the splits (and the templates) made, in
-//     room for all of them made once. Without templates the room is exact: each output array is
-//     allocated once per frame and its points copied once. Templates fill the leaves when the splits
-//     left coarse pieces (no real cap: r_templates).
-//   - Step (no real cap): the leaves filled by their templates. (Without a coarse piece every leaf
-//     is its own output triangle: emitted below as they are.)
-//   - Step: the leaves in record order: the mesh's triangles (or the piece each keeps), then the
-//     pieces the splits appended.
-//   - Nothing clipped: every point a split made is a corner of some leaf, so the points follow the
-//     mesh's visible vertices in id order, copied in bulk.
 
 }  // namespace slicing
 }  // namespace mesh4d
