@@ -12,6 +12,7 @@
 
 #include "mesh4d/refine/geometric_bound.h"
 #include "mesh4d/refine/measure.h"
+#include "moving_case.h"
 
 using namespace mesh4d;
 
@@ -46,16 +47,12 @@ TEST(GeometricBound, NeverBelowTheMeasuredDistanceAndTight) {
     double tightest = 0, below_parametric = 0;
     int violations_at_98 = 0;
     for (int trial = 0; trial < 400; ++trial) {
-        const double beta = trial % 7 == 0 ? 0.999 : 0.05 + 0.949 * (u(rng) + 1) / 2;
-        Vec3 dir{u(rng), u(rng), u(rng)};
-        dir = dir / norm(dir);
-        const Kinematics k = trial % 2 ? Kinematics::Lorentz : Kinematics::Galilean;
-        const double size = std::pow(10.0, 2 * u(rng) - 1.5);
-        const double distance = size * (trial % 5 == 0 ? 3.0 : std::pow(10.0, 1 + 1.5 * (u(rng) + 1)));
-        const Vec3 where = Vec3{u(rng), u(rng), -1} * distance;
-        const Motion m = makeMotion(k, 0.0, where, dir * beta);
-        const ViewSurface view{ViewKind::PastCone, distance * (1 + u(rng)), {0, 0, 0}};
-        const ViewAnchor anchor = viewAnchor(view, m);
+        const testcase::MovingCase c = testcase::randomMovingCase(trial, 1, 4, rng, u);
+        const double beta = c.beta, size = c.size, distance = c.distance;
+        const Vec3 where = c.where;
+        const Motion& m = c.m;
+        const ViewSurface& view = c.view;
+        const ViewAnchor& anchor = c.anchor;
         Vec3 q[3];
         for (auto& p : q) p = Vec3{u(rng), u(rng), u(rng)} * (0.5 * size);
         World4D w;
