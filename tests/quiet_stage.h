@@ -20,4 +20,16 @@ inline bool loadQuietStage(const std::string& scene, Stage* stage, std::string* 
     return loadStage(options, stage, log, error);
 }
 
+// Frames [frame_from, frame_to) of `scene` (its own models); false with the one-line error.
+inline bool loadQuietFrames(const std::string& scene, long long frame_from, long long frame_to, Stage* stage,
+                            std::string* error) {
+    StageOptions options;
+    options.scene_path = scene;
+    options.frame_from = frame_from;
+    options.frame_to = frame_to;
+    options.quiet = true;
+    std::ostringstream log;
+    return loadStage(options, stage, log, error);
+}
+
 }  // namespace apparent

@@ -19,6 +19,7 @@
 #include "pipeline/frame_loop.h"
 #include "pipeline/stage.h"
 #include "pipeline/worlds.h"
+#include "quiet_stage.h"
 #include "run_command.h"
 #include "file_bytes.h"
 
@@ -291,15 +292,10 @@ public:
 // The loop cuts frames [A, B) in parallel batches and hands them to every sink in frame order,
 // each with its own prepared conversion; the result does not depend on the thread count.
 TEST(Stage, FrameLoopDeliversFramesInOrder) {
-    StageOptions options;
-    options.scene_path = source("data/scenes/flanges.json");
-    options.frame_from = 37;
-    options.frame_to = 58;
-    options.quiet = true;
     Stage stage;
-    std::ostringstream log, progress;
     std::string error;
-    ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+    ASSERT_TRUE(loadQuietFrames(source("data/scenes/flanges.json"), 37, 58, &stage, &error)) << error;
+    std::ostringstream progress;
     size_t triangles_one_thread = 0;
     for (int threads : {1, 2}) {
         RecordingSink a, b;
@@ -333,15 +329,10 @@ TEST(Stage, FrameLoopDeliversFramesInOrder) {
 // and the same seen by a moving camera (pipeline/mirror.h: its reflections are made apart).
 TEST(Stage, LightFactorsOnlyWhenASinkReadsThem) {
     for (const char* scene : {"data/scenes/flanges.json", "data/fixtures/scene_mirror_camera.json"}) {
-        StageOptions options;
-        options.scene_path = source(scene);  // one mirror: reflections too
-        options.frame_from = 8;
-        options.frame_to = 11;
-        options.quiet = true;
         Stage stage;
-        std::ostringstream log, progress;
         std::string error;
-        ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+        ASSERT_TRUE(loadQuietFrames(source(scene), 8, 11, &stage, &error)) << error;  // one mirror: reflections too
+        std::ostringstream progress;
         for (Model model : {Model::Instant, Model::Finite, Model::Relativistic, Model::Contracted}) {
             for (bool second_reads : {false, true}) {
                 RecordingSink a, b;
@@ -367,15 +358,10 @@ TEST(Stage, LightFactorsOnlyWhenASinkReadsThem) {
 // them keeps them for every sink. The default scene with its mirror (reflections), frames held for
 // the estimate and delivered after it.
 TEST(Stage, RestPointsReleasedWhenNoSinkReadsThem) {
-    StageOptions options;
-    options.scene_path = source("data/scenes/flanges.json");
-    options.frame_from = 8;
-    options.frame_to = 16;
-    options.quiet = true;
     Stage stage;
-    std::ostringstream log, progress;
     std::string error;
-    ASSERT_TRUE(loadStage(options, &stage, log, &error)) << error;
+    ASSERT_TRUE(loadQuietFrames(source("data/scenes/flanges.json"), 8, 16, &stage, &error)) << error;
+    std::ostringstream progress;
     for (bool second_reads : {false, true}) {
         RecordingSink a, b;
         a.reads_rest = false;
