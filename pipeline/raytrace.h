@@ -77,7 +77,7 @@ struct TracerOptions {
     size_t window_prisms = slabPrismLimit(kDefaultSlabMemory);  // every object's slabs' prisms at once
 };
 
-class SlabPlanner;
+class SlabPlanner;  // pipeline/slab_planner.h
 
 // The scene's worlds for one model, prepared for tracing frames first..last (global numbers).
 // Uniform motions: one world each, extruded once over the span the camera and each mirror image

@@ -431,7 +431,7 @@ TEST(RaytraceCrossCheck, ReflectionsFollowTheMirrorsExistence) {
 // raytraced through time slabs for two frames as it passes in front of the camera, against the
 // cut of the same frames with a tolerance of T = 1e-3 x its size (worldline_refine.h), cast in 3D.
 // The slabs' stated error: every point of their tetrahedra within 1e-3 of the wheel's size of the
-// true history in the lab (raytrace.cpp, extrude.h); with the cut's T, at most 5.7e-3 ls, 0.29 of
+// true history in the lab (slab_planner.h, extrude.h); with the cut's T, at most 5.7e-3 ls, 0.29 of
 // a pixel at the wheel's nearest (4 ls; 160 x 90 at 20 degrees). So the two pictures of which
 // pixel shows the wheel must agree up to the sampling: every pixel where they differ has the
 // other picture's value within one pixel. The cut in vertex mode (straight spokes where the
