@@ -305,3 +305,45 @@ TEST(FrameObjects, ObjectIndexWidthFollowsTheSequence) {
         EXPECT_EQ(ply.comments.back(), "object " + std::to_string(c.objects - 1) + " object_" + std::to_string(c.objects - 1));
     }
 }
+
+// Frames across processes without shared spills (exporters/frame_files.h): a rank's sink, begun
+// with beginEncoding, encodes the bytes its writer would write, and the writing sink commits them
+// (addEncoded): the same file, comments and object indices included, as one process's add().
+TEST(FrameObjects, EncodedFramesAreTheOneProcessBytes) {
+    testcli::TempDir tmp;
+    SequenceInfo info;
+    info.model = "finite";
+    info.scene_path = "scenes/two.json";
+    info.objects = {{"a b", {0.8, 0.8, 0.8, 1}, -1, ""}, {"c", {0.5, 0.5, 0.5, 1}, -1, ""}};
+    ExportFrame frame;
+    frame.index = 7;
+    frame.t_c = 0.1 + 7.0 / 3;
+    for (int o = 0; o < 2; ++o) {
+        mesh4d::ApparentMesh m;
+        m.positions = {{double(o), 0, 0}, {double(o) + 1, 0, 0}, {double(o), 1, 0}};
+        m.emission_times = {0, -1, -2};
+        m.triangles = {{0, 1, 2}};
+        frame.objects.push_back(m);
+    }
+    for (const bool ply : {true, false}) {
+        const fs::path one = tmp / (ply ? "one_ply" : "one_obj"), writer = tmp / (ply ? "w_ply" : "w_obj");
+        auto direct = ply ? plySink(one.string()) : objSink(one.string());
+        auto rank = ply ? plySink(writer.string()) : objSink(writer.string());
+        auto rank0 = ply ? plySink(writer.string()) : objSink(writer.string());
+        std::string error;
+        std::vector<std::string> completed;
+        ASSERT_TRUE(direct->begin(info, &error)) << error;
+        ASSERT_TRUE(direct->add(frame, direct->prepare(frame).get(), &completed, &error)) << error;
+        ASSERT_TRUE(rank->beginEncoding(info, &error)) << error;
+        ASSERT_TRUE(rank0->begin(info, &error)) << error;
+        const EncodedOutput e = rank->encode(frame, rank->prepare(frame).get());
+        ASSERT_TRUE(rank0->addEncoded(frame.index, e, &completed, &error)) << error;
+        ASSERT_EQ(completed.size(), 2u);
+        const std::string name = frameName(7) + (ply ? ".ply" : ".obj");
+        const std::string bytes = testio::readBytes(one / name);
+        EXPECT_TRUE(bytes == testio::readBytes(writer / name)) << name;
+        // The comments came with the sequence: the rank's bytes name the objects and the scene.
+        EXPECT_NE(bytes.find(std::string(ply ? "comment " : "# ") + "object 0 a_b\n"), std::string::npos) << name;
+        EXPECT_NE(bytes.find(std::string(ply ? "comment " : "# ") + "scene: scenes/two.json\n"), std::string::npos);
+    }
+}
