@@ -189,8 +189,8 @@ void write(benchmark::State& state, bool ply) {
     fs::create_directories(dir);
     for (auto _ : state) {
         std::string error;
-        const bool ok = ply ? apparent::writePly((dir / "f.ply").string(), p.frame, &error)
-                            : apparent::writeObj((dir / "f.obj").string(), p.frame, &error);
+        const bool ok = ply ? apparent::writePly((dir / "f.ply").string(), p.frame, apparent::SequenceInfo{}, &error)
+                            : apparent::writeObj((dir / "f.obj").string(), p.frame, apparent::SequenceInfo{}, &error);
         if (!ok) state.SkipWithError(error.c_str());
     }
     state.counters["triangles"] = double(p.world.mesh.triangles.size());
@@ -203,7 +203,7 @@ void BM_SerializePly(benchmark::State& state) {
     const Passing& p = passing(state.range(0));
     std::string bytes;
     for (auto _ : state) {
-        apparent::serializePly(p.frame, &bytes);
+        apparent::serializePly(p.frame, apparent::SequenceInfo{}, &bytes);
         benchmark::DoNotOptimize(bytes.data());
     }
     state.counters["triangles"] = double(p.world.mesh.triangles.size());

@@ -154,7 +154,7 @@ void BM_ExportFrame(benchmark::State& state) {
         std::string error;
         const bool ok = state.range(0) == 0
                             ? apparent::writeAnimatedGlb((dir / "f.glb").string(), frames, info, {}, nullptr, &error)
-                            : apparent::writePly((dir / "f.ply").string(), frames[0], &error);
+                            : apparent::writePly((dir / "f.ply").string(), frames[0], info, &error);
         if (!ok) state.SkipWithError(error.c_str());
     }
     setProcessCpu(state, cpu0);
@@ -196,7 +196,7 @@ void BM_PlySerialize(benchmark::State& state) {
     std::string bytes;
     const double cpu0 = processCpuSeconds();
     for (auto _ : state) {
-        apparent::serializePly(frame, &bytes);
+        apparent::serializePly(frame, apparent::SequenceInfo{}, &bytes);
         benchmark::DoNotOptimize(bytes.data());
     }
     setProcessCpu(state, cpu0);

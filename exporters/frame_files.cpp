@@ -3,8 +3,10 @@
 #include "exporters/atomic_file.h"
 #include "exporters/frame_spill.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <charconv>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
@@ -36,6 +38,36 @@ mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame) {
     return all;
 }
 
+std::vector<std::string> frameFileComments(const ExportFrame& frame, const SequenceInfo& info) {
+    std::vector<std::string> lines;
+    if (!frame.units.empty()) lines.push_back("units: " + frame.units);
+    if (!info.model.empty()) lines.push_back("model: " + info.model);
+    if (!info.scene_path.empty()) {
+        std::string path = info.scene_path;
+        for (char& c : path)
+            if ((unsigned char)c < 0x20 || c == 0x7f) c = '_';
+        lines.push_back("scene: " + path);
+    }
+    // Step: the camera time, shortest round trip (std::to_chars without a precision: no locale).
+    char buffer[32];
+    const auto r = std::to_chars(buffer, buffer + sizeof(buffer), frame.t_c);
+    lines.push_back("camera_time: " + std::string(buffer, r.ptr));
+    const size_t objects = frameObjectCount(frame, info);
+    for (size_t i = 0; i < objects; ++i) lines.push_back("object " + std::to_string(i) + " " + frameObjectName(info, i));
+    return lines;
+}
+
+size_t frameObjectCount(const ExportFrame& frame, const SequenceInfo& info) {
+    return std::max(info.objects.size(), frame.objects.size());
+}
+
+std::string frameObjectName(const SequenceInfo& info, size_t i) {
+    std::string name = i < info.objects.size() ? info.objects[i].name : std::string();
+    for (char& c : name)
+        if ((unsigned char)c <= 0x20 || c == 0x7f) c = '_';
+    return name.empty() ? "object_" + std::to_string(i) : name;
+}
+
 long long leastFrameBytes(const ExportFrame& frame) {
     size_t vertices = 0;
     for (const auto& o : frame.objects) vertices += o.positions.size();
@@ -62,7 +94,8 @@ std::string FrameFileSink::path(long long k) const {
     return (std::filesystem::path(dir_) / (frameName(k) + "." + extension_)).string();
 }
 
-bool FrameFileSink::begin(const SequenceInfo&, std::string* error) {
+bool FrameFileSink::begin(const SequenceInfo& info, std::string* error) {
+    info_ = info;
     std::error_code ec;
     std::filesystem::create_directories(dir_, ec);
     if (ec) *error = dir_ + ": cannot create output folder: " + ec.message();
@@ -74,7 +107,7 @@ PendingOutput FrameFileSink::pending(const ExportFrame& frame) { return {leastFr
 bool FrameFileSink::add(const ExportFrame& frame, const PreparedFrame*, std::vector<std::string>* completed,
                         std::string* error) {
     const std::string p = path(frame.index);
-    if (!write_(p, frame, error)) return false;
+    if (!write_(p, frame, info_, error)) return false;
     completed->push_back(p);
     return true;
 }
@@ -84,7 +117,7 @@ bool FrameFileSink::finish(SinkSummary*, std::string*) { return true; }
 EncodedOutput FrameFileSink::encode(const ExportFrame& frame, const PreparedFrame*) const {
     EncodedOutput e;
     e.least = e.estimate = leastFrameBytes(frame);
-    serialize_(frame, &e.bytes);
+    serialize_(frame, info_, &e.bytes);
     return e;
 }
 
@@ -191,6 +224,7 @@ std::string FrameFileSink::temporaryPath(long long k) const {
 
 bool FrameFileSink::beginEncoding(const SequenceInfo& info, std::string* error) {
     // The rank writes into DIR, possibly before rank 0's begin() made it.
+    info_ = info;
     return !frameSpillInstalled() || begin(info, error);
 }
 

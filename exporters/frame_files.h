@@ -1,5 +1,6 @@
 // Sinks that write one file per frame, DIR/frame_NNNNN.EXT (global frame numbers), holding every
-// object of the frame in one mesh: the base of the PLY and OBJ sinks. begin() creates DIR; each
+// object of the frame, each object's vertices and faces together in scene order (the PLY's
+// per-vertex `object` index, the OBJ's `o` groups): the base of the PLY and OBJ sinks. begin() creates DIR; each
 // frame's file is serialized in memory and committed through AtomicOutput, so it is complete when
 // add() returns, and counts to the output budget at once.
 // Frames across processes (pipeline/distribute.h): when the ranks share the output folder (their
@@ -32,10 +33,29 @@
 
 namespace apparent {
 
-// Writes `frame` to `path` (through a temporary name); false with a message naming the file.
-using FrameWriter = bool (*)(const std::string& path, const ExportFrame& frame, std::string* error);
+// Writes `frame` of the sequence `info` to `path` (through a temporary name); false with a message
+// naming the file.
+using FrameWriter = bool (*)(const std::string& path, const ExportFrame& frame, const SequenceInfo& info,
+                             std::string* error);
 // The file's bytes for `frame` (what FrameWriter writes): the frame as another process sends it.
-using FrameSerializer = void (*)(const ExportFrame& frame, std::string* bytes);
+using FrameSerializer = void (*)(const ExportFrame& frame, const SequenceInfo& info, std::string* bytes);
+
+// What both frame files say of their frame, one line each without the line break, in this order:
+// "units: U" (when the frame's units are not light-seconds), "model: M" and "scene: PATH" (when
+// the sequence names them), "camera_time: T" (the frame's t_c in seconds, the shortest decimal that
+// reads back as the same double), then "object I NAME" for every object I of the sequence
+// (frameObjectCount) in scene order. The PLY writes each as `comment LINE`, the OBJ as `# LINE`.
+// Control characters in the scene's path become '_' (one line each).
+std::vector<std::string> frameFileComments(const ExportFrame& frame, const SequenceInfo& info);
+
+// The objects of a sequence as the frame files count them: the sequence's (info.objects, mirror
+// reflections included) or, when a frame holds more (a frame written without its sequence), the
+// frame's. Every frame of a sequence has the same count.
+size_t frameObjectCount(const ExportFrame& frame, const SequenceInfo& info);
+
+// Object `i`'s name as the frame files write it: whitespace and control characters become '_'
+// (an OBJ `o` name is one word); an empty or missing name becomes "object_I".
+std::string frameObjectName(const SequenceInfo& info, size_t i);
 
 class FrameFileSink final : public FrameSink {
 public:
@@ -65,6 +85,7 @@ private:
     std::string temporaryPath(long long k) const;  // a rank's file for frame k (shared spills only)
     int sent_slot_ = -1;                            // a rank: its last frame's name, for its interrupt cleanup
     std::string dir_, extension_;
+    SequenceInfo info_;  // the sequence's, from begin() or beginEncoding()
     FrameWriter write_;
     FrameSerializer serialize_;
     bool light_factors_;

@@ -40,19 +40,20 @@ struct Block {
 
 }  // namespace
 
-void serializeObj(const ExportFrame& frame, std::string* out) {
-    // Step: the blocks, every object's vertices first, then every object's faces, in file order.
+void serializeObj(const ExportFrame& frame, const SequenceInfo& info, std::string* out) {
+    // Step: the blocks in file order, per object its vertices, then its faces (its `o` group).
     std::vector<Block> blocks;
+    std::vector<size_t> first_block(frame.objects.size() + 1, 0);
     uint64_t vertices = 0;
     for (size_t o = 0; o < frame.objects.size(); ++o) {
+        first_block[o] = blocks.size();
         const size_t n = frame.objects[o].positions.size();
         for (size_t b = 0; b < n; b += kBlock) blocks.push_back({o, b, std::min(n, b + kBlock), false, 0});
+        const size_t m = frame.objects[o].triangles.size();
+        for (size_t b = 0; b < m; b += kBlock) blocks.push_back({o, b, std::min(m, b + kBlock), true, vertices});
+        vertices += n;
     }
-    for (size_t o = 0; o < frame.objects.size(); ++o) {
-        const size_t n = frame.objects[o].triangles.size();
-        for (size_t b = 0; b < n; b += kBlock) blocks.push_back({o, b, std::min(n, b + kBlock), true, vertices});
-        vertices += frame.objects[o].positions.size();
-    }
+    first_block[frame.objects.size()] = blocks.size();
     // Step: each block formatted in parallel into its own text (kept between frames), then joined
     // in order: the bytes do not depend on the thread count.
     thread_local std::vector<std::string> kept_texts;
@@ -94,16 +95,20 @@ void serializeObj(const ExportFrame& frame, std::string* out) {
         faces += faces_in[i];
         size += texts[i].size();
     }
+    // Step: the counts and comments (frameFileComments), then per object its `o` line and blocks.
     std::string& all = *out;
     all = "# " + std::to_string(vertices) + " vertices, " + std::to_string(faces) + " faces\n";
-    if (!frame.units.empty()) all += "# units: " + frame.units + "\n";
+    for (const std::string& line : frameFileComments(frame, info)) all += "# " + line + "\n";
     all.reserve(all.size() + size);
-    for (size_t i = 0; i < blocks.size(); ++i) all += texts[i];
+    for (size_t o = 0; o < frame.objects.size(); ++o) {
+        all += "o " + frameObjectName(info, o) + "\n";
+        for (size_t i = first_block[o]; i < first_block[o + 1]; ++i) all += texts[i];
+    }
 }
 
-bool writeObj(const std::string& path, const ExportFrame& frame, std::string* error) {
+bool writeObj(const std::string& path, const ExportFrame& frame, const SequenceInfo& info, std::string* error) {
     thread_local std::string all;  // kept between frames: no reallocation while frames do not grow
-    serializeObj(frame, &all);
+    serializeObj(frame, info, &all);
     // Step: written with every error checked (exporters/atomic_file.h).
     AtomicOutput out(path);
     return out.commitBytes(all, error);

@@ -49,7 +49,7 @@ struct FaceBlock {
 
 }  // namespace
 
-void serializePly(const ExportFrame& frame, std::string* out) {
+void serializePly(const ExportFrame& frame, const SequenceInfo& info, std::string* out) {
     const bool little = littleEndianHost();
     // Step: counts, per block of triangles (faces with a repeated corner are left out: zero area by
     // construction), so that every block knows where its bytes go.
@@ -74,26 +74,32 @@ void serializePly(const ExportFrame& frame, std::string* out) {
         faces += kept[i];
     }
 
-    // Step: the header, then every vertex (x y z quality, absolute lab values; doppler and
-    // proper_time when the frame loop computed them, mesh4d/light_factors.h) and face, each block
+    // Step: the header (comments, frameFileComments), then every vertex (x y z quality, absolute
+    // lab values; doppler and proper_time when the frame loop computed them,
+    // mesh4d/light_factors.h; the object's index) and face, each block
     // written in place in parallel: the bytes do not depend on the thread count.
     const bool factors = std::all_of(frame.objects.begin(), frame.objects.end(), [](const mesh4d::ApparentMesh& o) {
         return o.doppler.size() == o.positions.size() && o.proper_time.size() == o.positions.size();
     });
-    const size_t vertex_bytes = kVertexBytes + (factors ? kFactorBytes : 0);
-    const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
-                               "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n" +
-                               (factors ? "property double doppler\nproperty double proper_time\n" : "") +
-                               (frame.units.empty() ? "" : "comment units: " + frame.units + "\n") +
-                               "element face " + std::to_string(faces) +
-                               "\nproperty list uchar int vertex_indices\nend_header\n";
+    // The object index's type from the sequence's object count, the same in every frame of it.
+    const size_t objects = frameObjectCount(frame, info);
+    const size_t object_bytes = objects <= 256 ? 1 : objects <= 65536 ? 2 : 4;
+    const char* const object_type = object_bytes == 1 ? "uchar" : object_bytes == 2 ? "ushort" : "int";
+    const size_t vertex_bytes = kVertexBytes + (factors ? kFactorBytes : 0) + object_bytes;
+    std::string header = "ply\nformat binary_little_endian 1.0\n";
+    for (const std::string& line : frameFileComments(frame, info)) header += "comment " + line + "\n";
+    header += "element vertex " + std::to_string(vertices) +
+              "\nproperty double x\nproperty double y\nproperty double z\nproperty double quality\n" +
+              (factors ? "property double doppler\nproperty double proper_time\n" : "") + "property " + object_type +
+              " object\nelement face " + std::to_string(faces) + "\nproperty list uchar int vertex_indices\nend_header\n";
     std::string& bytes = *out;
     bytes.resize(header.size() + vertex_bytes * vertices + kFaceBytes * faces);
     std::memcpy(&bytes[0], header.data(), header.size());
     char* const vertex_start = &bytes[0] + header.size();
     char* const face_start = vertex_start + vertex_bytes * vertices;
     size_t base = 0;
-    for (const auto& part : frame.objects) {
+    for (size_t o = 0; o < frame.objects.size(); ++o) {
+        const mesh4d::ApparentMesh& part = frame.objects[o];
         char* const dst = vertex_start + vertex_bytes * base;
         tbb::parallel_for(size_t(0), part.positions.size(), kBlock, [&](size_t first) {
             const size_t last = std::min(part.positions.size(), first + kBlock);
@@ -108,6 +114,12 @@ void serializePly(const ExportFrame& frame, std::string* out) {
                     p = storeLittleEndian(p, part.doppler[i], little);
                     p = storeLittleEndian(p, part.proper_time[i], little);
                 }
+                if (object_bytes == 1)
+                    *p++ = char(uint8_t(o));
+                else if (object_bytes == 2)
+                    p = storeLittleEndian(p, uint16_t(o), little);
+                else
+                    p = storeLittleEndian(p, int32_t(o), little);
             }
         });
         base += part.positions.size();
@@ -125,9 +137,9 @@ void serializePly(const ExportFrame& frame, std::string* out) {
     });
 }
 
-bool writePly(const std::string& path, const ExportFrame& frame, std::string* error) {
+bool writePly(const std::string& path, const ExportFrame& frame, const SequenceInfo& info, std::string* error) {
     thread_local std::string bytes;  // kept between frames: no reallocation while frames do not grow
-    serializePly(frame, &bytes);
+    serializePly(frame, info, &bytes);
     // Step: written whole (writeWhole: past the page cache when large, else buffered after its
     // blocks are reserved), with every write, fsync and close checked, then renamed into place.
     AtomicOutput out(path);

@@ -301,6 +301,11 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
             index_prop = int(i);
         }
     if (index_prop < 0) return fail("element face", "no list property 'vertex_indices' (or 'vertex_index')");
+    // An apparent frame read back (exporters/ply.h): its objects' indices are not read.
+    for (const PlyProperty& p : vertex->props)
+        if (p.name == "object" && !p.list)
+            scan->warnings.push_back("element vertex: property 'object' ignored (the objects' indices of an apparent "
+                                     "frame): the file is one object here");
 
     // Step: counts against the limits and against the file size, before anything is allocated.
     if (vertex->count > limits.max_vertices)

@@ -12,6 +12,8 @@
 // bytes in binary files). Errors are one line, "mesh.ply: field: problem", for example
 // "mesh.ply: face[3].vertex_indices[2]: index 9 is out of range (8 vertices)". Faces with a
 // repeated index are dropped and counted as degenerate, polygons triangulated (a fan) and counted.
+// Other properties are skipped; an apparent PLY frame's per-vertex `object` index
+// (exporters/ply.h) with a warning: the frame is read as one object.
 #pragma once
 
 #include <string>

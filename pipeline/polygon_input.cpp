@@ -125,6 +125,7 @@ Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::Re
     const size_t scanned_triangles = scan.mesh.triangles.size();
     warnings->polygons_triangulated += scan.polygons.size();
     warnings->degenerate_dropped += scan.repeated_index;
+    warnings->other.insert(warnings->other.end(), scan.warnings.begin(), scan.warnings.end());
     if (addsAsGiven(scan.mesh)) {
         *mesh = std::move(scan.mesh);
     } else {

@@ -31,6 +31,7 @@ struct ScannedMesh {
     // Faces with more than 3 corners: (first triangle, corner count), in order.
     std::vector<std::pair<uint32_t, uint32_t>> polygons;
     size_t repeated_index = 0;  // faces left out for a repeated index (OpenMesh drops them too)
+    std::vector<std::string> warnings;  // the scanner's own, for MeshWarnings::other
 };
 
 // True when OpenMesh's importer would add every triangle of `mesh` as it is: each directed edge

@@ -177,12 +177,14 @@ std::vector<PlyVertex> renderPly(const std::string& name, const std::string& sce
     const size_t end = bytes.find("end_header\n");
     EXPECT_NE(end, std::string::npos);
     const std::string header = bytes.substr(0, end);
-    EXPECT_NE(header.find("property double quality\nproperty double doppler\n"), std::string::npos) << header;
+    EXPECT_NE(header.find("property double quality\nproperty double doppler\nproperty double proper_time\nproperty uchar object\n"),
+              std::string::npos)
+        << header;
     const size_t n = std::stoul(header.substr(header.find("element vertex ") + 15));
     std::vector<PlyVertex> v(n);
     for (size_t i = 0; i < n; ++i) {
         double d[6];
-        std::memcpy(d, bytes.data() + end + 11 + 48 * i, 48);  // x y z quality doppler proper_time
+        std::memcpy(d, bytes.data() + end + 11 + 49 * i, 48);  // x y z quality doppler proper_time, uchar object
         v[i] = {{d[0], d[1], d[2]}, d[3], d[4]};
     }
     fs::remove_all(dir);

@@ -62,7 +62,9 @@ std::string writeOn(int threads, bool ply, const ExportFrame& frame, const fs::p
     tbb::task_arena arena(threads);
     std::string error;
     bool ok = false;
-    arena.execute([&] { ok = ply ? writePly(file.string(), frame, &error) : writeObj(file.string(), frame, &error); });
+    arena.execute([&] {
+        ok = ply ? writePly(file.string(), frame, SequenceInfo{}, &error) : writeObj(file.string(), frame, SequenceInfo{}, &error);
+    });
     EXPECT_TRUE(ok) << error;
     return testio::readBytes(file);
 }
@@ -94,18 +96,23 @@ TEST(FrameExport, PlyHoldsAbsoluteValuesAndOffsetFaces) {
     }
     EXPECT_NE(bytes.find("element vertex " + std::to_string(vertices) + "\n"), std::string::npos);
     EXPECT_NE(bytes.find("element face " + std::to_string(kept) + "\n"), std::string::npos);
-    ASSERT_EQ(bytes.size(), body + 32 * vertices + 13 * kept);
+    // x y z quality (double), then the object index (uchar: 2 objects).
+    ASSERT_NE(bytes.find("property double quality\nproperty uchar object\n"), std::string::npos);
+    ASSERT_EQ(bytes.size(), body + 33 * vertices + 13 * kept);
     // Little-endian doubles on this (x86-64) host: compared with origin + local, computed here.
     size_t v = 0;
-    for (const auto& o : frame.objects)
+    for (size_t o_index = 0; o_index < frame.objects.size(); ++o_index) {
+        const auto& o = frame.objects[o_index];
         for (size_t i = 0; i < o.positions.size(); ++i, ++v) {
             double d[4];
-            std::memcpy(d, bytes.data() + body + 32 * v, 32);
+            std::memcpy(d, bytes.data() + body + 33 * v, 32);
+            ASSERT_EQ(bytes[body + 33 * v + 32], char(o_index));
             ASSERT_EQ(d[0], o.origin.x + o.positions[i].x);
             ASSERT_EQ(d[1], o.origin.y + o.positions[i].y);
             ASSERT_EQ(d[2], o.origin.z + o.positions[i].z);
             ASSERT_EQ(d[3], o.time_origin + o.emission_times[i]);
         }
+    }
     // The last face: the second object's last triangle, its indices offset by the first's vertices.
     const auto& last = frame.objects[1].triangles.back();
     int32_t idx[3];

@@ -197,14 +197,14 @@ TEST(HostileInput, FailedWriteKeepsThePreviousFile) {
     std::string error;
     ExportFrame small = frame;
     small.objects[0].triangles.resize(1);
-    ASSERT_TRUE(writePly(path, small, &error)) << error;
+    ASSERT_TRUE(writePly(path, small, SequenceInfo{}, &error)) << error;
     const std::string previous = testio::readBytes(path);
 
     bool ok = false;
     {
         const testio::FileSizeLimit limit(4096);
         ASSERT_TRUE(limit.ok());
-        ok = writePly(path, frame, &error);
+        ok = writePly(path, frame, SequenceInfo{}, &error);
     }
 
     EXPECT_FALSE(ok);

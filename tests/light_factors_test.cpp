@@ -30,20 +30,22 @@ struct PlyVertex {
     double t = 0, doppler = 0, proper_time = 0;
 };
 
-// Reads a binary PLY frame with x y z quality doppler proper_time (doubles, little-endian).
+// Reads a binary PLY frame with x y z quality doppler proper_time (doubles, little-endian) and the
+// object index (uchar: one object).
 std::vector<PlyVertex> readFrame(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const size_t end = bytes.find("end_header\n");
     EXPECT_NE(end, std::string::npos);
     const std::string header = bytes.substr(0, end);
-    EXPECT_NE(header.find("property double quality\nproperty double doppler\nproperty double proper_time\n"), std::string::npos)
+    EXPECT_NE(header.find("property double quality\nproperty double doppler\nproperty double proper_time\nproperty uchar object\n"),
+              std::string::npos)
         << header;
     const size_t n = std::stoul(header.substr(header.find("element vertex ") + 15));
     std::vector<PlyVertex> v(n);
     for (size_t i = 0; i < n; ++i) {
         double d[6];
-        std::memcpy(d, bytes.data() + end + 11 + 48 * i, 48);  // the test machine is little-endian
+        std::memcpy(d, bytes.data() + end + 11 + 49 * i, 48);  // the test machine is little-endian
         v[i] = {{d[0], d[1], d[2]}, d[3], d[4], d[5]};
     }
     return v;

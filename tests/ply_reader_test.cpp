@@ -64,7 +64,8 @@ TEST(PlyReader, PolygonsAndDegenerateFacesAreCounted) {
     EXPECT_EQ(w2.degenerate_dropped, 1u);
 }
 
-// Our own exporter's PLY (binary, float x y z plus a double quality) must read back vertex for vertex.
+// Our own exporter's PLY (binary, double x y z quality and the object index) must read back vertex
+// for vertex, as one object: the `object` property ignored with a warning.
 TEST(PlyReader, ExporterOutputReadsBack) {
     ExportFrame frame;
     mesh4d::ApparentMesh a;
@@ -83,7 +84,7 @@ TEST(PlyReader, ExporterOutputReadsBack) {
     fs::create_directories(dir);
     const std::string path = (dir / "frame.ply").string();
     std::string error;
-    ASSERT_TRUE(writePly(path, frame, &error)) << error;
+    ASSERT_TRUE(writePly(path, frame, SequenceInfo{}, &error)) << error;
     mesh4d::RestMesh m;
     MeshWarnings w;
     const Status st = read(path, &m, &w);
@@ -92,6 +93,8 @@ TEST(PlyReader, ExporterOutputReadsBack) {
     EXPECT_EQ(m.triangles.size(), 5u);
     EXPECT_DOUBLE_EQ(m.positions[5].x, 10.0);
     EXPECT_DOUBLE_EQ(m.positions[3].z, 2.0);
+    ASSERT_EQ(w.other.size(), 1u);
+    EXPECT_NE(w.other[0].find("element vertex: property 'object' ignored"), std::string::npos) << w.other[0];
     fs::remove_all(dir);
 }
 

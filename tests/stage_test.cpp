@@ -110,7 +110,8 @@ TEST(Stage, GlbBytesPinnedAcrossTheRefactor) {
 
 namespace {
 
-// The vertices of a binary little-endian PLY with double x y z quality, in file order.
+// The vertices of a binary little-endian PLY with double x y z quality (then doppler and
+// proper_time when computed, and the uchar object index), in file order.
 std::vector<std::array<double, 4>> readPlyDoubles(const fs::path& p, size_t* faces) {
     const std::string bytes = testio::readBytes(p);
     const size_t end = bytes.find("end_header\n");
@@ -121,10 +122,12 @@ std::vector<std::array<double, 4>> readPlyDoubles(const fs::path& p, size_t* fac
         << header;
     const size_t n = std::stoul(header.substr(header.find("element vertex ") + 15));
     *faces = std::stoul(header.substr(header.find("element face ") + 13));
-    // x y z quality, then doppler and proper_time when the frame loop computed them.
+    // x y z quality, then doppler and proper_time when the frame loop computed them, then the
+    // object index (a uchar: these scenes have fewer than 257 objects).
     const bool factors = header.find("property double quality\nproperty double doppler\nproperty double proper_time\n") !=
                          std::string::npos;
-    const size_t stride = factors ? 48 : 32;
+    EXPECT_NE(header.find("property uchar object\n"), std::string::npos) << header;
+    const size_t stride = (factors ? 48 : 32) + 1;
     std::vector<std::array<double, 4>> v(n);
     const char* data = bytes.data() + end + 11;
     EXPECT_EQ(bytes.size(), end + 11 + stride * n + 13 * *faces);

@@ -10,13 +10,16 @@ import apparent
 from conftest import ROOT, run_cli
 
 
+PLY_TYPES = {"double": "<f8", "uchar": "u1", "ushort": "<u2", "int": "<i4"}
+
+
 def read_ply(path):
     """A binary little-endian PLY as apparent writes it (exporters/ply.h): vertex doubles x y z
-    quality [doppler proper_time], faces as `list uchar int`. Returns (dict of vertex columns,
-    faces M x 3)."""
+    quality [doppler proper_time], the integer `object` index, faces as `list uchar int`. Returns
+    (dict of vertex columns, faces M x 3)."""
     data = pathlib.Path(path).read_bytes()
     end = data.index(b"end_header\n") + len(b"end_header\n")
-    header = data[:end].decode("ascii").splitlines()
+    header = data[:end].decode("utf-8").splitlines()
     assert header[0] == "ply" and header[1] == "format binary_little_endian 1.0"
     names, counts, element = [], {}, None
     for line in header[2:]:
@@ -25,16 +28,16 @@ def read_ply(path):
             element = words[1]
             counts[element] = int(words[2])
         elif words[0] == "property" and element == "vertex":
-            assert words[1] == "double"
-            names.append(words[2])
+            assert words[1] in PLY_TYPES
+            names.append((words[2], PLY_TYPES[words[1]]))
         elif words[0] == "property" and element == "face":
             assert words[1:4] == ["list", "uchar", "int"]
     n, m = counts["vertex"], counts["face"]
-    vertex = np.frombuffer(data, dtype=[(name, "<f8") for name in names], count=n, offset=end)
+    vertex = np.frombuffer(data, dtype=names, count=n, offset=end)
     faces = np.frombuffer(data, dtype=[("n", "u1"), ("v", "<i4", 3)], count=m, offset=end + vertex.nbytes)
     assert np.all(faces["n"] == 3)
     assert end + vertex.nbytes + faces.nbytes == len(data)
-    return {name: vertex[name] for name in names}, faces["v"].astype(np.int64)
+    return {name: vertex[name] for name, _ in names}, faces["v"].astype(np.int64)
 
 
 SCENES = [
@@ -67,6 +70,7 @@ def test_cut_equals_the_commands_ply(scene_path, tolerance, tmp_path):
         np.testing.assert_array_equal(frame.positions[:, 1], columns["y"])
         np.testing.assert_array_equal(frame.positions[:, 2], columns["z"])
         np.testing.assert_array_equal(frame.emission_time, columns["quality"])
+        np.testing.assert_array_equal(frame.object, columns["object"])
         if "doppler" in columns:
             np.testing.assert_array_equal(frame.doppler, columns["doppler"])
             np.testing.assert_array_equal(frame.proper_time, columns["proper_time"])
