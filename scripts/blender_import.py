@@ -16,7 +16,8 @@
 #   - sets the timeline to the file's frames: 0 .. N-1 for its N frames (scene extras "frame_times");
 #   - makes the file's camera the scene camera;
 #   - lights the scene as the file's scene is lit (scene extras "light"): a sun per distant light or a
-#     point light, and the world colour the ambient share (docs/VIEWERS.md "Blender" derives the strengths).
+#     point light, and the world colour the ambient share (docs/VIEWERS.md "Blender" derives the strengths),
+#     with the "Standard" view transform (sRGB, as apparent's raytracer writes its pictures).
 # --save PATH writes the result as a .blend file. --draco-library PATH: the Draco library (default: the
 # build's; BLENDER_EXTERN_DRACO_LIBRARY_PATH, when set and no option is given). Exit status (with
 # --background): 0 done, 1 the import failed, 2 a usage problem.
@@ -130,6 +131,7 @@ if not isinstance(frame_times, list):
     fail(1, f'{path}: scene extras "frame_times": {shown(frame_times)} is not a list')
 frames = len(frame_times) or 1
 
+
 def vector3(value):
     """A list of 3 finite numbers, or None."""
     if not isinstance(value, list) or len(value) != 3:
@@ -149,7 +151,7 @@ def read_light(light):
     """The scene extras "light" (apparent's glb writer, exporters/glb/document.cpp) as a list of
     ('SUN' or 'POINT', glTF vector, weight) and the ambient share; one line and exit 1 if malformed."""
     def bad(field, what):
-        fail(1, f'{path}: scene extras "light.{field}": {what}')
+        fail(1, f'{path}: scene extras "light": "{field}" {what}')
     if not isinstance(light, dict):
         fail(1, f'{path}: scene extras "light": {shown(light)} is not an object')
     ambient = fraction(light.get('ambient', 0.2))
@@ -262,6 +264,10 @@ if scene.world.use_nodes and 'Background' in scene.world.node_tree.nodes:
     background = scene.world.node_tree.nodes['Background']
     background.inputs['Color'].default_value = (ambient, ambient, ambient, 1)
     background.inputs['Strength'].default_value = 1
+# Linear radiance to the picture as the raytracer does (sRGB transfer curve, clipped at 1: Blender's
+# "Standard" view; its default "Filmic" compresses and desaturates the highlights).
+scene.view_settings.view_transform = 'Standard'
+scene.view_settings.look = 'None'
 print(f'blender_import: lit by {light_source}: ' +
       ', '.join(f'{kind.lower()} {weight:g}' for kind, _, weight in lights) + f', world {ambient:g}')
 print(f'blender_import: {path}: {frames} frames at {fps:g} fps, timeline 0..{frames - 1}, camera '
