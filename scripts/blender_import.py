@@ -232,10 +232,12 @@ if cameras:
 # Step: the lights, in linear radiance as the raytracer shades (pipeline/raytrace.cpp shadeWith: base x
 # (ambient + (1 - ambient) x weighted Lambert)). A diffuse surface of albedo a under a sun of strength S
 # at normal incidence leaves radiance a S / pi, and under a uniform world of colour W radiance a W: so
-# each sun gets pi (1 - ambient) weight and the world the ambient share. A point light of power P at
-# distance r gives a sun's S = P / (4 pi r^2) (Cycles; measured, docs/VIEWERS.md): P = 4 pi^2 r^2 x the
-# sun's strength, with r taken to the centre of the bounds of the meshes shown at frame 0 (the raytracer's point
-# light does not fall off; Blender's does, so it matches there).
+# each sun gets S = pi (1 - ambient) weight and the world the ambient share. The raytracer's point
+# light does not fall off: in Cycles a Light Falloff node's "Constant" output of strength X on a point
+# light of power P gives radiance a P X / (4 pi^2) at any distance, and without it (Eevee) a point light
+# lights like a sun of strength P / (4 pi r^2) at distance r (both measured, docs/VIEWERS.md); so
+# P = 4 pi r^2 S and X = 1 / r^2, with r from the light to the centre of the meshes shown at frame 0:
+# Cycles then matches the raytracer everywhere, Eevee there.
 # The meshes shown at frame 0 (the others have scale 0 there).
 meshes = [o for o in scene.objects if o.type == 'MESH' and len(o.data.vertices) and o.matrix_world.determinant() != 0]
 centre = mathutils.Vector((0.0, 0.0, 0.0))
@@ -255,7 +257,12 @@ for n, (kind, vector, weight) in enumerate(lights):
     else:
         obj.location = blender_axes(vector)
         r2 = max((obj.location - centre).length_squared, 1e-12)
-        data.energy = 4 * math.pi ** 2 * r2 * strength
+        data.energy = 4 * math.pi * r2 * strength
+        data.use_nodes = True
+        nodes = data.node_tree.nodes
+        falloff = nodes.new('ShaderNodeLightFalloff')
+        falloff.inputs['Strength'].default_value = 1 / r2
+        data.node_tree.links.new(falloff.outputs['Constant'], nodes['Emission'].inputs['Strength'])
     scene.collection.objects.link(obj)
 if scene.world is None:
     scene.world = bpy.data.worlds.new('apparent world')
