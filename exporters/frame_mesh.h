@@ -43,6 +43,18 @@ struct ExportCamera {
     bool orthographic() const { return width > 0; }
 };
 
+// The scene's light (pipeline/scene.h LightSpec, resolved: a scene without `light` gets its two
+// default distant lights), at rest in the lab, in the outputs' axes and units, for viewers that
+// light the files as the raytracer does (scene extras "light"; scripts/blender_import.py).
+struct ExportLight {
+    bool point = false;                   // a point light at `position`, else distant towards `direction`
+    mesh4d::Vec3 position{0, 0, 0};
+    mesh4d::Vec3 direction{0, 1, 0};      // unit vector towards the light
+    double ambient = 0.2;                 // share of the base colour lit whatever the normal, [0, 1]
+    mesh4d::Vec3 key_direction{0, 0, 1};  // the default key light (unit, towards it), when key_weight > 0
+    double key_weight = 0;                // its share of the diffuse light, [0, 1]
+};
+
 struct SequenceInfo {
     std::string model;            // instant, finite, relativistic, contracted
     double tolerance = 0;         // requested tolerance (in the scene's units of length)
@@ -51,6 +63,7 @@ struct SequenceInfo {
     std::string scene_path;
     std::vector<ExportObject> objects;  // parallel to ExportFrame::objects
     ExportCamera camera;
+    ExportLight light;
 };
 
 // "frame_00042": the name of global frame k in file and node names.

@@ -126,6 +126,12 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
     info.camera.up = scene.camera.up;
     info.camera.fov_deg = scene.camera.fov_deg;
     if (scene.camera.orthographic()) info.camera.width = scene.camera.width;
+    info.light.point = scene.light.kind == LightSpec::Kind::Point;
+    info.light.position = scene.light.position * u;
+    info.light.direction = scene.light.direction;
+    info.light.ambient = scene.light.ambient;
+    info.light.key_direction = scene.light.key_direction;
+    info.light.key_weight = scene.light.key_weight;
     return info;
 }
 

@@ -14,7 +14,7 @@
 
 namespace apparent {
 
-const std::string kShardMagic = "apparent shard 1\n";
+const std::string kShardMagic = "apparent shard 2\n";
 
 void putShardU64(std::string* out, uint64_t v) {
     for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));  // little-endian
@@ -126,6 +126,27 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
     o->doppler = flags[5] != 0;
     o->proper_time = flags[6] != 0;
     o->shade_doppler = flags[7] != 0;
+    // The light: a point flag, position, direction, ambient, key direction and weight.
+    ExportLight& l = info->light;
+    const uint64_t point = in->u64();
+    if (in->ok && point > 1) fail("light.point", std::to_string(point) + " is outside 0 .. 1");
+    l.point = point == 1;
+    for (mesh4d::Vec3* v : {&l.position, &l.direction}) {
+        v->x = in->real();
+        v->y = in->real();
+        v->z = in->real();
+    }
+    l.ambient = in->real();
+    l.key_direction.x = in->real();
+    l.key_direction.y = in->real();
+    l.key_direction.z = in->real();
+    l.key_weight = in->real();
+    if (in->ok && !finite({l.position.x, l.position.y, l.position.z, l.direction.x, l.direction.y, l.direction.z,
+                           l.key_direction.x, l.key_direction.y, l.key_direction.z}))
+        fail("light", "a position or direction coordinate is not finite");
+    if (in->ok && !(l.ambient >= 0 && l.ambient <= 1)) fail("light.ambient", formatNumber(l.ambient) + " is outside [0, 1]");
+    if (in->ok && !(l.key_weight >= 0 && l.key_weight <= 1))
+        fail("light.key_weight", formatNumber(l.key_weight) + " is outside [0, 1]");
 }
 
 }  // namespace
@@ -149,6 +170,13 @@ void putShardSequence(std::string* out, const SequenceInfo& info, const GlbOptio
     for (int v : {int(o.draco), o.position_bits, o.normal_bits, int(o.meshopt), o.meshopt_bits, int(o.doppler),
                   int(o.proper_time), int(o.shade_doppler)})
         putU64(out, uint64_t(int64_t(v)));
+    const ExportLight& l = info.light;
+    putU64(out, l.point ? 1 : 0);
+    for (const mesh4d::Vec3& v : {l.position, l.direction})
+        for (double c : {v.x, v.y, v.z}) putDouble(out, c);
+    putDouble(out, l.ambient);
+    for (double c : {l.key_direction.x, l.key_direction.y, l.key_direction.z}) putDouble(out, c);
+    putDouble(out, l.key_weight);
 }
 
 uint64_t ShardReader::u64() {

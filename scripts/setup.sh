@@ -58,11 +58,13 @@ if [ "$mode" = test ]; then
   npm ci --no-audit --no-fund --loglevel=error
 fi
 
-# Step: build: the demo needs the program alone; test and build make everything (tests, benchmarks).
+# Step: build: the demo needs the program and the Draco library Blender's glTF importer loads
+# (build/blender/libextern_draco.so, which scripts/blender_import.py finds: Debian's Blender ships none);
+# test and build make everything (tests, benchmarks).
 echo "== building in $build_dir"
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 if [ "$mode" = demo ]; then
-  cmake --build "$build_dir" -j "$jobs" --target apparent
+  cmake --build "$build_dir" -j "$jobs" --target apparent blender_draco
 else
   cmake --build "$build_dir" -j "$jobs"
 fi

@@ -358,6 +358,55 @@ void writePassingSphereScene(const fs::path& dir, const std::string& sphere) {
 
 }  // namespace
 
+// The scene extras "light" (exporters/glb/document.cpp writeLight): the scene's light in the file's
+// axes and units, for viewers that light the file (scripts/blender_import.py). Three scenes with a
+// box at rest: the default lights, derived here by hand for a camera at the origin looking down -z
+// with +y up (forward f = (0, 0, -1), right f x up = (1, 0, 0), up (0, 1, 0); the key light towards
+// back 1, left 0.45, up 0.15: (-0.45, 0.15, 1) / sqrt(1.225), weight 0.7; the overhead light +y);
+// a distant light given as (0, 2, 0), recorded as the unit (0, 1, 0); a point light in a scene in
+// metres, recorded in metres (the input's numbers, through light-seconds and back).
+TEST(Cli, GlbSceneExtrasRecordTheLight) {
+    TempDir dir;
+    fs::create_directories(dir / "scene");
+    fs::copy_file(source("data/meshes/box.obj"), dir / "scene/box.obj");
+    const std::string head = R"({
+  "camera": { "position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_deg": 60 },
+  "frames": { "start": 0, "end": 0.2, "fps": 10 }, "model": "instant",
+  "objects": [ { "name": "box", "mesh": "box.obj", "position": [0, 0, -10] } ])";
+    std::ofstream(dir / "scene/default.json") << head << "}";
+    std::ofstream(dir / "scene/distant.json") << head << R"(, "light": { "direction": [0, 2, 0], "ambient": 0.3 } })";
+    std::ofstream(dir / "scene/metres.json") << head
+                                             << R"(, "units": "m", "light": { "position": [1.5e8, 2, -3e9] } })";
+    auto light = [&](const std::string& name) {
+        const fs::path out = dir / ("out_" + name);
+        const CommandResult r = apparentRun(
+            {"render", (dir / "scene" / (name + ".json")).string(), "--out", out.string(), "--quiet"});
+        EXPECT_EQ(r.code, 0) << r.err;
+        return glbJson(out / "instant.glb")["scenes"][0]["extras"]["light"];
+    };
+    auto expectVector = [](const nlohmann::json& v, std::array<double, 3> expected, double tolerance) {
+        ASSERT_TRUE(v.is_array() && v.size() == 3) << v;
+        for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[i].get<double>(), expected[i], tolerance) << v;
+    };
+    const nlohmann::json d = light("default");
+    const double n = std::sqrt(1.225);
+    EXPECT_EQ(d["ambient"].get<double>(), 0.2) << d;
+    expectVector(d["direction"], {0, 1, 0}, 0);
+    expectVector(d["key_direction"], {-0.45 / n, 0.15 / n, 1 / n}, 1e-15);
+    EXPECT_EQ(d["key_weight"].get<double>(), 0.7) << d;
+    EXPECT_FALSE(d.contains("position")) << d;
+
+    const nlohmann::json s = light("distant");
+    EXPECT_EQ(s["ambient"].get<double>(), 0.3) << s;
+    expectVector(s["direction"], {0, 1, 0}, 0);
+    EXPECT_FALSE(s.contains("key_weight") || s.contains("key_direction") || s.contains("position")) << s;
+
+    const nlohmann::json m = light("metres");
+    EXPECT_EQ(m["ambient"].get<double>(), 0.2) << m;
+    expectVector(m["position"], {1.5e8, 2, -3e9}, 3e9 * 1e-15);
+    EXPECT_FALSE(m.contains("direction") || m.contains("key_weight")) << m;
+}
+
 // Shared index buffers (gltf.h): in vertex mode with nothing clipped every frame of an object has
 // the same triangles, so the .glb holds one index accessor per object, plain and meshopt; each
 // frame still has its own vertices (with meshopt, as morph targets of its run's mesh). Read from

@@ -43,11 +43,11 @@ std::string real(double v) {
 // independently): the header's fields, then the frame records, then the end record.
 struct ShardLayout {
     size_t model = 0, tolerance = 0, fps = 0, scene_path = 0, objects = 0, name0 = 0, color0 = 0, mirror0 = 0,
-           camera = 0, fov = 0, flags = 0;
+           camera = 0, fov = 0, flags = 0, light = 0;
     std::vector<std::pair<size_t, size_t>> records;  // each frame record: its start and its length in all
     size_t end = 0;                                  // the end record's start
     explicit ShardLayout(const std::string& b) {
-        size_t at = 17 + 5 * 8;  // "apparent shard 1\n", fingerprint, part, parts, first, last
+        size_t at = 17 + 5 * 8;  // "apparent shard 2\n", fingerprint, part, parts, first, last
         auto skipString = [&] { at += 8 + size_t(getU64(b, at)); };
         model = at;
         skipString();
@@ -74,6 +74,9 @@ struct ShardLayout {
         at += 8;
         flags = at;
         at += 8 * 8;
+        // The light: point flag, position, direction, ambient, key direction, key weight.
+        light = at;
+        at += 8 + 3 * 8 + 3 * 8 + 8 + 3 * 8 + 8;
         while (getU64(b, at) == 1) {
             const size_t length = 16 + size_t(getU64(b, at + 8));
             records.emplace_back(at, length);
@@ -180,6 +183,12 @@ TEST_F(MergeHostile, HeaderNumbersAndFlagsOutOfRangeAreRefused) {
         {l.flags + 32, u64(17), "meshopt bits"},
         {l.flags + 56, u64(uint64_t(1) << 40), "shade doppler"},
         {l.objects, u64(uint64_t(1) << 40), "objects"},
+        {l.light, u64(2), "light.point"},
+        {l.light + 8, real(inf), "light"},               // position
+        {l.light + 8 + 24 + 8, real(nan), "light"},      // direction's y
+        {l.light + 8 + 48, real(1.5), "light.ambient"},
+        {l.light + 8 + 48, real(nan), "light.ambient"},
+        {l.light + 8 + 56 + 24, real(-0.1), "light.key_weight"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.field);

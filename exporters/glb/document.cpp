@@ -288,7 +288,27 @@ void writeMaterials(gltfjson::Text* t, const SequenceInfo& info, bool shade_dopp
     }
 }
 
-// Scene extras: what was computed, in which units, at which camera times.
+// The scene's light, resolved (ExportLight): "ambient", then "position" (a point light) or
+// "direction" (towards a distant light), and with the default key light "key_direction" and
+// "key_weight" (docs/GLTF.md "Scene extras").
+void writeLight(gltfjson::Text* t, const ExportLight& light) {
+    t->key("light");
+    t->open('{');
+    t->key("ambient");
+    t->value(light.ambient);
+    const mesh4d::Vec3& main = light.point ? light.position : light.direction;
+    const double v[3] = {main.x, main.y, main.z};
+    numbers(t, light.point ? "position" : "direction", v, 3);
+    if (light.key_weight > 0) {
+        const double k[3] = {light.key_direction.x, light.key_direction.y, light.key_direction.z};
+        numbers(t, "key_direction", k, 3);
+        t->key("key_weight");
+        t->value(light.key_weight);
+    }
+    t->close('}');
+}
+
+// Scene extras: what was computed, in which units, at which camera times, in which light.
 void writeScenes(gltfjson::Text* t, const SequenceModel& model) {
     const SequenceInfo& info = model.info;
     t->key("scenes");
@@ -304,6 +324,7 @@ void writeScenes(gltfjson::Text* t, const SequenceModel& model) {
     t->open('[');
     for (const double time : model.frame_times) t->value(time);
     t->close(']');
+    writeLight(t, info.light);
     t->key("model");
     t->value(info.model);
     t->key("objects");

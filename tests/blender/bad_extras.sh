@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # ctest entry (issue 33, item 7): scripts/blender_import.py refuses a .glb whose scene extras it
-# reads are bad ("fps" 0, null, negative, Infinity, a string, true; "frame_times" not a list) with
+# reads are bad ("fps" 0, null, negative, Infinity, a string, true; "frame_times" not a list; "light"
+# not an object, an ambient outside [0, 1], neither or a zero direction, a position with a string,
+# a key weight without its direction) with
 # one line and exit status 1, as it documents, instead of a Python traceback after which Blender
 # exits 0. The files are the default scene's .glb with only those extras changed.
 # Usage: bad_extras.sh APPARENT_BINARY SOURCE_DIR
@@ -47,6 +49,10 @@ check() {  # KEY VALUE: exit status 1 and one line naming the key
 }
 for v in 0 null -24 Infinity '"24"' true; do check fps "$v"; done
 check frame_times 3
+for v in 5 '{"ambient": 2, "direction": [0, 1, 0]}' '{"ambient": 0.2}' '{"direction": [0, 0, 0]}' \
+         '{"position": [0, "a", 0]}' '{"direction": [0, 1, 0], "key_weight": 0.7}'; do
+  check light "$v"
+done
 # The unaltered file still imports (exit 0).
 "$blender" -b --factory-startup --python "$src/scripts/blender_import.py" -- "$tmp/out/relativistic.glb" \
   >"$tmp/out.log" 2>&1 || { echo "bad_extras.sh: FAIL: the unaltered file did not import" >&2; cat "$tmp/out.log" >&2; failed=1; }

@@ -1,11 +1,12 @@
 # Blender check of apparent's animated .glb files (one node per frame, STEP scale toggles visibility).
 #
 #   blender -b --factory-startup --python tests/blender/check_glb.py -- FILE.glb [FILE.glb ...]
-#           [--scene-fps N] [--frames 0,50,100,199]
+#           [--scene-fps N] [--frames 0,50,100,199] [--draco-library PATH]
 #
 # For each file, in a fresh empty Blender scene:
 #   - bpy.ops.import_scene.gltf succeeds (a KHR_draco_mesh_compression file needs Blender's Draco library,
-#     libextern_draco.so; when it is missing the file FAILS with the importer's own error message);
+#     libextern_draco.so: the build's, build/blender/, or --draco-library PATH, given to the importer as
+#     scripts/blender_import.py does; when it is missing the file FAILS with the importer's own error message);
 #   - one object per frame node, named like the node (frame_NNNNN; a Blender rename "frame_00007.001" is
 #     accepted and reported), MESH for a node with a mesh and EMPTY for an empty frame; the camera node too;
 #   - mesh vertex counts match the file (plain files: the referenced vertices of every primitive, which is what
@@ -42,7 +43,7 @@ T0 = time.time()
 def usage(msg):
     print(f'check_glb: {msg}', file=sys.stderr)
     print('usage: blender -b --factory-startup --python tests/blender/check_glb.py -- FILE.glb [...] '
-          '[--scene-fps N] [--frames 0,50,100,199]', file=sys.stderr)
+          '[--scene-fps N] [--frames 0,50,100,199] [--draco-library PATH]', file=sys.stderr)
     sys.stdout.flush()
     os._exit(2)
 
@@ -50,9 +51,18 @@ def usage(msg):
 # ---------------------------------------------------------------- arguments (everything after "--")
 argv = sys.argv[sys.argv.index('--') + 1:] if '--' in sys.argv else []
 files, scene_fps, frames_opt = [], None, None
+# The build's Draco library for Blender (CMakeLists.txt target blender_draco), as scripts/blender_import.py finds it.
+draco_path = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), 'build',
+                          'blender', 'libextern_draco.so')
 i = 0
 while i < len(argv):
     a = argv[i]
+    if a == '--draco-library':
+        if i + 1 >= len(argv):
+            usage(f'{a} needs a value')
+        draco_path = os.path.abspath(argv[i + 1])
+        i += 2
+        continue
     if a in ('--scene-fps', '--frames'):
         if i + 1 >= len(argv):
             usage(f'{a} needs a value')
@@ -76,6 +86,8 @@ while i < len(argv):
     i += 1
 if not files:
     usage('no .glb file given')
+# The importer loads the Draco library from this variable, read at each import (scripts/blender_import.py).
+os.environ['BLENDER_EXTERN_DRACO_LIBRARY_PATH'] = draco_path
 
 # ---------------------------------------------------------------- Debian workaround
 # Debian's blender 3.4.1 ships an importer that uses np.bool, which numpy >= 1.24 (Debian 12) removed
@@ -309,8 +321,8 @@ def check_file(path):
         detail = key[-1] if key else text.strip().splitlines()[-1]
         if d['draco'] and 'extern_draco' in text:
             detail = (f'Blender\'s Draco library is not available in this build: {detail} '
-                      '(Debian\'s blender package does not ship libextern_draco.so; '
-                      'tests/blender/run.sh --draco-shim provides a stand-in built on Debian\'s libdraco)')
+                      '(Debian\'s blender package does not ship libextern_draco.so; the build makes it: '
+                      'cmake --build build --target blender_draco, or give --draco-library PATH)')
         r.check(False, 'import_scene.gltf', detail)
         return r
     sys.stdout = tee.out

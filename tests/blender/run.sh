@@ -2,13 +2,11 @@
 # Imports apparent's animated .glb files into headless Blender and checks objects, animation and visibility over
 # time (tests/blender/check_glb.py has the list of checks).
 #
-#   tests/blender/run.sh [--draco-shim] [--scene-fps N] [--frames 0,50,100,199] FILE.glb [FILE.glb ...]
+#   tests/blender/run.sh [--draco-library PATH] [--scene-fps N] [--frames 0,50,100,199] FILE.glb [FILE.glb ...]
 #
-# --draco-shim  Debian's blender ships the glTF importer without Blender's Draco library (libextern_draco.so), so
-#               a KHR_draco_mesh_compression file FAILS to import there. With this flag the script builds a
-#               stand-in (tests/blender/extern_draco_shim.cpp, on Debian's libdraco; needs g++ and libdraco-dev)
-#               into a temporary directory and gives it to the importer via BLENDER_EXTERN_DRACO_LIBRARY_PATH.
-#               Ignored when BLENDER_EXTERN_DRACO_LIBRARY_PATH is already set.
+# --draco-library PATH  the Draco library for Blender that the build makes (default build/blender/libextern_draco.so,
+#               CMakeLists.txt target blender_draco; Debian's blender ships the glTF importer without it, so a
+#               KHR_draco_mesh_compression file FAILS to import when it is missing).
 # BLENDER=PATH  the blender binary (default: blender on PATH).
 #
 # Needs: apt-get install -y --no-install-recommends blender python3-numpy
@@ -18,17 +16,15 @@ set -uo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 blender="${BLENDER:-blender}"
-shim=0
 args=()
 files=()
 usage() {
-  echo "usage: tests/blender/run.sh [--draco-shim] [--scene-fps N] [--frames K,K,...] FILE.glb [FILE.glb ...]" >&2
+  echo "usage: tests/blender/run.sh [--draco-library PATH] [--scene-fps N] [--frames K,K,...] FILE.glb [FILE.glb ...]" >&2
   exit 2
 }
 while [ $# -gt 0 ]; do
   case "$1" in
-    --draco-shim) shim=1; shift ;;
-    --scene-fps|--frames) [ $# -ge 2 ] || usage; args+=("$1" "$2"); shift 2 ;;
+    --draco-library|--scene-fps|--frames) [ $# -ge 2 ] || usage; args+=("$1" "$2"); shift 2 ;;
     -h|--help) usage ;;
     -*) echo "run.sh: unknown option $1" >&2; usage ;;
     *) files+=("$1"); shift ;;
@@ -51,23 +47,6 @@ fi
 
 tmp="$(mktemp -d "${TMPDIR:-/tmp}/apparent-blender-XXXXXX")"
 trap 'rm -rf "$tmp"' EXIT
-
-if [ "$shim" = 1 ] && [ -z "${BLENDER_EXTERN_DRACO_LIBRARY_PATH:-}" ]; then
-  cxx="${CXX:-g++}"
-  if ! command -v "$cxx" >/dev/null 2>&1 || [ ! -f /usr/include/draco/compression/decode.h ]; then
-    echo "run.sh: SETUP ERROR: --draco-shim needs a C++ compiler ($cxx) and Debian's libdraco-dev" \
-         "(apt-get install -y g++ libdraco-dev)" >&2
-    exit 2
-  fi
-  if ! "$cxx" -std=c++17 -O2 -shared -fPIC "$here/extern_draco_shim.cpp" -o "$tmp/libextern_draco.so" -ldraco \
-       >"$tmp/shim.log" 2>&1; then
-    cat "$tmp/shim.log" >&2
-    echo "run.sh: SETUP ERROR: building the Draco stand-in failed" >&2
-    exit 2
-  fi
-  export BLENDER_EXTERN_DRACO_LIBRARY_PATH="$tmp/libextern_draco.so"
-  echo "run.sh: Draco: using the stand-in $BLENDER_EXTERN_DRACO_LIBRARY_PATH (Debian's libdraco), not Blender's own library"
-fi
 
 "$blender" -b --factory-startup --python-exit-code 1 --python "$here/check_glb.py" -- "${files[@]}" \
   ${args[@]+"${args[@]}"} 2>&1 | grep -v 'INFO: Draco Decoder: Decode primitive' | tee "$tmp/out.log"

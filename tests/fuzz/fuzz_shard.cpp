@@ -3,7 +3,8 @@
 // file, its size known), its header read and checked, then its frame records and end record read
 // as merge reads them (lengths bounded by the file). A refusal must be one line starting with the
 // path; an accepted header must hold what merge relies on (a known model, finite numbers in range,
-// names valid UTF-8 without control characters, a shard I/N, a range of frames). Seeds: the shards
+// names valid UTF-8 without control characters, a light of finite numbers with its shares in
+// [0, 1], a shard I/N, a range of frames). Seeds: the shards
 // of data/fixtures/scene_tetra.json in tests/fuzz/shard_seeds (plain, Draco, meshopt).
 #include <cmath>
 #include <cstdint>
@@ -55,6 +56,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             check(o.mirror_index >= -1 && o.mirror_index < int(h.info.objects.size()));
         }
         check(h.info.camera.fov_deg > 0 && h.info.camera.fov_deg < 180);
+        const apparent::ExportLight& l = h.info.light;
+        for (double c : {l.position.x, l.position.y, l.position.z, l.direction.x, l.direction.y, l.direction.z,
+                         l.key_direction.x, l.key_direction.y, l.key_direction.z})
+            check(std::isfinite(c));
+        check(l.ambient >= 0 && l.ambient <= 1 && l.key_weight >= 0 && l.key_weight <= 1);
         check(h.split.parts >= 1 && h.split.part >= 0 && h.split.part < h.split.parts);
         check(h.first >= 0 && h.last_excl > h.first);
         check(h.options.position_bits >= 1 && h.options.position_bits <= 30 && !(h.options.draco && h.options.meshopt));
