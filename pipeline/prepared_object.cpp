@@ -77,6 +77,7 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
         obj.rest = it->second.mesh;
         obj.has_color = it->second.has_color;
         obj.color = it->second.color;
+        obj.look = it->second.look;
         const auto& L = spec.linear;  // column-major
         const RotationXYZ rotate(spec.rotation_deg);
         for (Vec3& p : obj.rest.positions) {
