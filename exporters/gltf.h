@@ -198,8 +198,7 @@ public:
     // Only where it carries an object's look (surface_look.h: plain files).
     bool readsRestPoints() const override { return reads_rest_points_; }
     // Frames across processes: GlbSequenceWriter::encode and addEncoded.
-    // Refused for a sequence whose objects' looks the file carries (not encoded across processes yet).
-    bool beginEncoding(const SequenceInfo& info, std::string* error) override;
+    bool beginEncoding(const SequenceInfo& info, std::string* error) override { return begin(info, error); }
     EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const override;
     // Meshopt frames by reference that may be morph targets (GlbSequenceWriter::encode).
     bool encodesAfterPrevious() const override;

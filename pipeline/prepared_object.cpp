@@ -90,6 +90,7 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
                                   L[6] * (L[1] * L[5] - L[4] * L[2]);
         if (spec.scale.x * spec.scale.y * spec.scale.z * det_linear < 0)
             for (auto& t : obj.rest.triangles) std::swap(t[1], t[2]);
+        for (const Vec3& p : obj.rest.positions) obj.radius = std::max(obj.radius, mesh4d::norm(p));
         objects->push_back(std::move(obj));
     }
     clearGltfCache();  // the meshes are read: parsed glTF documents are not needed any more

@@ -59,7 +59,7 @@ void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const
 }  // namespace
 
 bool carriesLook(const GlbOptions& options, const ExportObject& object) {
-    return object.look && object.rest && !options.meshopt && !options.draco;
+    return object.look && !options.meshopt && !options.draco;
 }
 
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
@@ -155,7 +155,7 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     d->texcoords.clear();
     d->part_first.clear();
     d->part_material.clear();
-    if (carriesLook(options, object) && m.source_triangles.size() == m.triangles.size() &&
+    if (carriesLook(options, object) && object.rest && m.source_triangles.size() == m.triangles.size() &&
         m.rest_points.size() == m.positions.size())
         lookArrays(m, object, *map, shade, d);
     if (step > 0)

@@ -455,16 +455,6 @@ bool GlbSink::begin(const SequenceInfo& info, std::string*) {
     return true;  // the spill file's errors surface at the first add()
 }
 
-bool GlbSink::beginEncoding(const SequenceInfo& info, std::string* error) {
-    for (const ExportObject& o : info.objects)
-        if (glb::carriesLook(options_, o)) {
-            *error = path_ + ": object '" + o.name + "' has materials, textures or vertex colours, which frames made by " +
-                     "other processes (--shard, MPI) do not carry yet: render it in one process, or with --compress";
-            return false;
-        }
-    return begin(info, error);
-}
-
 std::shared_ptr<const PreparedFrame> GlbSink::prepare(const ExportFrame& frame) const { return writer_->prepare(frame); }
 
 PendingOutput GlbSink::pending(const ExportFrame& frame) {

@@ -6,7 +6,8 @@ factor), faces +-z material 2 (a grey factor, metallic 0.5). Every vertex has TE
 that are linear on its face, so the value at any point q of face a (the axis |q_a| = 0.5) is known in
 closed form: with b < c the two other axes, u = q_b + 0.5, v = q_c + 0.5 and COLOR_0 = (u, v, 0.25, 1).
 
-usage: make_textured_box.py OUT.glb OUT_TEXTURE.png
+usage: make_textured_box.py OUT.glb OUT_TEXTURE.png [--no-colors]
+  --no-colors: without COLOR_0 (the texture's own colours show, for the screenshot test)
 """
 import json
 import struct
@@ -37,7 +38,7 @@ def face(axis, sign):
     return verts, tris
 
 
-def main(out_glb, out_png):
+def main(out_glb, out_png, colors=True):
     image = png_2x2()
     with open(out_png, "wb") as f:
         f.write(image)
@@ -75,7 +76,10 @@ def main(out_glb, out_png):
                           "count": len(col), "type": "VEC4"})
         accessors.append({"bufferView": view(struct.pack("<%dH" % len(idx), *idx), 34963), "componentType": 5123,
                           "count": len(idx), "type": "SCALAR"})
-        primitives.append({"attributes": {"POSITION": a_pos, "TEXCOORD_0": a_pos + 1, "COLOR_0": a_pos + 2},
+        attributes = {"POSITION": a_pos, "TEXCOORD_0": a_pos + 1}
+        if colors:
+            attributes["COLOR_0"] = a_pos + 2
+        primitives.append({"attributes": attributes,
                            "indices": a_pos + 3, "material": material})
     image_view = view(image)
     doc = {
@@ -106,6 +110,6 @@ def main(out_glb, out_png):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 4) or (len(sys.argv) == 4 and sys.argv[3] != "--no-colors"):
         sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2])
+    main(sys.argv[1], sys.argv[2], len(sys.argv) == 3)
