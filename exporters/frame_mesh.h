@@ -3,9 +3,11 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "exporters/surface_look.h"
 #include "mesh4d/slice.h"
 
 namespace apparent {
@@ -32,6 +34,10 @@ struct ExportObject {
     // scene's own objects) and by name (for node names).
     int mirror_index = -1;
     std::string mirror;
+    // The look its input file gives (texture coordinates, vertex colours, materials: surface_look.h)
+    // and the rest mesh its cut's rest points and source triangles refer to; null: none.
+    std::shared_ptr<const SurfaceLook> look;
+    std::shared_ptr<const mesh4d::RestMesh> rest;
 };
 
 struct ExportCamera {

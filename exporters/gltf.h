@@ -195,7 +195,8 @@ public:
     void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
     // Only --attributes doppler/proper_time and --shade doppler read them.
     bool readsLightFactors() const override { return options_.doppler || options_.proper_time || options_.shade_doppler; }
-    bool readsRestPoints() const override { return false; }
+    // Only where it carries an object's look (surface_look.h: plain files).
+    bool readsRestPoints() const override { return reads_rest_points_; }
     // Frames across processes: GlbSequenceWriter::encode and addEncoded.
     bool beginEncoding(const SequenceInfo& info, std::string* error) override { return begin(info, error); }
     EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const override;
@@ -213,6 +214,8 @@ private:
     bool verbose_;
     std::string model_;
     double tolerance_ = 0;
+    std::vector<std::string> dropped_looks_;  // objects whose look a compressed file leaves out
+    bool reads_rest_points_ = false;
     OutputCheck check_;
     long long least_ = 0;  // least size of the file so far uncompressed (positions and normals alone)
     std::unique_ptr<GlbSequenceWriter> writer_;

@@ -70,7 +70,7 @@ void Text::string(std::string_view s) {
 }
 
 const char* attributeName(int a) {
-    static const char* const names[kAttributes] = {"COLOR_0",  "NORMAL",         "POSITION",
+    static const char* const names[kAttributes] = {"COLOR_0",  "NORMAL",         "POSITION",     "TEXCOORD_0",
                                                    "_DOPPLER", "_EMISSION_TIME", "_PROPER_TIME"};
     return names[a];
 }
@@ -131,7 +131,7 @@ void write(Text* t, const Accessor& a) {
         t->value(true);
     }
     t->key("type");
-    t->value(a.vec3 ? "VEC3" : "SCALAR");
+    t->value(a.vec3 ? "VEC3" : a.vec2 ? "VEC2" : "SCALAR");
     t->close('}');
 }
 

@@ -58,6 +58,11 @@ public:
         string(s);
     }
     void value(const char* s) { value(std::string_view(s)); }
+    // A value given as JSON text already in this form (nlohmann::json::dump()).
+    void raw(std::string_view json) {
+        separate();
+        out += json;
+    }
 
 private:
     void separate() {
@@ -69,13 +74,14 @@ private:
 };
 
 // glTF vertex attributes, in the byte order of their names (so written in index order).
-enum Attribute { kColor0, kNormal, kPosition, kDoppler, kEmissionTime, kProperTime, kAttributes };
+enum Attribute { kColor0, kNormal, kPosition, kTexcoord0, kDoppler, kEmissionTime, kProperTime, kAttributes };
 const char* attributeName(int a);
 
 struct Accessor {
     int view = -1;          // -1: none (Draco)
     int component = 0;      // glTF componentType
-    bool vec3 = false;      // type VEC3, else SCALAR
+    bool vec3 = false;      // type VEC3, else SCALAR (or VEC2)
+    bool vec2 = false;      // type VEC2
     bool normalized = false;
     uint8_t bounds = 0;     // min/max values (0: none)
     uint64_t count = 0, offset = 0;

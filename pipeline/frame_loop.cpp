@@ -119,6 +119,10 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
         ExportObject o;
         o.name = stage.objects[i].spec.name;
         o.base_color = objectBaseColor(stage.objects, i);
+        if (stage.objects[i].look) {
+            o.look = stage.objects[i].look;
+            o.rest = std::make_shared<const mesh4d::RestMesh>(stage.objects[i].rest);
+        }
         info.objects.push_back(o);
     }
     info.camera.position = scene.camera.position * u;
@@ -153,12 +157,13 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     const bool sender = settings.distributed && group.rank() > 0;
     const bool receiver = settings.distributed && group.rank() == 0 && group.size() > 1;
     const FrameSplit split = settings.split;
-    // Step: the static 4D worlds and the mirrors' reflections, once per model.
+    // Step: the static 4D worlds and the mirrors' reflections, once per model (what the sinks are
+    // told first: the worlds may take the rest meshes it copies for the objects' looks).
+    SequenceInfo info = sequenceInfo(stage, model);
     const std::vector<mesh4d::World4D> worlds = take && stage.mirrors.empty()
                                                     ? takeWorlds(take, model, scene, first, last_excl - 1)
                                                     : buildWorlds(stage.objects, model, scene, first, last_excl - 1);
     const MirrorReflections reflections(scene, stage.objects, stage.mirrors, model, first, last_excl - 1);
-    SequenceInfo info = sequenceInfo(stage, model);
     reflections.describe(&info);
     for (FrameSink* sink : sinks)
         if (!(sender ? sink->beginEncoding(info, error) : sink->begin(info, error))) {

@@ -91,8 +91,11 @@ bool confinedRead(std::vector<unsigned char>* out, std::string* err, const std::
     return true;
 }
 
-// Images are not needed for geometry: accept them undecoded (the library is built without stb).
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// Images are not decoded (the library is built without stb): each keeps its file bytes (PNG or
+// JPEG) in Image::image, for the outputs that carry the model's textures (GltfDocument).
+bool keepImageBytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
+                    int size, void*) {
+    if (bytes && size > 0) image->image.assign(bytes, bytes + size);
     return true;
 }
 
@@ -394,7 +397,7 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
     Confinement conf{canonical.parent_path(), limits.max_file_bytes, {}, {}};
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&confinedExists, &confinedExpand, &confinedRead, &refuseWrite, &conf});
-    loader.SetImageLoader(&skipImage, nullptr);
+    loader.SetImageLoader(&keepImageBytes, nullptr);
     std::string err, warn;
     const std::string base_dir = conf.root.string();
     const bool ok = binary ? loader.LoadBinaryFromMemory(model, &err, &warn, bytes.data(), unsigned(bytes.size()), base_dir)
@@ -413,6 +416,10 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
     };
     extrasOf("nodes", model->nodes.size(), &doc->node_extras);
     extrasOf("scenes", model->scenes.size(), &doc->scene_extras);
+    for (const char* array : {"materials", "textures", "samplers", "images"}) {
+        auto it = j.find(array);
+        doc->looks[array] = it != j.end() && it->is_array() ? *it : json::array();
+    }
     *read = std::move(conf.read);
     return Status::success();
 }

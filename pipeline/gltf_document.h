@@ -37,6 +37,10 @@ struct GltfDocument {
     // model.nodes and model.scenes: tinygltf's Value drops null elements of arrays, and a scene
     // field such as exists: [null, 5] needs them.
     std::vector<nlohmann::json> node_extras, scene_extras;
+    // The arrays "materials", "textures", "samplers" and "images" as written (empty arrays where
+    // absent), for the outputs that carry the model's look (gltf_reader.h); each image's file
+    // bytes (PNG or JPEG, not decoded) are in model.images[i].image.
+    nlohmann::json looks;
 };
 
 // Opens `path` (no "#Node" suffix) as above. On failure the message is one line naming the file,

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <set>
 
 #include <tiny_gltf.h>
 
 #include "pipeline/gltf_document.h"
+#include "pipeline/gltf_look.h"
 #include "pipeline/gltf_nodes.h"
 #include "pipeline/mesh_check.h"
 
@@ -59,7 +61,10 @@ private:
 
     // Reads accessor `index` as `components` doubles per element, with every range checked and
     // sparse substitutions applied.
-    bool readAccessor(int index, const std::string& where, int components, bool integer, std::vector<double>* values) {
+    // `integer`: indices (unsigned integers); else POSITION (FLOAT), or with `attribute` a vertex
+    // attribute (FLOAT, or normalized UNSIGNED_BYTE or UNSIGNED_SHORT mapped to [0, 1]).
+    bool readAccessor(int index, const std::string& where, int components, bool integer, std::vector<double>* values,
+                      bool attribute = false) {
         if (index < 0 || size_t(index) >= model_.accessors.size())
             return fail(where, "accessor " + std::to_string(index) + " out of range (" + std::to_string(model_.accessors.size()) + " accessors)");
         const tinygltf::Accessor& a = model_.accessors[size_t(index)];
@@ -68,8 +73,13 @@ private:
         if (ncomp != components) return fail(aw + ".type", "expected " + std::to_string(components) + " components, got " + std::to_string(ncomp));
         const int csize = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
         if (csize <= 0) return fail(aw + ".componentType", "invalid (" + std::to_string(a.componentType) + ")");
-        if (!integer && a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
-            return fail(aw + ".componentType", std::string("POSITION must be FLOAT, got ") + componentName(a.componentType));
+        const bool normalized = attribute && a.normalized &&
+                                (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                 a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+        if (!integer && !normalized && a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+            return fail(aw + ".componentType", std::string(attribute ? "must be FLOAT or normalized UNSIGNED_BYTE or UNSIGNED_SHORT, got "
+                                                                     : "POSITION must be FLOAT, got ") +
+                                                   componentName(a.componentType));
         if (integer && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
             a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
             return fail(aw + ".componentType", std::string("indices must be unsigned integers, got ") + componentName(a.componentType));
@@ -91,8 +101,8 @@ private:
                 const uint8_t* q = p + size_t(c) * size_t(csize);
                 switch (a.componentType) {
                     case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, q, 4); dst[c] = f; break; }
-                    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: dst[c] = *q; break;
-                    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, q, 2); dst[c] = v; break; }
+                    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: dst[c] = normalized ? *q / 255.0 : *q; break;
+                    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, q, 2); dst[c] = normalized ? v / 65535.0 : v; break; }
                     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, q, 4); dst[c] = v; break; }
                 }
             }
@@ -159,6 +169,49 @@ private:
         }
         return true;
     }
+
+    // The primitive's TEXCOORD_0 and COLOR_0 (for its `nv` vertices, just added) and the material of
+    // its `nt` triangles, into the look (gltf_look.h); primitives without them get (0, 0), white
+    // and glTF's default material.
+    bool addLook(const tinygltf::Primitive& prim, const std::string& where, size_t nv, size_t nt) {
+        look_.triangle_material.insert(look_.triangle_material.end(), nt, prim.material);
+        for (const auto& [name, accessor] : prim.attributes) {
+            const bool uv = name == "TEXCOORD_0", rgba = name == "COLOR_0";
+            if (!uv && !rgba) {
+                if (name != "POSITION" && name != "NORMAL" && name != "TANGENT") ignored_attributes_.insert(name);
+                continue;
+            }
+            const int components = uv ? 2 : tinygltf::GetNumComponentsInType(
+                                                 accessor >= 0 && size_t(accessor) < model_.accessors.size()
+                                                     ? uint32_t(model_.accessors[size_t(accessor)].type)
+                                                     : uint32_t(TINYGLTF_TYPE_VEC4));
+            if (!uv && components != 3 && components != 4)
+                return fail(where + ".attributes.COLOR_0", "must be VEC3 or VEC4");
+            std::vector<double> values;
+            if (!readAccessor(accessor, where + ".attributes." + name, components, false, &values, true)) return false;
+            if (values.size() != nv * size_t(components))
+                return fail(where + ".attributes." + name, "count " + std::to_string(values.size() / size_t(components)) +
+                                                               " differs from POSITION's " + std::to_string(nv));
+            for (double v : values)
+                if (!std::isfinite(v)) return fail(where + ".attributes." + name, "a value is not finite");
+            std::vector<double>& to = uv ? look_.texcoord : look_.color;
+            const size_t per = uv ? 2 : 4, first = out_->mesh.positions.size() - nv;
+            to.resize(per * first, uv ? 0.0 : 1.0);  // earlier primitives without it
+            for (size_t i = 0; i < nv; ++i)
+                for (size_t c = 0; c < per; ++c) to.push_back(c < size_t(components) ? values[i * size_t(components) + c] : 1.0);
+        }
+        // Later primitives without an attribute: filled when the mesh is complete (finishLook).
+        return true;
+    }
+
+public:
+    // What addLook gathered, over every primitive read.
+    GltfLookParts& look() { return look_; }
+    const std::set<std::string>& ignoredAttributes() const { return ignored_attributes_; }
+
+private:
+    GltfLookParts look_;
+    std::set<std::string> ignored_attributes_;
 
 public:
     // The vertices and triangles mesh `mesh_index` adds per instance, from the accessors' counts
@@ -228,6 +281,7 @@ public:
                     return fail(where + ".indices", "index " + std::to_string((unsigned long long)idx[i]) + " out of range (" + std::to_string(nv) + " vertices)");
 
             // Step: triangles from lists, strips and fans (glTF 2.0 section 3.7.2.1).
+            const size_t triangles_before = out_->mesh.triangles.size();
             auto add = [&](size_t a, size_t b, size_t c) {
                 std::array<uint32_t, 3> t{base + uint32_t(idx[a]), base + uint32_t(idx[b]), base + uint32_t(idx[c])};
                 if (mirrored) std::swap(t[1], t[2]);
@@ -246,6 +300,9 @@ public:
             }
             if (out_->mesh.triangles.size() > limits_.max_faces)
                 return fail(where, "more than " + std::to_string(limits_.max_faces) + " triangles in all (raise with --max-faces)");
+
+            // Step: the look: texture coordinates, vertex colours and the triangles' material.
+            if (!addLook(prim, where, nv, out_->mesh.triangles.size() - triangles_before)) return false;
 
             // Step: the first material with a base colour gives the object's colour.
             if (!out_->has_color && prim.material >= 0 && size_t(prim.material) < model_.materials.size()) {
@@ -328,9 +385,12 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
                                (warnings->points_lines_skipped
                                     ? " (" + std::to_string(warnings->points_lines_skipped) + " point or line primitives skipped)"
                                     : std::string()));
-    warnings->degenerate_dropped += dropDegenerateTriangles(&out->mesh);
+    GltfLookParts& look = reader.look();
+    warnings->degenerate_dropped += dropDegenerateTriangles(&out->mesh, &look.triangle_material);
     if (out->mesh.triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
-    return Status::success();
+    for (const std::string& name : reader.ignoredAttributes())
+        warnings->other.push_back("attribute " + name + ": not carried to the outputs (TEXCOORD_0 and COLOR_0 are)");
+    return buildGltfLook(path, *doc, std::move(look), out->mesh.positions.size(), warnings, &out->look);
 }
 
 }  // namespace apparent

@@ -19,17 +19,20 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 Point toPoint(const mesh4d::Vec3& v) { return Point(v.x, v.y, v.z); }
 }  // namespace
 
-size_t dropDegenerateTriangles(mesh4d::RestMesh* mesh) {
+size_t dropDegenerateTriangles(mesh4d::RestMesh* mesh, std::vector<int>* per_triangle) {
     size_t kept = 0;
     const size_t before = mesh->triangles.size();
+    const bool follow = per_triangle && per_triangle->size() == before;
     for (size_t f = 0; f < before; ++f) {
         const auto& t = mesh->triangles[f];
         if (CGAL::collinear(toPoint(mesh->positions[t[0]]), toPoint(mesh->positions[t[1]]),
                             toPoint(mesh->positions[t[2]])))
             continue;
+        if (follow) (*per_triangle)[kept] = (*per_triangle)[f];
         mesh->triangles[kept++] = t;
     }
     mesh->triangles.resize(kept);
+    if (follow) per_triangle->resize(kept);
     return before - kept;
 }
 

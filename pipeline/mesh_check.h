@@ -13,8 +13,8 @@
 namespace apparent {
 
 // Removes triangles whose three corners are exactly collinear (CGAL::collinear, exact predicate)
-// and returns how many were removed.
-size_t dropDegenerateTriangles(mesh4d::RestMesh* mesh);
+// and returns how many were removed; `per_triangle` (one value per triangle), when given, follows.
+size_t dropDegenerateTriangles(mesh4d::RestMesh* mesh, std::vector<int>* per_triangle = nullptr);
 
 struct Topology {
     bool manifold = false;       // the triangles form an oriented 2-manifold (with or without boundary)

@@ -2,9 +2,11 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "exporters/surface_look.h"
 #include "mesh4d/extrude.h"
 #include "pipeline/status.h"
 
@@ -34,6 +36,9 @@ struct LoadedMesh {
     mesh4d::RestMesh mesh;
     bool has_color = false;               // the file gave a base colour (glTF material)
     std::array<double, 4> color{1, 1, 1, 1};
+    // Texture coordinates, vertex colours and materials (glTF inputs; null: none), parallel to
+    // `mesh`'s vertices and triangles.
+    std::shared_ptr<const SurfaceLook> look;
 };
 
 // Reads an OBJ (.obj), PLY (.ply), glTF (.gltf) or binary glTF (.glb) file; a glTF path may end in

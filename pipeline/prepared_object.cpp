@@ -77,6 +77,7 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
         obj.rest = it->second.mesh;
         obj.has_color = it->second.has_color;
         obj.color = it->second.color;
+        obj.look = it->second.look;
         const auto& L = spec.linear;  // column-major
         const RotationXYZ rotate(spec.rotation_deg);
         for (Vec3& p : obj.rest.positions) {
@@ -89,6 +90,7 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
                                   L[6] * (L[1] * L[5] - L[4] * L[2]);
         if (spec.scale.x * spec.scale.y * spec.scale.z * det_linear < 0)
             for (auto& t : obj.rest.triangles) std::swap(t[1], t[2]);
+        for (const Vec3& p : obj.rest.positions) obj.radius = std::max(obj.radius, mesh4d::norm(p));
         objects->push_back(std::move(obj));
     }
     clearGltfCache();  // the meshes are read: parsed glTF documents are not needed any more

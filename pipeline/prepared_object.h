@@ -17,6 +17,8 @@ struct PreparedObject {
     mesh4d::RestMesh rest;             // rest-frame mesh with rotation, scale and `linear` applied
     bool has_color = false;            // the mesh file gave a base colour
     std::array<double, 4> color{1, 1, 1, 1};
+    std::shared_ptr<const SurfaceLook> look;  // the mesh file's look (mesh_input.h LoadedMesh::look)
+    double radius = 0;  // the largest |q| of `rest` (kept when the worlds take the mesh: worlds.h takeWorlds)
 };
 
 // The base colour object i is drawn with (linear RGBA): its mesh file's, else a palette colour.

@@ -47,6 +47,8 @@ bool finite(std::initializer_list<double> values) {
     return true;
 }
 
+void getLooks(ShardReader* in, SequenceInfo* info, std::string* problem);
+
 // The header's fields back, each checked as the scene's and the command line's are (a shard is
 // input like any other); the first problem as "field: problem" in `problem`, read or not.
 void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string* problem) {
@@ -147,6 +149,118 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
     if (in->ok && !(l.ambient >= 0 && l.ambient <= 1)) fail("light.ambient", formatNumber(l.ambient) + " is outside [0, 1]");
     if (in->ok && !(l.key_weight >= 0 && l.key_weight <= 1))
         fail("light.key_weight", formatNumber(l.key_weight) + " is outside [0, 1]");
+    if (in->ok && problem->empty()) getLooks(in, info, problem);
+}
+
+// The objects' looks (exporters/surface_look.h) as the .glb needs them: per distinct look its
+// materials, textures and samplers (JSON text), images and extensions, then per object the index
+// of its look + 1 (0: none). The per-vertex arrays stay with the frames.
+void putLooks(std::string* out, const SequenceInfo& info) {
+    std::vector<const SurfaceLook*> looks;
+    for (const ExportObject& e : info.objects)
+        if (e.look && std::find(looks.begin(), looks.end(), e.look.get()) == looks.end()) looks.push_back(e.look.get());
+    putU64(out, looks.size());
+    for (const SurfaceLook* l : looks) {
+        for (const auto* list : {&l->materials, &l->textures, &l->samplers, &l->extensions}) {
+            putU64(out, list->size());
+            for (const std::string& s : *list) putString(out, s);
+        }
+        putU64(out, l->images.size());
+        for (const LookImage& im : l->images) {
+            putString(out, im.mime_type);
+            putString(out, im.name);
+            putString(out, std::string(im.bytes.begin(), im.bytes.end()));
+        }
+    }
+    for (const ExportObject& e : info.objects)
+        putU64(out, e.look ? uint64_t(std::find(looks.begin(), looks.end(), e.look.get()) - looks.begin()) + 1 : 0);
+}
+
+// A JSON object of at most `limit` bytes, its nesting bounded (json_limits.h), or null.
+nlohmann::json parseObject(const std::string& text) {
+    if (!checkJsonDepth("", text).ok) return nlohmann::json();
+    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    return j.is_object() ? j : nlohmann::json();
+}
+
+// Every textureInfo ("...Texture": {"index": i}) below `j` refers to one of `textures`.
+bool textureInfosWithin(const nlohmann::json& j, size_t textures) {
+    for (const auto& [key, value] : j.items()) {
+        if (!value.is_object()) continue;
+        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index")) {
+            const nlohmann::json& i = value["index"];
+            if (!i.is_number_integer() || i.get<long long>() < 0 || uint64_t(i.get<long long>()) >= textures) return false;
+        } else if (!textureInfosWithin(value, textures)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+void getLooks(ShardReader* in, SequenceInfo* info, std::string* problem) {
+    auto fail = [problem](const std::string& field, const std::string& what) {
+        if (problem->empty()) *problem = field + ": " + what;
+    };
+    constexpr uint64_t kText = 1 << 20;
+    const uint64_t n = in->u64();
+    if (in->ok && n > info->objects.size()) fail("looks", std::to_string(n) + " looks for " + std::to_string(info->objects.size()) + " objects");
+    std::vector<std::shared_ptr<const SurfaceLook>> looks;
+    for (uint64_t k = 0; in->ok && problem->empty() && k < n; ++k) {
+        const std::string at = "looks[" + std::to_string(k) + "]";
+        auto look = std::make_shared<SurfaceLook>();
+        std::vector<std::string>* lists[4] = {&look->materials, &look->textures, &look->samplers, &look->extensions};
+        const char* names[4] = {"materials", "textures", "samplers", "extensions"};
+        for (int i = 0; i < 4 && in->ok && problem->empty(); ++i) {
+            const uint64_t count = in->u64();
+            if (in->ok && count > in->left() / 8) fail(at + "." + names[i], "more than the file holds");
+            for (uint64_t c = 0; in->ok && problem->empty() && c < count; ++c) lists[i]->push_back(in->bytes(kText));
+        }
+        const uint64_t images = in->u64();
+        if (in->ok && images > in->left() / 24) fail(at + ".images", "more than the file holds");
+        for (uint64_t c = 0; in->ok && problem->empty() && c < images; ++c) {
+            LookImage im;
+            im.mime_type = in->bytes(kText);
+            im.name = in->bytes(kText);
+            const std::string bytes = in->bytes(in->left());
+            im.bytes.assign(bytes.begin(), bytes.end());
+            if (in->ok && im.mime_type != "image/png" && im.mime_type != "image/jpeg")
+                fail(at + ".images[" + std::to_string(c) + "].mimeType", "'" + printable(im.mime_type, 60) + "' is not image/png or image/jpeg");
+            if (in->ok && !nameProblem(im.name).empty()) fail(at + ".images[" + std::to_string(c) + "].name", nameProblem(im.name));
+            look->images.push_back(std::move(im));
+        }
+        // Step: the JSON the .glb takes as it is: objects, references within the lists.
+        for (size_t m = 0; in->ok && problem->empty() && m < look->materials.size(); ++m) {
+            const nlohmann::json j = parseObject(look->materials[m]);
+            if (j.is_null() || !textureInfosWithin(j, look->textures.size()))
+                fail(at + ".materials[" + std::to_string(m) + "]", "not a JSON object whose textures are among the look's");
+            else look->materials[m] = j.dump();
+        }
+        for (size_t t = 0; in->ok && problem->empty() && t < look->textures.size(); ++t) {
+            const nlohmann::json j = parseObject(look->textures[t]);
+            auto within = [&](const char* key, size_t count, bool required) {
+                if (!j.contains(key)) return !required;
+                const nlohmann::json& v = j[key];
+                return v.is_number_integer() && v.get<long long>() >= 0 && uint64_t(v.get<long long>()) < count;
+            };
+            if (j.is_null() || !within("source", look->images.size(), true) || !within("sampler", look->samplers.size(), false))
+                fail(at + ".textures[" + std::to_string(t) + "]", "not a JSON object whose source and sampler are among the look's");
+            else look->textures[t] = j.dump();
+        }
+        for (size_t s = 0; in->ok && problem->empty() && s < look->samplers.size(); ++s) {
+            const nlohmann::json j = parseObject(look->samplers[s]);
+            if (j.is_null()) fail(at + ".samplers[" + std::to_string(s) + "]", "not a JSON object");
+            else look->samplers[s] = j.dump();
+        }
+        for (const std::string& e : look->extensions)
+            if (in->ok && e != "KHR_texture_transform" && e.rfind("KHR_materials_", 0) != 0)
+                fail(at + ".extensions", "'" + printable(e, 60) + "' is not an extension a look carries");
+        looks.push_back(std::move(look));
+    }
+    for (size_t i = 0; in->ok && problem->empty() && i < info->objects.size(); ++i) {
+        const uint64_t ref = in->u64();
+        if (in->ok && ref > looks.size()) fail("objects[" + std::to_string(i) + "].look", std::to_string(ref) + " is outside 0 .. " + std::to_string(looks.size()));
+        else if (ref > 0) info->objects[i].look = looks[ref - 1];
+    }
 }
 
 }  // namespace
@@ -177,6 +291,7 @@ void putShardSequence(std::string* out, const SequenceInfo& info, const GlbOptio
     putDouble(out, l.ambient);
     for (double c : {l.key_direction.x, l.key_direction.y, l.key_direction.z}) putDouble(out, c);
     putDouble(out, l.key_weight);
+    putLooks(out, info);
 }
 
 uint64_t ShardReader::u64() {

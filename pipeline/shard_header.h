@@ -2,8 +2,10 @@
 // by a shard's sink, read back by `merge` as untrusted input. The file is the magic line
 // "apparent shard 2", then little-endian fields: the fingerprint, part, parts, first and last
 // frame (exclusive), the sequence (model, tolerance, fps, scene path, the objects' names, colours
-// and mirrors, the camera, the .glb options, the light), then one record per frame (tag 1, length, the
-// frame encoded whole: GlbSequenceWriter::encode) and the end record (tag 2, the frame count).
+// and mirrors, the camera, the .glb options, the light, the objects' looks: materials, textures,
+// samplers as JSON objects whose references stay within the look, PNG or JPEG images), then one
+// record per frame (tag 1, length, the frame encoded whole: GlbSequenceWriter::encode) and the end
+// record (tag 2, the frame count).
 // Every field read is checked as the scene's and the command line's are: names against the
 // known models, UTF-8 without control characters; finite numbers in range; flags and bits in
 // the ranges the options take; lengths and counts against the bytes the file still holds, before

@@ -14,7 +14,7 @@ bool objectInView(const Stage& stage, Model model, size_t object, long long k) {
     // The bound needs only the motion in the cut's frame and the rest mesh's radius.
     mesh4d::World4D w;
     w.motion = cutMotionOf(stage.objects[object].spec, model, stage.scene).motion;
-    for (const mesh4d::Vec3& q : stage.objects[object].rest.positions) w.shape_radius = std::max(w.shape_radius, mesh4d::norm(q));
+    w.shape_radius = stage.objects[object].radius;  // the rest mesh may be taken by the worlds by now
     return inCameraView(stage.scene.camera, mesh4d::apparentBound(w, viewForFrame(stage.scene, model, k)));
 }
 

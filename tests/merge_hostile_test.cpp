@@ -43,7 +43,7 @@ std::string real(double v) {
 // independently): the header's fields, then the frame records, then the end record.
 struct ShardLayout {
     size_t model = 0, tolerance = 0, fps = 0, scene_path = 0, objects = 0, name0 = 0, color0 = 0, mirror0 = 0,
-           camera = 0, fov = 0, flags = 0, light = 0;
+           camera = 0, fov = 0, flags = 0, light = 0, looks = 0;
     std::vector<std::pair<size_t, size_t>> records;  // each frame record: its start and its length in all
     size_t end = 0;                                  // the end record's start
     explicit ShardLayout(const std::string& b) {
@@ -77,6 +77,20 @@ struct ShardLayout {
         // The light: point flag, position, direction, ambient, key direction, key weight.
         light = at;
         at += 8 + 3 * 8 + 3 * 8 + 8 + 3 * 8 + 8;
+        looks = at;  // the objects' looks: none in these scenes' shards, then one reference per object
+        const uint64_t nl = getU64(b, at);
+        at += 8;
+        for (uint64_t l = 0; l < nl; ++l) {
+            for (int list = 0; list < 4; ++list) {  // materials, textures, samplers, extensions
+                const uint64_t count = getU64(b, at);
+                at += 8;
+                for (uint64_t k = 0; k < count; ++k) skipString();
+            }
+            const uint64_t images = getU64(b, at);
+            at += 8;
+            for (uint64_t k = 0; k < 3 * images; ++k) skipString();  // type, name, bytes
+        }
+        at += 8 * n;
         while (getU64(b, at) == 1) {
             const size_t length = 16 + size_t(getU64(b, at + 8));
             records.emplace_back(at, length);
@@ -189,6 +203,8 @@ TEST_F(MergeHostile, HeaderNumbersAndFlagsOutOfRangeAreRefused) {
         {l.light + 8 + 48, real(1.5), "light.ambient"},
         {l.light + 8 + 48, real(nan), "light.ambient"},
         {l.light + 8 + 56 + 24, real(-0.1), "light.key_weight"},
+        {l.looks, u64(1000), "looks"},
+        {l.looks + 8, u64(5), "objects[0].look"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.field);

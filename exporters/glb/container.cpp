@@ -64,7 +64,7 @@ int GlbBuilder::addNormalized(int view, int component, bool vec3, size_t count, 
     return a;
 }
 
-gltfjson::Primitive GlbBuilder::plainPrimitive(const PrimitiveData& d, int shared_indices) {
+gltfjson::Primitive GlbBuilder::plainPrimitive(const PrimitiveData& d, int shared_indices, std::vector<int>* part_indices) {
     gltfjson::Primitive prim;
     double lo[3], hi[3];
     if (d.remote.on) {
@@ -88,6 +88,21 @@ gltfjson::Primitive GlbBuilder::plainPrimitive(const PrimitiveData& d, int share
         at[gltfjson::kProperTime] = addAccessor(addView(d, d.proper_time, r.proper_time, kArray), kFloat, false, nv);
     if (d.has(d.colors, r.colors))
         at[gltfjson::kColor0] = addAccessor(addView(d, d.colors, r.colors, kArray), kFloat, true, nv);
+    if (d.has(d.texcoords, r.texcoords)) {
+        at[gltfjson::kTexcoord0] = addAccessor(addView(d, d.texcoords, r.texcoords, kArray), kFloat, false, nv);
+        accessors.back().vec2 = true;
+    }
+    if (!d.part_first.empty() && part_indices) {
+        // One index view, one accessor per material's part.
+        const int view = addView(d, d.indices, r.indices, kElements);
+        part_indices->clear();
+        for (size_t p = 0; p + 1 < d.part_first.size(); ++p)
+            part_indices->push_back(addAccessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false,
+                                                3 * size_t(d.part_first[p + 1] - d.part_first[p]),
+                                                12 * size_t(d.part_first[p])));
+        prim.indices = part_indices->front();
+        return prim;
+    }
     prim.indices = shared_indices >= 0 ? shared_indices
                                        : addAccessor(addView(d, d.indices, r.indices, kElements),
                                                      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false, d.indexCount());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "exporters/glb/glb.h"
@@ -98,6 +99,25 @@ void SequenceModel::morphWeights() {
 }
 
 namespace {
+
+// Every textureInfo's "index" below `j` ("...Texture": {"index": i}) moved by `offset`.
+void moveTextureIndices(nlohmann::json* j, int offset) {
+    for (auto& [key, value] : j->items()) {
+        if (!value.is_object()) continue;
+        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index"))
+            value["index"] = value["index"].get<int>() + offset;
+        else
+            moveTextureIndices(&value, offset);
+    }
+}
+
+// A look's material (JSON text) with its texture references moved by `offset`.
+std::string renumbered(const std::string& material, int offset) {
+    if (offset == 0) return material;
+    nlohmann::json j = nlohmann::json::parse(material);
+    moveTextureIndices(&j, offset);
+    return j.dump();
+}
 
 // A key and its array of records, strings or numbers (records and strings: left out when empty).
 template <class Records>
@@ -247,11 +267,23 @@ void writeCamera(gltfjson::Text* t, const SequenceInfo& info, double far) {
 // when not opaque (e.g. a mirror, to show the reflections behind it). With --shade
 // doppler COLOR_0 holds the whole shaded colour (glTF multiplies it with the factor): a
 // white factor, the plain colour kept in extras for viewers that switch between the two.
-void writeMaterials(gltfjson::Text* t, const SequenceInfo& info, bool shade_doppler) {
+// An object whose look the file carries gets its input's materials instead (surface_look.h),
+// their textures renumbered for the file.
+void writeMaterials(gltfjson::Text* t, const SequenceModel& model) {
+    const SequenceInfo& info = model.info;
+    const bool shade_doppler = model.shade_doppler;
     if (!info.objects.empty()) {
         t->key("materials");
         t->open('[');
-        for (const ExportObject& o : info.objects) {
+        for (size_t i = 0; i < info.objects.size(); ++i) {
+            const ExportObject& o = info.objects[i];
+            const int count = (i + 1 < model.material_first.size() ? model.material_first[i + 1] : model.materials) -
+                              model.material_first[i];
+            if (o.look && count == int(o.look->materials.size()) && model.lookPlace(o.look.get())) {
+                const int offset = model.lookPlace(o.look.get())->texture;
+                for (const std::string& m : o.look->materials) t->raw(renumbered(m, offset));
+                continue;
+            }
             t->open('{');
             if (o.base_color[3] < 1) {
                 t->key("alphaMode");
@@ -309,6 +341,46 @@ void writeLight(gltfjson::Text* t, const ExportLight& light) {
 }
 
 // Scene extras: what was computed, in which units, at which camera times, in which light.
+// The looks' images (views written with the first frame), samplers and textures, in look order.
+void writeLookArrays(gltfjson::Text* t, const SequenceModel& model, const char* which) {
+    if (model.looks.empty()) return;
+    const std::string key = which;
+    size_t n = 0;
+    for (const auto& p : model.looks)
+        n += key == "images" ? p.look->images.size() : key == "samplers" ? p.look->samplers.size() : p.look->textures.size();
+    if (n == 0) return;
+    t->key(which);
+    t->open('[');
+    size_t image = 0;
+    for (const auto& p : model.looks) {
+        if (key == "images") {
+            for (const LookImage& im : p.look->images) {
+                t->open('{');
+                t->key("bufferView");
+                t->value(model.image_views[image++]);
+                t->key("mimeType");
+                t->value(im.mime_type);
+                if (!im.name.empty()) {
+                    t->key("name");
+                    t->value(im.name);
+                }
+                t->close('}');
+            }
+        } else if (key == "samplers") {
+            for (const std::string& s : p.look->samplers) t->raw(s);
+        } else {
+            for (const std::string& tex : p.look->textures) {
+                nlohmann::json j = nlohmann::json::parse(tex);
+                if (j.contains("source")) j["source"] = j["source"].get<int>() + p.image;
+                if (j.contains("sampler")) j["sampler"] = j["sampler"].get<int>() + p.sampler;
+                t->raw(j.dump());
+            }
+        }
+    }
+    t->close(']');
+}
+
+// Scene extras: what was computed, in which units, at which camera times.
 void writeScenes(gltfjson::Text* t, const SequenceModel& model) {
     const SequenceInfo& info = model.info;
     t->key("scenes");
@@ -365,13 +437,16 @@ std::string jsonChunk(const SequenceModel& model, const std::vector<std::pair<in
     writeBuffers(t, b);
     writeCamera(t, model.info, far);
     strings(t, "extensionsRequired", model.extensions);
-    strings(t, "extensionsUsed", model.extensions);
-    writeMaterials(t, model.info, model.shade_doppler);
+    strings(t, "extensionsUsed", model.extensions_used);
+    writeLookArrays(t, model, "images");
+    writeMaterials(t, model);
     array(t, "meshes", b.meshes);
     array(t, "nodes", b.nodes);
+    writeLookArrays(t, model, "samplers");
     t->key("scene");
     t->value(0);
     writeScenes(t, model);
+    writeLookArrays(t, model, "textures");
     t->close('}');
     return std::move(text.out);
 }

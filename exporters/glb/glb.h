@@ -54,7 +54,14 @@ struct DracoCoded {
 struct PrimitiveData {
     std::vector<float> positions, normals, emission;
     std::vector<float> doppler, proper_time;  // --attributes: empty unless asked for
-    std::vector<float> colors;  // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else empty
+    // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else the input's COLOR_0
+    // (surface_look.h, RGB) when it has one; else empty.
+    std::vector<float> colors;
+    std::vector<float> texcoords;  // the input's TEXCOORD_0 (surface_look.h; plain files only); else empty
+    // The object's triangles grouped by material (plain files of an object with a look): part p
+    // is indices [3 part_first[p], 3 part_first[p + 1]) in material part_material[p] of the look;
+    // empty: one part, the object's one material.
+    std::vector<uint32_t> part_first, part_material;
     std::vector<uint32_t> indices;  // as cut (what index sharing compares)
     // POSITION's bounds (of the float32 values, in vertex order), found by prepare()'s conversion;
     // `bounded` false (frames decoded from bytes): plainPrimitive() finds them from `positions`.
@@ -69,7 +76,7 @@ struct PrimitiveData {
     // are then empty (draco.bytes too; the rest of DracoCoded is filled).
     struct Remote {
         bool on = false;
-        FileSpan positions, normals, emission, doppler, proper_time, colors, indices, draco;
+        FileSpan positions, normals, emission, doppler, proper_time, colors, texcoords, indices, draco;
         FileSpan ordered;  // meshopt frames of two objects or more (for a partly shared index stream)
         uint64_t vertices = 0, index_count = 0, packed_vertices = 0, ordered_count = 0;
         double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // POSITION's bounds (of the float32 values)
@@ -77,8 +84,10 @@ struct PrimitiveData {
     } remote;
     // Empties the float32 arrays and the index list (an object the frame does not show).
     void clearArrays() {
-        for (auto* v : {&positions, &normals, &emission, &doppler, &proper_time, &colors}) v->clear();
+        for (auto* v : {&positions, &normals, &emission, &doppler, &proper_time, &colors, &texcoords}) v->clear();
         indices.clear();
+        part_first.clear();
+        part_material.clear();
     }
     size_t vertexCount() const { return remote.on ? size_t(remote.vertices) : emission.size(); }
     size_t indexCount() const { return remote.on ? size_t(remote.index_count) : indices.size(); }
@@ -170,7 +179,9 @@ struct MeshoptScratch {
 // ---- primitive.cpp ----
 
 // Float32 data of one object's mesh relative to `origin`; tracks the largest rounding. Vertices
-// are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth.
+// are split along creases sharper than kCreaseDeg so folds shade flat and curves smooth. In a plain
+// file an object with a look (`object.look`) also gets its texture coordinates and colours and
+// its triangles grouped by material (PrimitiveData::part_first).
 // With `step` > 0 also the meshopt form, positions quantized to multiples of `step` (*max_quant
 // receives the largest coordinate error). The conversion runs in parallel (TBB) and writes into
 // `d`, whose vectors keep their capacity from frame to frame; `map` and `work` are the crease
@@ -179,7 +190,10 @@ struct MeshoptScratch {
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
                  MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
-                 const std::array<double, 4>& base_color);
+                 const ExportObject& object);
+
+// Whether the .glb carries `object`'s look (plain files: meshopt and Draco do not yet).
+bool carriesLook(const GlbOptions& options, const ExportObject& object);
 
 // ---- meshopt.cpp ----
 
@@ -323,7 +337,9 @@ public:
     int addNormalized(int view, int component, bool vec3, size_t count, size_t offset);
 
     // A plain (uncompressed) primitive; `shared_indices` >= 0: that index accessor instead of a new one.
-    gltfjson::Primitive plainPrimitive(const PrimitiveData& d, int shared_indices);
+    // Data grouped by material (PrimitiveData::part_first) with `part_indices`: one index accessor
+    // per part into it, on one view (the primitive's own is the first part's).
+    gltfjson::Primitive plainPrimitive(const PrimitiveData& d, int shared_indices, std::vector<int>* part_indices = nullptr);
 
     // An EXT_meshopt_compression primitive: its vertices at `first_vertex` of the frame's vertex
     // view `vview` (records of `layout`, `stride` bytes each) and normal view `nview` (-1: the
@@ -485,6 +501,21 @@ struct SequenceModel {
     };
     std::vector<MorphNode> morph_nodes;
     std::vector<unsigned char> morph_records;  // scratch
+    // The objects' looks (surface_look.h) where the file carries them (carriesLook): per object its
+    // first material (one each without a look), and per distinct look its first image, texture
+    // and sampler in the file; the images' views are written with the first frame.
+    std::vector<int> material_first;
+    int materials = 0;
+    struct LookPlace {
+        const SurfaceLook* look;
+        int image = 0, texture = 0, sampler = 0;
+    };
+    std::vector<LookPlace> looks;
+    std::vector<int> image_views;
+    bool images_written = false;
+    std::vector<std::string> extensions_used;  // `extensions` and the looks' (KHR_texture_transform, ...)
+    const LookPlace* lookPlace(const SurfaceLook* look) const;
+    void writeImages();
 };
 
 // The JSON chunk's text of `model` (its keys in byte order at every level, gltf_json.h), once

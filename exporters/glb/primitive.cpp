@@ -19,12 +19,54 @@ namespace {
 // Vertices are split along creases sharper than this (degrees).
 constexpr double kCreaseDeg = 30.0;
 
+// The look's attributes per split vertex, as float32 (surface_look.h), and the triangles grouped by
+// material (a stable counting sort: each part keeps the cut's order).
+void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const mesh4d::CreaseMap& map, bool shade,
+                PrimitiveData* d) {
+    const SurfaceLook& look = *object.look;
+    std::vector<double> uv, rgba;
+    interpolateLook(look, *object.rest, m, &uv, &rgba);
+    const size_t nv = map.source.size();
+    d->texcoords.resize(uv.empty() ? 0 : 2 * nv);
+    for (size_t k = 0; k < d->texcoords.size() / 2; ++k)
+        for (size_t c = 0; c < 2; ++c) d->texcoords[2 * k + c] = float(uv[2 * map.source[k] + c]);
+    if (!shade && !rgba.empty()) {
+        d->colors.resize(3 * nv);
+        for (size_t k = 0; k < nv; ++k)
+            for (size_t c = 0; c < 3; ++c)  // within [0, 1] as glTF asks (rounding of the interpolation)
+                d->colors[3 * k + c] = float(std::clamp(rgba[4 * map.source[k] + c], 0.0, 1.0));
+    }
+    std::vector<uint32_t> count(look.materials.size() + 1, 0);
+    for (const uint32_t s : m.source_triangles) ++count[look.triangle_material[s] + 1];
+    d->part_first.clear();
+    d->part_material.clear();
+    std::vector<uint32_t> next(look.materials.size(), 0);
+    uint32_t at = 0;
+    for (uint32_t p = 0; p < look.materials.size(); ++p) {
+        next[p] = at;
+        if (count[p + 1] == 0) continue;
+        d->part_first.push_back(at);
+        d->part_material.push_back(p);
+        at += count[p + 1];
+    }
+    d->part_first.push_back(at);
+    for (size_t t = 0; t < map.triangles.size(); ++t) {
+        const uint32_t p = look.triangle_material[m.source_triangles[t]];
+        std::memcpy(d->indices.data() + 3 * size_t(next[p]++), map.triangles[t].data(), sizeof(map.triangles[t]));
+    }
+}
+
 }  // namespace
+
+bool carriesLook(const GlbOptions& options, const ExportObject& object) {
+    return object.look && !options.meshopt && !options.draco;
+}
 
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,
                  MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
-                 const std::array<double, 4>& base_color) {
+                 const ExportObject& object) {
+    const std::array<double, 4>& base_color = object.base_color;
     mesh4d::creaseSplitMap(m, kCreaseDeg, map, work);
     const size_t nv = map->source.size();
     d->positions.resize(3 * nv);
@@ -110,6 +152,12 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     tbb::parallel_for(tbb::blocked_range<size_t>(0, map->triangles.size(), 65536), [&](const tbb::blocked_range<size_t>& r) {
         std::memcpy(d->indices.data() + 3 * r.begin(), map->triangles.data() + r.begin(), r.size() * sizeof(map->triangles[0]));
     });
+    d->texcoords.clear();
+    d->part_first.clear();
+    d->part_material.clear();
+    if (carriesLook(options, object) && object.rest && m.source_triangles.size() == m.triangles.size() &&
+        m.rest_points.size() == m.positions.size())
+        lookArrays(m, object, *map, shade, d);
     if (step > 0)
         *max_quant = std::max(*max_quant, packMeshopt(d, exact, step, MeshoptLayout(options), order,
                                                       &scratch->normals));

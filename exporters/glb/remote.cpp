@@ -146,6 +146,23 @@ bool getText(FrameBytesIn* in, std::string* text) {
     return true;
 }
 
+// The materials of object `o`'s look the file carries (0: none, so no parts).
+size_t lookMaterials(const SequenceInfo& info, const GlbOptions& options, size_t o) {
+    return o < info.objects.size() && glb::carriesLook(options, info.objects[o]) ? info.objects[o].look->materials.size() : 0;
+}
+
+// A frame's material parts as add() takes them (PrimitiveData::part_first): none, or increasing
+// triangle offsets from 0 to the index count's triangles, each part in one of `materials`.
+bool validParts(const PrimitiveData& p, uint64_t index_count, size_t materials) {
+    if (p.part_first.empty()) return p.part_material.empty();
+    if (p.part_first.size() != p.part_material.size() + 1 || p.part_first.front() != 0 ||
+        3 * uint64_t(p.part_first.back()) != index_count)
+        return false;
+    for (size_t i = 0; i + 1 < p.part_first.size(); ++i)
+        if (p.part_first[i + 1] <= p.part_first[i] || p.part_material[i] >= materials) return false;
+    return true;
+}
+
 }  // namespace
 
 // A frame by reference: its arrays written to this process's frame spill in the order the file
@@ -227,6 +244,7 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         piece(p.draco.bytes);
         static const std::vector<uint32_t> none;
         piece(meshopt && shown > 1 && p.ordered ? *p.ordered : none);  // a partly shared stream is made from them
+        piece(p.texcoords);
     }
     piece(target_encoded[0]);
     piece(target_encoded[1]);
@@ -251,7 +269,7 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
     for (int i = 0; i < 3; ++i) putSpan(&out, spans[k++]);
     out.put(uint64_t(d.data.size()));
     for (const PrimitiveData& p : d.data) {
-        for (int i = 0; i < 9; ++i) putSpan(&out, spans[k++]);
+        for (int i = 0; i < 10; ++i) putSpan(&out, spans[k++]);
         uint64_t hash[2] = {0, 0};
         indexHash(p.indices, hash);
         std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
@@ -271,6 +289,8 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         for (int c = 0; c < 3; ++c) out.put(int32_t(p.qmax[c]));
         const DracoCoded& dc = p.draco;
         putDracoFacts(&out, dc);
+        out.putVector(p.part_first);
+        out.putVector(p.part_material);
     }
     out.put(may_run);
     out.put(targets);
@@ -324,7 +344,7 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
         PrimitiveData::Remote& r = p.remote;
         r.on = true;
         for (FileSpan* s : {&r.positions, &r.normals, &r.emission, &r.doppler, &r.proper_time, &r.colors, &r.indices,
-                            &r.draco, &r.ordered})
+                            &r.draco, &r.ordered, &r.texcoords})
             ok = ok && getSpan(&in, s);
         ok = ok && in.get(&r.vertices) && in.get(&r.index_count) && in.get(&r.packed_vertices) &&
              in.get(&r.ordered_count);
@@ -338,16 +358,17 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
         for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.lo[c]);
         for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.hi[c]);
         for (int a = 0; ok && a < 6; ++a) ok = in.get(&dc.ids[a]);
-        ok = ok && in.get(&dc.quantization_error) && getText(&in, &dc.error);
+        ok = ok && in.get(&dc.quantization_error) && getText(&in, &dc.error) && in.getVector(&p.part_first) &&
+             in.getVector(&p.part_material) && validParts(p, r.index_count, lookMaterials(impl_->info, impl_->options, o));
         // What add() takes of the spans: whole vertices and triangles, every source known.
         const uint64_t nv = r.vertices;
         auto optional = [nv](const FileSpan& s, uint64_t per) { return s.length == 0 || s.length == per * nv; };
         ok = ok && r.positions.length == 12 * nv && r.normals.length == 12 * nv && r.emission.length == 4 * nv &&
-             optional(r.doppler, 4) && optional(r.proper_time, 4) && optional(r.colors, 12) &&
+             optional(r.doppler, 4) && optional(r.proper_time, 4) && optional(r.colors, 12) && optional(r.texcoords, 8) &&
              r.indices.length == 4 * r.index_count && r.index_count % 3 == 0 &&
              (r.ordered.length == 0 || r.ordered.length == 4 * r.ordered_count);
         for (const FileSpan* s : {&r.positions, &r.normals, &r.emission, &r.doppler, &r.proper_time, &r.colors,
-                                  &r.indices, &r.draco, &r.ordered})
+                                  &r.indices, &r.draco, &r.ordered, &r.texcoords})
             if (ok && s->length > 0) {
                 ok = frameSource(s->source) >= 0;
                 impl_->use(*s);
@@ -400,9 +421,11 @@ std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& 
     out.putVector(d.meshopt.first);
     out.put(uint64_t(d.data.size()));
     for (const PrimitiveData& p : d.data) {
-        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
             out.putVector(*v);
         out.putVector(p.indices);
+        out.putVector(p.part_first);
+        out.putVector(p.part_material);
         out.putVector(p.packed);
         out.putVector(p.packed_normals);
         out.putVector(p.packed_snorm);
@@ -453,10 +476,11 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
     if (ok) d.data.resize(size_t(primitives));
     for (size_t o = 0; ok && o < d.data.size(); ++o) {
         PrimitiveData& p = d.data[o];
-        for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+        for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
             ok = ok && in.getVector(v);
         uint8_t has_ordered = 0;
-        ok = ok && in.getVector(&p.indices) && in.getVector(&p.packed) && in.getVector(&p.packed_normals) &&
+        ok = ok && in.getVector(&p.indices) && in.getVector(&p.part_first) && in.getVector(&p.part_material) &&
+             validParts(p, p.indices.size(), lookMaterials(impl_->info, impl_->options, o)) && in.getVector(&p.packed) && in.getVector(&p.packed_normals) &&
              in.getVector(&p.packed_snorm) && in.get(&has_ordered);
         if (ok && has_ordered) {
             auto ordered = std::make_shared<std::vector<uint32_t>>();
@@ -474,7 +498,7 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
         ok = ok && in.get(&dc.quantization_error) && in.getVector(&draco_error);
         dc.error.assign(draco_error.begin(), draco_error.end());
         // What add() writes as it is: finite attributes (a NaN gives an invalid accessor).
-        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors})
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
             ok = ok && std::all_of(v->begin(), v->end(), [](float x) { return std::isfinite(x); });
         // What add() indexes by: whole vertices, indices within them, the meshopt stream's offsets.
         const size_t nv = p.emission.size();

@@ -63,11 +63,45 @@ SequenceModel::SequenceModel(const SequenceInfo& info_, const GlbOptions& option
         for (const char* e : {"EXT_meshopt_compression", "KHR_mesh_quantization"}) extensions.push_back(e);
     compression = options.draco ? Compression::draco : options.meshopt ? Compression::meshopt : Compression::none;
     previous.resize(info.objects.size());
+    // Step: each object's first material: its look's materials where the file carries them, else
+    // one; each distinct look's images, textures and samplers once.
+    extensions_used = extensions;
+    LookPlace next{nullptr};
+    for (const ExportObject& o : info.objects) {
+        material_first.push_back(materials);
+        if (!carriesLook(options, o)) {
+            ++materials;
+            continue;
+        }
+        materials += int(o.look->materials.size());
+        if (lookPlace(o.look.get())) continue;
+        next.look = o.look.get();
+        looks.push_back(next);
+        next.image += int(o.look->images.size());
+        next.texture += int(o.look->textures.size());
+        next.sampler += int(o.look->samplers.size());
+        for (const std::string& e : o.look->extensions)
+            if (std::find(extensions_used.begin(), extensions_used.end(), e) == extensions_used.end())
+                extensions_used.push_back(e);
+    }
+}
+
+const SequenceModel::LookPlace* SequenceModel::lookPlace(const SurfaceLook* look) const {
+    for (const LookPlace& p : looks)
+        if (p.look == look) return &p;
+    return nullptr;
+}
+
+void SequenceModel::writeImages() {
+    images_written = true;
+    for (const LookPlace& p : looks)
+        for (const LookImage& image : p.look->images) image_views.push_back(b.addView(image.bytes.data(), image.bytes.size(), 0));
 }
 
 bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveData>& data, const double origin[3],
                              double scale, const MeshoptFrame* meshopt, GlbStats* stats, std::string* error) {
     gltfjson::Node node;
+    if (!images_written) writeImages();
     if (previous.size() < f.objects.size()) previous.resize(f.objects.size());
     node.name = frameName(f.index);
     // Step: the objects' groups in order: -1 (the frame node) first, then mirrors as they appear.
@@ -84,7 +118,7 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
     for (size_t o = 0; o < f.objects.size(); ++o) {
         const Previous& prev = previous[o];
         if (compression != Compression::draco && !f.objects[o].triangles.empty() && prev.accessor >= 0 &&
-            prev.same(data[o]))
+            data[o].part_first.empty() && prev.same(data[o]))
             shared[o] = prev.accessor;
     }
     // Step (meshopt): a frame that continues the open run becomes a morph target of its mesh.
@@ -168,12 +202,25 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
             } else if (compression == Compression::meshopt) {
                 prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
                                           shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
+            } else if (!data[o].part_first.empty()) {
+                // Step: one primitive per material, sharing the vertices (never the indices).
+                std::vector<int> parts;
+                prim = b.plainPrimitive(data[o], -1, &parts);
+                prev = Previous();
+                shown[o] = true;
+                for (size_t p = 0; p < parts.size(); ++p) {
+                    gltfjson::Primitive part = prim;
+                    part.indices = parts[p];
+                    part.material = material_first[o] + int(data[o].part_material[p]);
+                    mesh.primitives.push_back(std::move(part));
+                }
+                continue;
             } else {
                 prim = b.plainPrimitive(data[o], shared[o]);
             }
             if (compression != Compression::draco && shared[o] < 0) prev.take(prim.indices, data[o], borrow_indices);
             shown[o] = true;
-            prim.material = o < info.objects.size() ? int(o) : -1;
+            prim.material = o < material_first.size() ? material_first[o] : -1;
             mesh.primitives.push_back(std::move(prim));
         }
         b.meshes.push_back(std::move(mesh));

@@ -253,7 +253,7 @@ std::shared_ptr<GlbFrameData> GlbSequenceWriter::prepare(const ExportFrame& f, b
                 toPrimitive(f.objects[o], d->origin, d->step, &d->max_float_error, &worst_coordinate, &d->data[o],
                             &scratch->crease_map[o], &scratch->crease_work[o], &scratch->meshopt,
                             &scratch->meshopt.orders[o], impl_->options,
-                            impl_->info.objects[o].base_color);
+                            impl_->info.objects[o]);
         // Step (Draco): every shown primitive coded here, on the worker thread.
         if (impl_->options.draco)
             for (size_t o = 0; o < f.objects.size(); ++o)
@@ -445,6 +445,12 @@ GlbSink::~GlbSink() = default;
 bool GlbSink::begin(const SequenceInfo& info, std::string*) {
     model_ = info.model;
     tolerance_ = info.tolerance;
+    // Compressed files do not carry the inputs' looks yet: say whose are dropped.
+    dropped_looks_.clear();
+    reads_rest_points_ = false;
+    for (const ExportObject& o : info.objects) reads_rest_points_ = reads_rest_points_ || glb::carriesLook(options_, o);
+    for (const ExportObject& o : info.objects)
+        if (o.look && !glb::carriesLook(options_, o) && o.mirror_index < 0) dropped_looks_.push_back(o.name);
     writer_ = std::make_unique<GlbSequenceWriter>(path_, info, options_);
     return true;  // the spill file's errors surface at the first add()
 }
@@ -495,6 +501,10 @@ bool GlbSink::finish(SinkSummary* summary, std::string* error) {
                                           : "leave out --meshopt-bits (the step then follows the tolerance)");
         summary->warnings.push_back(w.str());
     }
+    for (const std::string& name : dropped_looks_)
+        summary->warnings.push_back(path_ + ": object '" + name + "': its materials, textures, texture coordinates and " +
+                                    "vertex colours are not carried with --compress " + (options_.draco ? "draco" : "meshopt") +
+                                    " (one colour per object; leave out --compress to keep them)");
     // Warn when Draco's quantization is coarser than the accuracy asked for (gltfpack warns the
     // same way about position bits).
     if (options_.draco && tolerance_ > 0 && stats.max_quantization_error > tolerance_) {

@@ -367,8 +367,10 @@ async function main() {
     }
 
     // 5b. Doppler colours: the toggle against the plain colours, in the same viewports
+    // (--shade doppler's COLOR_0: on materials with extras.base_color; an input's own COLOR_0 is not Doppler)
     const withColour = opts.models.filter((m) => (files[m].json.meshes || []).some((me) =>
-      me.primitives.some((p) => p.attributes.COLOR_0 !== undefined)));
+      me.primitives.some((p) => p.attributes.COLOR_0 !== undefined &&
+        (files[m].json.materials || [])[p.material]?.extras?.base_color !== undefined)));
     if (withColour.length) {
       for (const m of withColour) {
         check(info[m].dopplerColours > 0, `${m}: viewer found the COLOR_0 meshes`, `${info[m].dopplerColours}`);

@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Checks a .glb that `apparent render` made of tests/looks/make_textured_box.py's box (standard library only).
+
+usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ
+  P the box's position at t = 0, V its velocity (relativistic model, t0 = 0), R its rotation_deg (X then
+  Y then Z). For every vertex of every frame: its rest point follows from its position and emission time
+  in closed form (the inverse Lorentz boost of the uniform motion, then the inverse rotation), lies on a
+  face of the unit box, and its TEXCOORD_0 and COLOR_0 must be the face's closed form at that point
+  (make_textured_box.py), to float32 rounding; the primitive's material must be the face's. The
+  materials, their count and factors equal the input's, the texture's image is the input's bytes, once.
+"""
+import json
+import math
+import struct
+import sys
+
+
+def read_glb(path):
+    data = open(path, "rb").read()
+    assert data[:4] == b"glTF", path
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + jlen])
+    off = 20 + jlen
+    blen = struct.unpack_from("<I", data, off)[0]
+    return doc, data[off + 8:off + 8 + blen]
+
+
+def accessor(doc, binary, i):
+    a = doc["accessors"][i]
+    v = doc["bufferViews"][a["bufferView"]]
+    n = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[a["type"]]
+    fmt = {5126: "f", 5125: "I", 5123: "H"}[a["componentType"]]
+    start = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+    vals = struct.unpack_from("<%d%s" % (a["count"] * n, fmt), binary, start)
+    return [vals[k * n:(k + 1) * n] for k in range(a["count"])]
+
+
+def rot_xyz(deg):
+    ax, ay, az = (math.radians(d) for d in deg)
+    rx = [[1, 0, 0], [0, math.cos(ax), -math.sin(ax)], [0, math.sin(ax), math.cos(ax)]]
+    ry = [[math.cos(ay), 0, math.sin(ay)], [0, 1, 0], [-math.sin(ay), 0, math.cos(ay)]]
+    rz = [[math.cos(az), -math.sin(az), 0], [math.sin(az), math.cos(az), 0], [0, 0, 1]]
+    mul = lambda a, b: [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    return mul(rz, mul(ry, rx))  # X first, then Y, then Z
+
+
+def main(out, inp, p, v, r):
+    doc, binary = read_glb(out)
+    idoc, ibin = read_glb(inp)
+    fails = []
+    # Materials: the input's, in first-use order (here the input's order), factors equal.
+    if [m.get("pbrMetallicRoughness") for m in doc["materials"]] != [m.get("pbrMetallicRoughness") for m in idoc["materials"]]:
+        fails.append("materials differ: %s" % doc["materials"])
+    if len(doc.get("images", [])) != 1:
+        fails.append("images: %d, expected 1" % len(doc.get("images", [])))
+    else:
+        iv = doc["bufferViews"][doc["images"][0]["bufferView"]]
+        image = binary[iv.get("byteOffset", 0):iv.get("byteOffset", 0) + iv["byteLength"]]
+        ivi = idoc["bufferViews"][idoc["images"][0]["bufferView"]]
+        if image != ibin[ivi.get("byteOffset", 0):ivi.get("byteOffset", 0) + ivi["byteLength"]]:
+            fails.append("the image's bytes differ from the input's")
+    views_of_image = sum(1 for v_ in doc["bufferViews"] if v_["byteLength"] == ivi["byteLength"])
+    R = rot_xyz(r)
+    b2 = sum(x * x for x in v)
+    g = 1 / math.sqrt(1 - b2)
+    n = [x / math.sqrt(b2) for x in v] if b2 > 0 else [1.0, 0.0, 0.0]
+    worst_uv = worst_rest = 0.0
+    checked = 0
+    for node in doc["nodes"]:
+        if "mesh" not in node:
+            continue
+        t0 = node.get("translation", [0, 0, 0])
+        for prim in doc["meshes"][node["mesh"]]["primitives"]:
+            pos = accessor(doc, binary, prim["attributes"]["POSITION"])
+            tim = accessor(doc, binary, prim["attributes"]["_EMISSION_TIME"])
+            uv = accessor(doc, binary, prim["attributes"]["TEXCOORD_0"])
+            col = accessor(doc, binary, prim["attributes"]["COLOR_0"])
+            used = sorted({i for (i,) in accessor(doc, binary, prim["indices"])})
+            for k in used:
+                x = [t0[c] + pos[k][c] - p[c] for c in range(3)]
+                t = tim[k][0]
+                # Inverse boost of the uniform motion: the rest-frame point (relativistic model, t0 = 0).
+                xn = sum(x[c] * n[c] for c in range(3))
+                tn = math.sqrt(b2) * t
+                q_lab = [x[c] + (g - 1) * xn * n[c] - g * tn * n[c] for c in range(3)]
+                q = [sum(R[i][c] * q_lab[i] for i in range(3)) for c in range(3)]  # R^T q_lab
+                # Material m holds the faces of axis m (on an edge the point lies on both faces).
+                axis = prim["material"]
+                worst_rest = max(worst_rest, abs(abs(q[axis]) - 0.5), max(abs(x) for x in q) - 0.5)
+                b, c = [a for a in range(3) if a != axis]
+                want = (q[b] + 0.5, q[c] + 0.5)
+                worst_uv = max(worst_uv, abs(uv[k][0] - want[0]), abs(uv[k][1] - want[1]),
+                               abs(col[k][0] - min(1, max(0, want[0]))), abs(col[k][1] - min(1, max(0, want[1]))),
+                               abs(col[k][2] - 0.25))
+                checked += 1
+    print("%s: %d vertices checked, rest points within %.2e of the box, texture coordinates and colours within %.2e "
+          "of the closed form; %d materials, %d images" % (out, checked, worst_rest, worst_uv, len(doc["materials"]),
+                                                          len(doc.get("images", []))))
+    if checked == 0:
+        fails.append("no vertex checked")
+    if worst_rest > 1e-4 or worst_uv > 1e-4:
+        fails.append("beyond 1e-4")
+    for f in fails[:5]:
+        print("FAIL", f)
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    a = sys.argv[1:]
+    if len(a) != 11:
+        sys.exit(__doc__)
+    sys.exit(main(a[0], a[1], [float(x) for x in a[2:5]], [float(x) for x in a[5:8]], [float(x) for x in a[8:11]]))

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# A textured, three-material box with vertex colours (make_textured_box.py) rendered at 0.9c: at the
+# default tolerance, in vertex mode, and at rest in the instant model; each .glb passes the Khronos
+# glTF-Validator and check_textured.py (every vertex's TEXCOORD_0 and COLOR_0 equal the closed form
+# at its rest point, the materials and the image are the input's, the image once). With --compress
+# the look is dropped with a warning; shards and MPI ranks give the one process's bytes; three.js in
+# headless Chromium shows the texture.
+# Usage: run.sh APPARENT_BINARY SOURCE_DIR
+set -euo pipefail
+apparent=$1
+src=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+python3 "$src/tests/looks/make_textured_box.py" "$out/box.glb" "$out/texture.png"
+scene() {  # velocity x, model, frames start
+  cat > "$out/scene_$2.json" <<JSON
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 60},
+ "frames": {"start": $3, "end": $(($3 + 2)), "fps": 2}, "model": "$2",
+ "objects": [{"name": "box", "mesh": "box.glb", "position": [-2, 0.3, -4], "velocity": [$1, 0, 0],
+              "rotation_deg": [20, 30, 0]}]}
+JSON
+}
+scene 0.9 relativistic 16
+scene 0 instant 0
+"$apparent" render "$out/scene_relativistic.json" --out "$out/refined" --quiet
+"$apparent" render "$out/scene_relativistic.json" --out "$out/vertex" --tolerance vertex --quiet
+"$apparent" render "$out/scene_instant.json" --out "$out/rest" --tolerance vertex --quiet
+python3 "$src/tests/looks/check_textured.py" "$out/refined/relativistic.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0
+python3 "$src/tests/looks/check_textured.py" "$out/vertex/relativistic.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0
+python3 "$src/tests/looks/check_textured.py" "$out/rest/instant.glb" "$out/box.glb" -2 0.3 -4 0 0 0 20 30 0
+(cd "$src" && node tests/validators/validate_gltf.js "$out/refined/relativistic.glb" "$out/vertex/relativistic.glb" \
+  "$out/rest/instant.glb")
+# three.js in headless Chromium shows the texture: texels of the texture's own colours in the picture
+# (the box without COLOR_0, near the camera), and the viewer takes an input's COLOR_0 for no Doppler shading.
+python3 "$src/tests/looks/make_textured_box.py" "$out/plain_box.glb" "$out/texture2.png" --no-colors
+cat > "$out/near.json" <<JSON
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 40},
+ "frames": {"start": 9.5, "end": 10.5, "fps": 4},
+ "objects": [{"name": "box", "mesh": "plain_box.glb", "position": [-3.8, 0, -2.5], "velocity": [0.9, 0, 0],
+              "rotation_deg": [20, 30, 0]}]}
+JSON
+"$apparent" render "$out/near.json" --out "$out/near" --quiet
+(cd "$src" && node tests/web/viewer_test.js "$out/near" --models relativistic --frames 0,3 --shot-time 0.3 \
+  --screenshot "$out/near.png" && node tests/looks/texels.js "$out/near.png" &&
+  node tests/web/viewer_test.js "$out/refined" --models relativistic --frames 0,3 --shot-time 0.3)
+"$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt" --compress meshopt 2> "$out/meshopt.err"
+grep -q "object 'box': its materials, textures" "$out/meshopt.err" || { echo "FAIL: no warning with --compress"; exit 1; }
+# Frames made by other processes carry the look too: two shards merged, and three MPI ranks, give the
+# one process's bytes.
+for i in 0 1; do
+  "$apparent" render "$out/scene_relativistic.json" --out "$out/shard" --shard $i/2 --quiet
+done
+"$apparent" merge "$out/shard" --quiet
+cmp "$out/refined/relativistic.glb" "$out/shard/relativistic.glb" || { echo "FAIL: shards differ from one process"; exit 1; }
+# A shard is input too: a look whose material is not a JSON object, or whose texture reference
+# leaves the look, is refused by merge with the field named.
+for tamper in 'b"{\"name\":\"textured\"", b"[\"name\":\"textured\""' 'b"{\"index\":0}", b"{\"index\":7}"'; do
+  rm -rf "$out/bad" && mkdir -p "$out/bad/shards"
+  cp "$out/shard/shards/"* "$out/bad/shards/" 2>/dev/null || { "$apparent" render "$out/scene_relativistic.json" --out "$out/bad" --shard 0/2 --quiet; }
+  for f in "$out/bad/shards/"*; do
+    python3 -c "import sys; p=sys.argv[1]; b=open(p,'rb').read(); a,c=$tamper; assert a in b, p; open(p,'wb').write(b.replace(a,c,1))" "$f"
+  done
+  if "$apparent" merge "$out/bad" 2> "$out/bad.err"; then echo "FAIL: merge took a tampered look"; exit 1; fi
+  grep -q "looks\[0\]\.materials\[0\]" "$out/bad.err" || { echo "FAIL: merge's message:"; cat "$out/bad.err"; exit 1; }
+done
+timeout 300 mpirun --oversubscribe -n 3 "$apparent" render "$out/scene_relativistic.json" --out "$out/mpi" --quiet
+cmp "$out/refined/relativistic.glb" "$out/mpi/relativistic.glb" || { echo "FAIL: MPI ranks differ from one process"; exit 1; }
+echo "looks: ok"
