@@ -38,6 +38,9 @@ struct ExportObject {
     // and the rest mesh its cut's rest points and source triangles refer to; null: none.
     std::shared_ptr<const SurfaceLook> look;
     std::shared_ptr<const mesh4d::RestMesh> rest;
+    // The material's other PBR factors (the scene's `material`).
+    double metallic = 0, roughness = 0.8;
+    std::array<double, 3> emissive{0, 0, 0};  // linear RGB
 };
 
 struct ExportCamera {

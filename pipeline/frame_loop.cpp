@@ -119,6 +119,9 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
         ExportObject o;
         o.name = stage.objects[i].spec.name;
         o.base_color = objectBaseColor(stage.objects, i);
+        o.metallic = stage.objects[i].spec.material.metallic;
+        o.roughness = stage.objects[i].spec.material.roughness;
+        o.emissive = stage.objects[i].spec.material.emissive;
         if (stage.objects[i].look) {
             o.look = stage.objects[i].look;
             o.rest = std::make_shared<const mesh4d::RestMesh>(stage.objects[i].rest);

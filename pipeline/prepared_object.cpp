@@ -78,6 +78,15 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
         obj.has_color = it->second.has_color;
         obj.color = it->second.color;
         obj.look = it->second.look;
+        // Step: the scene's own colour or material replaces the file's (and its materials).
+        if (spec.material.given) {
+            if (obj.look && !obj.look->materials.empty() && !quiet)
+                log << "warning: " << scene.path << ": " << spec.field_path << ": the scene's "
+                    << "color/material replaces the " << obj.look->materials.size() << " material(s) of " << spec.mesh_path << "\n";
+            obj.has_color = true;
+            obj.color = spec.material.base_color;
+            obj.look = nullptr;
+        }
         const auto& L = spec.linear;  // column-major
         const RotationXYZ rotate(spec.rotation_deg);
         for (Vec3& p : obj.rest.positions) {

@@ -103,6 +103,14 @@ struct ObjectSpec {
     // mean velocity, and `linear` holds the pose at t0. keys_field names the channels, for messages.
     std::shared_ptr<const mesh4d::KeyPath> keys;
     std::string keys_field;
+    // `color` or `material` (docs/SCENES.md): the object's glTF PBR material, replacing its mesh file's
+    // colour and materials; not given: the file's (else a palette colour).
+    struct Material {
+        bool given = false;
+        std::array<double, 4> base_color{1, 1, 1, 1};  // linear RGBA in [0, 1]
+        double metallic = 0, roughness = 0.8;           // in [0, 1]
+        std::array<double, 3> emissive{0, 0, 0};        // linear RGB in [0, 1]
+    } material;
 };
 
 // The default tolerance, as a fraction of each object's bounding-box diagonal: an object that fills

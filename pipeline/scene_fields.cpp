@@ -262,6 +262,42 @@ void readMirror(FieldReader& r, const json& j, const std::string& path, const Ob
         r.fail(path + ".mirror", "a mirror must be at rest (velocity [0, 0, 0])");
 }
 
+// `color`: [r, g, b] or [r, g, b, a]; `material`: {base_color, metallic, roughness, emissive}.
+void readMaterial(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
+    ObjectSpec::Material& m = obj->material;
+    auto unit = [&](const json& v, const std::string& at, double* out) {
+        r.readNumber(v, at, out);
+        if (!r.failed() && !(*out >= 0 && *out <= 1)) r.fail(at, formatNumber(*out) + " is outside [0, 1]");
+    };
+    auto colour = [&](const json& v, const std::string& at, double* out, size_t least, size_t most) {
+        if (!v.is_array() || v.size() < least || v.size() > most)
+            return r.fail(at, std::string("expected ") + (least == most ? "[r, g, b]" : "[r, g, b] or [r, g, b, a]") +
+                                  " (linear, each in [0, 1]), got " + FieldReader::describe(v));
+        for (size_t i = 0; i < v.size() && !r.failed(); ++i) unit(v[i], at + "[" + std::to_string(i) + "]", &out[i]);
+    };
+    const auto c = j.find("color"), mat = j.find("material");
+    if (c != j.end() && mat != j.end())
+        return r.fail(path + ".color", "give either color or material.base_color, not both");
+    if (c != j.end()) {
+        m.given = true;
+        colour(*c, path + ".color", m.base_color.data(), 3, 4);
+    }
+    if (mat == j.end()) return;
+    m.given = true;
+    if (!mat->is_object())
+        return r.fail(path + ".material", "expected an object {base_color, metallic, roughness, emissive}, got " +
+                                              FieldReader::describe(*mat));
+    for (const auto& [key, value] : mat->items()) {
+        const std::string at = path + ".material." + key;
+        if (key == "base_color") colour(value, at, m.base_color.data(), 3, 4);
+        else if (key == "metallic") unit(value, at, &m.metallic);
+        else if (key == "roughness") unit(value, at, &m.roughness);
+        else if (key == "emissive") colour(value, at, m.emissive.data(), 3, 3);
+        else r.fail(at, "unknown field (material has base_color, metallic, roughness, emissive)");
+        if (r.failed()) return;
+    }
+}
+
 void readExists(FieldReader& r, const json& j, const std::string& path, const ObjectContext&, ObjectSpec* obj) {
     auto it = j.find("exists");
     if (it == j.end()) return;
@@ -340,6 +376,7 @@ const std::vector<ObjectField>& objectFields() {
         {{"scale"}, false, &readScale},
         {{"mirror"}, false, &readMirror},
         {{"exists"}, false, &readExists},
+        {{"color", "material"}, false, &readMaterial},
         {{"angular_velocity"}, false, &readAngularVelocity, true},
         {{"acceleration"}, false, &readAcceleration, true},
         {{"orbit"}, false, &readOrbit, true},

@@ -69,9 +69,10 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
     info->scene_path = in->bytes(kText);
     if (in->ok && !isValidUtf8(info->scene_path))
         fail("scene path", "not valid UTF-8 ('" + printable(info->scene_path, 60) + "')");
-    // Each object takes at least 56 bytes (a name length, 4 colours, a mirror index and name length).
+    // Each object takes at least 96 bytes (a name length, 4 colours, 5 material factors, a mirror
+    // index and name length).
     const uint64_t n = in->u64();
-    if (in->ok && (n < 1 || n > in->left() / 56)) fail("objects", std::to_string(n) + " objects, more than the file holds");
+    if (in->ok && (n < 1 || n > in->left() / 96)) fail("objects", std::to_string(n) + " objects, more than the file holds");
     for (uint64_t i = 0; in->ok && problem->empty() && i < n; ++i) {
         const std::string at = "objects[" + std::to_string(i) + "]";
         ExportObject e;
@@ -80,6 +81,11 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
         for (double& c : e.base_color) c = in->real();
         for (double c : e.base_color)
             if (in->ok && !(c >= 0 && c <= 1)) fail(at + ".base_color", formatNumber(c) + " is outside [0, 1]");
+        e.metallic = in->real();
+        e.roughness = in->real();
+        for (double& c : e.emissive) c = in->real();
+        for (double c : {e.metallic, e.roughness, e.emissive[0], e.emissive[1], e.emissive[2]})
+            if (in->ok && !(c >= 0 && c <= 1)) fail(at + ".material", formatNumber(c) + " is outside [0, 1]");
         const uint64_t mirror = in->u64();
         if (in->ok && !(int64_t(mirror) >= -1 && int64_t(mirror) < int64_t(n)))
             fail(at + ".mirror_index", std::to_string(int64_t(mirror)) + " is outside -1 .. " + std::to_string(n - 1));
@@ -274,6 +280,7 @@ void putShardSequence(std::string* out, const SequenceInfo& info, const GlbOptio
     for (const ExportObject& e : info.objects) {
         putString(out, e.name);
         for (double c : e.base_color) putDouble(out, c);
+        for (double c : {e.metallic, e.roughness, e.emissive[0], e.emissive[1], e.emissive[2]}) putDouble(out, c);
         putU64(out, uint64_t(int64_t(e.mirror_index)));
         putString(out, e.mirror);
     }

@@ -63,7 +63,7 @@ struct ShardLayout {
             if (i == 0) name0 = at;
             skipString();
             if (i == 0) color0 = at;
-            at += 32;
+            at += 32 + 40;  // base colour, metallic, roughness, emissive
             if (i == 0) mirror0 = at;
             at += 8;
             skipString();
@@ -190,6 +190,8 @@ TEST_F(MergeHostile, HeaderNumbersAndFlagsOutOfRangeAreRefused) {
         {l.fov, real(nan), "camera.fov_deg"},
         {l.color0, real(nan), "objects[0].base_color"},
         {l.color0 + 8, real(2), "objects[0].base_color"},
+        {l.color0 + 32, real(-1), "objects[0].material"},
+        {l.color0 + 64, real(nan), "objects[0].material"},
         {l.mirror0, u64(7), "objects[0].mirror_index"},
         {l.flags, u64(2), "draco"},
         {l.flags + 8, u64(999), "draco position bits"},

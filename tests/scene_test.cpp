@@ -2,6 +2,7 @@
 // naming the file, the field and the problem.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <fstream>
 
 #include "pipeline/scene.h"
@@ -145,4 +146,42 @@ TEST(Scene, ExactSpeedAsGammaOrRapidity) {
     st = loadScene(write("c.json", R"({"objects":[{"mesh":"tetra.obj","direction":[1,0,0],"gamma":0.5}]})"), &s);
     EXPECT_FALSE(st.ok);
     EXPECT_NE(st.message.find("objects[0].gamma: must be in [1, 1e15]"), std::string::npos) << st.message;
+}
+
+// An object's `color` or `material` (docs/SCENES.md), and each refusal naming the field.
+TEST(Scene, ColorAndMaterialFields) {
+    const std::string dir = testio::processTempDir();
+    auto write = [&](const std::string& name, const std::string& text) {
+        std::ofstream(dir + name) << text;
+        return dir + name;
+    };
+    std::ofstream(dir + "tetra.obj") << "v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\nf 1 2 4\nf 1 3 2\nf 1 4 3\nf 2 3 4\n";
+    Scene s;
+    ASSERT_TRUE(loadScene(write("c.json", R"({"objects":[{"mesh":"tetra.obj","color":[0.9,0.1,0.2]}]})"), &s).ok);
+    EXPECT_TRUE(s.objects[0].material.given);
+    EXPECT_EQ(s.objects[0].material.base_color, (std::array<double, 4>{0.9, 0.1, 0.2, 1}));
+    EXPECT_EQ(s.objects[0].material.roughness, 0.8);
+    ASSERT_TRUE(loadScene(write("m.json", R"({"objects":[{"mesh":"tetra.obj","material":{"base_color":[0.1,0.2,0.3,0.5],
+        "metallic":1,"roughness":0.25,"emissive":[0,0.5,1]}}]})"), &s).ok);
+    const ObjectSpec::Material& m = s.objects[0].material;
+    EXPECT_EQ(m.base_color, (std::array<double, 4>{0.1, 0.2, 0.3, 0.5}));
+    EXPECT_EQ(m.metallic, 1);
+    EXPECT_EQ(m.roughness, 0.25);
+    EXPECT_EQ(m.emissive, (std::array<double, 3>{0, 0.5, 1}));
+    ASSERT_TRUE(loadScene(write("n.json", R"({"objects":[{"mesh":"tetra.obj"}]})"), &s).ok);
+    EXPECT_FALSE(s.objects[0].material.given);
+    const std::pair<const char*, const char*> bad[] = {
+        {R"("color":[1,2,0])", "objects[0].color[1]: 2 is outside [0, 1]"},
+        {R"("color":[1,0])", "objects[0].color: expected [r, g, b] or [r, g, b, a]"},
+        {R"("color":[1,0,0],"material":{})", "objects[0].color: give either color or material.base_color"},
+        {R"("material":{"shiny":1})", "objects[0].material.shiny: unknown field"},
+        {R"("material":{"emissive":[0,0,0,1]})", "objects[0].material.emissive: expected [r, g, b]"},
+        {R"("material":{"roughness":-0.5})", "objects[0].material.roughness: -0.5 is outside [0, 1]"},
+        {R"("material":"red")", "objects[0].material: expected an object"},
+    };
+    for (const auto& [fields, message] : bad) {
+        const Status st = loadScene(write("bad.json", std::string(R"({"objects":[{"mesh":"tetra.obj",)") + fields + "}]}"), &s);
+        EXPECT_FALSE(st.ok) << fields;
+        EXPECT_NE(st.message.find(message), std::string::npos) << st.message;
+    }
 }

@@ -291,6 +291,7 @@ void writeMaterials(gltfjson::Text* t, const SequenceModel& model) {
             }
             t->key("doubleSided");
             t->value(true);
+            if (o.emissive[0] > 0 || o.emissive[1] > 0 || o.emissive[2] > 0) numbers(t, "emissiveFactor", o.emissive.data(), 3);
             const double plain[4] = {o.base_color[0], o.base_color[1], o.base_color[2], o.base_color[3]};
             const double white[4] = {1.0, 1.0, 1.0, o.base_color[3]};
             if (shade_doppler) {
@@ -310,9 +311,9 @@ void writeMaterials(gltfjson::Text* t, const SequenceModel& model) {
             if (std::any_of(factor, factor + 4, [](double c) { return !(std::fabs(c - 1.0) < 1e-12); }))
                 numbers(t, "baseColorFactor", factor, 4);
             t->key("metallicFactor");
-            t->value(0.0);
+            t->value(o.metallic);
             t->key("roughnessFactor");
-            t->value(0.8);
+            t->value(o.roughness);
             t->close('}');
             t->close('}');
         }

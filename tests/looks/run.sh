@@ -45,6 +45,26 @@ JSON
   node tests/web/viewer_test.js "$out/refined" --models relativistic --frames 0,3 --shot-time 0.3)
 "$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt" --compress meshopt 2> "$out/meshopt.err"
 grep -q "object 'box': its materials, textures" "$out/meshopt.err" || { echo "FAIL: no warning with --compress"; exit 1; }
+# A JSON scene's own material on an OBJ mesh: its factors in the .glb, and in the shard header.
+cp "$src/data/meshes/box.obj" "$out/box.obj"
+cat > "$out/material.json" <<JSON
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1]}, "frames": {"start": 0, "end": 1, "fps": 2},
+ "objects": [{"name": "marker", "mesh": "box.obj", "position": [0, 0, -4],
+              "material": {"base_color": [0.9, 0.1, 0.05], "metallic": 0.5, "roughness": 0.25, "emissive": [0, 0, 0.5]}}]}
+JSON
+"$apparent" render "$out/material.json" --out "$out/material" --quiet
+for i in 0 1; do "$apparent" render "$out/material.json" --out "$out/material_shards" --shard $i/2 --quiet; done
+"$apparent" merge "$out/material_shards" --quiet
+cmp "$out/material/relativistic.glb" "$out/material_shards/relativistic.glb" || { echo "FAIL: material: shards differ"; exit 1; }
+python3 - "$out/material/relativistic.glb" <<'PY'
+import json, struct, sys
+b = open(sys.argv[1], "rb").read()
+m = json.loads(b[20:20 + struct.unpack_from("<I", b, 12)[0]])["materials"][0]
+want = {"baseColorFactor": [0.9, 0.1, 0.05, 1.0], "metallicFactor": 0.5, "roughnessFactor": 0.25}
+assert m["pbrMetallicRoughness"] == want and m["emissiveFactor"] == [0, 0, 0.5], m
+print("material.json: the scene's material in the .glb:", m)
+PY
+(cd "$src" && node tests/validators/validate_gltf.js "$out/material/relativistic.glb")
 # Frames made by other processes carry the look too: two shards merged, and three MPI ranks, give the
 # one process's bytes.
 for i in 0 1; do
