@@ -148,6 +148,8 @@ TEST(GltfScene, EveryObjectFieldInExtrasGivesTheJsonObject) {
         {{"angular_velocity", {0, 0.5, -0.25}}, {"velocity", {0.3, 0, 0}}},
         {{"acceleration", {0.5, 0, 0.25}}, {"velocity", {0, 0.3, 0}}},
         {{"orbit", {{"center", {1, 0, 0}}, {"axis", {0, 0, 2}}, {"speed", 0.5}, {"orientation", "locked"}}}},
+        {{"color", {0.9, 0.1, 0.2}}},
+        {{"material", {{"base_color", {0.1, 0.2, 0.3, 0.5}}, {"metallic", 1}, {"roughness", 0.25}, {"emissive", {0, 0.5, 1}}}}},
     };
     // Every key of the table that a node does not give itself is covered by a case above.
     for (const std::string& key : objectMarkerKeys()) {
@@ -182,6 +184,11 @@ TEST(GltfScene, EveryObjectFieldInExtrasGivesTheJsonObject) {
         EXPECT_EQ(g.mirror, j.mirror);
         EXPECT_EQ(g.angular_velocity, j.angular_velocity);
         EXPECT_EQ(g.acceleration, j.acceleration);
+        EXPECT_EQ(g.material.given, j.material.given);
+        EXPECT_EQ(g.material.base_color, j.material.base_color);
+        EXPECT_EQ(g.material.metallic, j.material.metallic);
+        EXPECT_EQ(g.material.roughness, j.material.roughness);
+        EXPECT_EQ(g.material.emissive, j.material.emissive);
         ASSERT_EQ(bool(g.kinds.orbit), bool(j.kinds.orbit));
         if (g.kinds.orbit) {
             EXPECT_EQ(g.kinds.orbit->center, j.kinds.orbit->center);
