@@ -47,6 +47,25 @@ JSON
   node tests/web/viewer_test.js "$out/refined" --models relativistic --frames 0,3 --shot-time 0.3)
 "$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt" --compress meshopt 2> "$out/meshopt.err"
 grep -q "object 'box': its materials, textures" "$out/meshopt.err" || { echo "FAIL: no warning with --compress"; exit 1; }
+# A Khronos sample with COLOR_0 (tests/data/gltf-samples/BoxVertexColors.gltf) at 0.5c: its colours
+# carried (COLOR_0 in every primitive, the input's material), valid for the Khronos validator.
+cp "$src/tests/data/gltf-samples/BoxVertexColors.gltf" "$out/"
+cat > "$out/vertex_colors.json" <<JSON
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1]}, "frames": {"start": 6, "end": 7, "fps": 2},
+ "objects": [{"name": "vc", "mesh": "BoxVertexColors.gltf", "position": [-1, 0, -5], "velocity": [0.5, 0, 0]}]}
+JSON
+"$apparent" render "$out/vertex_colors.json" --out "$out/vertex_colors" --quiet
+python3 - "$out/vertex_colors/relativistic.glb" "$out/BoxVertexColors.gltf" <<'PY'
+import json, struct, sys
+b = open(sys.argv[1], "rb").read()
+doc = json.loads(b[20:20 + struct.unpack_from("<I", b, 12)[0]])
+src = json.load(open(sys.argv[2]))
+prims = [p for m in doc["meshes"] for p in m["primitives"]]
+assert prims and all("COLOR_0" in p["attributes"] for p in prims), "COLOR_0 missing"
+assert [m.get("pbrMetallicRoughness") for m in doc["materials"]] == [m.get("pbrMetallicRoughness") for m in src["materials"]]
+print("BoxVertexColors: COLOR_0 in all %d primitives, the input's %d material(s)" % (len(prims), len(doc["materials"])))
+PY
+(cd "$src" && node tests/validators/validate_gltf.js "$out/vertex_colors/relativistic.glb")
 # A JSON scene's own material on an OBJ mesh: its factors in the .glb, and in the shard header.
 cp "$src/data/meshes/box.obj" "$out/box.obj"
 cat > "$out/material.json" <<JSON
