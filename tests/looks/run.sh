@@ -38,7 +38,7 @@ python3 "$src/tests/looks/make_textured_box.py" "$out/plain_box.glb" "$out/textu
 cat > "$out/near.json" <<JSON
 {"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 40},
  "frames": {"start": 9.5, "end": 10.5, "fps": 4},
- "objects": [{"name": "box", "mesh": "plain_box.glb", "position": [-3.8, 0, -2.5], "velocity": [0.9, 0, 0],
+ "objects": [{"name": "box", "mesh": "plain_box.glb", "position": [-5.2, 0, -2.5], "velocity": [0.9, 0, 0],
               "rotation_deg": [20, 30, 0]}]}
 JSON
 "$apparent" render "$out/near.json" --out "$out/near" --quiet
