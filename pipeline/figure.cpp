@@ -111,6 +111,19 @@ struct FigureGroup {
 
 // The side-by-side video of `figure --video`: one video frame per scene frame in the stage's range,
 // the models in columns under their names, the camera time (after the title) above.
+// The summary line's shared end, each part after `sep`: samples per pixel, the framing, the processes.
+void summaryTail(std::ostream& log, const char* sep, int side, const FigureSettings& settings, const Scene& scene,
+                 const FigureGroup& fg) {
+    if (side > 1) log << sep << side * side << " samples a pixel";
+    if (settings.frame_objects) {
+        const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
+        log << sep << "framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
+            << scene.camera.fov_deg;
+    }
+    if (fg.receiver) log << sep << fg.group.size() << " processes shared the frames";
+    log << "\n";
+}
+
 int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPainter* painter, FigureGroup& fg,
                 std::ostream& log, std::ostream& err) {
     const Scene& scene = stage.scene;
@@ -180,14 +193,7 @@ int figureVideo(const FigureSettings& settings, const Stage& stage, const TextPa
     if (!settings.quiet) {
         log << settings.video_path << ": " << writer.frames() << " frames of " << sheet_width << "x" << sheet_height
             << " at " << scene.frames.fps << " fps (H.264), frames " << stage.first << ".." << stage.last_excl - 1;
-        if (side > 1) log << ", " << side * side << " samples a pixel";
-        if (settings.frame_objects) {
-            const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
-            log << ", framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
-                << scene.camera.fov_deg;
-        }
-        if (fg.receiver) log << ", " << fg.group.size() << " processes shared the frames";
-        log << "\n";
+        summaryTail(log, ", ", side, settings, scene, fg);
     }
     return kExitOk;
 }
@@ -339,14 +345,7 @@ int figure(const FigureSettings& settings, std::ostream& log_out, std::ostream& 
         const TimePrefix prefix = cameraTimePrefix(scene);
         for (long long k : frames)
             log << " " << k << " (t = " << frameTime(scene.frames, k) / prefix.seconds << " " << prefix.name << ")";
-        if (side > 1) log << "; " << side * side << " samples a pixel";
-        if (settings.frame_objects) {
-            const Vec3 at = scene.camera.look_at * unitsPerLightSecond(scene.units);  // in the scene's units
-            log << "; framed: camera.look_at [" << at.x << ", " << at.y << ", " << at.z << "], camera.fov_deg "
-                << scene.camera.fov_deg;
-        }
-        if (fg.receiver) log << "; " << fg.group.size() << " processes shared the frames";
-        log << "\n";
+        summaryTail(log, "; ", side, settings, scene, fg);
     }
     return kExitOk;
 }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <fstream>
+#include <functional>
 
 #include "pipeline/scene.h"
 
@@ -124,13 +125,18 @@ TEST(Scene, GltfSceneErrorsNameTheNode) {
 
 // Speeds stated exactly: direction with gamma or rapidity; velocity is derived, and mixing the
 // two forms is refused.
-TEST(Scene, ExactSpeedAsGammaOrRapidity) {
+// Writes scene text beside a tetrahedron "tetra.obj" in the process's temporary folder; returns its path.
+std::function<std::string(const std::string&, const std::string&)> tetraSceneWriter() {
     const std::string dir = testio::processTempDir();
-    auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "tetra.obj") << "v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\nf 1 2 4\nf 1 3 2\nf 1 4 3\nf 2 3 4\n";
+    return [dir](const std::string& name, const std::string& text) {
         std::ofstream(dir + name) << text;
         return dir + name;
     };
-    std::ofstream(dir + "tetra.obj") << "v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\nf 1 2 4\nf 1 3 2\nf 1 4 3\nf 2 3 4\n";
+}
+
+TEST(Scene, ExactSpeedAsGammaOrRapidity) {
+    const auto write = tetraSceneWriter();
     Scene s;
     ASSERT_TRUE(loadScene(write("g.json", R"({"objects":[{"mesh":"tetra.obj","direction":[0,0,2],"gamma":1e7}]})"), &s).ok);
     EXPECT_EQ(s.objects[0].speed, ObjectSpec::Speed::Gamma);
@@ -150,12 +156,7 @@ TEST(Scene, ExactSpeedAsGammaOrRapidity) {
 
 // An object's `color` or `material` (docs/SCENES.md), and each refusal naming the field.
 TEST(Scene, ColorAndMaterialFields) {
-    const std::string dir = testio::processTempDir();
-    auto write = [&](const std::string& name, const std::string& text) {
-        std::ofstream(dir + name) << text;
-        return dir + name;
-    };
-    std::ofstream(dir + "tetra.obj") << "v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\nf 1 2 4\nf 1 3 2\nf 1 4 3\nf 2 3 4\n";
+    const auto write = tetraSceneWriter();
     Scene s;
     ASSERT_TRUE(loadScene(write("c.json", R"({"objects":[{"mesh":"tetra.obj","color":[0.9,0.1,0.2]}]})"), &s).ok);
     EXPECT_TRUE(s.objects[0].material.given);
