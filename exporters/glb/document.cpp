@@ -341,47 +341,60 @@ void writeLight(gltfjson::Text* t, const ExportLight& light) {
     t->close('}');
 }
 
-// Scene extras: what was computed, in which units, at which camera times, in which light.
-// The looks' images (views written with the first frame), samplers and textures, in look order.
-void writeLookArrays(gltfjson::Text* t, const SequenceModel& model, const char* which) {
-    if (model.looks.empty()) return;
-    const std::string key = which;
+// The looks' arrays, in look order (SequenceModel::looks): `count` of each look's, `write` one.
+template <class Count, class Write>
+void writeLookArray(gltfjson::Text* t, const SequenceModel& model, const char* key, const Count& count,
+                    const Write& write) {
     size_t n = 0;
-    for (const auto& p : model.looks)
-        n += key == "images" ? p.look->images.size() : key == "samplers" ? p.look->samplers.size() : p.look->textures.size();
+    for (const auto& p : model.looks) n += count(*p.look);
     if (n == 0) return;
-    t->key(which);
+    t->key(key);
     t->open('[');
-    size_t image = 0;
-    for (const auto& p : model.looks) {
-        if (key == "images") {
-            for (const LookImage& im : p.look->images) {
-                t->open('{');
-                t->key("bufferView");
-                t->value(model.image_views[image++]);
-                t->key("mimeType");
-                t->value(im.mime_type);
-                if (!im.name.empty()) {
-                    t->key("name");
-                    t->value(im.name);
-                }
-                t->close('}');
-            }
-        } else if (key == "samplers") {
-            for (const std::string& s : p.look->samplers) t->raw(s);
-        } else {
-            for (const std::string& tex : p.look->textures) {
-                nlohmann::json j = nlohmann::json::parse(tex);
-                if (j.contains("source")) j["source"] = j["source"].get<int>() + p.image;
-                if (j.contains("sampler")) j["sampler"] = j["sampler"].get<int>() + p.sampler;
-                t->raw(j.dump());
-            }
-        }
-    }
+    for (const auto& p : model.looks) write(p);
     t->close(']');
 }
 
-// Scene extras: what was computed, in which units, at which camera times.
+// The images: their views (written with the first frame) and types.
+void writeImages(gltfjson::Text* t, const SequenceModel& model) {
+    size_t view = 0;
+    writeLookArray(t, model, "images", [](const SurfaceLook& l) { return l.images.size(); },
+                   [&](const SequenceModel::LookPlace& p) {
+                       for (const LookImage& im : p.look->images) {
+                           t->open('{');
+                           t->key("bufferView");
+                           t->value(model.image_views[view++]);
+                           t->key("mimeType");
+                           t->value(im.mime_type);
+                           if (!im.name.empty()) {
+                               t->key("name");
+                               t->value(im.name);
+                           }
+                           t->close('}');
+                       }
+                   });
+}
+
+void writeSamplers(gltfjson::Text* t, const SequenceModel& model) {
+    writeLookArray(t, model, "samplers", [](const SurfaceLook& l) { return l.samplers.size(); },
+                   [&](const SequenceModel::LookPlace& p) {
+                       for (const std::string& s : p.look->samplers) t->raw(s);
+                   });
+}
+
+// The textures, their image and sampler moved to the look's place in the file.
+void writeTextures(gltfjson::Text* t, const SequenceModel& model) {
+    writeLookArray(t, model, "textures", [](const SurfaceLook& l) { return l.textures.size(); },
+                   [&](const SequenceModel::LookPlace& p) {
+                       for (const std::string& tex : p.look->textures) {
+                           nlohmann::json j = nlohmann::json::parse(tex);
+                           if (j.contains("source")) j["source"] = j["source"].get<int>() + p.image;
+                           if (j.contains("sampler")) j["sampler"] = j["sampler"].get<int>() + p.sampler;
+                           t->raw(j.dump());
+                       }
+                   });
+}
+
+// Scene extras: what was computed, in which units, at which camera times, in which light.
 void writeScenes(gltfjson::Text* t, const SequenceModel& model) {
     const SequenceInfo& info = model.info;
     t->key("scenes");
@@ -439,15 +452,15 @@ std::string jsonChunk(const SequenceModel& model, const std::vector<std::pair<in
     writeCamera(t, model.info, far);
     strings(t, "extensionsRequired", model.extensions);
     strings(t, "extensionsUsed", model.extensions_used);
-    writeLookArrays(t, model, "images");
+    writeImages(t, model);
     writeMaterials(t, model);
     array(t, "meshes", b.meshes);
     array(t, "nodes", b.nodes);
-    writeLookArrays(t, model, "samplers");
+    writeSamplers(t, model);
     t->key("scene");
     t->value(0);
     writeScenes(t, model);
-    writeLookArrays(t, model, "textures");
+    writeTextures(t, model);
     t->close('}');
     return std::move(text.out);
 }

@@ -36,20 +36,21 @@ void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const
             for (size_t c = 0; c < 3; ++c)  // within [0, 1] as glTF asks (rounding of the interpolation)
                 d->colors[3 * k + c] = float(std::clamp(rgba[4 * map.source[k] + c], 0.0, 1.0));
     }
-    std::vector<uint32_t> count(look.materials.size() + 1, 0);
-    for (const uint32_t s : m.source_triangles) ++count[look.triangle_material[s] + 1];
+    // Step: each material's triangles, then where its part starts (materials without any: no part).
+    std::vector<uint32_t> count(look.materials.size(), 0), next(look.materials.size(), 0);
+    for (const uint32_t s : m.source_triangles) ++count[look.triangle_material[s]];
     d->part_first.clear();
     d->part_material.clear();
-    std::vector<uint32_t> next(look.materials.size(), 0);
     uint32_t at = 0;
-    for (uint32_t p = 0; p < look.materials.size(); ++p) {
+    for (uint32_t p = 0; p < count.size(); ++p) {
         next[p] = at;
-        if (count[p + 1] == 0) continue;
+        if (count[p] == 0) continue;
         d->part_first.push_back(at);
         d->part_material.push_back(p);
-        at += count[p + 1];
+        at += count[p];
     }
     d->part_first.push_back(at);
+    // Step: the triangles into their parts, in the cut's order within each.
     for (size_t t = 0; t < map.triangles.size(); ++t) {
         const uint32_t p = look.triangle_material[m.source_triangles[t]];
         std::memcpy(d->indices.data() + 3 * size_t(next[p]++), map.triangles[t].data(), sizeof(map.triangles[t]));
