@@ -64,6 +64,8 @@ class Frame:
       emission_time  N float64, lab time (s) at which each point emitted the light seen
       doppler        N float64, Doppler factor of that light (received / emitted frequency)
       proper_time    N float64, the object's own clock at emission, seconds
+      texcoords      N x 2 float64, the input's TEXCOORD_0 at each point (NaN where its file has none)
+      colors         N x 4 float64, the input's COLOR_0, linear RGBA (NaN where its file has none)
       camera_time    the camera time (s); model: the model's name; objects: the object names
     """
 
@@ -77,6 +79,8 @@ class Frame:
         self.emission_time = data.emission_time
         self.doppler = data.doppler
         self.proper_time = data.proper_time
+        self.texcoords = data.texcoords
+        self.colors = data.colors
 
     def object_mesh(self, name):
         """(vertices K x 3 float64, triangles L x 3 int64) of the object called ``name``, its
