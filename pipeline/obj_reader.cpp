@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <set>
 
 #include "pipeline/input_file.h"
 #include "pipeline/polygon_input.h"
@@ -46,7 +47,8 @@ bool parseIndex(std::string_view token, long* out) {
 // Reads `text` line by line into `scan`, checking everything as it goes.
 Status scanObj(const std::string& path, const std::string& text, const MeshLimits& limits, ScannedMesh* scan,
                MeshWarnings* warnings) {
-    size_t mtllibs = 0, line_no = 0, faces = 0;
+    size_t mtllibs = 0, line_no = 0, faces = 0, texcoords = 0;
+    std::set<std::string> materials;  // usemtl names
     std::vector<uint32_t> idx, sorted;
     // UTF-16 (a byte-order mark, or NUL bytes among the first characters, as Windows tools write
     // it): every line would read as garbage and the file as "no vertices".
@@ -122,10 +124,21 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             for (size_t k = 1; k + 1 < idx.size(); ++k) triangles.push_back({idx[0], idx[k], idx[k + 1]});
         } else if (key == "mtllib") {
             ++mtllibs;
+        } else if (key == "usemtl") {
+            const std::string_view name = nextToken(&p, eol);
+            materials.insert(std::string(name.substr(0, std::min<size_t>(name.size(), 256))));
+        } else if (key == "vt") {
+            ++texcoords;
         }
     }
     if (mtllibs)
         warnings->other.push_back(std::to_string(mtllibs) + " mtllib lines ignored (material libraries are not read)");
+    if (!materials.empty())
+        warnings->other.push_back(std::to_string(materials.size()) +
+                                  " usemtl materials not kept: the object has one colour (give it a colour or material "
+                                  "in the scene, or convert the file to glTF, whose materials are kept)");
+    if (texcoords)
+        warnings->other.push_back(std::to_string(texcoords) + " vt texture coordinates not kept (glTF's TEXCOORD_0 are)");
     if (positions.empty()) return Status::failure(path + ": no vertices ('v' lines)");
     if (faces == 0)
         return Status::failure(path + ": no usable faces ('f' lines)" +

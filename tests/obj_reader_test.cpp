@@ -2,6 +2,7 @@
 // malformed files fail with the line number, and no truncated prefix of a file crashes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -39,6 +40,25 @@ TEST(ObjReader, PolygonsAreTriangulatedAndCounted) {
     EXPECT_EQ(w.polygons_triangulated, 1u);
     ASSERT_EQ(w.lines().size(), 1u);
     EXPECT_EQ(w.lines()[0], "1 polygons triangulated");
+}
+
+// What an OBJ gives that is not kept is said: its materials (usemtl) and texture coordinates (vt).
+TEST(ObjReader, MaterialsAndTextureCoordinatesNotKeptAreNamed) {
+    const std::string path = (std::filesystem::temp_directory_path() / "apparent_obj_usemtl.obj").string();
+    std::ofstream(path) << "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                           "usemtl red\nf 1/1 2/2 3/3\nusemtl blue\nf 1/1 3/3 4/2\nusemtl red\nf 1 4 2\n";
+    mesh4d::RestMesh m;
+    MeshWarnings w;
+    ASSERT_TRUE(readObj(path, {}, &m, &w).ok);
+    EXPECT_EQ(m.triangles.size(), 3u);
+    const std::vector<std::string> lines = w.lines();
+    auto has = [&](const std::string& text) {
+        return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+    };
+    EXPECT_TRUE(has("1 mtllib lines ignored"));
+    EXPECT_TRUE(has("2 usemtl materials not kept"));
+    EXPECT_TRUE(has("3 vt texture coordinates not kept"));
+    std::filesystem::remove(path);
 }
 
 TEST(ObjReader, DegenerateTrianglesAreDroppedAndCounted) {
