@@ -48,8 +48,8 @@ bool framesAtTimes(const Scene& scene, const std::vector<double>& times, std::ve
 
 // "t = 10.0 s": frame k's camera time with as many decimals as the frame rate needs (10 fps: 1,
 // 12 or 30 fps: 2), as the figure labels its columns and video frames. The unit
-// (cameraTimePrefix) is ms, us or ns when the scene's frame times are all below 1 s, 1 ms or
-// 1 us, and the decimals are counted in that unit.
+// (cameraTimePrefix) is ms, us or ns when every frame time of the scene is below a second, a
+// millisecond or a microsecond, and the decimals are counted in that unit.
 std::string cameraTimeLabel(const Scene& scene, long long k);
 TimePrefix cameraTimePrefix(const Scene& scene);
 

@@ -131,13 +131,7 @@ ObjFile readObj(const fs::path& p) {
         } else if (key == "v") {
             ++vertex;
             std::array<double, 3> q{};
-            const char* s = line.data() + 2;
-            const char* e = line.data() + line.size();
-            for (double& x : q) {
-                const auto r = std::from_chars(s, e, x);  // exact: round to nearest
-                EXPECT_EQ(r.ec, std::errc()) << line;
-                s = r.ptr + (r.ptr < e ? 1 : 0);
-            }
+            EXPECT_TRUE(testio::objVertex(line, &q)) << line;
             if (f.groups.empty())
                 ++f.vertices_outside_groups;
             else

@@ -2,7 +2,7 @@
 // mesh4d/refine/measure.h (nearest-point projection onto the exact surface, and onto the straight
 // triangle) on random straight triangles with exact corners: uniform motion, both kinematics,
 // b up to 0.999, near and far, every orientation. Never below the measured distance, and tight:
-// some measured distance comes within 2 % of the bound, so a bound made 2 % low fails.
+// the test fails when the bound is lowered by a fiftieth (some measured distance comes that close).
 #include <gtest/gtest.h>
 
 #include <algorithm>

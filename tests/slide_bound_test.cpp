@@ -1,6 +1,6 @@
 // Faces that contain the velocity (mesh4d/refine/slide_bound.h): the rim's chord-to-arc bound
 // against the distance measured from exact images along random edges (never below it, and tight:
-// some measured distance comes within 2 % of the bound, so a bound made 2 % low fails),
+// the test fails when the bound is lowered by a fiftieth: some measured distance comes that close),
 // and the refinement that uses it: a box whose four faces contain v, refined to T, within T of the
 // exact surface in the geometric two-sided distance (mesh4d/refine/measure.h), at least 0.5 T
 // where it refines, and with the faces that contain v refined only along their rims.

@@ -143,14 +143,8 @@ std::vector<mesh4d::Vec3> readObjPositions(const fs::path& p) {
     std::string line;
     while (std::getline(in, line)) {
         if (line.rfind("v ", 0) != 0) continue;
-        double c[3];
-        const char* s = line.data() + 2;
-        const char* e = line.data() + line.size();
-        for (double& x : c) {
-            const auto r = std::from_chars(s, e, x);  // exact: round to nearest
-            EXPECT_EQ(r.ec, std::errc()) << line;
-            s = r.ptr + (r.ptr < e ? 1 : 0);
-        }
+        std::array<double, 3> c{};
+        EXPECT_TRUE(testio::objVertex(line, &c)) << line;
         v.push_back({c[0], c[1], c[2]});
     }
     return v;
