@@ -46,6 +46,20 @@ std::array<double, 3> dopplerChannels(const std::array<double, 3>& a, double dop
     return out;
 }
 
+std::array<std::array<double, 3>, 3> dopplerMatrix(double doppler) {
+    // Column j: the channels of amplitude e_j (dopplerChannels is linear).
+    std::array<std::array<double, 3>, 3> a{};
+    for (size_t j = 0; j < 3; ++j) {
+        std::array<double, 3> e{0, 0, 0};
+        e[j] = 1;
+        const std::array<double, 3> column = dopplerChannels(e, doppler);
+        for (size_t i = 0; i < 3; ++i) a[i][j] = column[i];
+    }
+    return a;
+}
+
+std::array<double, 3> dopplerModulation(double doppler) { return dopplerColour({1, 1, 1}, doppler); }
+
 std::array<double, 3> toneMap(const std::array<double, 3>& c) {
     std::array<double, 3> out{};
     for (size_t k = 0; k < 3; ++k) out[k] = std::isfinite(c[k]) ? std::max(0.0, c[k]) : 0.0;

@@ -21,6 +21,27 @@
 // Bounds: D > 0 and finite (anything else gives black); a colour's channels are read as given
 // (linear, normally in [0, 1]). Far outside 0.5 < D < 2 every band has left the samples and the
 // colour goes to black (red shift) or saturates to the hue of what remains (blue shift).
+//
+// The shift as a matrix. I_obs is linear in a, and so are the samples and the unmixing:
+//     dopplerChannels(a, D) = A(D) a,  A(D) = D^3 M^-1 G(D),  G_kc = g(l_k D - l_c),
+// a 3x3 matrix that mixes the channels (A(1) = I). A texel t of a texture is seen as
+// toneMap(A(D) t): what the web viewer computes per fragment (exporters/web/doppler.js).
+//
+// The modulation for glTF viewers. A vertex colour multiplies the material (glTF: COLOR_0 times
+// baseColorFactor times the texture), so it can only apply a diagonal. `--shade doppler` on an
+// object that keeps its input's look writes COLOR_0 = W(D) * c per channel, with
+//     W(D) = toneMap(A(D) (1, 1, 1))  (the shaded colour of white),
+// c the input's COLOR_0 (1 without one), and keeps the input's materials. Against the exact
+// E(a) = toneMap(A(D) a) of the material's colour a (factor times texel times c, in [0, 1]^3),
+// the modulation P(a) = W(D) * a per channel errs as follows, w = A(D) (1, 1, 1):
+// - Grey a = (g, g, g): where white does not saturate (max_i w_i <= 1), P = E exactly. Where it
+//   does (m = max_i w_i > 1), P = E max(1/m, g): the hue is E's, the brightness of a grey darker
+//   than 1/m is E's divided by m (a vertex colour cannot brighten past the material).
+// - Any a, where neither saturates (max_i w_i <= 1 and max_i (A a)_i <= 1): per channel
+//       |P_i - E_i| <= |sum_{j != i} A_ij (a_j - a_i)|
+//   (P_i = max(0, w_i a_i), the clamp at 0 moves nothing closer, and (A a)_i - w_i a_i is the
+//   sum): the error is the shift's mixing of the channels' differences, nothing for a grey.
+// docs/DOPPLER.md gives its size over the colour cube at the D a scene meets.
 #pragma once
 
 #include <array>
@@ -41,5 +62,11 @@ std::array<double, 3> toneMap(const std::array<double, 3>& c);
 
 // The shaded colour: toneMap(dopplerChannels(base, D)).
 std::array<double, 3> dopplerColour(const std::array<double, 3>& base, double doppler);
+
+// A(D) above, row-major (A[i][j]: channel i from amplitude j); zero where D is not > 0 and finite.
+std::array<std::array<double, 3>, 3> dopplerMatrix(double doppler);
+
+// W(D) above, the per-channel modulation of a material: the shaded colour of white, in [0, 1].
+std::array<double, 3> dopplerModulation(double doppler);
 
 }  // namespace mesh4d

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <Eigen/Dense>
 #include <tiny_gltf.h>
 
 #include "exporters/png.h"
@@ -123,6 +124,95 @@ TEST(DopplerColour, ToneMapKeepsHueAndUnitRange) {
     // Dimming below D = 1 shows: a red shift of a grey far enough leaves it darker in every channel.
     const auto dim = mesh4d::dopplerColour({0.5, 0.5, 0.5}, 0.5);
     for (double v : dim) EXPECT_LT(v, 0.5);
+}
+
+namespace {
+
+// A(D) = D^3 M^-1 G(D), G_kc = g(l_k D - l_c), built here from the stated bands (Eigen's inverse).
+Eigen::Matrix3d shiftMatrix(double d) {
+    const double l[3] = {kR, kG, kB};
+    Eigen::Matrix3d m, g;
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) {
+            m(k, c) = gauss(l[k] - l[c]);
+            g(k, c) = gauss(l[k] * d - l[c]);
+        }
+    return d * d * d * m.inverse() * g;
+}
+
+// The tone map as docs/DOPPLER.md states it.
+Eigen::Vector3d toned(Eigen::Vector3d c) {
+    c = c.cwiseMax(0.0);
+    return c.maxCoeff() > 1 ? Eigen::Vector3d(c / c.maxCoeff()) : c;
+}
+
+}  // namespace
+
+TEST(DopplerColour, TheShiftIsTheMatrixA) {
+    for (double d : {0.25, 0.6, 0.9, 1.0, 1.1, 1.5, 2.3, 4.4}) {
+        const Eigen::Matrix3d want = shiftMatrix(d);
+        const auto a = mesh4d::dopplerMatrix(d);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) EXPECT_NEAR(a[size_t(i)][size_t(j)], want(i, j), 1e-12 * (1 + want.norm())) << d;
+        // dopplerChannels is A(D) a for any a (linear).
+        for (const Eigen::Vector3d& c : {Eigen::Vector3d(0.8, 0.2, 0.1), Eigen::Vector3d(0.05, 0.7, 1.0)}) {
+            const auto got = mesh4d::dopplerChannels({c[0], c[1], c[2]}, d);
+            const Eigen::Vector3d ac = want * c;
+            for (int i = 0; i < 3; ++i) EXPECT_NEAR(got[size_t(i)], ac[i], 1e-12 * (1 + ac.norm())) << d;
+        }
+        // The modulation is the shaded colour of white.
+        const Eigen::Vector3d w = toned(want * Eigen::Vector3d::Ones());
+        const auto mod = mesh4d::dopplerModulation(d);
+        for (int i = 0; i < 3; ++i) EXPECT_NEAR(mod[size_t(i)], w[i], 1e-12) << d;
+    }
+    for (const double w : mesh4d::dopplerModulation(1.0)) EXPECT_NEAR(w, 1.0, 1e-14);  // A(1) = I
+    EXPECT_EQ(mesh4d::dopplerMatrix(0.0)[0][0], 0.0);
+}
+
+// The modulation W(D) a against the exact toneMap(A(D) a), as doppler_colour.h states it: exact for
+// a grey while white does not saturate, E max(1/m, g) for a grey when it does, and within
+// |sum_{j != i} A_ij (a_j - a_i)| per channel for any colour where neither saturates.
+TEST(DopplerColour, ModulationAgainstTheExactShift) {
+    size_t greys = 0, saturated_greys = 0, colours = 0, mixed = 0;
+    for (int n = 0; n <= 80; ++n) {
+        const double d = 0.3 * std::pow(4.4 / 0.3, n / 80.0);  // 0.3 to 4.4, 0.9c's range of D
+        const Eigen::Matrix3d a = shiftMatrix(d);
+        const Eigen::Vector3d w = a * Eigen::Vector3d::Ones();
+        const double m = w.maxCoeff();
+        const auto mod = mesh4d::dopplerModulation(d);
+        for (int g10 = 0; g10 <= 10; ++g10) {
+            const double g = g10 / 10.0;
+            const auto exact = mesh4d::dopplerColour({g, g, g}, d);
+            for (size_t i = 0; i < 3; ++i) {
+                const double p = mod[i] * g;
+                const double want = m <= 1 ? exact[i] : exact[i] * std::max(1 / m, g);
+                EXPECT_NEAR(p, want, 1e-12) << "D " << d << " grey " << g << " channel " << i;
+            }
+            ++(m <= 1 ? greys : saturated_greys);
+        }
+        for (int r = 0; r <= 5; ++r)
+            for (int gg = 0; gg <= 5; ++gg)
+                for (int b = 0; b <= 5; ++b) {
+                    const Eigen::Vector3d c(r / 5.0, gg / 5.0, b / 5.0);
+                    const Eigen::Vector3d ac = a * c;
+                    if (m > 1 || ac.maxCoeff() > 1) continue;
+                    const auto exact = mesh4d::dopplerColour({c[0], c[1], c[2]}, d);
+                    for (int i = 0; i < 3; ++i) {
+                        double bound = 0;
+                        for (int j = 0; j < 3; ++j)
+                            if (j != i) bound += a(i, j) * (c[j] - c[i]);
+                        const double err = std::fabs(mod[size_t(i)] * c[i] - exact[size_t(i)]);
+                        EXPECT_LE(err, std::fabs(bound) + 1e-12) << "D " << d << " colour " << c.transpose();
+                        if (err > 0.01) ++mixed;
+                    }
+                    ++colours;
+                }
+    }
+    // Every case met, and the bound is not idle: some colours do differ.
+    EXPECT_GT(greys, 0u);
+    EXPECT_GT(saturated_greys, 0u);
+    EXPECT_GT(colours, 0u);
+    EXPECT_GT(mixed, 0u);
 }
 
 namespace {

@@ -268,7 +268,8 @@ void writeCamera(gltfjson::Text* t, const SequenceInfo& info, double far) {
 // doppler COLOR_0 holds the whole shaded colour (glTF multiplies it with the factor): a
 // white factor, the plain colour kept in extras for viewers that switch between the two.
 // An object whose look the file carries gets its input's materials instead (surface_look.h),
-// their textures renumbered for the file.
+// their textures renumbered for the file; with --shade doppler its COLOR_0 is the modulation of
+// them (mesh4d/doppler_colour.h).
 void writeMaterials(gltfjson::Text* t, const SequenceModel& model) {
     const SequenceInfo& info = model.info;
     const bool shade_doppler = model.shade_doppler;

@@ -30,11 +30,13 @@ void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const
     d->texcoords.resize(uv.empty() ? 0 : 2 * nv);
     for (size_t k = 0; k < d->texcoords.size() / 2; ++k)
         for (size_t c = 0; c < 2; ++c) d->texcoords[2 * k + c] = float(uv[2 * map.source[k] + c]);
-    if (!shade && !rgba.empty()) {
-        d->colors.resize(3 * nv);
+    // With --shade doppler COLOR_0 holds the modulation W(D) already (toPrimitive): times the input's.
+    if (!rgba.empty()) {
+        d->colors.resize(3 * nv, 1.0f);
         for (size_t k = 0; k < nv; ++k)
             for (size_t c = 0; c < 3; ++c)  // within [0, 1] as glTF asks (rounding of the interpolation)
-                d->colors[3 * k + c] = float(std::clamp(rgba[4 * map.source[k] + c], 0.0, 1.0));
+                d->colors[3 * k + c] = float((shade ? double(d->colors[3 * k + c]) : 1.0) *
+                                             std::clamp(rgba[4 * map.source[k] + c], 0.0, 1.0));
     }
     // Step: each material's triangles, then where its part starts (materials without any: no part).
     std::vector<uint32_t> count(look.materials.size(), 0), next(look.materials.size(), 0);
@@ -79,7 +81,11 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
     d->proper_time.resize(proper_time ? nv : 0);
     const bool shade = options.shade_doppler && m.doppler.size() == m.positions.size();
     d->colors.resize(shade ? 3 * nv : 0);
-    const std::array<double, 3> base{base_color[0], base_color[1], base_color[2]};
+    // With --shade doppler: the shaded base colour, or for an object that keeps its input's
+    // materials the modulation W(D) of them (mesh4d/doppler_colour.h), the shaded colour of white.
+    const bool look = carriesLook(options, object);
+    const std::array<double, 3> base = look ? std::array<double, 3>{1, 1, 1}
+                                            : std::array<double, 3>{base_color[0], base_color[1], base_color[2]};
     std::vector<double>& exact = scratch->exact;
     exact.resize(step > 0 ? 3 * nv : 0);
     // The object's own origin first: both large terms cancel before the small local one is added.
@@ -124,7 +130,8 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                 if (doppler) d->doppler[k] = float(m.doppler[v]);
                 if (proper_time) d->proper_time[k] = float(m.proper_time[v]);
                 if (shade) {
-                    const std::array<double, 3> c = mesh4d::dopplerColour(base, m.doppler[v]);
+                    const std::array<double, 3> c =
+                        look ? mesh4d::dopplerModulation(m.doppler[v]) : mesh4d::dopplerColour(base, m.doppler[v]);
                     for (int j = 0; j < 3; ++j) d->colors[3 * k + size_t(j)] = float(c[size_t(j)]);
                 }
             }

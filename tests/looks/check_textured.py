@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """Checks a .glb that `apparent render` made of tests/looks/make_textured_box.py's box (standard library only).
 
-usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ
+usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ [--shade-doppler]
   P the box's position at t = 0, V its velocity (relativistic model, t0 = 0), R its rotation_deg (X then
   Y then Z). For every vertex of every frame: its rest point follows from its position and emission time
   in closed form (the inverse Lorentz boost of the uniform motion, then the inverse rotation), lies on a
   face of the unit box, and its TEXCOORD_0 and COLOR_0 must be the face's closed form at that point
   (make_textured_box.py), to float32 rounding; the primitive's material must be the face's. The
   materials, their count and factors equal the input's, the texture's image is the input's bytes, once.
+  --shade-doppler (a render with --shade doppler --attributes doppler): COLOR_0 must be the modulation
+  W(D) of docs/DOPPLER.md at the vertex's _DOPPLER (the band model computed here) times that closed form.
 """
 import json
 import math
@@ -35,6 +37,23 @@ def accessor(doc, binary, i):
     return [vals[k * n:(k + 1) * n] for k in range(a["count"])]
 
 
+BANDS_NM = (610.0, 550.0, 465.0)  # R, G, B centres and the width, as docs/DOPPLER.md states them
+WIDTH_NM = 40.0
+
+
+def modulation(d):
+    """W(D) = toneMap(A(D) (1, 1, 1)): the band samples D^3 sum_c g(l_k D - l_c), unmixed by M (Cramer)."""
+    g = lambda x: math.exp(-x * x / (2 * WIDTH_NM ** 2))
+    m = [[g(lk - lc) for lc in BANDS_NM] for lk in BANDS_NM]
+    s = [d ** 3 * sum(g(lk * d - lc) for lc in BANDS_NM) for lk in BANDS_NM]
+    det = lambda a: (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]))
+    w = [det([[s[k] if c == i else m[k][c] for c in range(3)] for k in range(3)]) / det(m) for i in range(3)]
+    w = [max(0.0, x) for x in w]
+    top = max(w)
+    return [x / top for x in w] if top > 1 else w
+
+
 def rot_xyz(deg):
     ax, ay, az = (math.radians(d) for d in deg)
     rx = [[1, 0, 0], [0, math.cos(ax), -math.sin(ax)], [0, math.sin(ax), math.cos(ax)]]
@@ -44,7 +63,7 @@ def rot_xyz(deg):
     return mul(rz, mul(ry, rx))  # X first, then Y, then Z
 
 
-def main(out, inp, p, v, r):
+def main(out, inp, p, v, r, shade=False):
     doc, binary = read_glb(out)
     idoc, ibin = read_glb(inp)
     fails = []
@@ -65,6 +84,8 @@ def main(out, inp, p, v, r):
     g = 1 / math.sqrt(1 - b2)
     n = [x / math.sqrt(b2) for x in v] if b2 > 0 else [1.0, 0.0, 0.0]
     worst_uv = worst_rest = 0.0
+    doppler_range = [math.inf, -math.inf]
+    shifted = 0  # vertices whose colour the shift changed by more than 0.05 (the check is not idle)
     checked = 0
     for node in doc["nodes"]:
         if "mesh" not in node:
@@ -75,6 +96,7 @@ def main(out, inp, p, v, r):
             tim = accessor(doc, binary, prim["attributes"]["_EMISSION_TIME"])
             uv = accessor(doc, binary, prim["attributes"]["TEXCOORD_0"])
             col = accessor(doc, binary, prim["attributes"]["COLOR_0"])
+            dop = accessor(doc, binary, prim["attributes"]["_DOPPLER"]) if shade else None
             used = sorted({i for (i,) in accessor(doc, binary, prim["indices"])})
             for k in used:
                 x = [t0[c] + pos[k][c] - p[c] for c in range(3)]
@@ -89,13 +111,24 @@ def main(out, inp, p, v, r):
                 worst_rest = max(worst_rest, abs(abs(q[axis]) - 0.5), max(abs(x) for x in q) - 0.5)
                 b, c = [a for a in range(3) if a != axis]
                 want = (q[b] + 0.5, q[c] + 0.5)
+                colour = [min(1, max(0, want[0])), min(1, max(0, want[1])), 0.25]
+                if shade:
+                    d = dop[k][0]
+                    doppler_range = [min(doppler_range[0], d), max(doppler_range[1], d)]
+                    unshifted = colour
+                    colour = [w * x for w, x in zip(modulation(d), colour)]
+                    shifted += max(abs(a - b) for a, b in zip(colour, unshifted)) > 0.05
                 worst_uv = max(worst_uv, abs(uv[k][0] - want[0]), abs(uv[k][1] - want[1]),
-                               abs(col[k][0] - min(1, max(0, want[0]))), abs(col[k][1] - min(1, max(0, want[1]))),
-                               abs(col[k][2] - 0.25))
+                               *(abs(col[k][i] - colour[i]) for i in range(3)))
                 checked += 1
     print("%s: %d vertices checked, rest points within %.2e of the box, texture coordinates and colours within %.2e "
           "of the closed form; %d materials, %d images" % (out, checked, worst_rest, worst_uv, len(doc["materials"]),
                                                           len(doc.get("images", []))))
+    if shade:
+        print("  COLOR_0 the modulation W(D) times the input's colour, D from %.4f to %.4f; %d vertices shifted by "
+              "more than 0.05" % (*doppler_range, shifted))
+        if shifted == 0:
+            fails.append("no colour shifted")
     if checked == 0:
         fails.append("no vertex checked")
     if worst_rest > 1e-4 or worst_uv > 1e-4:
@@ -107,6 +140,8 @@ def main(out, inp, p, v, r):
 
 if __name__ == "__main__":
     a = sys.argv[1:]
-    if len(a) != 11:
+    shade = a[11:] == ["--shade-doppler"]
+    if len(a) != 11 + shade:
         sys.exit(__doc__)
-    sys.exit(main(a[0], a[1], [float(x) for x in a[2:5]], [float(x) for x in a[5:8]], [float(x) for x in a[8:11]]))
+    sys.exit(main(a[0], a[1], [float(x) for x in a[2:5]], [float(x) for x in a[5:8]], [float(x) for x in a[8:11]],
+                  shade))

@@ -2,7 +2,8 @@
 # A textured, three-material box with vertex colours (make_textured_box.py) rendered at 0.9c: at the
 # default tolerance, in vertex mode, and at rest in the instant model; each .glb passes the Khronos
 # glTF-Validator and check_textured.py (every vertex's TEXCOORD_0 and COLOR_0 equal the closed form
-# at its rest point, the materials and the image are the input's, the image once). With --compress
+# at its rest point, the materials and the image are the input's, the image once; with --shade
+# doppler COLOR_0 is the modulation at the vertex's Doppler factor times that closed form). With --compress
 # the look is dropped with a warning; shards and MPI ranks give the one process's bytes; three.js in
 # headless Chromium shows the texture.
 # Usage: run.sh APPARENT_BINARY SOURCE_DIR
@@ -14,8 +15,8 @@ src=$2
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 python3 "$src/tests/looks/make_textured_box.py" "$out/box.glb" "$out/texture.png"
-scene() {  # velocity x, model, frames start
-  cat > "$out/scene_$2.json" <<JSON
+scene() {  # velocity x, model, frames start[, file name]
+  cat > "$out/${4:-scene_$2}.json" <<JSON
 {"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 60},
  "frames": {"start": $3, "end": $(($3 + 2)), "fps": 2}, "model": "$2",
  "objects": [{"name": "box", "mesh": "box.glb", "position": [-2, 0.3, -4], "velocity": [$1, 0, 0],
@@ -30,8 +31,19 @@ scene 0 instant 0
 python3 "$src/tests/looks/check_textured.py" "$out/refined/relativistic.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0
 python3 "$src/tests/looks/check_textured.py" "$out/vertex/relativistic.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0
 python3 "$src/tests/looks/check_textured.py" "$out/rest/instant.glb" "$out/box.glb" -2 0.3 -4 0 0 0 20 30 0
+# --shade doppler keeps the input's materials and writes COLOR_0 = W(D) times the input's colour
+# (docs/DOPPLER.md), W at each vertex's _DOPPLER.
+# Camera times 3 to 5 s: D from about 0.6 to 1.9, where the shift changes colours without blacking them out.
+scene 0.9 relativistic 3 scene_shaded
+"$apparent" render "$out/scene_shaded.json" --out "$out/shaded" --shade doppler --attributes doppler --quiet
+"$apparent" render "$out/scene_shaded.json" --out "$out/shaded_vertex" --tolerance vertex --shade doppler \
+  --attributes doppler --quiet
+python3 "$src/tests/looks/check_textured.py" "$out/shaded/relativistic.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0 \
+  --shade-doppler
+python3 "$src/tests/looks/check_textured.py" "$out/shaded_vertex/relativistic.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 \
+  20 30 0 --shade-doppler
 (cd "$src" && node tests/validators/validate_gltf.js "$out/refined/relativistic.glb" "$out/vertex/relativistic.glb" \
-  "$out/rest/instant.glb")
+  "$out/rest/instant.glb" "$out/shaded/relativistic.glb")
 # three.js in headless Chromium shows the texture: texels of the texture's own colours in the picture
 # (the box without COLOR_0, near the camera), and the viewer takes an input's COLOR_0 for no Doppler shading.
 python3 "$src/tests/looks/make_textured_box.py" "$out/plain_box.glb" "$out/texture2.png" --no-colors
