@@ -6,12 +6,16 @@
 // but inside the animation is read as animation time (from the first frame written), as links before issue 38 meant.
 // Colours: files rendered with `--shade doppler` carry COLOR_0 (the Doppler-shifted colour) with a white
 // material whose extras.base_color is the plain colour; the "Doppler" toggle switches between the two.
+// An object that keeps its input's materials (textures, factors) has COLOR_0 = W(D) times the input's colour
+// instead (docs/DOPPLER.md); with _DOPPLER in the file (--attributes doppler) the viewer shows the exact shift
+// toneMap(A(D) colour) per fragment (doppler.mjs), the toggle off shows the input's own look.
 // Test hook: window.apparentViewer (see the end of this file and README.md).
 
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
+import { DOPPLER_GLSL, dopplerModulation, dopplerUniformValues } from './doppler.mjs';
 
 const VIEW_BG = '#1b1f27';   // viewport background (keep in sync with --view-bg in index.html)
 const PAGE_BG = '#0e1014';   // gaps between viewports
@@ -231,12 +235,68 @@ async function loadModel(m) {
     const base = o.material?.userData?.base_color;
     if (o.isMesh && o.geometry?.attributes?.color && Array.isArray(base)) m.shaded.push({ mesh: o, base });
   });
+  // The input's own materials with COLOR_0 = W(D) c and _DOPPLER: the exact shift per fragment
+  m.exact = [];
+  const recovered = new Map();
+  gltf.scene.traverse((o) => {
+    const g = o.geometry;
+    if (!o.isMesh || Array.isArray(o.material) || !g?.attributes?.color || !g.attributes._doppler) return;
+    if (Array.isArray(o.material.userData?.base_color)) return;
+    if (!recovered.has(g.attributes.color)) recovered.set(g.attributes.color, inputColours(g.attributes.color, g.attributes._doppler));
+    g.setAttribute('color', recovered.get(g.attributes.color));
+    exactShift(o.material);
+    m.exact.push(o);
+  });
   m.loaded = true;
   return m;
 }
 
+// The input's COLOR_0 c from the file's W(D) c (doppler.mjs), per vertex; a channel whose W is 0 (shifted
+// out of the samples) has lost c and is taken as 1.
+function inputColours(color, doppler) {
+  const out = new Float32Array(color.count * 3);
+  for (let k = 0; k < color.count; ++k) {
+    const w = dopplerModulation(doppler.getX(k));
+    const c = [color.getX(k), color.getY(k), color.getZ(k)];
+    for (let i = 0; i < 3; ++i) out[3 * k + i] = w[i] > 1e-30 ? Math.min(1, Math.max(0, c[i] / w[i])) : 1;
+  }
+  return new THREE.BufferAttribute(out, 3);
+}
+
+// One set of uniforms for every material the exact shift patches; `dopplerOn` follows the toggle.
+const exactUniforms = (() => {
+  const v = dopplerUniformValues();
+  return {
+    dopplerUnmix: { value: new THREE.Matrix3().fromArray(v.dopplerUnmix) },
+    dopplerCentres: { value: new THREE.Vector3(...v.dopplerCentres) },
+    dopplerWidth: { value: v.dopplerWidth },
+    dopplerOn: { value: 1 },
+  };
+})();
+const patched = new WeakSet();
+
+// The material's linear colour after texture and vertex colour (three's color_fragment) shifted by
+// toneMap(A(D) colour), D interpolated from the vertices' _DOPPLER.
+function exactShift(material) {
+  if (patched.has(material)) return;
+  patched.add(material);
+  material.onBeforeCompile = (shader) => {
+    Object.assign(shader.uniforms, exactUniforms);
+    shader.vertexShader = shader.vertexShader
+      .replace('#include <common>', '#include <common>\nattribute float _doppler;\nvarying float vDoppler;')
+      .replace('#include <begin_vertex>', '#include <begin_vertex>\nvDoppler = _doppler;');
+    shader.fragmentShader = shader.fragmentShader
+      .replace('#include <common>', `#include <common>\nvarying float vDoppler;\nuniform float dopplerOn;\n${DOPPLER_GLSL}`)
+      .replace('#include <color_fragment>',
+        '#include <color_fragment>\nif (dopplerOn > 0.5) diffuseColor.rgb = dopplerShift(diffuseColor.rgb, vDoppler);');
+  };
+  material.customProgramCacheKey = () => 'apparent-doppler-exact';
+  material.needsUpdate = true;
+}
+
 // 'doppler': COLOR_0 times a white material; 'plain': the material's extras.base_color without COLOR_0.
 function applyShade() {
+  exactUniforms.dopplerOn.value = shade === 'doppler' ? 1 : 0;
   for (const m of models) {
     if (!m.loaded) continue;
     for (const { mesh, base } of m.shaded) {
@@ -525,7 +585,7 @@ function info() {
     url: m.url, loaded: m.loaded, fps: m.fps, duration: m.duration, frames: m.frames.length,
     firstFrame: m.firstFrame, frameTimes: m.frameTimes.length, camera: m.cameraSource,
     fov: m.baseFov ?? null, aspect, zoom, cameraNote: m.cameraNote || null, cameraStart,
-    dopplerColours: (m.shaded || []).length, shade,
+    dopplerColours: (m.shaded || []).length, dopplerExact: (m.exact || []).length, shade,
   }]));
 }
 
@@ -550,7 +610,7 @@ const ready = (async () => {
   const steps = ok.filter((m) => m.fps > 0).map((m) => 1 / m.fps);
   minFrameStep = steps.length ? Math.min(...steps) : 0.1;
   slider.max = String(maxDuration || 1);
-  dopplerBox.disabled = !ok.some((m) => m.shaded.length);
+  dopplerBox.disabled = !ok.some((m) => m.shaded.length || m.exact.length);
   dopplerBox.checked = shade === 'doppler';
   applyShade();
   // ?t: camera time; outside the files' camera times but inside the animation, the old animation time.

@@ -5,7 +5,7 @@
 # at its rest point, the materials and the image are the input's, the image once; with --shade
 # doppler COLOR_0 is the modulation at the vertex's Doppler factor times that closed form). With --compress
 # the look is dropped with a warning; shards and MPI ranks give the one process's bytes; three.js in
-# headless Chromium shows the texture.
+# headless Chromium shows the texture, and with --shade doppler its exact shift (tests/web/doppler_*.js).
 # Usage: run.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
 # OpenMPI's own allocations are not ours: no leak report for them under the sanitizers (as mpi_test.sh).
@@ -57,6 +57,30 @@ JSON
 (cd "$src" && node tests/web/viewer_test.js "$out/near" --models relativistic --frames 0,3 --shot-time 0.3 \
   --screenshot "$out/near.png" && node tests/looks/texels.js "$out/near.png" &&
   node tests/web/viewer_test.js "$out/refined" --models relativistic --frames 0,3 --shot-time 0.3)
+# The same box with --shade doppler --attributes doppler, approaching (camera times 6.5 to 7.5 s, D from
+# about 0.6 to 1.8), beside a JSON scene's coloured box: COLOR_0 is W(D) on the box's own materials and
+# the shaded colour on the other, as the viewer's model (exporters/web/doppler.mjs) computes them; the
+# viewer's shader computes that model's colours; the viewer shows the exact shift of the texture, and
+# its Doppler toggle changes the picture (docs/gallery/textured_box_doppler.png is this file at 0.3 s).
+cp "$src/data/meshes/box.obj" "$out/box.obj"
+cat > "$out/approach.json" <<JSON
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 40},
+ "frames": {"start": 6.5, "end": 7.5, "fps": 4},
+ "objects": [{"name": "box", "mesh": "plain_box.glb", "position": [-5.2, 0, -2.5], "velocity": [0.9, 0, 0],
+              "rotation_deg": [20, 30, 0]}]}
+JSON
+python3 - "$out/approach.json" "$out/agree.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+scene["objects"].append({"name": "marker", "mesh": "box.obj", "position": [-6, 1, -6], "velocity": [0.8, 0, 0],
+                         "color": [0.2, 0.7, 0.4]})
+json.dump(scene, open(sys.argv[2], "w"))
+PY
+"$apparent" render "$out/agree.json" --out "$out/agree" --shade doppler --attributes doppler --quiet
+"$apparent" render "$out/approach.json" --out "$out/approach" --shade doppler --attributes doppler --quiet
+(cd "$src" && node tests/web/doppler_agree.js "$out/agree/relativistic.glb" "$out/approach/relativistic.glb" &&
+  node tests/web/doppler_shader.js &&
+  node tests/web/viewer_test.js "$out/approach" --models relativistic --frames 0,3 --shot-time 0.3)
 "$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt" --compress meshopt 2> "$out/meshopt.err"
 grep -q "object 'box': its materials, textures" "$out/meshopt.err" || { echo "FAIL: no warning with --compress"; exit 1; }
 # A Khronos sample with COLOR_0 (tests/data/gltf-samples/BoxVertexColors.gltf) at 0.5c: its colours

@@ -19,8 +19,9 @@
 //     height less the labels);
 //   - with --open-time T: the viewer opened with ?t=T shows camera time C (--expect-camera-time: T for a camera
 //     time of the files, the first frame's time plus T for an older link's animation time);
-//   - for files with COLOR_0 (render --shade doppler): the viewer found the Doppler colours, and switching to
-//     plain colours changes the picture where objects move (relativistic) but not where D = 1 (instant);
+//   - for files with COLOR_0 (render --shade doppler): the viewer found the Doppler colours (on objects keeping
+//     their input's materials, with _DOPPLER: the exact shift), and switching to plain colours changes the
+//     picture where objects move (relativistic) but not where D = 1 (instant);
 //   - with --plain DIR (the plain export of the same render; OUTDIR a --compress meshopt one, whose frames may be
 //     morph targets of an earlier frame's mesh, exporters/gltf.h): at each checked time the world-space bounds of
 //     the shown frame as three.js draws it (Mesh.getVertexPosition: morph targets applied) equal those of the plain
@@ -371,15 +372,23 @@ async function main() {
     const withColour = opts.models.filter((m) => (files[m].json.meshes || []).some((me) =>
       me.primitives.some((p) => p.attributes.COLOR_0 !== undefined &&
         (files[m].json.materials || [])[p.material]?.extras?.base_color !== undefined)));
-    if (withColour.length) {
+    // (an object keeping its input's materials, with _DOPPLER: the viewer's exact shift, exporters/web/doppler.mjs)
+    const withExact = opts.models.filter((m) => (files[m].json.meshes || []).some((me) =>
+      me.primitives.some((p) => p.attributes.COLOR_0 !== undefined && p.attributes._DOPPLER !== undefined &&
+        (files[m].json.materials || [])[p.material]?.extras?.base_color === undefined)));
+    const toggled = [...new Set([...withColour, ...withExact])];
+    if (toggled.length) {
       for (const m of withColour) {
         check(info[m].dopplerColours > 0, `${m}: viewer found the COLOR_0 meshes`, `${info[m].dopplerColours}`);
+      }
+      for (const m of withExact) {
+        check(info[m].dopplerExact > 0, `${m}: viewer shifts the input's materials exactly`, `${info[m].dopplerExact}`);
       }
       await page.evaluate(() => window.apparentViewer.setShade('plain'));
       await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
       const plain = decodePNG(await page.screenshot({ type: 'png' }));
       await page.evaluate(() => window.apparentViewer.setShade('doppler'));
-      for (const m of withColour) {
+      for (const m of toggled) {
         const r = vps[m];
         let changed = 0, total = 0;
         for (let y = Math.ceil(r.y) + 2; y < Math.min(img.height, Math.floor(r.y + r.height) - 2); ++y) {
