@@ -61,7 +61,8 @@ JSON
 # about 0.6 to 1.8), beside a JSON scene's coloured box: COLOR_0 is W(D) on the box's own materials and
 # the shaded colour on the other, as the viewer's model (exporters/web/doppler.mjs) computes them; the
 # viewer's shader computes that model's colours; the viewer shows the exact shift of the texture, and
-# its Doppler toggle changes the picture (docs/gallery/textured_box_doppler.png is this file at 0.3 s).
+# its Doppler toggle changes the picture (docs/gallery/textured_box_doppler.png is this file at 0.3 s), also
+# where the input has its own COLOR_0 (the shaded box above, its colour recovered as COLOR_0 / W(D)).
 cp "$src/data/meshes/box.obj" "$out/box.obj"
 cat > "$out/approach.json" <<JSON
 {"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 40},
@@ -80,7 +81,15 @@ PY
 "$apparent" render "$out/approach.json" --out "$out/approach" --shade doppler --attributes doppler --quiet
 (cd "$src" && node tests/web/doppler_agree.js "$out/agree/relativistic.glb" "$out/approach/relativistic.glb" &&
   node tests/web/doppler_shader.js &&
-  node tests/web/viewer_test.js "$out/approach" --models relativistic --frames 0,3 --shot-time 0.3)
+  node tests/web/viewer_test.js "$out/approach" --models relativistic --frames 0,3 --shot-time 0.3 &&
+  node tests/web/viewer_test.js "$out/shaded" --models relativistic --frames 0,3 --shot-time 0.3)
+# Shards merged give the one process's shaded file.
+for i in 0 1; do
+  "$apparent" render "$out/scene_shaded.json" --out "$out/shaded_shards" --shard $i/2 --shade doppler --attributes doppler \
+    --quiet
+done
+"$apparent" merge "$out/shaded_shards" --quiet
+cmp "$out/shaded/relativistic.glb" "$out/shaded_shards/relativistic.glb" || { echo "FAIL: shaded shards differ"; exit 1; }
 "$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt" --compress meshopt 2> "$out/meshopt.err"
 grep -q "object 'box': its materials, textures" "$out/meshopt.err" || { echo "FAIL: no warning with --compress"; exit 1; }
 # A Khronos sample with COLOR_0 (tests/data/gltf-samples/BoxVertexColors.gltf) at 0.5c: its colours
