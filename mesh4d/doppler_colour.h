@@ -25,7 +25,7 @@
 // The shift as a matrix. I_obs is linear in a, and so are the samples and the unmixing:
 //     dopplerChannels(a, D) = A(D) a,  A(D) = D^3 M^-1 G(D),  G_kc = g(l_k D - l_c),
 // a 3x3 matrix that mixes the channels (A(1) = I). A texel t of a texture is seen as
-// toneMap(A(D) t): what the web viewer computes per fragment (exporters/web/doppler.js).
+// toneMap(A(D) t): what the web viewer computes per fragment (exporters/web/doppler.mjs).
 //
 // The modulation for glTF viewers. A vertex colour multiplies the material (glTF: COLOR_0 times
 // baseColorFactor times the texture), so it can only apply a diagonal. `--shade doppler` on an
@@ -39,8 +39,8 @@
 //   than 1/m is E's divided by m (a vertex colour cannot brighten past the material).
 // - Any a, where neither saturates (max_i w_i <= 1 and max_i (A a)_i <= 1): per channel
 //       |P_i - E_i| <= |sum_{j != i} A_ij (a_j - a_i)|
-//   (P_i = max(0, w_i a_i), the clamp at 0 moves nothing closer, and (A a)_i - w_i a_i is the
-//   sum): the error is the shift's mixing of the channels' differences, nothing for a grey.
+//   (P_i = max(0, w_i a_i) as a_i >= 0, the clamp at 0 widens no difference, and
+//   (A a)_i - w_i a_i is that sum): the shift's mixing of the channels' differences, 0 for a grey.
 // docs/DOPPLER.md gives its size over the colour cube at the D a scene meets.
 #pragma once
 

@@ -30,13 +30,16 @@ void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const
     d->texcoords.resize(uv.empty() ? 0 : 2 * nv);
     for (size_t k = 0; k < d->texcoords.size() / 2; ++k)
         for (size_t c = 0; c < 2; ++c) d->texcoords[2 * k + c] = float(uv[2 * map.source[k] + c]);
-    // With --shade doppler COLOR_0 holds the modulation W(D) already (toPrimitive): times the input's.
+    // With --shade doppler the modulation W(D) (toPrimitive's COLOR_0) times the input's colour.
     if (!rgba.empty()) {
-        d->colors.resize(3 * nv, 1.0f);
-        for (size_t k = 0; k < nv; ++k)
+        d->colors.resize(3 * nv);
+        for (size_t k = 0; k < nv; ++k) {
+            const uint32_t v = map.source[k];
+            const std::array<double, 3> w =
+                shade ? mesh4d::dopplerModulation(m.doppler[v]) : std::array<double, 3>{1, 1, 1};
             for (size_t c = 0; c < 3; ++c)  // within [0, 1] as glTF asks (rounding of the interpolation)
-                d->colors[3 * k + c] = float((shade ? double(d->colors[3 * k + c]) : 1.0) *
-                                             std::clamp(rgba[4 * map.source[k] + c], 0.0, 1.0));
+                d->colors[3 * k + c] = float(w[c] * std::clamp(rgba[4 * v + c], 0.0, 1.0));
+        }
     }
     // Step: each material's triangles, then where its part starts (materials without any: no part).
     std::vector<uint32_t> count(look.materials.size(), 0), next(look.materials.size(), 0);
