@@ -251,14 +251,15 @@ async function loadModel(m) {
   return m;
 }
 
-// The input's COLOR_0 c from the file's W(D) c (doppler.mjs), per vertex; a channel whose W is 0 (shifted
-// out of the samples) has lost c and is taken as 1.
+// The input's COLOR_0 c from the file's W(D) c (doppler.mjs), per vertex. A channel whose W is below
+// kLostChannel (shifted out of the samples; W's rounding is about 1e-16) has lost c and is taken as 1.
+const kLostChannel = 1e-6;
 function inputColours(color, doppler) {
   const out = new Float32Array(color.count * 3);
   for (let k = 0; k < color.count; ++k) {
     const w = dopplerModulation(doppler.getX(k));
     const c = [color.getX(k), color.getY(k), color.getZ(k)];
-    for (let i = 0; i < 3; ++i) out[3 * k + i] = w[i] > 1e-30 ? Math.min(1, Math.max(0, c[i] / w[i])) : 1;
+    for (let i = 0; i < 3; ++i) out[3 * k + i] = w[i] > kLostChannel ? Math.min(1, Math.max(0, c[i] / w[i])) : 1;
   }
   return new THREE.BufferAttribute(out, 3);
 }
