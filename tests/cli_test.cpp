@@ -151,7 +151,7 @@ TEST(Cli, GlbHoldsEveryFrameAsAStepAnimation) {
     EXPECT_EQ(extras.Get("model").Get<std::string>(), "relativistic");
 }
 
-// Mirrors (issue #7): the reflections of each frame are their own node, a child of the frame
+// Mirrors: the reflections of each frame are their own node, a child of the frame
 // node named "frame_NNNNN mirror <mirror>", with no transform of its own (the frame's origin and
 // animation apply), one primitive per reflected object with that reflection's material; the
 // animation still targets the frame nodes 1 + k. Checked against the frame's PLY (same triangle
@@ -590,10 +590,10 @@ TEST(Cli, GlbIsIdenticalForAnyThreadCountOnALargeMesh) {
         }
 }
 
-// An absurdly fine tolerance is refused up front (below 1e-6 of the object's size, issue 15); one
-// just above that floor, on a tetrahedron passing 1.6 ls from the camera at 0.99c, stops at the
-// refinement limit with a warning, not a crash. (The tetra of scene_tetra.json at 4e-6 is met within
-// 256 segments since the whole-piece form passes pieces as they are, issue 13.)
+// An absurdly fine tolerance is refused up front (below 1e-6 of the object's size); one just above
+// that floor, on a tetrahedron passing 1.6 ls from the camera at 0.99c, stops at the refinement
+// limit with a warning, not a crash. (The tetra of scene_tetra.json at 4e-6 is met within 256
+// segments: the whole-piece form passes pieces as they are.)
 TEST(Cli, AbsurdToleranceHitsTheLimitWithAWarning) {
     TempDir dir;
     CommandResult r = apparentRun({"render", source("data/fixtures/scene_tetra.json"), "--out", dir.str(),

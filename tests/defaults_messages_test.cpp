@@ -1,4 +1,4 @@
-// Issue 20, items 1 and 6: the default tolerance follows each object's size, the output-size
+// The default tolerance follows each object's size, the output-size
 // estimate stops a run before it writes, and the messages for the mistakes new users make.
 #include <gtest/gtest.h>
 

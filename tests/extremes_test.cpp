@@ -1,4 +1,4 @@
-// Geometry at the edges (issue: numerical stability): the view grazing a face, a frame at the
+// Geometry at the edges, numerical stability: the view grazing a face, a frame at the
 // exact instant an object begins or ends existing, an object that exists for a tiny proper time,
 // nearly degenerate triangles, and very high and very low frame rates.
 #include <gtest/gtest.h>

@@ -177,7 +177,7 @@ TEST(Extrude, ChunkBoxesAreTheBoxesOfTheirTrianglesEvents) {
     }
 }
 
-// Issue 18: the slab grid (extrude.h SlabGrid) is fixed by the motion alone: the samples of a span
+// The slab grid (extrude.h SlabGrid) is fixed by the motion alone: the samples of a span
 // are the tau_a, tau_b given and exactly the grid points between them, so the samples of a narrower
 // span are a wider one's inside it, bit for bit; every step is within slabSpacing over its own
 // interval; atOrBefore / atOrAfter bracket a time by neighbouring samples.

@@ -1,4 +1,4 @@
-// Objects apart in the PLY and OBJ frames (exporters/ply.h, exporters/obj.h, issue 35 point 4):
+// Objects apart in the PLY and OBJ frames (exporters/ply.h, exporters/obj.h):
 // a two-object scene rendered to both, against each object rendered alone from the same scene
 // (an independent oracle: objects are cut independently, so object i's vertices in the pair's
 // files are the lone render's, in order); every face within one object; the header comments name

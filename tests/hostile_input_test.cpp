@@ -277,7 +277,7 @@ TEST(HostileInput, MaterialLibrariesAreNeverReadAndOnlyRegularFilesAre) {
     EXPECT_FALSE(fs::exists(box / "out2"));
 }
 
-// Issue 15, item 2: nesting deeper than kMaxJsonDepth is refused before any recursive parse or
+// Nesting deeper than kMaxJsonDepth is refused before any recursive parse or
 // dump (a 100 000-deep array crashed json::dump in the error message; deep glTF extras crashed
 // tinygltf), as a scene, as a glTF mesh and as a glTF scene; keys print escaped on one line.
 TEST(HostileInput, DeepNestingAndControlCharactersGiveOneLine) {
@@ -333,7 +333,7 @@ TEST(HostileInput, DeepNestingAndControlCharactersGiveOneLine) {
     EXPECT_EQ(printable("a\xff\n\x1b", 100), "a\\xFF\\n\\u001B");
 }
 
-// Issue 15, item 5: temporaries are created exclusively under unguessable names: a symlink
+// Temporaries are created exclusively under unguessable names: a symlink
 // planted at the old predictable name (".NAME.tmp-PID.EXT") or anywhere else is never written
 // through, the final name never becomes a link, and the .glb's spill file has no name at all.
 TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
@@ -387,7 +387,7 @@ TEST(HostileInput, TemporaryFilesNeverFollowPlantedSymlinks) {
     ::close(fd);
 }
 
-// Issue 15, item 6: confinement is decided on resolved paths everywhere a file is opened: a
+// Confinement is decided on resolved paths everywhere a file is opened: a
 // buffer named inside the glTF's folder that is a symlink to a file outside is refused, by the
 // Draco pre-check (which read it and printed its size) and by tinygltf's file callbacks alike.
 TEST(HostileInput, SymlinkedBuffersOutsideTheGltfFolderAreRefused) {
@@ -453,7 +453,7 @@ std::string base64(const std::string& bytes) {
 
 }  // namespace
 
-// Issue 15, item 3: small inputs that would exhaust memory are refused before the work, each
+// Small inputs that would exhaust memory are refused before the work, each
 // with one line naming the file, the field and the limit, within 500 MB of peak RSS.
 TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
     Sandbox box;
@@ -581,7 +581,7 @@ TEST(HostileInput, AmplificationIsBoundedBeforeTheWork) {
     EXPECT_TRUE(filesUnder(out).empty());
 }
 
-// Issue 15, item 7: derived quantities are checked, not only the inputs: a scale or rotation
+// Derived quantities are checked, not only the inputs: a scale or rotation
 // that sends vertices beyond range, a glTF node scale that overflows, a look-back beyond range.
 TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
     Sandbox box;
@@ -647,7 +647,7 @@ TEST(HostileInput, NonFiniteOrHugeDerivedQuantitiesAreRefused) {
     EXPECT_FALSE(fs::exists(box / "out"));
 }
 
-// Issue 15, item 8: a scene file name that is not UTF-8 is refused up front (it rendered every
+// A scene file name that is not UTF-8 is refused up front (it rendered every
 // frame, then failed in the .glb's JSON); --max-output-bytes counts the .glb's JSON side before
 // writing it.
 TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
@@ -684,7 +684,7 @@ TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
     EXPECT_NE(r.err.find("--threads: 10000000 is outside 0 (all cores) .. 1024"), std::string::npos) << r.err;
 }
 
-// Issue 18, item 4: malformed animation channels on an object node of a glTF scene, each refused
+// Malformed animation channels on an object node of a glTF scene, each refused
 // with one line naming the file, the glTF path and the problem, and exit code 2
 // (pipeline/gltf_animation.h).
 TEST(HostileInput, MalformedAnimationsAreRefusedWithOneLine) {
@@ -750,7 +750,7 @@ TEST(HostileInput, MalformedAnimationsAreRefusedWithOneLine) {
     }
 }
 
-// Issue 33, item 6: time slabs bounded by a memory budget (--max-slab-memory, default 2 GiB at
+// Time slabs bounded by a memory budget (--max-slab-memory, default 2 GiB at
 // kTraceBytesPerPrism = 320 bytes a prism: 6 710 886 prisms) over every object's slabs, before
 // they are built. A 320-triangle sphere moving at 0.97c and spinning at a rim speed of 0.97c needs
 // 761 slabs for one frame (243 520 prisms); 40 of them, 9.7M prisms, were within the old limits

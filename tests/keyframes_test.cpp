@@ -1,4 +1,4 @@
-// Keyframed paths (issue 18, item 4; mesh4d/motion/keyed.h, pipeline/gltf_animation.h): glTF
+// Keyframed paths (mesh4d/motion/keyed.h, pipeline/gltf_animation.h): glTF
 // animation channels on an object node, through the whole stage, against the uniform and spin
 // models and against a path, a boost and a clock written out here.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 33, item 1: `apparent merge DIR` reads shard files as untrusted input. Each test renders
+// `apparent merge DIR` reads shard files as untrusted input. Each test renders
 // real shards of a small scene (`render --shard I/3`), alters one header or record field, and
 // expects one line naming the shard file and the field, exit code 2, and nothing written.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Motion beyond uniform (issue 18; mesh4d/motion/worldline.h): spinning and rolling bodies, against
+// Motion beyond uniform (mesh4d/motion/worldline.h): spinning and rolling bodies, against
 // closed forms and against a computation written here that shares nothing with the code under
 // test (its own rotation, its own Lorentz boost as a matrix, its own root search by bisection).
 #include <gtest/gtest.h>

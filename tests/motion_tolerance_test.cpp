@@ -1,4 +1,4 @@
-// Tolerance mode for motions that are not uniform (issue 18; mesh4d/refine/worldline_refine.h): the
+// Tolerance mode for motions that are not uniform (mesh4d/refine/worldline_refine.h): the
 // two-sided distance between the refined output and the exact apparent surface stays within T,
 // the exact surface computed here from the true worldlines with kinematics of this file's own (a
 // rotation written out, a Lorentz boost as a matrix, Born-rigid hyperbolas, the crossing by plain

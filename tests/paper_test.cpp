@@ -31,9 +31,8 @@ Vec3 absolutePoint(const mesh4d::ApparentMesh& m, size_t i) { return m.absoluteP
 
 // The apparent speed is a central difference of section points 0.1 s apart, each within T of the
 // exact surface: its error is at most 2 T / 0.1 s = 4e-4 c at this T, within the 2e-3 relative
-// tolerance of the speeds (about 1.3e-3 c). At 2e-4 ls (a bound of 4e-3 c) the test passed only
-// while the two sections' errors happened to agree (branch plate, issue 13: a mesh triangle's
-// level decided at once moved flange-a's finite receding speed by 1.4e-3 c).
+// tolerance of the speeds (about 1.3e-3 c). At 2e-4 ls (a bound of 4e-3 c) the test would pass
+// only where the two sections' errors happened to agree.
 constexpr double kTolerance = 2e-5;
 
 // The front plate's apparent section at eye level (y = 0): its x extent.

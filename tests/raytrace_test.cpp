@@ -1,6 +1,6 @@
 // The paper's 4D raytracer (mesh4d/ray4d.h, pipeline/raytrace.h): hits against the closed-form
 // retarded point, the lab normal against the boosted triangle, PNG round trip, command errors,
-// and the cross-check of issue #7: the apparent meshes of the cone cut, ray-cast in plain 3D from
+// and the cross-check of both: the apparent meshes of the cone cut, ray-cast in plain 3D from
 // the camera, show the same object as the 4D raytracer in at least 99% of the covered pixels.
 #include <gtest/gtest.h>
 
@@ -239,7 +239,7 @@ TEST(RaytraceCommand, FigureLaysOutRowsAndColumns) {
     std::filesystem::remove(path);
 }
 
-// The scene fields of issue #7 give one-line errors naming the field.
+// The light's and the mirrors' scene fields give one-line errors naming the field.
 TEST(RaytraceScene, BadLightAndMirrorFields) {
     const auto dir = std::filesystem::temp_directory_path() / ("apparent_scenes_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
@@ -267,7 +267,7 @@ TEST(RaytraceScene, BadLightAndMirrorFields) {
 
 using testcast::MeshCaster;
 
-// The cross-check of issue #7 on one scene with one mirror, every model, every `stride`-th frame
+// The cross-check on one scene with one mirror, every model, every `stride`-th frame
 // at 240 x 135: the object each pixel shows first, by the 4D raytracer and by a 3D ray cast over
 // the cone cut's output (tolerance 1e-3 ls), agree on >= 99% of covered pixels; so do the
 // reflections where the raytracer's ray meets the mirror. Returns per model the frames whose
@@ -379,12 +379,12 @@ void crossCheck(const std::string& scene_file, long long stride, long long min_m
 
 }  // namespace
 
-// Issue #7's cross-check on the default scene (flanges, stage, mirrored backdrop).
+// The cross-check on the default scene (flanges, stage, mirrored backdrop).
 TEST(RaytraceCrossCheck, ApparentMeshesShowWhatThe4DRaytracerShows) {
     crossCheck("data/scenes/flanges.json", 10, 1000, nullptr);
 }
 
-// Issue 17: the same agreement for a moving camera, the fly-by (camera at 0.9c past seven boxes at
+// The same agreement for a moving camera, the fly-by (camera at 0.9c past seven boxes at
 // rest): every model the scene allows (instant, relativistic, contracted; finite is refused for a
 // moving camera), every 10th frame.
 TEST(RaytraceCrossCheck, FlybyFromAMovingCamera) {
@@ -427,7 +427,7 @@ TEST(RaytraceCrossCheck, ReflectionsFollowTheMirrorsExistence) {
     }
 }
 
-// Issue 18: the rolling wheel at 0.9c (rolling_wheel.json, 1.8 ls spokes turning at 0.9 rad/s)
+// The rolling wheel at 0.9c (rolling_wheel.json, 1.8 ls spokes turning at 0.9 rad/s)
 // raytraced through time slabs for two frames as it passes in front of the camera, against the
 // cut of the same frames with a tolerance of T = 1e-3 x its size (worldline_refine.h), cast in 3D.
 // The slabs' stated error: every point of their tetrahedra within 1e-3 of the wheel's size of the
@@ -507,7 +507,7 @@ std::string writeFacesScene(const std::filesystem::path& dir, const std::string&
 
 }  // namespace
 
-// Issue 20: every pixel of a flat face under uniform motion has one shade, Lambert's law with the
+// Every pixel of a flat face under uniform motion has one shade, Lambert's law with the
 // face's outward lab normal, in every model: the rest normal (Galilean) or the contracted one,
 // n + (gamma - 1)(n . u) u normalised (Lorentz), from the rest mesh and the closed form alone.
 // Before the fix the normal was turned by the spatial test n . d, which aberration flips across
@@ -792,7 +792,7 @@ TEST(RaytraceCommand, LabelFontLoadsOrSaysWhichPackage) {
     EXPECT_EQ(error.find('\n'), std::string::npos);
 }
 
-// Issue 18, item 3: `raytrace --shade doppler` of a keyframed object takes the Doppler factor of
+// `raytrace --shade doppler` of a keyframed object takes the Doppler factor of
 // its worldline at each hit (raytrace.h). Three collinear keys at constant velocity v, the middle
 // one at a lab time the frame sees (so the history is traced in several slabs, cut at the key),
 // give the uniform model with velocity v, whose factor is the closed form 1 / (g (1 - v.n))
@@ -926,7 +926,7 @@ TEST(RaytraceShading, DopplerOfAKeyframedPathIsItsSegmentsVelocitys) {
     EXPECT_LE(worst, 0.03);
 }
 
-// `raytrace --shade doppler` of a spinning object (issue 18): a flat disk of radius 1 in the plane
+// `raytrace --shade doppler` of a spinning object: a flat disk of radius 1 in the plane
 // z = -3, its centre X0 = (1.6, 0, -3) at rest (off the axis, so that u.d is not small), spinning
 // about z at w = 0.5 rad/s (rim speed 0.5). The disk's plane holds still, so the pixel with ray
 // direction d sees the point x where its ray meets z = -3, moving at u = w x (x - X0)
@@ -1153,7 +1153,7 @@ long long coveredPixels(const std::vector<int32_t>& object) {
 
 }  // namespace
 
-// Issue 18, item 5: an accelerated and a keyframed body traced over only the span their frames see
+// An accelerated and a keyframed body traced over only the span their frames see
 // (worlds.h pathSpanSeen) give the pictures of the padded span (buildWorld: light-crossing time
 // over 1 - b), byte for byte, with far fewer slabs: the slabs lie on the motion's grid (extrude.h
 // SlabGrid), so the seen span's slabs are the padded span's that the frames can reach, and a seen
@@ -1196,7 +1196,7 @@ TEST(RaytraceSpan, SeenSpanTracesWhatThePaddedSpanTraces) {
     std::filesystem::remove_all(dir);
 }
 
-// Issue 18: a long frame range traced in windows of slabs (SceneTracer: at most window_slabs per
+// A long frame range traced in windows of slabs (SceneTracer: at most window_slabs per
 // object at once, rebuilt as the frames advance) gives each frame the picture of a short range
 // traced in one window, byte for byte; the run below needs several windows.
 TEST(RaytraceSpan, WindowsOfFramesTraceWhatOneWindowTraces) {
@@ -1220,7 +1220,7 @@ TEST(RaytraceSpan, WindowsOfFramesTraceWhatOneWindowTraces) {
     }
 }
 
-// Issue 18: a window keeps the slabs it shares with the last one (SceneTracer TraceChunk): frames
+// A window keeps the slabs it shares with the last one (SceneTracer TraceChunk): frames
 // traced one window after another extrude each slab of their range once, exactly the slabs one
 // window over the range extrudes, and give its pictures byte for byte. Backwards the same, but
 // for the first window (the constructor's, at the range's start), whose slabs the window of the
@@ -1260,7 +1260,7 @@ TEST(RaytraceSpan, AWindowExtrudesOnlyTheSlabsTheLastOneDidNotHold) {
     }
 }
 
-// Issue 18: only a frame that alone needs more slabs than one window may hold is refused, with one
+// Only a frame that alone needs more slabs than one window may hold is refused, with one
 // line naming the field, the count and the frame (exit 2): the rolling wheel at 0.99c (w R = |v|).
 TEST(RaytraceSpan, AFrameThatAloneNeedsTooManySlabsIsRefused) {
     const std::string dir = ::testing::TempDir() + "span_fast_wheel_" + std::to_string(::getpid());

@@ -1220,20 +1220,8 @@ TEST(Refine, FarPlateNoMoreTrianglesThanUniformAtEqualError) {
 // The bisection's output near the camera, byte for byte: the box passing 2 ls from the camera
 // and the 320-face sphere passing 4 ls away at 0.9c, seen at closest approach and cut at
 // T = 1e-4 x size (benchmarks/refine_bench.cpp's scenes). The FNV-1a of every output array and
-// counter was computed by `refine_bench --count 0 4` and `--count 1 4` on branch near (issue 13):
-// re-pinned there because the whole-piece form (chord_error.h pieceForm) became tighter near the
-// camera, so pieces pass by it without further splits (the sphere: 5490 triangles instead of
-// 5702) and the box's large pieces are filled by templates kept whole (7490 instead of 7152; the
-// hashes before were 0x397194ba27445839 and 0x2215a7c5bcfd9d5a from main at 8498c8d). Pinned
-// again on branch near2 (issue 13): every template is kept whole unless the neighbour's forced
-// template would make more than twice its bisection's triangles (slice.cpp, kForceRatio), so
-// the box's pieces near the camera are templated instead of bisected (6540 triangles instead of
-// 7490; before 0xc0a5ec92a4c91812 and 0x4f58d9c69d32b2f0, the sphere's count unchanged). Pinned
-// again on branch aniso (issue 13): a piece stretched in its form's metric that needs at most
-// 16 (slice.cpp kAnisoMaxNeed) is filled by the bisection in that metric (mesh4d/refine/form_bisect.h)
-// instead of the global bisection (the sphere: 5604 triangles instead of 5490, the box 6548
-// instead of 6540; before 0x1ca0664b8e71d7c8 and 0x0276f2fd7b6f9f8a). A change meant to alter
-// the output pins them again and says why.
+// counter, as `refine_bench --count 0 4` and `--count 1 4` print them. A change meant to alter
+// the output pins them again and says why in its commit message (the pins' history is in git).
 TEST(Refine, NearCameraBisectionBytesPinned) {
     auto fnv = [](const ApparentMesh& m) {
         uint64_t h = 1469598103934665603ull;
@@ -1343,7 +1331,7 @@ TEST(Refine, NothingToRefineIsVertexModesOutputBitForBit) {
     EXPECT_EQ(unrefined, 6);
 }
 
-// (helper "order", issue 13.) The refinement's first pass takes a candidate triangle's sides'
+// The refinement's first pass takes a candidate triangle's sides'
 // |u|_M^2 from the edges' spreads (one per mesh edge, from its lo end to its hi end) and its bound
 // from chordErrorOfSides: that must be chordErrorOfPoints's bound and quadratic part bit for bit,
 // whatever the orientation of each side, with the bubbles' coefficients from edgeBubble, near the
@@ -1408,7 +1396,7 @@ TEST(Refine, BoundFromEdgeSpreadsIsThePointsBoundBitForBit) {
     EXPECT_GT(infinite, 100);
 }
 
-// ---- Helper "form" (issue 13): the whole-piece forms at fewer instructions, the same bits ----
+// ---- The whole-piece forms against their straightforward reference: the same bits ----
 namespace form_reference {
 
 // A straightforward copy of bubbleMax, scanPieceForms, pieceForm and pieceFormWithin as they were

@@ -50,35 +50,11 @@ fs::path freshDir(const std::string& name) {
 }  // namespace
 
 // The .glb bytes of a small scene (the default scene's frames 98..100: mirror reflections
-// included), as main wrote them before the stage layer and the sinks existed: the FNV-1a of each
-// file computed on main at 9da8dea (`apparent render data/scenes/flanges.json --out DIR ARGS`,
-// run from the source folder, so the scene_file extras read "data/scenes/flanges.json"). The
-// finite and relativistic files were pinned again afterwards, for two intended changes of their
-// numbers: 1 - b^2 is now exact to rounding (0.25004399999999999 for b = 0.866, was
-// 0.25004400000000004), which moves the last bits of every point seen through the cone, and the
-// adaptive refinement (slice.h) replaced the grid tessellation at the scene's tolerance. All were
-// pinned again when the .glb began to share index buffers between frames with equal index lists
-// and to keep the animation's key times and scale sequences in one view each (gltf.h): the same
-// geometry, animation and scene (checked accessor by accessor against the earlier files), fewer
-// accessors and buffer views. The finite and relativistic files were pinned again when the
-// refinement began to decide its splits from the a-priori bound (chord_error.h edgeBubble, no
-// midpoint cut) and to emit its pieces and points in record order (slice.cpp): other pieces at
-// the same tolerance, in another order; and again when pieces whose whole-piece form asks for a
-// level of 2 or more began to be filled by templates (slice.cpp, tessellate.h): the flanges'
-// pieces far from the camera are split evenly instead of bisected; and again when the
-// whole-piece form became tighter (chord_error.h pieceForm: second-order slack along the line of
-// sight) and began to pass pieces as they are (issue 13, branch near): other pieces, fewer
-// splits, at the same tolerance. The finite file again when every template began to be kept
-// whole unless the neighbour's forced template would make more than twice its bisection's
-// triangles (issue 13, branch near2, slice.cpp kForceRatio): other pieces near the camera.
-// The finite file again when a piece's halves began to be estimated from the centroid's form on
-// their own sides where the form is nearly uniform (issue 13, branch plate, slice.cpp
-// halvesEstimate): more pieces far from the camera filled at once instead of halved first.
-// The finite and relativistic files again when --tolerance began to bound the geometric distance
-// (issue 31, mesh4d/refine/slide_bound.h): the flanges' faces that contain the velocity are
-// refined only along their rims; with --attribute-tolerance at the tolerance the earlier bytes.
-// All again when the scene extras began to record the scene's light (issue 35, "light"): the same
-// BIN chunks and the same JSON but for that key (checked file by file against the earlier files).
+// included): the FNV-1a of each file of `apparent render data/scenes/flanges.json --out DIR ARGS`,
+// run from the source folder (so the scene_file extras read "data/scenes/flanges.json"). A
+// reshaping of the code keeps these bytes; a change meant to alter them (other numbers, other
+// pieces at the same tolerance, another layout of the file) pins them again and says why in its
+// commit message, checked file by file against the earlier files (the pins' history is in git).
 TEST(Stage, GlbBytesPinnedAcrossTheRefactor) {
     struct Case {
         std::vector<std::string> args;

@@ -136,7 +136,7 @@ TEST(Stress, ObjectThroughTheCamera) {
     }
 }
 
-// Relative accuracy far from the camera (issue: sizes 1e-6..1e6 at distances up to 1e9): a rod on
+// Relative accuracy far from the camera (sizes 1e-6..1e6 at distances up to 1e9): a rod on
 // the line of sight has the distance-independent apparent lengths of Lampa, L/(1-b) or L/(1+b)
 // (finite) and L sqrt((1+b)/(1-b)) or L sqrt((1-b)/(1+b)) (relativistic). The shape is computed
 // relative to the object's origin (lightcone.h, ViewAnchor), so it keeps ~1e-12 relative

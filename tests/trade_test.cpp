@@ -100,7 +100,7 @@ TEST(Trade, AffineModelsAndBadOptions) {
     EXPECT_NE(help.out.find("--tolerances"), std::string::npos);
 }
 
-// Motions beyond uniform (issue 18): the shipped spinning wheel (rim at 0.9c, seen along its axis)
+// Motions beyond uniform: the shipped spinning wheel (rim at 0.9c, seen along its axis)
 // gets all three families; every tolerance row lies within its T (measured against the exact
 // surface from the true worldlines, measure.h crossingBySearch), and the error falls as T does and
 // as the uniform level rises. An object that cannot take a tolerance (a spinning one that begins

@@ -1,4 +1,4 @@
-// The scene's units (pipeline/units.h, scene field `units`), issue 38's proof: a scene in metres
+// The scene's units (pipeline/units.h, scene field `units`): a scene in metres
 // (positions p metres, frame times t seconds) gives the output of the light-second scene with
 // positions p / c at the same times, times c, to 1e-12 relative; its labels read in ns. And an
 // oracle in metres: the instant model shows a vertex at p + s q + v c (t - t0) metres.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ctest entry (issue 33, item 7): scripts/blender_import.py refuses a .glb whose scene extras it
+# ctest entry: scripts/blender_import.py refuses a .glb whose scene extras it
 # reads are bad ("fps" 0, null, negative, Infinity, a string, true; "frame_times" not a list; "light"
 # not an object, an ambient outside [0, 1], neither or a zero direction, a position with a string,
 # a key weight without its direction) with

@@ -397,7 +397,7 @@ def check_file(path):
                         f'file {[round(x, 4) for x in list(wlo) + list(whi)]}')
     r.check(not badb, 'mesh bounding boxes match the POSITION min/max of the file',
             f'{len(badb)} differ, e.g. {"; ".join(badb[:2])}')
-    # reflections in mirrors (issue #7): child nodes "frame_NNNNN mirror M" of the frame nodes, imported as child
+    # reflections in mirrors: child nodes "frame_NNNNN mirror M" of the frame nodes, imported as child
     # objects of their frame objects with the file's vertex counts
     new_by_name = {}
     for o in new:

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ctest entry (issue 35, point 5): a Draco .glb opened in Blender exactly as docs/VIEWERS.md "Blender" says,
+# ctest entry: a Draco .glb opened in Blender exactly as docs/VIEWERS.md "Blender" says,
 # then rendered headless and checked not dark (tests/blender/check_render.py). No environment variable:
 # scripts/blender_import.py finds the build's Draco library itself (build/blender/libextern_draco.so); only a
 # build directory other than SOURCE_DIR/build is named with --draco-library. Blender runs with

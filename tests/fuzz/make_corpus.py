@@ -97,7 +97,7 @@ def main():
                 with open(os.path.join(out, "glb", hashlib.sha1(glb).hexdigest()), "wb") as f:
                     f.write(glb)
         print("%s: %d of %d files (<= %d bytes), %d seeds in all" % (target, kept, len(paths), max_bytes, len(os.listdir(folder))))
-    # Generated nesting seeds (issue 15): just under and over the depth limit (128), and deep.
+    # Generated nesting seeds: just under and over the depth limit (128), and deep.
     for depth in (127, 129, 5000):
         nested = "[" * depth + "]" * depth
         scene = ('{"frames": {"start": 0, "end": 1, "fps": 2}, "objects": [{"mesh": "m.obj", "position": %s}]}' % nested)

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 33, item 5: under `mpirun -n 3 apparent render` every rank must render the same thing.
+# Under `mpirun -n 3 apparent render` every rank must render the same thing.
 # Rank 1 given another copy of the scene (one velocity changed), another --model, or another
 # --tolerance: every rank stops before any frame, exit 2, one line naming rank 1 and what differs
 # (scene, option), and nothing is written. The same three ranks agreeing render as before.

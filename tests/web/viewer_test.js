@@ -12,7 +12,7 @@
 //   - at t = k/fps + eps (several k, plus t = 0 and t = duration) exactly the expected frame node is visible, the
 //     expectation being computed here in Node from the file's own animation data, and it is frame k;
 //   - each visible node's vertex count in three.js equals the POSITION accessor counts in the file, and so does
-//     that of its reflection child nodes ("frame_NNNNN mirror M", issue #7) shown with it (a child that three.js
+//     that of its reflection child nodes ("frame_NNNNN mirror M") shown with it (a child that three.js
 //     did not attach to its frame, or shows at another time, changes the count);
 //   - a screenshot at t = --shot-time (default 10 s) has a meaningful number of non-background pixels in every
 //     model's viewport, and the viewports fill the window (their widths and gaps its width, their heights its
