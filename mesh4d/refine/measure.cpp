@@ -343,35 +343,18 @@ GeometricError geometricError(const World4D& w, const ViewSurface& view, const A
     }
     // Step: the lattice of every input triangle (exactToOutput's points), against the whole output,
     // the largest parametric distance first.
-    std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
-    for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
+    const std::vector<std::vector<size_t>> by_source = outputBySource(w, m);
     std::vector<std::pair<double, Vec3>> lattice;  // (parametric distance, exact point)
     for (size_t f = 0; f < w.mesh.triangles.size(); ++f) {
         if (by_source[f].empty()) continue;
-        const auto& it = w.mesh.triangles[f];
-        const Vec3 a = w.mesh.positions[it[0]], b = w.mesh.positions[it[1]], c = w.mesh.positions[it[2]];
-        const Vec3 n = cross(b - a, c - a);
-        for (int i = 0; i <= grid; ++i)
-            for (int j = 0; i + j <= grid; ++j) {
-                const double l1 = double(i) / grid, l2 = double(j) / grid;
-                const Vec3 q = a * (1 - l1 - l2) + b * l1 + c * l2;
-                const Vec3 x = exact.exact(q);
-                // The parametric distance (the output point of the same rest point) bounds the search;
-                // a point no output triangle covers (radius infinite) is searched over the whole output.
-                double radius = INFINITY;
-                for (size_t t : by_source[f]) {
-                    const auto& ot = m.triangles[t];
-                    const Vec3 p0 = m.rest_points[ot[0]], p1 = m.rest_points[ot[1]], p2 = m.rest_points[ot[2]];
-                    const double area = dot(cross(p1 - p0, p2 - p0), n);
-                    if (area == 0) continue;
-                    const double l[3] = {dot(cross(p1 - q, p2 - q), n) / area, dot(cross(p2 - q, p0 - q), n) / area,
-                                         dot(cross(p0 - q, p1 - q), n) / area};
-                    if (std::min({l[0], l[1], l[2]}) < -1e-9) continue;
-                    const Vec3 out = m.positions[ot[0]] * l[0] + m.positions[ot[1]] * l[1] + m.positions[ot[2]] * l[2];
-                    radius = std::min(radius, norm(x - out));
-                }
-                if (radius > r.exact_to_output) lattice.push_back({radius, x});  // others cannot raise it
-            }
+        Vec3 n;
+        forEachLatticePoint(w.mesh, f, grid, &n, [&](const Vec3& q) {
+            const Vec3 x = exact.exact(q);
+            // The parametric distance (the output point of the same rest point) bounds the search;
+            // a point no output triangle covers (radius infinite) is searched over the whole output.
+            const double radius = sameRestPoint(m, by_source[f], n, q, x);
+            if (radius > r.exact_to_output) lattice.push_back({radius, x});  // others cannot raise it
+        });
     }
     std::sort(lattice.begin(), lattice.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
     for (const auto& [radius, x] : lattice) {

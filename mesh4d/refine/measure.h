@@ -117,38 +117,59 @@ inline double outputToExact(const World4D& w, const ViewSurface& view, const App
     return worst;
 }
 
+// The output triangles that lie on each input triangle (source_triangles), by input triangle.
+inline std::vector<std::vector<size_t>> outputBySource(const World4D& w, const ApparentMesh& m) {
+    std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
+    for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
+    return by_source;
+}
+
+// fn(q) for the points of the barycentric grid of input triangle f: (grid + 1)(grid + 2) / 2 rest
+// points, row by row; n is the triangle's (unnormalised) normal, for sameRestPoint.
+template <class Fn>
+void forEachLatticePoint(const RestMesh& mesh, size_t f, int grid, Vec3* n, Fn fn) {
+    const auto& it = mesh.triangles[f];
+    const Vec3 a = mesh.positions[it[0]], b = mesh.positions[it[1]], c = mesh.positions[it[2]];
+    *n = cross(b - a, c - a);
+    for (int i = 0; i <= grid; ++i)
+        for (int j = 0; i + j <= grid; ++j) {
+            const double l1 = double(i) / grid, l2 = double(j) / grid;
+            fn(a * (1 - l1 - l2) + b * l1 + c * l2);
+        }
+}
+
+// The distance from x, the exact image of rest point q on an input triangle of normal n, to the
+// output point of the same rest point: the least over the output triangles `on` that input
+// triangle whose rest triangle contains q; INFINITY when none does.
+inline double sameRestPoint(const ApparentMesh& m, const std::vector<size_t>& on, const Vec3& n, const Vec3& q,
+                            const Vec3& x) {
+    double best = INFINITY;
+    for (size_t t : on) {
+        const auto& ot = m.triangles[t];
+        const Vec3 p0 = m.rest_points[ot[0]], p1 = m.rest_points[ot[1]], p2 = m.rest_points[ot[2]];
+        const double area = dot(cross(p1 - p0, p2 - p0), n);
+        if (area == 0) continue;
+        const double l[3] = {dot(cross(p1 - q, p2 - q), n) / area, dot(cross(p2 - q, p0 - q), n) / area,
+                             dot(cross(p0 - q, p1 - q), n) / area};
+        if (std::min({l[0], l[1], l[2]}) < -1e-9) continue;
+        const Vec3 out = m.positions[ot[0]] * l[0] + m.positions[ot[1]] * l[1] + m.positions[ot[2]] * l[2];
+        best = std::min(best, norm(x - out));
+    }
+    return best;
+}
+
 // Exact -> output: for points on a barycentric grid of every input triangle, the distance from
 // the exact point to the output point at the same rest point (found in the output triangles that
 // lie on that input triangle). Bounds the distance from every sampled exact point to the mesh.
 inline double exactToOutput(const World4D& w, const ViewSurface& view, const ApparentMesh& m,
                             int grid) {
-    std::vector<std::vector<size_t>> by_source(w.mesh.triangles.size());
-    for (size_t t = 0; t < m.triangles.size(); ++t) by_source[m.source_triangles[t]].push_back(t);
+    const std::vector<std::vector<size_t>> by_source = outputBySource(w, m);
     double worst = 0;
     for (size_t f = 0; f < w.mesh.triangles.size(); ++f) {
-        const auto& it = w.mesh.triangles[f];
-        const Vec3 a = w.mesh.positions[it[0]], b = w.mesh.positions[it[1]], c = w.mesh.positions[it[2]];
-        const Vec3 n = cross(b - a, c - a);
-        for (int i = 0; i <= grid; ++i)
-            for (int j = 0; i + j <= grid; ++j) {
-                const double l1 = double(i) / grid, l2 = double(j) / grid;
-                const Vec3 q = a * (1 - l1 - l2) + b * l1 + c * l2;
-                const Vec3 exact = exactRelative(w, view, q, m.origin);
-                double best = INFINITY;
-                for (size_t t : by_source[f]) {
-                    const auto& ot = m.triangles[t];
-                    const Vec3 p0 = m.rest_points[ot[0]], p1 = m.rest_points[ot[1]], p2 = m.rest_points[ot[2]];
-                    const double area = dot(cross(p1 - p0, p2 - p0), n);
-                    if (area == 0) continue;
-                    const double l[3] = {dot(cross(p1 - q, p2 - q), n) / area,
-                                         dot(cross(p2 - q, p0 - q), n) / area,
-                                         dot(cross(p0 - q, p1 - q), n) / area};
-                    if (std::min({l[0], l[1], l[2]}) < -1e-9) continue;
-                    const Vec3 out = m.positions[ot[0]] * l[0] + m.positions[ot[1]] * l[1] + m.positions[ot[2]] * l[2];
-                    best = std::min(best, norm(exact - out));
-                }
-                worst = std::max(worst, best);
-            }
+        Vec3 n;
+        forEachLatticePoint(w.mesh, f, grid, &n, [&](const Vec3& q) {
+            worst = std::max(worst, sameRestPoint(m, by_source[f], n, q, exactRelative(w, view, q, m.origin)));
+        });
     }
     return worst;
 }
