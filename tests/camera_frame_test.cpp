@@ -18,6 +18,7 @@
 #include "pipeline/worlds.h"
 #include "run_command.h"
 #include "box_scene.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 using mesh4d::Event;
@@ -180,7 +181,7 @@ TEST(CameraFrame, NearLightSpeedCameraStaysFiniteAndInvariant) {
 
 // Refusals, one line each: a camera at or beyond light speed.
 TEST(CameraFrame, ImpossibleOrUnsupportedCamerasAreRefused) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_camera_bad_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_camera_bad_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(fs::path(APPARENT_SOURCE_DIR) / "data/meshes/box.obj", dir / "box.obj");

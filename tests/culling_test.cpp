@@ -8,6 +8,7 @@
 
 #include "pipeline/render.h"
 #include "pipeline/worlds.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 
@@ -43,7 +44,7 @@ TEST(Culling, ConeAroundTheViewAxis) {
 // A scene with one flange ahead of the camera and one behind it: with --cull-view the frames hold
 // the one ahead, vertex for vertex as without the option, and nothing of the one behind.
 TEST(Culling, RenderLeavesOnlyWhatIsOutOfViewEmpty) {
-    const auto dir = std::filesystem::temp_directory_path() / "apparent_culling";
+    const auto dir = testio::tempPath() / "apparent_culling";
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     std::filesystem::copy_file(std::string(APPARENT_SOURCE_DIR) + "/data/meshes/flange.obj", dir / "flange.obj");

@@ -21,6 +21,7 @@
 #include "pipeline/stage.h"
 #include "run_command.h"
 #include "quiet_stage.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -33,7 +34,7 @@ class Folder {
 public:
     Folder() {
         static int counter = 0;
-        path_ = fs::temp_directory_path() / ("apparent_people_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        path_ = testio::tempPath() / ("apparent_people_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
         fs::remove_all(path_);
         fs::create_directories(path_);
     }

@@ -18,6 +18,7 @@
 #include "exporters/png.h"
 #include "mesh4d/doppler_colour.h"
 #include "run_command.h"
+#include "temp_dir.h"
 
 using testcli::apparentRun;
 using testcli::CommandResult;
@@ -218,7 +219,7 @@ TEST(DopplerColour, ModulationAgainstTheExactShift) {
 namespace {
 
 fs::path freshDir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_dcolour_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_dcolour_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(testcli::source("data/meshes/box.obj"), dir / "box.obj");

@@ -13,6 +13,7 @@
 #include "pipeline/mesh_check.h"
 #include "pipeline/scene.h"
 #include "test_meshes.h"
+#include "temp_dir.h"
 
 using namespace mesh4d;
 
@@ -186,7 +187,7 @@ TEST(Extremes, NearlyDegenerateTriangles) {
 
 namespace {
 std::string writeScene(const std::string& name, const std::string& frames) {
-    const auto dir = std::filesystem::temp_directory_path() / "apparent_extremes";
+    const auto dir = testio::tempPath() / "apparent_extremes";
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     const auto path = dir / (name + ".json");

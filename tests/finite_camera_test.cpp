@@ -24,6 +24,7 @@
 #include "box_scene.h"
 #include "run_command.h"
 #include "test_meshes.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 using mesh4d::Event;
@@ -164,7 +165,7 @@ struct PlyVertex {
 
 // Renders `scene_json` (finite, one object of box.obj) to PLY with the light factors; frame 0.
 std::vector<PlyVertex> renderPly(const std::string& name, const std::string& scene_json) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_finite_doppler_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_finite_doppler_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(fs::path(APPARENT_SOURCE_DIR) / "data/meshes/box.obj", dir / "box.obj");

@@ -31,6 +31,7 @@
 #include "exporters/ply.h"
 #include "file_bytes.h"
 #include "file_size_limit.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -72,7 +73,7 @@ std::string writeOn(int threads, bool ply, const ExportFrame& frame, const fs::p
 }  // namespace
 
 TEST(FrameExport, PlyAndObjBytesDoNotDependOnTheThreadCount) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_frame_export_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_frame_export_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const ExportFrame frame = testFrame();
     for (bool ply : {true, false}) {
@@ -84,7 +85,7 @@ TEST(FrameExport, PlyAndObjBytesDoNotDependOnTheThreadCount) {
 }
 
 TEST(FrameExport, PlyHoldsAbsoluteValuesAndOffsetFaces) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_frame_export_v_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_frame_export_v_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const ExportFrame frame = testFrame();
     const std::string bytes = writeOn(2, true, frame, dir / "f.ply");
@@ -129,7 +130,7 @@ TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
     info.fps = 10;
     info.objects.push_back({"a", {0.8, 0.8, 0.8, 1}, -1, ""});
     info.objects.push_back({"b", {0.5, 0.5, 0.5, 1}, -1, ""});
-    const fs::path dir = fs::temp_directory_path() / ("apparent_glb_bounds_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_glb_bounds_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::string bytes[2];
     for (int threads : {1, 2}) {
@@ -182,7 +183,7 @@ TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
 // number of pages; and a write that fails (RLIMIT_FSIZE: EFBIG, as a full disk gives ENOSPC) says
 // so, with the bytes written up to the limit.
 TEST(FrameExport, WriteWholeWritesThePiecesInOrder) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_write_whole_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_write_whole_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::mt19937_64 rng(5);
     auto bytes = [&](size_t n) {
@@ -244,7 +245,7 @@ TEST(FrameExport, WriteWholeWritesThePiecesInOrder) {
 // write's file, and went through the page cache (mincore: every page of it resident) where the
 // direct write's left none there: the refused writes were made again buffered.
 TEST(FrameExport, WriteWholeFallsBackWhereDirectWritesAreRefused) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_write_fallback_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_write_fallback_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     {
         const int probe = ::open((dir / "probe.bin").c_str(), O_RDWR | O_CREAT | O_TRUNC | O_DIRECT, 0644);

@@ -27,6 +27,7 @@
 #include "exporters/gltf.h"
 #include "exporters/ply.h"
 #include "file_bytes.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -131,7 +132,7 @@ Written write(const fs::path& file, const GlbOptions& options, bool by_reference
 class FrameSpill : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("apparent_frame_spill_" + std::to_string(::getpid()));
+        dir_ = testio::tempPath() / ("apparent_frame_spill_" + std::to_string(::getpid()));
         fs::create_directories(dir_);
     }
     void TearDown() override { fs::remove_all(dir_); }

@@ -15,6 +15,7 @@
 #include "pipeline/cli.h"
 #include "pipeline/gltf_document.h"
 #include "pipeline/mesh_input.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -224,7 +225,7 @@ TEST(GltfReader, TruncatedGlbPrefixesNeverCrash) {
     std::ifstream in(src, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), {});
     ASSERT_GT(bytes.size(), 100u);
-    const fs::path dir = fs::temp_directory_path() / ("apparent_glb_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_glb_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const std::string path = (dir / "prefix.glb").string();
     for (size_t n = 0; n < bytes.size(); n += std::max<size_t>(1, bytes.size() / 300)) {
@@ -259,7 +260,7 @@ std::string editGlbJson(const std::string& glb, const std::function<void(nlohman
 // tinygltf 2.7 dereferences the Draco attribute named by each id without checking it exists:
 // a file listing an id its payload lacks must be refused before tinygltf sees it.
 TEST(GltfReader, DracoAttributeIdMissingFromThePayloadIsRefused) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_draco_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_draco_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const std::string scene = std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/scene_tetra.json";
     const char* argv[] = {"apparent", "render", scene.c_str(), "--out", dir.c_str(), "--draco", "--frames", "0:1",

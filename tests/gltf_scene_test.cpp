@@ -19,6 +19,7 @@
 #include "pipeline/mesh_input.h"
 #include "pipeline/scene.h"
 #include "pipeline/scene_fields.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -31,7 +32,7 @@ class Folder {
 public:
     Folder() {
         static int counter = 0;
-        path_ = fs::temp_directory_path() / ("apparent_gltf_scene_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        path_ = testio::tempPath() / ("apparent_gltf_scene_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
         fs::remove_all(path_);
         fs::create_directories(path_);
     }

@@ -17,6 +17,7 @@
 
 #include "mesh4d/event.h"
 #include "run_command.h"
+#include "temp_dir.h"
 
 using mesh4d::Vec3;
 using testcli::apparentRun;
@@ -54,7 +55,7 @@ std::vector<PlyVertex> readFrame(const fs::path& p) {
 // Renders a one-object scene (a box of edge `size`) to PLY and returns frame 0's vertices.
 std::vector<PlyVertex> render(const std::string& name, const std::string& model, double size, const std::string& object_fields,
                               double t_c) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_light_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_light_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(testcli::source("data/meshes/box.obj"), dir / "box.obj");
@@ -126,7 +127,7 @@ TEST(LightFactors, EveryVertexMatchesTheTextbookFormsAndTheClock) {
 // values in float32 (the crease split repeats vertices, so the sets of values are compared), plain
 // and in Draco's attribute map; with meshopt the attribute asked for is there and no other.
 TEST(LightFactors, GlbAttributesHoldThePlyValues) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_light_glb_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_light_glb_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(testcli::source("data/meshes/box.obj"), dir / "box.obj");

@@ -20,6 +20,7 @@
 #include "pipeline/ply_reader.h"
 #include "pipeline/polygon_input.h"
 #include "test_meshes.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -70,7 +71,7 @@ void expectSameMesh(const mesh4d::RestMesh& ours, const mesh4d::RestMesh& ref, c
 }
 
 fs::path freshDir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_loader_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_loader_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;

@@ -24,6 +24,7 @@
 #include "pipeline/worlds.h"
 #include "quiet_stage.h"
 #include "run_command.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 using mesh4d::Event;
@@ -75,7 +76,7 @@ struct Fixture {
 // (box.obj) between them; the mirror shows every reflection whole.
 void loadScene(const std::string& name, const std::string& camera, const std::string& model, const std::string& objects,
                Fixture* f) {
-    f->dir = fs::temp_directory_path() / ("apparent_mirror_camera_" + name + "_" + std::to_string(::getpid()));
+    f->dir = testio::tempPath() / ("apparent_mirror_camera_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(f->dir);
     fs::create_directories(f->dir);
     fs::copy_file(fs::path(APPARENT_SOURCE_DIR) / "data/meshes/box.obj", f->dir / "box.obj");

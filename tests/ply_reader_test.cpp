@@ -13,6 +13,7 @@
 #include "pipeline/mesh_input.h"
 #include "pipeline/ply_reader.h"
 #include "file_bytes.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -80,7 +81,7 @@ TEST(PlyReader, ExporterOutputReadsBack) {
     b.rest_points = b.positions;
     b.triangles = {{0, 1, 2}};
     frame.objects.push_back(b);
-    const fs::path dir = fs::temp_directory_path() / ("apparent_ply_rt_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_ply_rt_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const std::string path = (dir / "frame.ply").string();
     std::string error;
@@ -179,7 +180,7 @@ TEST(PlyReader, ThirdPartyFilesImportOrAreRefusedClearly) {
 
 // Every truncated prefix of a binary and an ascii file either loads or fails with a message.
 TEST(PlyReader, TruncatedPrefixesNeverCrash) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_ply_trunc_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_ply_trunc_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const std::string path = (dir / "prefix.ply").string();
     for (const char* name : {"tetra_binary.ply", "tetra_ascii.ply"}) {

@@ -21,6 +21,7 @@
 #include "pipeline/raytrace.h"
 #include "quiet_stage.h"
 #include "srgb.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 using mesh4d::Vec3;
@@ -216,7 +217,7 @@ TEST(RaytraceLight, TheTestsDirectionMapsAreInverse) {
 // it shows to a camera at rest. Before the fix the light was used with the camera frame's normals
 // and points (contracted and displaced under the boost; displaced under the Galilean map).
 TEST(RaytraceLight, AFaceAtRestInTheLabHasItsShadeWhateverTheCameraDoes) {
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_light_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_light_" + std::to_string(::getpid()));
     const Light lights[] = {{R"("light": {"direction": [0.3, 1, 0.6], "ambient": 0.2},)", false, unit({0.3, 1, 0.6})},
                             {R"("light": {"position": [1.5, 2, -3], "ambient": 0.2},)", true, {1.5, 2, -3}}};
     for (Model model : {Model::Relativistic, Model::Contracted, Model::Instant, Model::Finite})

@@ -158,7 +158,7 @@ TEST(Mirror, ReflectionIsAnInvolutionAndKeepsPathLengths) {
 TEST(Png, RoundTrip) {
     RgbImage img(7, 3);
     for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = uint8_t(i * 37);
-    const std::string path = (std::filesystem::temp_directory_path() / ("apparent_png_" + std::to_string(::getpid()) + ".png")).string();
+    const std::string path = (testio::tempPath() / ("apparent_png_" + std::to_string(::getpid()) + ".png")).string();
     std::string error;
     ASSERT_TRUE(writePng(path, img, &error)) << error;
     RgbImage back;
@@ -190,7 +190,7 @@ CommandRun run(std::vector<std::string> args) {
 }  // namespace
 
 TEST(RaytraceCommand, WritesPngFramesAndRefusesBadInput) {
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_rt_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_rt_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     const CommandRun r = run({"raytrace", source("data/scenes/flanges.json"), "--out", dir.string(), "--model",
                        "instant,relativistic", "--size", "64x36", "--frames", "99:101"});
@@ -226,7 +226,7 @@ TEST(RaytraceCommand, WritesPngFramesAndRefusesBadInput) {
 }
 
 TEST(RaytraceCommand, FigureLaysOutRowsAndColumns) {
-    const auto path = std::filesystem::temp_directory_path() / ("apparent_sheet_" + std::to_string(::getpid()) + ".png");
+    const auto path = testio::tempPath() / ("apparent_sheet_" + std::to_string(::getpid()) + ".png");
     const CommandRun r = run({"figure", source("data/scenes/flanges.json"), "--out", path.string(), "--columns", "2",
                                  "--size", "32x18", "--quiet", "--no-labels"});
     ASSERT_EQ(r.code, 0) << r.err;
@@ -241,7 +241,7 @@ TEST(RaytraceCommand, FigureLaysOutRowsAndColumns) {
 
 // The light's and the mirrors' scene fields give one-line errors naming the field.
 TEST(RaytraceScene, BadLightAndMirrorFields) {
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_scenes_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_scenes_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const std::pair<const char*, const char*> cases[] = {
         {R"("light": {"position": [0, 1, 0], "direction": [0, 1, 0]})", "light: give exactly one of position"},
@@ -515,7 +515,7 @@ std::string writeFacesScene(const std::filesystem::path& dir, const std::string&
 // light, and by the default pair (docs/SCENES.md): overhead with weight 0.3 and a key light
 // towards (back 1, left 0.45, up 0.15) in the camera's basis with weight 0.7.
 TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_faces_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_faces_" + std::to_string(::getpid()));
     const double beta = 0.9, gamma = 1 / std::sqrt(1 - beta * beta);
     const Vec3 u{1, 0, 0};
     struct Light {
@@ -577,7 +577,7 @@ TEST(RaytraceShading, EveryPixelOfAFlatFaceHasItsFacesShade) {
 // The default light shows a box's faces apart: a single-coloured static cube seen from above left
 // shows three faces in three shades; the overhead light alone shows the two side faces alike.
 TEST(RaytraceShading, DefaultLightShowsTheFacesOfABoxApart) {
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_box_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_box_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     std::filesystem::copy_file(source("data/meshes/box.obj"), dir / "box.obj", std::filesystem::copy_options::overwrite_existing);
     for (const bool overhead_only : {false, true}) {
@@ -628,7 +628,7 @@ std::map<std::string, std::string> probeVideo(const std::string& path) {
 // raytrace --video and figure --video: H.264 MP4 in yuv420p that ffprobe reads, with the frame
 // count asked for, the scene's 10 fps and odd sizes padded to even; without ffmpeg one line, exit 2.
 TEST(RaytraceVideo, RaytraceAndFigureWriteH264) {
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_video_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_video_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     const std::string one = (dir / "one.mp4").string(), side = (dir / "side.mp4").string();
     const CommandRun r = run({"raytrace", source("data/scenes/flanges.json"), "--model", "relativistic", "--size", "65x37",
@@ -674,7 +674,7 @@ TEST(RaytraceVideo, RaytraceAndFigureWriteH264) {
 // figure's labels: with them, bands left of and above the panels hold text (bright pixels drawn by
 // FreeType); with --no-labels the sheet is the bare grid, every pixel between panels gap grey.
 TEST(RaytraceCommand, FigureLabelsRowsAndColumns) {
-    const auto base = std::filesystem::temp_directory_path() / ("apparent_labels_" + std::to_string(::getpid()));
+    const auto base = testio::tempPath() / ("apparent_labels_" + std::to_string(::getpid()));
     const std::string labelled = base.string() + "_on.png", bare = base.string() + "_off.png";
     const std::vector<std::string> common = {"figure", source("data/scenes/flanges.json"), "--times", "5,10", "--models",
                                              "instant,relativistic", "--size", "96x54", "--quiet"};

@@ -22,6 +22,7 @@
 #include "quiet_stage.h"
 #include "run_command.h"
 #include "file_bytes.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 using testcli::apparentRun;
@@ -41,7 +42,7 @@ uint64_t fnv1a(const std::string& bytes) {
 }
 
 fs::path freshDir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_stage_test_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_stage_test_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;

@@ -22,4 +22,7 @@ inline std::string processTempDir() {
     return dir;
 }
 
+// processTempDir() as a path, for `testio::tempPath() / "name"`.
+inline std::filesystem::path tempPath() { return processTempDir(); }
+
 }  // namespace testio

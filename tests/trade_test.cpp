@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "run_command.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using testcli::apparentRun;
@@ -38,7 +39,7 @@ std::vector<std::map<std::string, std::string>> readCsv(const fs::path& path) {
 }  // namespace
 
 TEST(Trade, TableCsvAndPlotOnTheBoxScene) {
-    const fs::path dir = fs::temp_directory_path() / ("apparent_trade_" + std::to_string(::getpid()));
+    const fs::path dir = testio::tempPath() / ("apparent_trade_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     const auto r = apparentRun({"trade", source("data/scenes/trade/box_near.json"), "--out", dir.string(), "--levels",
                                 "3", "--tolerances", "1e-2,1e-3", "--quiet"});
@@ -86,7 +87,7 @@ TEST(Trade, TableCsvAndPlotOnTheBoxScene) {
 
 TEST(Trade, AffineModelsAndBadOptions) {
     const auto inst = apparentRun({"trade", source("data/scenes/trade/plate.json"), "--model", "instant", "--out",
-                                   (fs::temp_directory_path() / "apparent_trade_inst").string()});
+                                   (testio::tempPath() / "apparent_trade_inst").string()});
     EXPECT_EQ(inst.code, 0);
     EXPECT_NE(inst.out.find("vertex mode is exact"), std::string::npos) << inst.out;
     const auto bad = apparentRun({"trade", source("data/scenes/trade/plate.json"), "--tolerances", "1e-3,x"});
