@@ -45,6 +45,12 @@ JSON
 (cd "$src" && node tests/web/viewer_test.js "$out/near" --models relativistic --frames 0,3 --shot-time 0.3 \
   --screenshot "$out/near.png" && node tests/looks/texels.js "$out/near.png" &&
   node tests/web/viewer_test.js "$out/refined" --models relativistic --frames 0,3 --shot-time 0.3)
+# The same through three.js's DRACOLoader and MeshoptDecoder (the viewer's): the compressed files show the texture.
+for c in draco meshopt; do
+  "$apparent" render "$out/near.json" --out "$out/near-$c" --compress $c --quiet
+  (cd "$src" && node tests/web/viewer_test.js "$out/near-$c" --models relativistic --frames 0,3 --shot-time 0.3 \
+    --screenshot "$out/near-$c.png" && node tests/looks/texels.js "$out/near-$c.png")
+done
 # Compressed files keep the look: --compress draco (one Draco mesh per material, TEXCOORD_0 quantized to
 # --draco-texcoord-bits) and --compress meshopt (float32 TEXCOORD_0, normalized uint16 COLOR_0), refined and in
 # vertex mode, decoded by the decoders three.js uses (decode_glb.js) and checked against the closed form
