@@ -562,6 +562,8 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
     if (rs.glb.texcoord_bits < 1 || rs.glb.texcoord_bits > 30)
         return usage("--draco-texcoord-bits: " + std::to_string(rs.glb.texcoord_bits) + " is outside 1..30");
+    if (render_cmd->count("--draco-texcoord-bits") > 0 && !rs.glb.draco)
+        return usage("--draco-texcoord-bits needs --compress draco");
     if (rs.threads < 0 || rs.threads > kMaxThreads) return usage(threadsProblem(rs.threads));
     if (rs.max_frame_triangles < 0) return usage("--max-triangles: must be 0 (the default budget) or positive");
     if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0)
