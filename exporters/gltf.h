@@ -22,6 +22,11 @@
 // are Edgebreaker-coded; POSITION is quantized to `position_bits` over the primitive's largest
 // extent, NORMAL to `normal_bits`, and _EMISSION_TIME kept lossless. Accessor counts and bounds
 // are taken from the decoded Draco mesh, because Draco drops degenerate faces and reorders points.
+// An object whose look the file carries (surface_look.h) is one Draco mesh per material part
+// (each part's triangles and the vertices they use, as glTF-Transform splits a mesh), each its own
+// primitive with that material: TEXCOORD_0 as a TEX_COORD attribute quantized to `texcoord_bits`
+// over the mesh's larger u or v range R (error at most R / (2 (2^bits - 1)) per coordinate, as for
+// POSITION), COLOR_0 as COLOR, float RGB, lossless.
 // With meshopt (EXT_meshopt_compression and KHR_mesh_quantization, both required; the BIN chunk
 // holds the compressed streams, a fallback buffer without data stands for the decoded ones):
 // a frame's vertices (all its primitives') are one interleaved stream of records, with the
@@ -33,7 +38,11 @@
 // (within step / 2 seconds of the plain file's, c = 1: its low mantissa bits compress), then with
 // --attributes _DOPPLER and/or _PROPER_TIME as float32 (the plain file's values, bit for bit), and
 // with --shade doppler COLOR_0 as normalized uint16 RGB (8 bytes with padding; within 0.5 / 65535
-// of the plain file's float colour, clamped to [0, 1]). NORMAL in its own view goes through the
+// of the plain file's float colour, clamped to [0, 1]); when the file carries an object's look
+// (surface_look.h) the looks' COLOR_0 in that slot (unless --shade doppler) and TEXCOORD_0 as
+// float32 (the plain file's values, bit for bit), one primitive per material sharing the frame's
+// records, each with its part of the object's index list (each part vertex-cache ordered on its
+// own; no morph targets). NORMAL in its own view goes through the
 // OCTAHEDRAL filter at 8 bits (decoded to normalized int8; each component within 2.63 / 127 of
 // the plain file's normal, derived in tests/web/meshopt_roundtrip.js); in the record it is
 // normalized int8 x, y, z, 0 (within 0.5 / 127). Indices
@@ -83,6 +92,9 @@ struct GlbOptions {
     bool draco = false;
     int position_bits = 14;  // Draco position quantization, 1..30
     int normal_bits = 10;    // Draco normal quantization, 1..30
+    // Draco TEXCOORD_0 quantization, 1..30 (an object whose look the file carries): over the larger
+    // of the u and v ranges R of each Draco mesh, error at most R / (2 (2^bits - 1)) per coordinate.
+    int texcoord_bits = 12;
     bool meshopt = false;    // EXT_meshopt_compression + KHR_mesh_quantization (not with draco)
     int meshopt_bits = 0;    // meshopt position bits 2..16 over each frame's extent; 0: step from the tolerance
     // --attributes: per-vertex float attributes _DOPPLER and _PROPER_TIME (mesh4d/light_factors.h),
@@ -94,6 +106,10 @@ struct GlbOptions {
     // then white (alpha kept) and the plain colour is in the material's extras "base_color".
     // Plain or Draco (COLOR, unquantized) as float; meshopt as normalized uint16 (see above).
     bool shade_doppler = false;
+    // Set by the .glb writer from the sequence's objects (withMeshoptLooks), not by the command
+    // line: with meshopt, the vertex record has slots for the looks' COLOR_0 and TEXCOORD_0
+    // (an object whose look the file carries, surface_look.h).
+    bool meshopt_looks = false;
 };
 
 struct GlbStats {
@@ -101,6 +117,10 @@ struct GlbStats {
     size_t bytes_without_draco = 0;   // with Draco or meshopt: size of the same file without it (0 otherwise)
     double max_float_error = 0;       // largest |float32 - double| over exported positions, light-seconds
     double max_quantization_error = 0;  // Draco, meshopt: largest position quantization error bound, light-seconds
+    // Draco: largest TEXCOORD_0 quantization error bound (texture coordinate units; 0 without any,
+    // and with meshopt, whose TEXCOORD_0 is the plain file's float32); whether any primitive has one.
+    double max_texcoord_error = 0;
+    bool texcoords = false;
     bool meshopt_range_clamped = false;  // meshopt: a frame's step had to grow to fit int16
     double max_extent = 0;            // largest frame extent, light-seconds (to judge the errors above)
 };
@@ -214,7 +234,6 @@ private:
     bool verbose_;
     std::string model_;
     double tolerance_ = 0;
-    std::vector<std::string> dropped_looks_;  // objects whose look a compressed file leaves out
     bool reads_rest_points_ = false;
     OutputCheck check_;
     long long least_ = 0;  // least size of the file so far uncompressed (positions and normals alone)

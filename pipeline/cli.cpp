@@ -194,6 +194,9 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
                            "colours')");
     render_cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
         ->capture_default_str();
+    render_cmd->add_option("--draco-texcoord-bits", rs.glb.texcoord_bits,
+                           "Draco texture-coordinate quantization bits (1-30; input glTF TEXCOORD_0)")
+        ->capture_default_str();
     render_cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
                            "output is byte-identical for any count")->capture_default_str();
     render_cmd->add_flag("--cull-view", rs.cull_view,
@@ -557,6 +560,10 @@ int runCommandLine(int argc, const char* const* argv, std::ostream& out, std::os
     if (rs.glb.meshopt_bits != 0 && !rs.glb.meshopt) return usage("--meshopt-bits needs --compress meshopt");
     if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
         return usage("--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
+    if (rs.glb.texcoord_bits < 1 || rs.glb.texcoord_bits > 30)
+        return usage("--draco-texcoord-bits: " + std::to_string(rs.glb.texcoord_bits) + " is outside 1..30");
+    if (render_cmd->count("--draco-texcoord-bits") > 0 && !rs.glb.draco)
+        return usage("--draco-texcoord-bits needs --compress draco");
     if (rs.threads < 0 || rs.threads > kMaxThreads) return usage(threadsProblem(rs.threads));
     if (rs.max_frame_triangles < 0) return usage("--max-triangles: must be 0 (the default budget) or positive");
     if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0)

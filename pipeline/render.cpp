@@ -45,6 +45,7 @@ std::string outputSettings(const RenderSettings& s, const Stage& stage) {
     os << "\nglb " << g.draco << " " << g.position_bits << " " << g.normal_bits << " " << g.meshopt << " "
        << g.meshopt_bits << " " << g.doppler << " " << g.proper_time << " " << g.shade_doppler << "\ncull "
        << s.cull_view << "\nmax-triangles " << s.max_frame_triangles << "\nscene " << stage.scene.path << "\n";
+    if (g.texcoord_bits != GlbOptions().texcoord_bits) os << "draco-texcoord-bits " << g.texcoord_bits << "\n";
     return os.str();
 }
 

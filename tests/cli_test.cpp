@@ -513,6 +513,12 @@ TEST(Cli, CompressOptions) {
     r = render("c", {"--meshopt-bits", "12"});
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--meshopt-bits needs --compress meshopt"), std::string::npos) << r.err;
+    r = render("c", {"--draco", "--draco-texcoord-bits", "31"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--draco-texcoord-bits: 31 is outside 1..30"), std::string::npos) << r.err;
+    r = render("c", {"--draco-texcoord-bits", "12"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--draco-texcoord-bits needs --compress draco"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "c"));
 
     // 6 bits over the frame (about 50 light-seconds across): a step near 0.8 ls, far above the

@@ -129,6 +129,10 @@ gltfjson::Primitive GlbBuilder::meshoptPrimitive(const PrimitiveData& d, const M
     if (layout.color >= 0 && d.has(d.colors, d.remote.colors))
         at[gltfjson::kColor0] =
             addNormalized(vview, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true, nv, at0 + size_t(layout.color));
+    if (layout.texcoord >= 0 && d.has(d.texcoords, d.remote.texcoords)) {
+        at[gltfjson::kTexcoord0] = addAccessor(vview, kFloat, false, nv, at0 + size_t(layout.texcoord));
+        accessors.back().vec2 = true;
+    }
     prim.indices = indices;
     return prim;
 }
@@ -162,27 +166,41 @@ int GlbBuilder::newMeshoptView(size_t length, size_t count, size_t stride, bool 
 }
 
 bool GlbBuilder::dracoPrimitive(const PrimitiveData& d, gltfjson::Primitive* prim, double* quantization_error,
-                                std::string* error) {
+                                std::string* error, int part) {
     const DracoCoded& c = d.draco;
     if (!c.error.empty()) {
         *error = c.error;
         return false;
     }
     *quantization_error = c.quantization_error;
-    const size_t n_points = size_t(c.points);
+    // The mesh's counts, bounds and bytes: the whole coding's, or the part's.
+    const DracoCoded::Part* p = part >= 0 ? &c.parts[size_t(part)] : nullptr;
+    const size_t n_points = size_t(p ? p->points : c.points);
     auto& at = prim->attributes;
-    at[gltfjson::kPosition] = addAccessor(-1, kFloat, true, n_points, 0, c.lo, c.hi, 3);
+    at[gltfjson::kPosition] = addAccessor(-1, kFloat, true, n_points, 0, p ? p->lo : c.lo, p ? p->hi : c.hi, 3);
     at[gltfjson::kNormal] = addAccessor(-1, kFloat, true, n_points);
     at[gltfjson::kEmissionTime] = addAccessor(-1, kFloat, false, n_points);
     if (c.ids[3] >= 0) at[gltfjson::kDoppler] = addAccessor(-1, kFloat, false, n_points);
     if (c.ids[4] >= 0) at[gltfjson::kProperTime] = addAccessor(-1, kFloat, false, n_points);
     if (c.ids[5] >= 0) at[gltfjson::kColor0] = addAccessor(-1, kFloat, true, n_points);
-    prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false, size_t(c.faces) * 3);
-    prim->draco_view = d.remote.on ? addView(d.remote.draco, 0) : addView(c.bytes.data(), c.bytes.size(), 0);
-    // The Draco ids in DracoCoded's order: POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME, COLOR_0.
-    static constexpr int kOrder[6] = {gltfjson::kPosition, gltfjson::kNormal,     gltfjson::kEmissionTime,
-                                      gltfjson::kDoppler,  gltfjson::kProperTime, gltfjson::kColor0};
-    for (int i = 0; i < 6; ++i) prim->draco_ids[size_t(kOrder[i])] = c.ids[i];
+    if (c.ids[6] >= 0) {
+        at[gltfjson::kTexcoord0] = addAccessor(-1, kFloat, false, n_points);
+        accessors.back().vec2 = true;
+    }
+    prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false, size_t(p ? p->faces : c.faces) * 3);
+    if (p) {
+        const FileSpan& r = d.remote.draco;
+        prim->draco_view = d.remote.on ? addView(FileSpan{r.source, r.offset + p->offset, p->length}, 0)
+                                       : addView(c.bytes.data() + p->offset, size_t(p->length), 0);
+    } else {
+        prim->draco_view = d.remote.on ? addView(d.remote.draco, 0) : addView(c.bytes.data(), c.bytes.size(), 0);
+    }
+    // The Draco ids in DracoCoded's order: POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME,
+    // COLOR_0, TEXCOORD_0.
+    static constexpr int kOrder[7] = {gltfjson::kPosition,  gltfjson::kNormal,     gltfjson::kEmissionTime,
+                                      gltfjson::kDoppler,   gltfjson::kProperTime, gltfjson::kColor0,
+                                      gltfjson::kTexcoord0};
+    for (int i = 0; i < 7; ++i) prim->draco_ids[size_t(kOrder[i])] = c.ids[i];
     return true;
 }
 

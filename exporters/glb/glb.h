@@ -36,13 +36,24 @@ namespace apparent::glb {
 
 // One primitive's KHR_draco_mesh_compression coding (encodeDraco): the Edgebreaker bytes and what
 // the accessors take from the decoded mesh (point and face counts, position bounds, attribute ids).
+// With material parts (PrimitiveData::part_first) each part is a Draco mesh of its own (its
+// triangles and the vertices they use): `bytes` holds their codings one after another, `parts`
+// where each lies and its counts and bounds; the attribute ids are every part's.
 struct DracoCoded {
     std::vector<char> bytes;
     uint64_t points = 0, faces = 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    // Draco unique ids of POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME, COLOR_0 (-1: absent).
-    int32_t ids[6] = {-1, -1, -1, -1, -1, -1};
+    // Draco unique ids of POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME, COLOR_0,
+    // TEXCOORD_0 (-1: absent).
+    int32_t ids[7] = {-1, -1, -1, -1, -1, -1, -1};
     double quantization_error = 0;
+    double texcoord_error = 0;  // TEXCOORD_0's bound (gltf.h), 0 without
+    struct Part {
+        uint64_t offset = 0, length = 0;  // in `bytes`
+        uint64_t points = 0, faces = 0;
+        double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    };
+    std::vector<Part> parts;  // empty: one mesh, the fields above
     std::string error;  // Draco failed (reported by add())
 };
 
@@ -129,17 +140,27 @@ struct MeshoptFrame {
 constexpr size_t kMeshoptViewJsonBytes = 200;
 
 // The meshopt vertex record (gltf.h): int16 x, y, z, 0 | float32 emission time, then with
-// --attributes float32 _DOPPLER and/or _PROPER_TIME, with --shade doppler uint16 (normalized)
-// R, G, B, 0; the same for every frame of a sequence (an offset < 0: not in the record).
+// --attributes float32 _DOPPLER and/or _PROPER_TIME, with --shade doppler or the looks' COLOR_0
+// uint16 (normalized) R, G, B, 0, with the looks float32 TEXCOORD_0 u, v; the same for every frame
+// of a sequence (an offset < 0: not in the record). The looks' slots are there when any object's
+// look is carried, whether or not it has texture coordinates or colours (zeros then): the layout
+// must follow from what every process of a sequence knows (a shard's header carries the looks'
+// materials and images, not their vertex arrays).
 struct MeshoptLayout {
     explicit MeshoptLayout(const GlbOptions& o) {
         if (o.doppler) { doppler = int(stride); stride += 4; }
         if (o.proper_time) { proper_time = int(stride); stride += 4; }
-        if (o.shade_doppler) { color = int(stride); stride += 8; }
+        if (o.shade_doppler || o.meshopt_looks) { color = int(stride); stride += 8; }
+        if (o.meshopt_looks) { texcoord = int(stride); stride += 8; }
     }
     size_t stride = 12;
-    int doppler = -1, proper_time = -1, color = -1;
+    int doppler = -1, proper_time = -1, color = -1, texcoord = -1;
 };
+
+// `options` with GlbOptions::meshopt_looks set when the file is meshopt's and carries any of
+// `info`'s objects' looks (carriesLook).
+GlbOptions withMeshoptLooks(const GlbOptions& options, const SequenceInfo& info);
+
 // The normals' stream: the EXT_meshopt_compression OCTAHEDRAL filter's 8-bit form (4 bytes a
 // vertex), which the decoder turns into normalized int8 x, y, z (and a fourth byte); in the
 // record instead (MeshoptFrame), normalized int8 x, y, z, 0 rounded from the float normal.
@@ -161,6 +182,7 @@ constexpr size_t kMorphVertexTargets = size_t(1) << 22;
 // step of a large frame's packing).
 struct MeshoptOrder {
     std::vector<uint32_t> indices;   // the index list they were computed for
+    std::vector<uint32_t> part_first;  // and its material parts (PrimitiveData::part_first)
     size_t vertices = 0;             // and its vertex count
     std::shared_ptr<std::vector<uint32_t>> ordered;  // the triangles in cache order, in fetch numbering
     std::vector<unsigned int> remap; // fetch number of each vertex (~0u: unused)
@@ -192,16 +214,17 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
                  MeshoptScratch* scratch, MeshoptOrder* order, const GlbOptions& options,
                  const ExportObject& object);
 
-// Whether the .glb carries `object`'s look (plain files: meshopt and Draco do not yet).
+// Whether the .glb carries `object`'s look (it has one: plain, Draco and meshopt files alike).
 bool carriesLook(const GlbOptions& options, const ExportObject& object);
 
 // ---- meshopt.cpp ----
 
 // The meshopt form of `d`: positions quantized from the exact relative coordinates `rel` (xyz
-// per vertex) to multiples of `step`, triangles in vertex-cache order, vertices in the order the
-// triangles first use them (both depend on the index list alone, so frames with equal index
-// lists get equal orders; `order` keeps them from the object's last frame). Returns the largest
-// |step * q - rel| over the coordinates.
+// per vertex) to multiples of `step`, triangles in vertex-cache order (within each material
+// part, which keeps its place), vertices in the order the triangles first use them (both depend
+// on the index list and parts alone, so frames with equal ones get equal orders; `order` keeps
+// them from the object's last frame); the look's TEXCOORD_0 and COLOR_0 in their slots of
+// `layout`. Returns the largest |step * q - rel| over the coordinates.
 double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step, const MeshoptLayout& layout,
                    MeshoptOrder* order, std::vector<float>* normal_work);
 
@@ -250,7 +273,8 @@ std::vector<unsigned char> encodeMorphRecords(const std::vector<unsigned char>& 
 // One primitive's Draco coding (KHR_draco_mesh_compression), made by prepare() on the worker
 // threads (and, with MPI, on the rank that cut the frame); `error` set when Draco failed. The
 // position error bound is half a step of the quantization grid, which spans the largest extent
-// of the primitive's positions in 2^bits - 1 steps.
+// of the primitive's positions in 2^bits - 1 steps (TEXCOORD_0's the same over the larger of its
+// u and v ranges). Data with material parts: one Draco mesh per part (DracoCoded::parts).
 void encodeDraco(const PrimitiveData& d, const GlbOptions& options, DracoCoded* out);
 
 // ---- bin.cpp ----
@@ -357,11 +381,11 @@ public:
     template <class Write>
     int newMeshoptView(size_t length, size_t count, size_t stride, bool indices, bool octahedral, const Write& write);
 
-    // A KHR_draco_mesh_compression primitive from its coding (DracoCoded, made by prepare());
-    // returns false with the message when Draco failed there. `quantization_error` receives the
-    // position error bound.
+    // A KHR_draco_mesh_compression primitive from its coding (DracoCoded, made by prepare()), or
+    // with `part` >= 0 that material part's mesh; returns false with the message when Draco failed
+    // there. `quantization_error` receives the position error bound.
     bool dracoPrimitive(const PrimitiveData& d, gltfjson::Primitive* prim, double* quantization_error,
-                        std::string* error);
+                        std::string* error, int part = -1);
 
 private:
     // A new view of `n` bytes that `write` puts into the sink, 4-byte aligned for float/uint32.

@@ -25,14 +25,23 @@ float emissionRounded(float t, double q) { return float(std::round(double(t) / q
 double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step, const MeshoptLayout& layout,
                    MeshoptOrder* order, std::vector<float>* normal_work) {
     const size_t nv = d->vertexCount();
-    if (!order->ordered || order->vertices != nv || order->indices != d->indices) {
+    if (!order->ordered || order->vertices != nv || order->indices != d->indices || order->part_first != d->part_first) {
         order->indices = d->indices;
+        order->part_first = d->part_first;
         order->vertices = nv;
         // A frame still held refers to the old order: a new vector then, else this one again.
         if (!order->ordered || order->ordered.use_count() > 1) order->ordered = std::make_shared<std::vector<uint32_t>>();
         std::vector<uint32_t>& ordered = *order->ordered;
         ordered.resize(d->indices.size());
-        meshopt_optimizeVertexCache(ordered.data(), d->indices.data(), d->indices.size(), nv);
+        if (d->part_first.empty()) {
+            meshopt_optimizeVertexCache(ordered.data(), d->indices.data(), d->indices.size(), nv);
+        } else {
+            // Each material part on its own: its triangles stay a contiguous range.
+            for (size_t p = 0; p + 1 < d->part_first.size(); ++p) {
+                const size_t at = 3 * size_t(d->part_first[p]), n = 3 * size_t(d->part_first[p + 1]) - at;
+                meshopt_optimizeVertexCache(ordered.data() + at, d->indices.data() + at, n, nv);
+            }
+        }
         order->remap.resize(nv);
         order->used = meshopt_optimizeVertexFetchRemap(order->remap.data(), ordered.data(), ordered.size(), nv);
         meshopt_remapIndexBuffer(ordered.data(), ordered.data(), ordered.size(), order->remap.data());
@@ -78,6 +87,7 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
                     for (int c = 0; c < 3; ++c) rgb[c] = uint16_t(meshopt_quantizeUnorm(std::clamp(d->colors[3 * i + c], 0.0f, 1.0f), 16));
                     std::memcpy(v + layout.color, rgb, 8);
                 }
+                if (layout.texcoord >= 0 && !d->texcoords.empty()) std::memcpy(v + layout.texcoord, &d->texcoords[2 * i], 8);
             }
             return x;
         },
@@ -92,6 +102,12 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
     if (used > 0)
         meshopt_encodeFilterOct(d->packed_normals.data(), used, kMeshoptNormalStride, kMeshoptNormalBits, normals.data());
     return worst;
+}
+
+GlbOptions withMeshoptLooks(const GlbOptions& options, const SequenceInfo& info) {
+    GlbOptions o = options;
+    for (const ExportObject& object : info.objects) o.meshopt_looks = o.meshopt_looks || (o.meshopt && carriesLook(o, object));
+    return o;
 }
 
 // In vertex mode at least 14 bits over E (Draco's and gltfpack's default): E / 16382 rounded down

@@ -64,9 +64,7 @@ void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const
 
 }  // namespace
 
-bool carriesLook(const GlbOptions& options, const ExportObject& object) {
-    return object.look && !options.meshopt && !options.draco;
-}
+bool carriesLook(const GlbOptions& /*options*/, const ExportObject& object) { return bool(object.look); }
 
 void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double step, double* max_err,
                  double* max_quant, PrimitiveData* d, mesh4d::CreaseMap* map, mesh4d::CreaseWork* work,

@@ -137,6 +137,13 @@ void putDracoFacts(FrameBytesOut* out, const DracoCoded& dc) {
     for (int c = 0; c < 3; ++c) out->put(dc.hi[c]);
     for (int32_t id : dc.ids) out->put(id);
     out->put(dc.quantization_error);
+    out->put(dc.texcoord_error);
+    out->put(uint64_t(dc.parts.size()));
+    for (const DracoCoded::Part& p : dc.parts) {
+        for (uint64_t v : {p.offset, p.length, p.points, p.faces}) out->put(v);
+        for (int c = 0; c < 3; ++c) out->put(p.lo[c]);
+        for (int c = 0; c < 3; ++c) out->put(p.hi[c]);
+    }
     putText(out, dc.error);
 }
 bool getText(FrameBytesIn* in, std::string* text) {
@@ -144,6 +151,26 @@ bool getText(FrameBytesIn* in, std::string* text) {
     if (!in->getVector(&v)) return false;
     text->assign(v.begin(), v.end());
     return true;
+}
+// putDracoFacts' facts back; the parts must lie one after another within the `length` bytes of
+// the coding.
+bool getDracoFacts(FrameBytesIn* in, DracoCoded* dc, uint64_t length) {
+    bool ok = in->get(&dc->points) && in->get(&dc->faces);
+    for (int c = 0; ok && c < 3; ++c) ok = in->get(&dc->lo[c]);
+    for (int c = 0; ok && c < 3; ++c) ok = in->get(&dc->hi[c]);
+    for (int a = 0; ok && a < 7; ++a) ok = in->get(&dc->ids[a]);
+    uint64_t parts = 0;
+    ok = ok && in->get(&dc->quantization_error) && in->get(&dc->texcoord_error) && in->get(&parts) && parts <= length;
+    uint64_t end = 0;
+    for (uint64_t i = 0; ok && i < parts; ++i) {
+        DracoCoded::Part& p = dc->parts.emplace_back();
+        ok = in->get(&p.offset) && in->get(&p.length) && in->get(&p.points) && in->get(&p.faces) && p.offset == end &&
+             p.length <= length - end;
+        end += ok ? p.length : 0;
+        for (int c = 0; ok && c < 3; ++c) ok = in->get(&p.lo[c]);
+        for (int c = 0; ok && c < 3; ++c) ok = in->get(&p.hi[c]);
+    }
+    return ok && getText(in, &dc->error);
 }
 
 // The materials of object `o`'s look the file carries (0: none, so no parts).
@@ -353,13 +380,9 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
         ok = ok && in.get(&r.index_hash[0]) && in.get(&r.index_hash[1]);
         for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmin[c]);
         for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmax[c]);
-        DracoCoded& dc = p.draco;
-        ok = ok && in.get(&dc.points) && in.get(&dc.faces);
-        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.lo[c]);
-        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.hi[c]);
-        for (int a = 0; ok && a < 6; ++a) ok = in.get(&dc.ids[a]);
-        ok = ok && in.get(&dc.quantization_error) && getText(&in, &dc.error) && in.getVector(&p.part_first) &&
-             in.getVector(&p.part_material) && validParts(p, r.index_count, lookMaterials(impl_->info, impl_->options, o));
+        ok = ok && getDracoFacts(&in, &p.draco, r.draco.length) && in.getVector(&p.part_first) &&
+             in.getVector(&p.part_material) && validParts(p, r.index_count, lookMaterials(impl_->info, impl_->options, o)) &&
+             (p.draco.parts.empty() || p.draco.parts.size() == p.part_material.size());
         // What add() takes of the spans: whole vertices and triangles, every source known.
         const uint64_t nv = r.vertices;
         auto optional = [nv](const FileSpan& s, uint64_t per) { return s.length == 0 || s.length == per * nv; };
@@ -490,13 +513,8 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
         for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmin[c]);
         for (int c = 0; ok && c < 3; ++c) ok = in.get(&p.qmax[c]);
         DracoCoded& dc = p.draco;
-        std::vector<char> draco_error;
-        ok = ok && in.getVector(&dc.bytes) && in.get(&dc.points) && in.get(&dc.faces);
-        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.lo[c]);
-        for (int c = 0; ok && c < 3; ++c) ok = in.get(&dc.hi[c]);
-        for (int a = 0; ok && a < 6; ++a) ok = in.get(&dc.ids[a]);
-        ok = ok && in.get(&dc.quantization_error) && in.getVector(&draco_error);
-        dc.error.assign(draco_error.begin(), draco_error.end());
+        ok = ok && in.getVector(&dc.bytes) && getDracoFacts(&in, &dc, dc.bytes.size()) &&
+             (dc.parts.empty() || dc.parts.size() == p.part_material.size());
         // What add() writes as it is: finite attributes (a NaN gives an invalid accessor).
         for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
             ok = ok && std::all_of(v->begin(), v->end(), [](float x) { return std::isfinite(x); });

@@ -138,6 +138,7 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
     // that do not share, uint16 unless one of them has more than 65535 vertices.
     int vview = -1, nview = -1;
     std::vector<int> meshopt_indices(f.objects.size(), -1);
+    std::vector<std::vector<int>> meshopt_parts(f.objects.size());  // per object with material parts
     if (compression == Compression::meshopt && meshopt && meshopt->count > 0) {
         vview = meshopt->remote ? b.addMeshoptView(meshopt->remote_encoded, meshopt->count, meshopt->stride, false)
                                 : b.addMeshoptView(meshopt->encoded, meshopt->count, meshopt->stride, false);
@@ -175,12 +176,18 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
                 encodeIndexStream(all, most, &encoded);
                 iview = b.addMeshoptView(encoded, all.size(), size, true);
             }
+            const int component = size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
             for (size_t o = 0; o < f.objects.size(); ++o)
-                if (!f.objects[o].triangles.empty() && shared[o] < 0) {
-                    meshopt_indices[o] = b.addAccessor(iview,
-                                                       size == 2 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
-                                                                 : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                                       false, data[o].orderedCount(), first[o] * size);
+                if (!f.objects[o].triangles.empty() && shared[o] < 0 && !data[o].part_first.empty()) {
+                    // One accessor per material part, each part's triangles one range of the list.
+                    const std::vector<uint32_t>& parts = data[o].part_first;
+                    for (size_t p = 0; p + 1 < parts.size(); ++p)
+                        meshopt_parts[o].push_back(b.addAccessor(iview, component, false,
+                                                                 3 * size_t(parts[p + 1] - parts[p]),
+                                                                 (first[o] + 3 * size_t(parts[p])) * size));
+                    meshopt_indices[o] = meshopt_parts[o].front();
+                } else if (!f.objects[o].triangles.empty() && shared[o] < 0) {
+                    meshopt_indices[o] = b.addAccessor(iview, component, false, data[o].orderedCount(), first[o] * size);
                 }
         }
     }
@@ -192,16 +199,51 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
             if (f.objects[o].triangles.empty() || groupOf(o) != group) continue;
             gltfjson::Primitive prim;
             Previous& prev = previous[o];
-            if (compression == Compression::draco) {
+            if (compression == Compression::draco && !data[o].draco.parts.empty()) {
+                // Step: one primitive per material, each its own Draco mesh.
+                const DracoCoded& c = data[o].draco;
+                for (size_t p = 0; p < c.parts.size() && p < data[o].part_material.size(); ++p) {
+                    gltfjson::Primitive part;
+                    double qerr = 0;
+                    if (!b.dracoPrimitive(data[o], &part, &qerr, error, int(p))) {
+                        *error = mesh.name + ": " + *error;
+                        return false;
+                    }
+                    part.material = material_first[o] + int(data[o].part_material[p]);
+                    mesh.primitives.push_back(std::move(part));
+                }
+                stats->max_quantization_error = std::max(stats->max_quantization_error, c.quantization_error);
+                stats->max_texcoord_error = std::max(stats->max_texcoord_error, c.texcoord_error);
+                stats->texcoords = stats->texcoords || c.ids[6] >= 0;
+                shown[o] = true;
+                continue;
+            } else if (compression == Compression::draco) {
                 double qerr = 0;
                 if (!b.dracoPrimitive(data[o], &prim, &qerr, error)) {
                     *error = mesh.name + ": " + *error;
                     return false;
                 }
                 stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
+                stats->max_texcoord_error = std::max(stats->max_texcoord_error, data[o].draco.texcoord_error);
+                stats->texcoords = stats->texcoords || data[o].draco.ids[6] >= 0;
+            } else if (compression == Compression::meshopt && !meshopt_parts[o].empty()) {
+                // Step: one primitive per material, sharing the vertices (never the indices).
+                prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
+                                          meshopt_indices[o]);
+                stats->texcoords = stats->texcoords || prim.attributes[gltfjson::kTexcoord0] >= 0;
+                prev = Previous();
+                shown[o] = true;
+                for (size_t p = 0; p < meshopt_parts[o].size(); ++p) {
+                    gltfjson::Primitive part = prim;
+                    part.indices = meshopt_parts[o][p];
+                    part.material = material_first[o] + int(data[o].part_material[p]);
+                    mesh.primitives.push_back(std::move(part));
+                }
+                continue;
             } else if (compression == Compression::meshopt) {
                 prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
                                           shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
+                stats->texcoords = stats->texcoords || prim.attributes[gltfjson::kTexcoord0] >= 0;
             } else if (!data[o].part_first.empty()) {
                 // Step: one primitive per material, sharing the vertices (never the indices).
                 std::vector<int> parts;

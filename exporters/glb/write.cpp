@@ -122,7 +122,7 @@ void GlbFrameData::reset(size_t objects) {
 }
 
 GlbSequenceWriter::Impl::Impl(const std::string& p, const SequenceInfo& i, const GlbOptions& o)
-    : path(p), info(i), options(o), model(info, options, &sink) {
+    : path(p), info(i), options(glb::withMeshoptLooks(o, i)), model(info, options, &sink) {
     sink.dir = std::filesystem::path(p).parent_path().string();
     sink.holding = true;  // the first frame (BinSink)
     count_only.counting = true;
@@ -445,12 +445,9 @@ GlbSink::~GlbSink() = default;
 bool GlbSink::begin(const SequenceInfo& info, std::string*) {
     model_ = info.model;
     tolerance_ = info.tolerance;
-    // Compressed files do not carry the inputs' looks yet: say whose are dropped.
-    dropped_looks_.clear();
     reads_rest_points_ = false;
     for (const ExportObject& o : info.objects) reads_rest_points_ = reads_rest_points_ || glb::carriesLook(options_, o);
-    for (const ExportObject& o : info.objects)
-        if (o.look && !glb::carriesLook(options_, o) && o.mirror_index < 0) dropped_looks_.push_back(o.name);
+    options_ = glb::withMeshoptLooks(options_, info);
     writer_ = std::make_unique<GlbSequenceWriter>(path_, info, options_);
     return true;  // the spill file's errors surface at the first add()
 }
@@ -489,7 +486,10 @@ bool GlbSink::finish(SinkSummary* summary, std::string* error) {
     if (verbose_) os << "; float32 position error <= " << stats.max_float_error << " ls";
     if (options_.draco && verbose_)
         os << "; Draco " << options_.position_bits << "-bit position error <= " << stats.max_quantization_error << " ls";
+    if (options_.draco && verbose_ && stats.texcoords)
+        os << "; Draco texture-coordinate error <= " << stats.max_texcoord_error;
     if (options_.meshopt && verbose_) os << "; meshopt position error <= " << stats.max_quantization_error << " ls";
+    if (options_.meshopt && verbose_ && stats.texcoords) os << "; meshopt texture coordinates float32 (error 0)";
     summary->text += os.str();
     // meshopt's bound against the tolerance: a requested bit count too coarse, or a tolerance
     // finer than int16 can hold over a frame.
@@ -501,10 +501,6 @@ bool GlbSink::finish(SinkSummary* summary, std::string* error) {
                                           : "leave out --meshopt-bits (the step then follows the tolerance)");
         summary->warnings.push_back(w.str());
     }
-    for (const std::string& name : dropped_looks_)
-        summary->warnings.push_back(path_ + ": object '" + name + "': its materials, textures, texture coordinates and " +
-                                    "vertex colours are not carried with --compress " + (options_.draco ? "draco" : "meshopt") +
-                                    " (one colour per object; leave out --compress to keep them)");
     // Warn when Draco's quantization is coarser than the accuracy asked for (gltfpack warns the
     // same way about position bits).
     if (options_.draco && tolerance_ > 0 && stats.max_quantization_error > tolerance_) {

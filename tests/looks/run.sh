@@ -4,8 +4,9 @@
 # glTF-Validator and check_textured.py (every vertex's TEXCOORD_0 and COLOR_0 equal the closed form
 # at its rest point, the materials and the image are the input's, the image once; with --shade
 # doppler COLOR_0 is the modulation at the vertex's Doppler factor times that closed form). With --compress
-# the look is dropped with a warning; shards and MPI ranks give the one process's bytes; three.js in
-# headless Chromium shows the texture, and with --shade doppler its exact shift (tests/web/doppler_*.js).
+# draco and meshopt the same, decoded (decode_glb.js), within the codecs' stated bounds; shards and
+# MPI ranks give the one process's bytes; three.js in headless Chromium shows the texture, also of the
+# compressed files, and with --shade doppler its exact shift (tests/web/doppler_*.js).
 # Usage: run.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
 # OpenMPI's own allocations are not ours: no leak report for them under the sanitizers (as mpi_test.sh).
@@ -90,8 +91,44 @@ for i in 0 1; do
 done
 "$apparent" merge "$out/shaded_shards" --quiet
 cmp "$out/shaded/relativistic.glb" "$out/shaded_shards/relativistic.glb" || { echo "FAIL: shaded shards differ"; exit 1; }
-"$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt" --compress meshopt 2> "$out/meshopt.err"
-grep -q "object 'box': its materials, textures" "$out/meshopt.err" || { echo "FAIL: no warning with --compress"; exit 1; }
+# The same through three.js's DRACOLoader and MeshoptDecoder (the viewer's): the compressed files show the texture.
+for c in draco meshopt; do
+  "$apparent" render "$out/near.json" --out "$out/near-$c" --compress $c --quiet
+  (cd "$src" && node tests/web/viewer_test.js "$out/near-$c" --models relativistic --frames 0,3 --shot-time 0.3 \
+    --screenshot "$out/near-$c.png" && node tests/looks/texels.js "$out/near-$c.png")
+done
+# Compressed files keep the look: --compress draco (one Draco mesh per material, TEXCOORD_0 quantized to
+# --draco-texcoord-bits) and --compress meshopt (float32 TEXCOORD_0, normalized uint16 COLOR_0), refined and in
+# vertex mode, decoded by the decoders three.js uses (decode_glb.js) and checked against the closed form
+# and, vertex by vertex, against the plain file within the stated bounds; no warning; valid files.
+for mode in refined vertex; do
+  args=()
+  [ "$mode" = vertex ] && args=(--tolerance vertex)
+  "$apparent" render "$out/scene_relativistic.json" --out "$out/draco-$mode" --compress draco "${args[@]}" \
+    2> "$out/draco-$mode.err"
+  "$apparent" render "$out/scene_relativistic.json" --out "$out/draco10-$mode" --compress draco \
+    --draco-texcoord-bits 10 "${args[@]}" --quiet
+  "$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt-$mode" --compress meshopt "${args[@]}" \
+    2> "$out/meshopt-$mode.err"
+  if grep -q "not carried" "$out/draco-$mode.err" "$out/meshopt-$mode.err"; then echo "FAIL: a look dropped"; exit 1; fi
+  for c in draco draco10 meshopt; do
+    (cd "$src" && node tests/looks/decode_glb.js "$out/$c-$mode/relativistic.glb" "$out/$c-$mode/decoded.glb")
+  done
+  plain="$out/$mode/relativistic.glb"
+  python3 "$src/tests/looks/check_textured.py" "$out/draco-$mode/decoded.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0 \
+    draco 14 12 "$plain"
+  python3 "$src/tests/looks/check_textured.py" "$out/draco10-$mode/decoded.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0 \
+    draco 14 10 "$plain"
+  python3 "$src/tests/looks/check_textured.py" "$out/meshopt-$mode/decoded.glb" "$out/box.glb" -2 0.3 -4 0.9 0 0 20 30 0 \
+    meshopt "$plain"
+  (cd "$src" && node tests/validators/validate_gltf.js "$out/draco-$mode/relativistic.glb" \
+    "$out/meshopt-$mode/relativistic.glb")
+done
+# The stated error where the position error is (--verbose).
+"$apparent" render "$out/scene_relativistic.json" --out "$out/draco-verbose" --compress draco --verbose 2>&1 |
+  grep -q "Draco texture-coordinate error <= 0.000122" || { echo "FAIL: no Draco texture-coordinate error"; exit 1; }
+"$apparent" render "$out/scene_relativistic.json" --out "$out/meshopt-verbose" --compress meshopt --verbose 2>&1 |
+  grep -q "meshopt texture coordinates float32 (error 0)" || { echo "FAIL: no meshopt texture-coordinate error"; exit 1; }
 # A Khronos sample with COLOR_0 (tests/data/gltf-samples/BoxVertexColors.gltf) at 0.5c: its colours
 # carried (COLOR_0 in every primitive, the input's material), valid for the Khronos validator.
 cp "$src/tests/data/gltf-samples/BoxVertexColors.gltf" "$out/"
@@ -151,4 +188,15 @@ for tamper in 'b"{\"name\":\"textured\"", b"[\"name\":\"textured\""' 'b"{\"index
 done
 timeout 300 mpirun --oversubscribe -n 3 "$apparent" render "$out/scene_relativistic.json" --out "$out/mpi" --quiet
 cmp "$out/refined/relativistic.glb" "$out/mpi/relativistic.glb" || { echo "FAIL: MPI ranks differ from one process"; exit 1; }
+# And compressed: the material parts' Draco meshes and meshopt records made by other processes.
+for c in draco meshopt; do
+  for i in 0 1; do
+    "$apparent" render "$out/scene_relativistic.json" --out "$out/shard-$c" --compress $c --shard $i/2 --quiet
+  done
+  "$apparent" merge "$out/shard-$c" --quiet
+  cmp "$out/$c-refined/relativistic.glb" "$out/shard-$c/relativistic.glb" || { echo "FAIL: $c shards differ"; exit 1; }
+  timeout 300 mpirun --oversubscribe -n 3 "$apparent" render "$out/scene_relativistic.json" --out "$out/mpi-$c" \
+    --compress $c --quiet
+  cmp "$out/$c-refined/relativistic.glb" "$out/mpi-$c/relativistic.glb" || { echo "FAIL: $c MPI ranks differ"; exit 1; }
+done
 echo "looks: ok"
