@@ -14,7 +14,7 @@
 
 namespace apparent {
 
-const std::string kShardMagic = "apparent shard 2\n";
+const std::string kShardMagic = "apparent shard 3\n";
 
 void putShardU64(std::string* out, uint64_t v) {
     for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));  // little-endian
