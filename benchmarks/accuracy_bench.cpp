@@ -15,9 +15,9 @@
 #include <sstream>
 
 #include "mesh4d/refine/measure.h"
-#include "pipeline/cli.h"
-#include "pipeline/prepared_object.h"
-#include "pipeline/worlds.h"
+#include "pipeline/commands/cli.h"
+#include "pipeline/stage/prepared_object.h"
+#include "pipeline/stage/worlds.h"
 #include "test_meshes.h"
 
 namespace {

@@ -4,7 +4,7 @@
 //
 //   BM_LoadVsGltfpack/F/N  one process loads a torus of N triangles as `apparent` does before its
 //                          first frame (scene, mesh file, transform, the 4D history of one model:
-//                          pipeline/stage.h, pipeline/worlds.h takeWorlds); another runs
+//                          pipeline/stage/stage.h, pipeline/stage/worlds.h takeWorlds); another runs
 //                          `gltfpack -i FILE -o out.glb` on the same file (F = 0 OBJ, 2 .glb).
 //                          F = 1 loads the binary PLY of the same torus, compared with gltfpack on
 //                          its OBJ (gltfpack reads no PLY). Both are child processes measured alike
@@ -31,8 +31,8 @@
 
 #include "exporters/obj.h"
 #include "exporters/ply.h"
-#include "pipeline/stage.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/stage.h"
+#include "pipeline/stage/worlds.h"
 #include "test_meshes.h"
 #include "quiet_stage.h"
 

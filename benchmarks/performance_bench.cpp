@@ -43,9 +43,9 @@
 
 #include "exporters/gltf.h"
 #include "exporters/ply.h"
-#include "pipeline/cli.h"
-#include "pipeline/stage.h"
-#include "pipeline/worlds.h"
+#include "pipeline/commands/cli.h"
+#include "pipeline/stage/stage.h"
+#include "pipeline/stage/worlds.h"
 #include "test_meshes.h"
 #include "quiet_stage.h"
 

@@ -17,7 +17,7 @@
 
 #include <tbb/task_arena.h>
 
-#include "pipeline/raytrace.h"
+#include "pipeline/trace/raytrace.h"
 
 #include <cmath>
 #include <map>

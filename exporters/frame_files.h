@@ -3,14 +3,14 @@
 // per-vertex `object` index, the OBJ's `o` groups): the base of the PLY and OBJ sinks. begin() creates DIR; each
 // frame's file is serialized in memory and committed through AtomicOutput, so it is complete when
 // add() returns, and counts to the output budget at once.
-// Frames across processes (pipeline/distribute.h): when the ranks share the output folder (their
+// Frames across processes (pipeline/run/distribute.h): when the ranks share the output folder (their
 // frame spills are installed, exporters/frame_spill.h) a rank writes its frame's file itself, in
 // frame order just before sending the frame (beforeSending), to DIR/.frame_NNNNN.tmp-TOKEN.EXT
 // (TOKEN: the run's random token; created exclusively, never through a link, synced), and sends
 // only its size and inode, or the write's error. Rank 0 checks the budget as for its own frames and
 // renames the file into place in frame order (addEncoded: the same bytes, messages and order as one
 // process). Nothing is left behind: every rank registers every model's frame folder before any
-// rank writes a file there (removeFrameTemporariesOnInterrupt, from pipeline/distribute.cpp's
+// rank writes a file there (removeFrameTemporariesOnInterrupt, from pipeline/run/distribute.cpp's
 // shareFrameSpills): on SIGINT, SIGTERM or SIGHUP a rank removes every temporary of the run there
 // by its name's pattern, whichever rank made it and however many ranks there are. A rank killed by
 // SIGKILL (the OOM killer) leaves its frame under way to the others, which mpirun then ends with

@@ -17,7 +17,7 @@ struct ExportFrame {
     double t_c = 0;                             // camera time of the frame
     std::vector<mesh4d::ApparentMesh> objects;  // one per scene object, in scene order
     // The units of the positions when they are not light-seconds (a scene in metres: "metres,
-    // seconds, ...", pipeline/units.h), for the PLY and OBJ comments; empty: light-seconds.
+    // seconds, ...", pipeline/input/units.h), for the PLY and OBJ comments; empty: light-seconds.
     std::string units;
 
     size_t triangleCount() const {
@@ -52,7 +52,7 @@ struct ExportCamera {
     bool orthographic() const { return width > 0; }
 };
 
-// The scene's light (pipeline/scene.h LightSpec, resolved: a scene without `light` gets its two
+// The scene's light (pipeline/input/scene.h LightSpec, resolved: a scene without `light` gets its two
 // default distant lights), at rest in the lab, in the outputs' axes and units, for viewers that
 // light the files as the raytracer does (scene extras "light"; scripts/blender_import.py).
 struct ExportLight {
@@ -67,7 +67,7 @@ struct ExportLight {
 struct SequenceInfo {
     std::string model;            // instant, finite, relativistic, contracted
     double tolerance = 0;         // requested tolerance (in the scene's units of length)
-    std::string units = "light-seconds, seconds, c = 1";  // the scene's (pipeline/units.h unitsText)
+    std::string units = "light-seconds, seconds, c = 1";  // the scene's (pipeline/input/units.h unitsText)
     double fps = 1;
     std::string scene_path;
     std::vector<ExportObject> objects;  // parallel to ExportFrame::objects

@@ -1,10 +1,10 @@
 // Where the frames of a sequence go: one sink per output format (.glb, PLY, OBJ; CONTRIBUTING.md "Adding a
-// format"). The frame loop (pipeline/frame_loop.h) calls, for one model:
+// format"). The frame loop (pipeline/run/frame_loop.h) calls, for one model:
 //   begin(info)                 once, before any frame;
 //   prepare(frame)              on worker threads, several frames at once (optional conversion);
 //   pending(frame), add(...)   on one thread, frames in order;
 //   finish(...)                 once, after the last frame.
-// Frames made by another process (pipeline/distribute.h: MPI ranks, job-array shards) reach the
+// Frames made by another process (pipeline/run/distribute.h: MPI ranks, job-array shards) reach the
 // sink as bytes instead: beginEncoding(info) and encode(frame) where the frame was cut, then
 // pendingEncoded(...) and addEncoded(...) in frame order where the file is written, with the same
 // bytes in the file as add() would have written.

@@ -1,4 +1,4 @@
-// Frame data by reference (frames across processes, pipeline/distribute.h): instead of sending a
+// Frame data by reference (frames across processes, pipeline/run/distribute.h): instead of sending a
 // frame's binary data to the writing process, the process that cut the frame writes it to a file
 // of its own, its frame spill, and sends only where it lies (FileSpan). The writing process reads
 // those files through the table of frame sources and copies the pieces into the output with
@@ -10,7 +10,7 @@
 //   write side by side without a lock.
 // - writing side: addFrameSource(source, fd) for every process (its own included); frameSource()
 //   finds the file; releaseFrameData() gives a range back (a hole punched) once it is copied.
-// The files are opened by name once at the start and unlinked at once (pipeline/distribute.cpp):
+// The files are opened by name once at the start and unlinked at once (pipeline/run/distribute.cpp):
 // nothing is left behind afterwards, whatever ends the processes. Every process must see the
 // others' files: a file system all ranks share (Lustre, GPFS, NFS with close-to-open: rank 0
 // opens them after the writes that it reads, as the frames' messages order them).
@@ -40,10 +40,10 @@ bool frameSpillInstalled();
 // each process cuts the frame before each of its frames again and encodes both forms
 // (GlbSink::encodesAfterPrevious), about 2.5 times a process's work per frame for rank 0's 0.1 times;
 // false: such frames travel whole to rank 0 (docs/PERFORMANCE.md, "Meshopt morph targets by
-// reference"). pipeline/distribute.cpp sets it from the number of processes.
+// reference"). pipeline/run/distribute.cpp sets it from the number of processes.
 void setMorphTargetsByReference(bool on);
 bool morphTargetsByReference();
-// The run's random token (the same on every process, pipeline/distribute.h): names of files the
+// The run's random token (the same on every process, pipeline/run/distribute.h): names of files the
 // processes make for one another in the output folder carry it (exporters/frame_files.h).
 void setFrameRunToken(const std::string& token);
 const std::string& frameRunToken();
@@ -62,7 +62,7 @@ struct Placement {
 bool placeHere(const std::string& path, const std::vector<Placement>& placements, std::string* error);
 // How the writer places frame data at the end: placeHere() unless another placer is installed.
 // Under MPI rank 0 installs one that has each rank copy its own frames' ranges, all at once
-// (pipeline/distribute.h): rank 0 then writes only the file's head and its own frames.
+// (pipeline/run/distribute.h): rank 0 then writes only the file's head and its own frames.
 using FramePlacer = std::function<bool(const std::string& path, const std::vector<Placement>& placements,
                                        std::string* error)>;
 void setFramePlacer(FramePlacer placer);

@@ -158,7 +158,7 @@ public:
     // previous frame), not a frame for add().
     std::shared_ptr<GlbFrameData> prepare(const ExportFrame& frame, bool streams = true) const;
     bool add(const ExportFrame& frame, const GlbFrameData& prepared, std::string* error);
-    // Frames across processes (pipeline/distribute.h): a prepared frame as bytes (its number,
+    // Frames across processes (pipeline/run/distribute.h): a prepared frame as bytes (its number,
     // camera time, which objects show, and the prepared data: float32 attributes, index lists, the
     // meshopt streams), made where the frame was cut, and add() of such bytes where the file is
     // written, frames in order: the file is the same bytes as add(frame, prepare(frame)) gives.

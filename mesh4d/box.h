@@ -1,7 +1,7 @@
 // The 4D bounding box of events: a time range [t_lo, t_hi] and a spatial box [lo, hi], empty
 // until something is added (infinite bounds the wrong way round). Used wherever the code needs
 // bounds: the per-frame cull of triangle runs (extrude.h, slice.h), the raytracer's prism bounds
-// (ray4d.h), a rest mesh's size (mesh4d/motion/seen.cpp, pipeline/mirror.cpp) and a frame's local
+// (ray4d.h), a rest mesh's size (mesh4d/motion/seen.cpp, pipeline/stage/mirror.cpp) and a frame's local
 // origin (exporters/glb/write.cpp). A box of points only (addPoint) keeps its time range empty.
 #pragma once
 

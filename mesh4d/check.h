@@ -1,8 +1,8 @@
 // Internal invariants: APPARENT_CHECK(a, op, b) states a relation the code relies on, such as
 // APPARENT_CHECK(objects.size(), >=, scene_objects). When it does not hold, it throws
 // std::logic_error naming the file, the line, the expression and both operands' values
-// ("pipeline/mirror.cpp:212: check failed: objects->size() >= scene_objects_ (2 >= 4)"); the
-// command turns that into "error: internal: ..." and exit code 1 (pipeline/cli.cpp).
+// ("pipeline/stage/mirror.cpp:212: check failed: objects->size() >= scene_objects_ (2 >= 4)"); the
+// command turns that into "error: internal: ..." and exit code 1 (pipeline/commands/cli.cpp).
 //
 // For broken invariants only: bad input is reported with a Status naming the file and field, never
 // with a check. Operands are evaluated once; they need an operator<< (numbers, strings).

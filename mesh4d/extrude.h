@@ -96,7 +96,7 @@ inline std::array<uint32_t, 4> World4D::tet(size_t i) const { return prismTet(me
 World4D extrude(const RestMesh& mesh, const Motion& motion, double tau_a, double tau_b,
                 bool cap_a_real, bool cap_b_real);
 // The same, the mesh handed to the world instead of copied (`mesh` is left empty): the world is
-// then its only copy, for a caller that needs the rest mesh no more (pipeline/worlds.h takeWorlds).
+// then its only copy, for a caller that needs the rest mesh no more (pipeline/stage/worlds.h takeWorlds).
 World4D extrude(RestMesh&& mesh, const Motion& motion, double tau_a, double tau_b, bool cap_a_real,
                 bool cap_b_real);
 
@@ -132,8 +132,8 @@ double slabSpacing(const RestMesh& mesh, const Motion& motion, double tau_a, dou
 
 // The slab grid (issue 18): sample times fixed by the motion, the mesh and the chord alone, never by
 // the span asked for, so that the slabs of any two spans are the same slabs where they overlap. A
-// narrower span (the one the frames see, pipeline/worlds.h) or a window of a long frame range
-// (pipeline/raytrace.h) then traces the very tetrahedra a wider span would: the same pictures, byte
+// narrower span (the one the frames see, pipeline/stage/worlds.h) or a window of a long frame range
+// (pipeline/trace/raytrace.h) then traces the very tetrahedra a wider span would: the same pictures, byte
 // for byte. The grid points, each step within slabSpacing over its own cell:
 //   spin: k ds for every integer k, ds = slabSpacing (constant: the bound does not depend on s);
 //   acceleration: none before t0 (s < 0: uniform motion, straight worldlines); from s = 0 on,

@@ -35,7 +35,7 @@ namespace mesh4d {
 // the classical factor with both velocities measured against the medium (1 - v.n formed as
 // 1 - u.n is); Lorentz, moving receiver: D = g_v (1 - v.n) / (g (1 - u.n)) (the frame's
 // frequency received by a moving observer). The pipeline's own cuts are in the camera's frame
-// (receiver zero) except finite's and the reflections a moving camera sees (pipeline/mirror.h).
+// (receiver zero) except finite's and the reflections a moving camera sees (pipeline/stage/mirror.h).
 double dopplerFactor(const Motion& m, ViewKind kind, const Vec3& apex, const Vec3& x, const Vec3& receiver = {0, 0, 0});
 
 // Fills m->doppler and m->proper_time (one per apparent point) for a cut of `world` by `view`.

@@ -46,7 +46,7 @@ struct ViewSurface {
     bool sheared() const { return shear.x != 0 || shear.y != 0 || shear.z != 0; }
     // A Hyperplane's tilt: the orthographic camera's unit view direction k (the null hyperplane
     // above); zero: the hyperplane t = t_c. Only uniform motion is cut on a tilted hyperplane
-    // (pipeline/scene.cpp checkSceneForModel refuses the rest).
+    // (pipeline/input/scene.cpp checkSceneForModel refuses the rest).
     Vec3 tilt{0, 0, 0};
     bool tilted() const { return tilt.x != 0 || tilt.y != 0 || tilt.z != 0; }
 };

@@ -148,7 +148,7 @@ struct SliceSettings {
     // The speed the refinement's bound multiplies the light delay's error by (chord_error.h
     // displacedChordError), for a cut whose outputs are mapped afterwards by a linear map that
     // turns the object's displacement (1, u) into one of this spatial length (reflections seen by a
-    // moving camera: pipeline/mirror.h). Negative: |u - view.shear| (the outputs themselves).
+    // moving camera: pipeline/stage/mirror.h). Negative: |u - view.shear| (the outputs themselves).
     double displacement = -1;
 };
 
@@ -171,7 +171,7 @@ ApparentMesh sliceWorld(const World4D& world, const ViewSurface& view, const Sli
 // points, so each point lies within |s| + b |s| / (1 - b) of the origin's image) and R on the
 // hyperplane. Under a shear (sliceWorld) the points are s - w delta, w = u - shear: radius
 // R (1 + |w| / (1 - b)), centred on the origin's sheared image. For view culling
-// (pipeline/render.cpp, --cull-view). A motion that is not
+// (pipeline/commands/render.cpp, --cull-view). A motion that is not
 // uniform (worldline.h) gets an infinite radius: it is never culled.
 struct BoundingSphere {
     Vec3 center;

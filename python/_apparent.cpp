@@ -1,7 +1,7 @@
 // The Python extension `apparent._apparent` (issue 34; docs/PYTHON.md): a scene loaded with the
-// commands' own stage (pipeline/stage.h), cut at any camera time with the frame loop's own step
-// (pipeline/frame_cut.h), and the `render` and `trade` commands run in-process
-// (pipeline/cli.h). Bad input raises apparent.Error with the command line's one line; the GIL is
+// commands' own stage (pipeline/stage/stage.h), cut at any camera time with the frame loop's own step
+// (pipeline/stage/frame_cut.h), and the `render` and `trade` commands run in-process
+// (pipeline/commands/cli.h). Bad input raises apparent.Error with the command line's one line; the GIL is
 // released while C++ works. The pure-Python layer (python/apparent/__init__.py) wraps these.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/cli.h"
-#include "pipeline/frame_cut.h"
-#include "pipeline/scene_fields.h"
-#include "pipeline/stage.h"
+#include "pipeline/commands/cli.h"
+#include "pipeline/input/scene_fields.h"
+#include "pipeline/stage/frame_cut.h"
+#include "pipeline/stage/stage.h"
 
 namespace py = pybind11;
 
@@ -70,7 +70,7 @@ public:
         base_.quiet = true;
         py::gil_scoped_release release;
         default_ = get("", "");  // validates the scene in its own model and tolerance
-        // Its mesh paths passed the confinement (pipeline/mesh_input.h) from the working folder of
+        // Its mesh paths passed the confinement (pipeline/input/mesh_input.h) from the working folder of
         // now: later stages of other models and tolerances read the same files whatever it becomes.
         base_.limits.allow_outside = true;
     }
@@ -135,7 +135,7 @@ private:
             options.models = {m};
         }
         if (!tolerance.empty()) {
-            // The command line's check and message (pipeline/cli.cpp, --tolerance).
+            // The command line's check and message (pipeline/commands/cli.cpp, --tolerance).
             if (!apparent::parseTolerance(tolerance, &options.tolerance, &options.tolerance_relative))
                 throw BadInput("--tolerance: '" + tolerance +
                                "' is neither a positive number of light-seconds, a fraction of each object's size "

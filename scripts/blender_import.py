@@ -229,7 +229,7 @@ cameras = [o for o in scene.objects if o.type == 'CAMERA']
 if cameras:
     scene.camera = cameras[0]
 
-# Step: the lights, in linear radiance as the raytracer shades (pipeline/raytrace.cpp shadeWith: base x
+# Step: the lights, in linear radiance as the raytracer shades (pipeline/trace/raytrace.cpp shadeWith: base x
 # (ambient + (1 - ambient) x weighted Lambert)). A diffuse surface of albedo a under a sun of strength S
 # at normal incidence leaves radiance a S / pi, and under a uniform world of colour W radiance a W: so
 # each sun gets S = pi (1 - ambient) weight and the world the ambient share. The raytracer's point

@@ -14,8 +14,8 @@
 
 #include "mesh4d/motion/motion.h"
 #include "mesh4d/motion/camera_frame.h"
-#include "pipeline/stage.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/stage.h"
+#include "pipeline/stage/worlds.h"
 #include "run_command.h"
 #include "box_scene.h"
 #include "temp_dir.h"

@@ -16,9 +16,9 @@
 #include <tiny_gltf.h>
 
 #include "mesh4d/event.h"
-#include "pipeline/cli.h"
+#include "pipeline/commands/cli.h"
 #include "run_command.h"
-#include "pipeline/scene.h"
+#include "pipeline/input/scene.h"
 
 namespace fs = std::filesystem;
 

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "pipeline/render.h"
-#include "pipeline/worlds.h"
+#include "pipeline/commands/render.h"
+#include "pipeline/stage/worlds.h"
 #include "temp_dir.h"
 
 using namespace apparent;

@@ -14,11 +14,11 @@
 
 #include <unistd.h>
 
-#include "pipeline/frame_loop.h"
-#include "pipeline/mesh_input.h"
-#include "pipeline/obj_reader.h"
-#include "pipeline/scene.h"
-#include "pipeline/stage.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/obj_reader.h"
+#include "pipeline/input/scene.h"
+#include "pipeline/run/frame_loop.h"
+#include "pipeline/stage/stage.h"
 #include "run_command.h"
 #include "quiet_stage.h"
 #include "temp_dir.h"

@@ -10,8 +10,8 @@
 
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
-#include "pipeline/mesh_check.h"
-#include "pipeline/scene.h"
+#include "pipeline/input/mesh_check.h"
+#include "pipeline/input/scene.h"
 #include "test_meshes.h"
 #include "temp_dir.h"
 

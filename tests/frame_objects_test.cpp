@@ -17,7 +17,7 @@
 #include "exporters/obj.h"
 #include "exporters/ply.h"
 #include "file_bytes.h"
-#include "pipeline/scene.h"
+#include "pipeline/input/scene.h"
 #include "run_command.h"
 
 using namespace apparent;

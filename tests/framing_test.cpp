@@ -1,4 +1,4 @@
-// `figure --frame-objects` (pipeline/framing.h) against closed forms: a unit box at rest, and a unit
+// `figure --frame-objects` (pipeline/stage/framing.h) against closed forms: a unit box at rest, and a unit
 // box at 0.6c in the contracted model (its Lorentz-contracted shape at the frame time, a box of
 // length 1/gamma) seen at two times when it is symmetric about the view axis. By symmetry the
 // framed camera looks along the axis; the box's extreme points are the near face's corners, at
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "mesh4d/angles.h"
-#include "pipeline/framing.h"
+#include "pipeline/stage/framing.h"
 #include "box_scene.h"
 #include "run_command.h"
 #include "exporters/png.h"

@@ -1,4 +1,4 @@
-// The gated camera (raytrace and figure --gate DEPTH, pipeline/raytrace.h SceneTracer::setGate):
+// The gated camera (raytrace and figure --gate DEPTH, pipeline/trace/raytrace.h SceneTracer::setGate):
 // the Vienna experiment's composite of exposures of light-path slices (Hornof et al., Commun. Phys.
 // 8, 161 (2025)), against its closed form.
 //
@@ -18,7 +18,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "pipeline/raytrace.h"
+#include "pipeline/trace/raytrace.h"
 #include "quiet_stage.h"
 #include "temp_dir.h"
 

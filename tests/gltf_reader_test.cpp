@@ -12,9 +12,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/cli.h"
-#include "pipeline/gltf_document.h"
-#include "pipeline/mesh_input.h"
+#include "pipeline/commands/cli.h"
+#include "pipeline/input/gltf_document.h"
+#include "pipeline/input/mesh_input.h"
 #include "temp_dir.h"
 
 using namespace apparent;

@@ -1,8 +1,8 @@
-// Scenes authored in glTF (pipeline/gltf_scene.h) against their JSON twins: every object field
+// Scenes authored in glTF (pipeline/input/gltf_scene.h) against their JSON twins: every object field
 // in node extras gives the same object as in a JSON scene, with the same errors; unknown and
 // misspelt keys are warnings that name the key and the known fields; a node left out for
 // near-misses is reported; and the file is parsed once however many objects it carries
-// (pipeline/gltf_document.h), also when the file changes between reads.
+// (pipeline/input/gltf_document.h), also when the file changes between reads.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -15,10 +15,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/gltf_document.h"
-#include "pipeline/mesh_input.h"
-#include "pipeline/scene.h"
-#include "pipeline/scene_fields.h"
+#include "pipeline/input/gltf_document.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/scene.h"
+#include "pipeline/input/scene_fields.h"
 #include "temp_dir.h"
 
 using namespace apparent;

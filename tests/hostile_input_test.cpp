@@ -20,12 +20,12 @@
 #include "exporters/atomic_file.h"
 #include "exporters/ply.h"
 #include "keyed_gltf.h"
-#include "pipeline/cli.h"
+#include "pipeline/commands/cli.h"
 #include "run_command.h"
-#include "pipeline/json_limits.h"
-#include "pipeline/mesh_input.h"
-#include "pipeline/ply_reader.h"
-#include "pipeline/scene.h"
+#include "pipeline/input/json_limits.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/ply_reader.h"
+#include "pipeline/input/scene.h"
 #include "file_bytes.h"
 #include "file_size_limit.h"
 #include "measured_run.h"
@@ -686,7 +686,7 @@ TEST(HostileInput, FileNamesAndTheGlbJsonSideAreCheckedBeforeTheWork) {
 
 // Malformed animation channels on an object node of a glTF scene, each refused
 // with one line naming the file, the glTF path and the problem, and exit code 2
-// (pipeline/gltf_animation.h).
+// (pipeline/input/gltf_animation.h).
 TEST(HostileInput, MalformedAnimationsAreRefusedWithOneLine) {
     Sandbox box;
     fs::create_directories(box / "s");

@@ -1,4 +1,4 @@
-// Keyframed paths (mesh4d/motion/keyed.h, pipeline/gltf_animation.h): glTF
+// Keyframed paths (mesh4d/motion/keyed.h, pipeline/input/gltf_animation.h): glTF
 // animation channels on an object node, through the whole stage, against the uniform and spin
 // models and against a path, a boost and a clock written out here.
 #include <gtest/gtest.h>
@@ -19,8 +19,8 @@
 #include "mesh4d/ray4d.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/motion/worldline.h"
-#include "pipeline/physics.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/physics.h"
+#include "pipeline/stage/worlds.h"
 #include "quiet_stage.h"
 #include "slab_rays.h"
 

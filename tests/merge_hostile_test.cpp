@@ -39,7 +39,7 @@ std::string real(double v) {
     return u64(bits);
 }
 
-// Where the fields of a shard file lie (the layout pipeline/shards.cpp writes, walked here
+// Where the fields of a shard file lie (the layout pipeline/run/shards.cpp writes, walked here
 // independently): the header's fields, then the frame records, then the end record.
 struct ShardLayout {
     size_t model = 0, tolerance = 0, fps = 0, scene_path = 0, objects = 0, name0 = 0, color0 = 0, mirror0 = 0,

@@ -11,8 +11,8 @@
 
 #include "mesh4d/event.h"
 #include "mesh4d/slice.h"
-#include "pipeline/raytrace.h"
-#include "pipeline/scene.h"
+#include "pipeline/input/scene.h"
+#include "pipeline/trace/raytrace.h"
 
 namespace testcast {
 

@@ -14,11 +14,11 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
-#include "pipeline/mesh_check.h"
-#include "pipeline/mesh_input.h"
-#include "pipeline/obj_reader.h"
-#include "pipeline/ply_reader.h"
-#include "pipeline/polygon_input.h"
+#include "pipeline/input/mesh_check.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/obj_reader.h"
+#include "pipeline/input/ply_reader.h"
+#include "pipeline/input/polygon_input.h"
 #include "test_meshes.h"
 #include "temp_dir.h"
 

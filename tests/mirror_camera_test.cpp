@@ -1,4 +1,4 @@
-// Mirrors seen by a moving camera (pipeline/mirror.h): the mirror is at rest in the lab, so the
+// Mirrors seen by a moving camera (pipeline/stage/mirror.h): the mirror is at rest in the lab, so the
 // test does the reflection there, with its own maps, independent of the program's: the camera's
 // lab event E (this file's inverse boost or shear of (t_c, position)), its image E' through the
 // plane, the lab emission event of each rest point on E''s past cone (solved here in long double),
@@ -19,9 +19,9 @@
 
 #include "mesh4d/motion/motion.h"
 #include "mesh4d/light_factors.h"
-#include "pipeline/mirror.h"
-#include "pipeline/stage.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/mirror.h"
+#include "pipeline/stage/stage.h"
+#include "pipeline/stage/worlds.h"
 #include "quiet_stage.h"
 #include "run_command.h"
 #include "temp_dir.h"

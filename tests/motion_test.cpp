@@ -16,9 +16,9 @@
 #include "test_meshes.h"
 #include "mesh4d/motion/worldline.h"
 #include "quiet_stage.h"
-#include "pipeline/physics.h"
-#include "pipeline/raytrace.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/physics.h"
+#include "pipeline/stage/worlds.h"
+#include "pipeline/trace/raytrace.h"
 
 #include "temp_dir.h"
 

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "pipeline/mesh_check.h"
-#include "pipeline/obj_reader.h"
+#include "pipeline/input/mesh_check.h"
+#include "pipeline/input/obj_reader.h"
 
 using namespace apparent;
 

@@ -1,6 +1,6 @@
 // The orthographic camera (scene camera.projection "orthographic") and the Vienna experiment
 // (Hornof et al., Commun. Phys. 8, 161 (2025)) reproduced with it: data/scenes/vienna_cube.json and
-// vienna_sphere.json, measured by `apparent measure` (pipeline/measure.h) and by this file's own
+// vienna_sphere.json, measured by `apparent measure` (pipeline/commands/measure.h) and by this file's own
 // computations.
 //
 // The far-field view. An orthographic camera looking along the unit vector k sees the light that
@@ -40,11 +40,11 @@
 #include "mesh4d/angles.h"
 #include "mesh4d/exact_side.h"
 #include "mesh4d/lightcone.h"
-#include "pipeline/frame_cut.h"
-#include "pipeline/measure.h"
-#include "pipeline/raytrace.h"
-#include "pipeline/scene_fields.h"
-#include "pipeline/view_hints.h"
+#include "pipeline/commands/measure.h"
+#include "pipeline/input/scene_fields.h"
+#include "pipeline/stage/frame_cut.h"
+#include "pipeline/stage/view_hints.h"
+#include "pipeline/trace/raytrace.h"
 #include "quiet_stage.h"
 #include "run_command.h"
 #include "temp_dir.h"

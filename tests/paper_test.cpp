@@ -18,7 +18,7 @@
 #include <sstream>
 
 #include "mesh4d/slice.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/worlds.h"
 
 using namespace apparent;
 using mesh4d::Vec3;

@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "exporters/ply.h"
-#include "pipeline/mesh_check.h"
-#include "pipeline/mesh_input.h"
-#include "pipeline/ply_reader.h"
+#include "pipeline/input/mesh_check.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/ply_reader.h"
 #include "file_bytes.h"
 #include "temp_dir.h"
 

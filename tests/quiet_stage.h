@@ -1,12 +1,12 @@
 // For tests and benchmarks: a scene's stage loaded as `apparent render` loads it, with nothing
-// printed (pipeline/stage.h loadStage with quiet options).
+// printed (pipeline/stage/stage.h loadStage with quiet options).
 #pragma once
 
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "pipeline/stage.h"
+#include "pipeline/stage/stage.h"
 
 namespace apparent {
 

@@ -1,4 +1,4 @@
-// The raytracer's light is at rest in the lab (pipeline/scene.h LightSpec), so the shade of a face
+// The raytracer's light is at rest in the lab (pipeline/input/scene.h LightSpec), so the shade of a face
 // at rest in the lab does not depend on how the camera moves: only where the face appears does.
 // Every pixel is checked against Lambert's law in the lab, from closed forms written here: the
 // pixel's camera-frame direction taken back to the lab ray it sees (per model), that ray met with
@@ -18,7 +18,7 @@
 #include <unistd.h>
 
 #include "mesh4d/angles.h"
-#include "pipeline/raytrace.h"
+#include "pipeline/trace/raytrace.h"
 #include "quiet_stage.h"
 #include "srgb.h"
 #include "temp_dir.h"

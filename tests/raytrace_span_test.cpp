@@ -1,4 +1,4 @@
-// The span of an accelerated body's time that the raytracer extrudes (pipeline/worlds.h
+// The span of an accelerated body's time that the raytracer extrudes (pipeline/stage/worlds.h
 // pathSpanSeen, mesh4d/motion/latest_crossing.h), checked against crossings found independently: the
 // rocket of data/scenes/rocket.json (a Born-rigid box 2 ls long at 0.5 ls/s^2, whose frames
 // see interior points of its faces emit after every vertex) and a turned torus, boosted and
@@ -20,9 +20,9 @@
 #include "mesh4d/refine/measure.h"
 #include "mesh4d/slice.h"
 #include "mesh4d/motion/worldline.h"
-#include "pipeline/physics.h"
-#include "pipeline/raytrace.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/physics.h"
+#include "pipeline/stage/worlds.h"
+#include "pipeline/trace/raytrace.h"
 #include "mesh_caster.h"
 #include "quiet_stage.h"
 #include "test_meshes.h"

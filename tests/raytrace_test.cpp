@@ -1,4 +1,4 @@
-// The paper's 4D raytracer (mesh4d/ray4d.h, pipeline/raytrace.h): hits against the closed-form
+// The paper's 4D raytracer (mesh4d/ray4d.h, pipeline/trace/raytrace.h): hits against the closed-form
 // retarded point, the lab normal against the boosted triangle, PNG round trip, command errors,
 // and the cross-check of both: the apparent meshes of the cone cut, ray-cast in plain 3D from
 // the camera, show the same object as the 4D raytracer in at least 99% of the covered pixels.
@@ -26,10 +26,10 @@
 #include "mesh4d/doppler_colour.h"
 #include "mesh4d/ray4d.h"
 #include "mesh4d/slice.h"
-#include "pipeline/cli.h"
-#include "pipeline/mirror.h"
-#include "pipeline/raytrace.h"
-#include "pipeline/worlds.h"
+#include "pipeline/commands/cli.h"
+#include "pipeline/stage/mirror.h"
+#include "pipeline/stage/worlds.h"
+#include "pipeline/trace/raytrace.h"
 #include "keyed_gltf.h"
 #include "test_meshes.h"
 #include "mesh_caster.h"
@@ -391,7 +391,7 @@ TEST(RaytraceCrossCheck, FlybyFromAMovingCamera) {
     crossCheck("data/scenes/flyby.json", 10, 0, nullptr);
 }
 
-// Mirrors seen by a moving camera (pipeline/mirror.h): the mirror, at rest in the lab, moves in the
+// Mirrors seen by a moving camera (pipeline/stage/mirror.h): the mirror, at rest in the lab, moves in the
 // camera's frame. The raytracer bounces each ray off it as the lab reflects it (mirror.h
 // reflectRayDirection), independently of the meshes' lab cut, reflection and map.
 TEST(RaytraceCrossCheck, MirrorSeenFromAMovingCamera) {

@@ -18,7 +18,7 @@
 #include "mesh4d/robust.h"
 #include "mesh4d/refine/subdivide.h"
 #include "mesh4d/slice.h"
-#include "pipeline/mesh_check.h"
+#include "pipeline/input/mesh_check.h"
 #include "mesh4d/refine/measure.h"
 #include "test_meshes.h"
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "mesh4d/robust.h"
-#include "pipeline/worlds.h"
+#include "pipeline/stage/worlds.h"
 
 using namespace apparent;
 

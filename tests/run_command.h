@@ -8,7 +8,7 @@
 
 #include <unistd.h>
 
-#include "pipeline/cli.h"
+#include "pipeline/commands/cli.h"
 
 namespace testcli {
 

@@ -1,4 +1,4 @@
-// The raytracer's anti-aliasing (pipeline/raytrace.h SceneTracer::setSamplesSide, `--samples N`): a
+// The raytracer's anti-aliasing (pipeline/trace/raytrace.h SceneTracer::setSamplesSide, `--samples N`): a
 // flat face, a 2 x 2 square at rest face-on 3.265 ls ahead, whose outline projects to a rectangle known
 // in closed form. With 4, 9 and 16 samples the picture differs from the 1-sample picture only in
 // pixels that the rectangle's outline crosses, and there each pixel shows the share of it that the
@@ -11,7 +11,7 @@
 #include <fstream>
 
 #include "mesh4d/angles.h"
-#include "pipeline/raytrace.h"
+#include "pipeline/trace/raytrace.h"
 #include "quiet_stage.h"
 #include "srgb.h"
 #include "temp_dir.h"

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <functional>
 
-#include "pipeline/scene.h"
+#include "pipeline/input/scene.h"
 
 #include "temp_dir.h"
 

@@ -1,5 +1,5 @@
-// Job-array shards (pipeline/shards.h) and the frame split they share with MPI
-// (pipeline/distribute.h): shards 0/3, 1/3, 2/3 run as separate commands and merged give the same
+// Job-array shards (pipeline/run/shards.h) and the frame split they share with MPI
+// (pipeline/run/distribute.h): shards 0/3, 1/3, 2/3 run as separate commands and merged give the same
 // bytes as one process for every output; a missing, duplicated or foreign shard is refused with one
 // line and exit code 2.
 #include <gtest/gtest.h>
@@ -12,8 +12,8 @@
 
 #include <unistd.h>
 
-#include "pipeline/distribute.h"
-#include "pipeline/shards.h"
+#include "pipeline/run/distribute.h"
+#include "pipeline/run/shards.h"
 #include "run_command.h"
 #include "file_bytes.h"
 

@@ -1,4 +1,4 @@
-// The figure's sheet (pipeline/sheet.h): a title wider than the sheet wrapped onto lines that fit it,
+// The figure's sheet (pipeline/trace/sheet.h): a title wider than the sheet wrapped onto lines that fit it,
 // shown whole (its words all there, its ink inside the sheet); `figure --row-labels` and
 // `--column-labels` in place of the model names and camera times.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 
 #include "exporters/png.h"
 #include "exporters/text.h"
-#include "pipeline/sheet.h"
+#include "pipeline/trace/sheet.h"
 #include "run_command.h"
 
 using namespace apparent;

@@ -1,5 +1,5 @@
 // The linear value of an 8-bit sRGB level and back (IEC 61966-2-1's transfer function), written
-// here independently of pipeline/raytrace.cpp's encoder, for the tests that read picture colours.
+// here independently of pipeline/trace/raytrace.cpp's encoder, for the tests that read picture colours.
 #pragma once
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// The stage layer and the frame sinks (pipeline/stage.h, pipeline/frame_loop.h,
+// The stage layer and the frame sinks (pipeline/stage/stage.h, pipeline/run/frame_loop.h,
 // exporters/frame_sink.h): output bytes pinned across the refactor, exact PLY and OBJ far from the
 // origin, one load preamble for every command, and the small shared pieces (check, box).
 #include <gtest/gtest.h>
@@ -16,9 +16,9 @@
 #include "exporters/ply.h"
 #include "mesh4d/box.h"
 #include "mesh4d/check.h"
-#include "pipeline/frame_loop.h"
-#include "pipeline/stage.h"
-#include "pipeline/worlds.h"
+#include "pipeline/run/frame_loop.h"
+#include "pipeline/stage/stage.h"
+#include "pipeline/stage/worlds.h"
 #include "quiet_stage.h"
 #include "run_command.h"
 #include "file_bytes.h"
@@ -302,7 +302,7 @@ TEST(Stage, FrameLoopDeliversFramesInOrder) {
 // The loop computes the light factors (doppler, proper_time) only when some sink reads them:
 // sinks that all say no get none, on the scene objects and on the mirror reflections alike; one
 // sink that says yes gets them for every object, and so does the sink beside it. The default scene
-// and the same seen by a moving camera (pipeline/mirror.h: its reflections are made apart).
+// and the same seen by a moving camera (pipeline/stage/mirror.h: its reflections are made apart).
 TEST(Stage, LightFactorsOnlyWhenASinkReadsThem) {
     for (const char* scene : {"data/scenes/flanges.json", "data/fixtures/scene_mirror_camera.json"}) {
         Stage stage;

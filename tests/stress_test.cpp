@@ -6,7 +6,7 @@
 
 #include "mesh4d/robust.h"
 #include "mesh4d/slice.h"
-#include "pipeline/mesh_check.h"
+#include "pipeline/input/mesh_check.h"
 #include "test_meshes.h"
 
 using namespace mesh4d;

@@ -1,4 +1,4 @@
-// `apparent trade` end to end (pipeline/trade.h): the table, trade.csv and the plot files on a
+// `apparent trade` end to end (pipeline/commands/trade.h): the table, trade.csv and the plot files on a
 // shipped trade scene; every tolerance row within its tolerance and the uniform rows' errors
 // falling about fourfold per level (the chord error of a halved edge: second order); bad options
 // refused with one line; the affine models said to need nothing.

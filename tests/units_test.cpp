@@ -1,4 +1,4 @@
-// The scene's units (pipeline/units.h, scene field `units`): a scene in metres
+// The scene's units (pipeline/input/units.h, scene field `units`): a scene in metres
 // (positions p metres, frame times t seconds) gives the output of the light-second scene with
 // positions p / c at the same times, times c, to 1e-12 relative; its labels read in ns. And an
 // oracle in metres: the instant model shows a vertex at p + s q + v c (t - t0) metres.
@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
-#include "pipeline/figure.h"
-#include "pipeline/frame_cut.h"
+#include "pipeline/stage/frame_cut.h"
+#include "pipeline/trace/figure.h"
 #include "quiet_stage.h"
 #include "run_command.h"
 #include "temp_dir.h"

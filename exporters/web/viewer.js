@@ -97,7 +97,7 @@ const models = modelNames.map((name) => {
 let time = 0;            // animation time: 0 at the first frame written
 let cameraStart = 0;     // the camera time of animation time 0 (frame_times[0]; 0 without frame_times)
 // Times shown in ns, us or ms when all the files' frame times are below 1 us, 1 ms or 1 s (a scene in metres
-// lasts nanoseconds), as apparent figure labels them (pipeline/units.h).
+// lasts nanoseconds), as apparent figure labels them (pipeline/input/units.h).
 let timeUnit = { name: 's', seconds: 1 };
 function timeText(t, digits = 3) { return `${(t / timeUnit.seconds).toFixed(digits)} ${timeUnit.name}`; }
 let zoom = 1;            // view zoom: fov' = 2 atan(tan(fov / 2) / zoom); the camera itself never moves

@@ -175,7 +175,7 @@ struct FrameBuilder {
     // The factor a piece's bound multiplies the light delay's error by (chord_error.h
     // chordErrorOfBubbles): the object's speed |u|; |w| = |u - shear| when the view shears its
     // outputs (the finite model with a moving camera); settings.displacement when that is given
-    // (outputs mapped afterwards: reflections seen by a moving camera, pipeline/mirror.h).
+    // (outputs mapped afterwards: reflections seen by a moving camera, pipeline/stage/mirror.h).
     double boundSpeed() const {
         if (settings.displacement >= 0) return settings.displacement;
         if (view.sheared()) return norm(world.motion.velocity - view.shear);

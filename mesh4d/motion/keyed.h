@@ -1,6 +1,6 @@
 // Keyframed paths (issue 18, item 4): an object's centre and orientation given at lab times (keys),
 // interpolated linearly between them, as a glTF animation's LINEAR translation and rotation
-// channels describe (pipeline/gltf_animation.h reads them). Plugged into worldline.h beside the spin
+// channels describe (pipeline/input/gltf_animation.h reads them). Plugged into worldline.h beside the spin
 // and the acceleration: Motion::keyed.
 //
 // The authored path (KeyPath, lab frame): keys at lab times t_0 < ... < t_{n-1}, the centre X_k

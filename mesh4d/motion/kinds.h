@@ -2,7 +2,7 @@
 // every answer the pipeline asks of a motion as one row of function pointers, KindAnswers, defined
 // in its file; answersOf (kinds.cpp) is the one switch over MotionKind that names the rows. The
 // questions' own switches (worldline.cpp, seen.cpp, extrude.cpp, worldline_bound.cpp, the stage's
-// checks in pipeline/physics.cpp, the raytracer's messages) keep their cases for the kinds that
+// checks in pipeline/stage/physics.cpp, the raytracer's messages) keep their cases for the kinds that
 // predate the table (uniform, spin, hyperbolic, keyed) and send every other kind to its row.
 #pragma once
 

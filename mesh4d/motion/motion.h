@@ -31,7 +31,7 @@
 // in KindParams (here), its answers as one KindAnswers row in its own file (kinds.h: the own-frame
 // event and rates, the clock, the fastest speed, the rates bound, the slab step and the stage's
 // refusals), named in answersOf (kinds.cpp, the one switch a new kind must join), and its scene
-// field as one row of pipeline/scene_fields.cpp's table (JSON and glTF extras alike). The
+// field as one row of pipeline/input/scene_fields.cpp's table (JSON and glTF extras alike). The
 // questions' switches send every kind they do not name to its row (a `default:`).
 //
 // Uniform motion of an object: the map from its rest frame (tau, q) into the lab frame.
@@ -58,7 +58,7 @@ enum class Kinematics { Galilean, Lorentz };
 struct KeyedMotion;  // keyed.h
 
 // The parameters of the kinds answered in their own file (kinds.h), as a scene states them: a scene
-// field's row in pipeline/scene_fields.cpp's table reads them into ObjectSpec::kinds, and motionOf
+// field's row in pipeline/input/scene_fields.cpp's table reads them into ObjectSpec::kinds, and motionOf
 // copies them whole into Motion::kinds. Empty: none of these kinds.
 //
 // A circular orbit (orbit.cpp; MotionKind::Orbit). The origin is at X0 at lab time t0 and moves

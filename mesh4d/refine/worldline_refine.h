@@ -35,7 +35,7 @@
 // triangle they lie in (source_triangles; refined_triangles and limited_triangles count input
 // triangles).
 // Preconditions (slice.cpp's hook): not isUniform(world.motion), tolerance > 0, no real cap (an
-// object that begins or ends existing is refused a tolerance by the callers, pipeline/physics.cpp:
+// object that begins or ends existing is refused a tolerance by the callers, pipeline/stage/physics.cpp:
 // the cap's clip curve is not bounded here), world not empty.
 // The output is as sliceWorld's (ApparentMesh, local coordinates about the origin's crossing):
 // first the used input vertices in input order (when every level is 1, exactly vertex mode's

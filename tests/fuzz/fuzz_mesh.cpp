@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "pipeline/mesh_input.h"
-#include "pipeline/scene.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/scene.h"
 #include "tests/fuzz/fuzz_input.h"
 
 #ifndef APPARENT_FUZZ_EXT

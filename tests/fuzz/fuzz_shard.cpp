@@ -1,4 +1,4 @@
-// libFuzzer harness for the job-array shard reader (pipeline/shard_header.h), what `merge` reads
+// libFuzzer harness for the job-array shard reader (pipeline/run/shard_header.h), what `merge` reads
 // first of every shard: the input bytes become a .shard file, opened as merge opens it (a regular
 // file, its size known), its header read and checked, then its frame records and end record read
 // as merge reads them (lengths bounded by the file). A refusal must be one line starting with the
@@ -12,10 +12,10 @@
 
 #include <unistd.h>
 
-#include "pipeline/input_file.h"
-#include "pipeline/json_limits.h"
-#include "pipeline/scene.h"
-#include "pipeline/shard_header.h"
+#include "pipeline/input/input_file.h"
+#include "pipeline/input/json_limits.h"
+#include "pipeline/input/scene.h"
+#include "pipeline/run/shard_header.h"
 #include "tests/fuzz/fuzz_input.h"
 
 namespace {

@@ -1,5 +1,5 @@
 #!/bin/bash
-# `mpirun -n 3 apparent render` (pipeline/mpi_group.h): every output byte-identical to one process
+# `mpirun -n 3 apparent render` (pipeline/run/mpi_group.h): every output byte-identical to one process
 # (the default scene and a mirrored, clipped one; .glb plain, Draco and meshopt, its frames by
 # reference, diff -r also finding any scratch file left; meshopt with attributes; PLY; OBJ, also
 # without a .glb, each rank writing its own frames' files;
@@ -39,7 +39,7 @@ for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
     done
 done
 # From 10 processes meshopt frames that may be morph targets travel by reference too (each rank
-# cuts the frame before its own again: pipeline/distribute.cpp); below, whole. The same bytes.
+# cuts the frame before its own again: pipeline/run/distribute.cpp); below, whole. The same bytes.
 for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
     rm -rf "$work/one" "$work/ten"
     "$apparent" render "$scene" --out "$work/one" --quiet --compress meshopt --frames 60:100 || fail "one process: $scene meshopt"

@@ -1,0 +1,286 @@
+#include "pipeline/commands/render.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <sstream>
+
+#include "exporters/obj.h"
+#include "exporters/ply.h"
+#include "pipeline/input/json_limits.h"
+#include "pipeline/input/mesh_check.h"
+#include "pipeline/run/shards.h"
+#include "pipeline/stage/view_hints.h"
+
+namespace apparent {
+
+namespace {
+
+// One output format: its --format name and how its sink is made for a model. `base` is
+// DIR/<model>: the folder of per-frame files and the stem of a file per sequence. A new format is
+// one more entry here and one sink in exporters/ (CONTRIBUTING.md "Adding a motion model, a format, a command").
+struct OutputFormat {
+    std::string name;
+    std::function<std::unique_ptr<FrameSink>(const RenderSettings&, const std::string& base)> make;
+};
+
+// Every setting that changes an output, as text: part of a shard's fingerprint (pipeline/run/shards.h).
+std::string outputSettings(const RenderSettings& s, const Stage& stage) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "models";
+    for (Model m : stage.models) os << " " << modelName(m);
+    os << "\nformats";
+    for (const std::string& f : s.formats) os << " " << f;
+    os << "\nframes " << stage.first << " " << stage.last_excl << "\ntolerance " << stage.scene.tolerance;
+    for (double t : stage.tolerances) os << " " << t;
+    if (std::any_of(stage.attribute_tolerances.begin(), stage.attribute_tolerances.end(),
+                    [](double t) { return t < INFINITY; })) {
+        os << "\nattribute-tolerance";
+        for (double t : stage.attribute_tolerances) os << " " << t;
+    }
+    const GlbOptions& g = s.glb;
+    os << "\nglb " << g.draco << " " << g.position_bits << " " << g.normal_bits << " " << g.meshopt << " "
+       << g.meshopt_bits << " " << g.doppler << " " << g.proper_time << " " << g.shade_doppler << "\ncull "
+       << s.cull_view << "\nmax-triangles " << s.max_frame_triangles << "\nscene " << stage.scene.path << "\n";
+    if (g.texcoord_bits != GlbOptions().texcoord_bits) os << "draco-texcoord-bits " << g.texcoord_bits << "\n";
+    return os.str();
+}
+
+// The files a run reads: the scene and every mesh (a glTF node reference without its "#node").
+std::vector<std::string> inputFiles(const Stage& stage) {
+    std::vector<std::string> files = {stage.scene.path};
+    for (const PreparedObject& o : stage.objects) {
+        std::string mesh = o.spec.mesh_path;
+        std::error_code ec;
+        if (const auto hash = mesh.rfind('#'); hash != std::string::npos && !std::filesystem::exists(mesh, ec))
+            mesh.resize(hash);
+        if (!mesh.empty() && std::find(files.begin(), files.end(), mesh) == files.end()) files.push_back(mesh);
+    }
+    return files;
+}
+
+std::string hex(uint64_t v) {
+    std::ostringstream os;
+    os << std::hex << v;
+    return os.str();
+}
+
+// Under mpirun, before any frame: every rank's scene bytes, mesh bytes and output settings (the
+// shard fingerprint's parts) compared with rank 0's. The code of the first rank that differs (2)
+// and, on rank 0, its line naming what differs; 0 when all agree.
+int ranksAgree(FrameGroup& group, const RenderSettings& settings, const Stage& stage, std::string* error) {
+    const std::vector<std::string> files = inputFiles(stage);
+    const std::vector<std::string> meshes(files.begin() + 1, files.end());
+    const std::string options = outputSettings(settings, stage);
+    uint64_t scene_print = 0, mesh_print = 0;
+    std::string problem;
+    bool ok = runFingerprint({files.front()}, "", &scene_print, &problem) &&
+              runFingerprint(meshes, "", &mesh_print, &problem);
+    const std::string mine = hex(scene_print) + "\n" + hex(mesh_print) + "\n" + options;
+    const std::string zero = group.broadcast(mine);
+    if (ok && mine != zero) {
+        const std::string rank = "rank " + std::to_string(group.rank());
+        std::istringstream a(mine), b(zero);
+        std::string line_a, line_b;
+        std::getline(a, line_a);
+        std::getline(b, line_b);
+        if (line_a != line_b) {
+            problem = rank + " read another scene than rank 0: " + files.front() + " differs (fingerprint " + line_a +
+                      ", rank 0 " + line_b + ")";
+        } else if (std::getline(a, line_a), std::getline(b, line_b), line_a != line_b) {
+            problem = rank + " read other meshes than rank 0 (fingerprint " + line_a + ", rank 0 " + line_b + ")";
+        } else {
+            while (std::getline(a, line_a) && std::getline(b, line_b) && line_a == line_b) {}
+            problem = rank + " has another output option than rank 0: '" + printable(line_a, 80) + "', rank 0 '" +
+                      printable(line_b, 80) + "'";
+        }
+        problem += "; every rank must read the same scene and meshes and get the same options";
+        ok = false;
+    }
+    *error = problem;
+    return group.agree(ok ? kExitOk : kExitBadInput, error) != 0 ? kExitBadInput : kExitOk;
+}
+
+// In the order the sinks take each frame (the byte budget checks them in this order too).
+const std::vector<OutputFormat>& formatTable() {
+    static const std::vector<OutputFormat> table = {
+        {"ply", [](const RenderSettings&, const std::string& base) { return plySink(base); }},
+        {"obj", [](const RenderSettings&, const std::string& base) { return objSink(base); }},
+        {"glb",
+         [](const RenderSettings& s, const std::string& base) -> std::unique_ptr<FrameSink> {
+             return std::make_unique<GlbSink>(base + ".glb", s.glb, s.verbose);
+         }},
+    };
+    return table;
+}
+
+}  // namespace
+
+const std::vector<std::string>& outputFormats() {
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> n;
+        for (const OutputFormat& f : formatTable()) n.push_back(f.name);
+        return n;
+    }();
+    return names;
+}
+
+int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& err_out) {
+    // Under mpirun the ranks other than 0 print nothing: rank 0 speaks for the job.
+    FrameGroup& group = frameGroup();
+    const bool distributed = group.size() > 1;
+    std::ostringstream silent;
+    std::ostream& log = group.rank() == 0 ? log_out : silent;
+    std::ostream& err = group.rank() == 0 ? err_out : silent;
+    if (distributed && settings.sharded) {
+        err << "error: --shard: not under mpirun with " << group.size()
+            << " processes (the ranks already share the frames); run each shard as its own process\n";
+        return kExitBadInput;
+    }
+    // Step: the stage: scene, models, frames, meshes, mirrors (every rank loads it; all agree).
+    Stage stage;
+    std::string error;
+    StageOptions stage_options = settings.stage;
+    stage_options.quiet = settings.quiet || group.rank() > 0;
+    const bool loaded = loadStage(stage_options, &stage, err, &error);
+    if (const int code = group.agree(loaded ? kExitOk : kExitBadInput, &error)) {
+        err << "error: " << error << "\n";
+        return code;
+    }
+    if (distributed) {
+        std::string problem;
+        if (const int code = ranksAgree(group, settings, stage, &problem)) {
+            err << "error: " << problem << "\n";
+            return code;
+        }
+    }
+    uint64_t fingerprint = 0;
+    if (settings.sharded && !runFingerprint(inputFiles(stage), outputSettings(settings, stage), &fingerprint, &error)) {
+        err << "error: " << error << "\n";
+        return kExitBadInput;
+    }
+    if (settings.verbose) {
+        for (const auto& o : stage.objects) {
+            const Topology t = analyzeTopology(o.rest.positions, o.rest.triangles);
+            log << o.spec.name << ": " << t.vertices << " vertices, " << t.faces << " triangles, "
+                << (t.closed ? "closed" : (t.manifold ? "open" : "non-manifold")) << ", speed "
+                << mesh4d::norm(o.spec.velocity) << " c\n";
+        }
+    }
+    std::error_code ec;
+    // A folder this run creates is removed again when the run stops before writing into it.
+    const bool had_folder = std::filesystem::exists(settings.out_dir, ec);
+    if (group.rank() == 0) std::filesystem::create_directories(settings.out_dir, ec);
+    if (ec) {
+        err << "error: " << settings.out_dir << ": cannot create output folder: " << ec.message() << "\n";
+        return kExitOutputError;
+    }
+
+    // DIR/<model> folders of per-frame files that did not exist (seen before the ranks start: they
+    // make them too, exporters/frame_files.h)
+    std::vector<std::string> created, model_folders;
+    for (Model model : stage.models) {
+        const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
+        if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
+        model_folders.push_back(folder);
+    }
+    if (settings.sharded) {
+        const std::string shards = (std::filesystem::path(settings.out_dir) / "shards").string();
+        if (!std::filesystem::exists(shards, ec)) created.push_back(shards);
+    }
+    // Step (MPI): the ranks write their frames' data (the .glb's) and files (PLY, OBJ) themselves
+    // when rank 0 sees their files.
+    const bool glb = std::find(settings.formats.begin(), settings.formats.end(), "glb") != settings.formats.end();
+    if (distributed && !shareFrameSpills(settings.out_dir, model_folders, &error) && !settings.quiet)
+        err << "warning: " << error << "; the " << (glb ? ".glb's frame data" : "frames' files")
+            << " goes through rank 0 instead (slower)\n";
+
+    // Step: per model, the frame loop into one sink per format; the budget spans the whole run.
+    OutputBudget budget(settings.max_output_bytes);
+    FrameLoopSettings loop;
+    loop.threads = settings.threads;
+    loop.max_frame_triangles =
+        settings.max_frame_triangles > 0 ? settings.max_frame_triangles : defaultFrameTriangleBudget(stage);
+    loop.cull_view = settings.cull_view;
+    loop.progress = !settings.quiet;
+    loop.models_left = (long long)stage.models.size();
+    loop.distributed = distributed;
+    if (distributed) loop.split = FrameSplit{group.rank(), group.size()};
+    if (settings.sharded) loop.split = settings.shard;
+    for (Model model : stage.models) {
+        const std::string name = modelName(model);
+        const std::string base = (std::filesystem::path(settings.out_dir) / name).string();
+        std::vector<std::unique_ptr<FrameSink>> owned;
+        std::vector<FrameSink*> sinks;
+        for (const OutputFormat& f : formatTable()) {
+            if (std::find(settings.formats.begin(), settings.formats.end(), f.name) == settings.formats.end()) continue;
+            if (settings.sharded && f.name == "glb")
+                owned.push_back(glbShardSink(settings.out_dir, name, settings.glb, settings.shard, fingerprint,
+                                             stage.first, stage.last_excl));
+            else
+                owned.push_back(f.make(settings, base));
+            sinks.push_back(owned.back().get());
+        }
+        FrameLoopResult result;
+        // The last model needs the stage's meshes no more: its worlds take them (held once).
+        const bool ran = loop.models_left == 1
+                             ? runLastFrameLoop(&stage, model, loop, sinks, &budget, err, &result, &error)
+                             : runFrameLoop(stage, model, loop, sinks, &budget, err, &result, &error);
+        --loop.models_left;
+        if (!ran && group.rank() > 0) return result.group_code;  // rank 0 reports it
+        if (!ran) {
+            owned.clear();  // the sinks remove their temporaries
+            // Folders this run created and left empty go too (remove() takes only empty ones).
+            for (const std::string& folder : created) std::filesystem::remove(folder, ec);
+            if (!had_folder) std::filesystem::remove(settings.out_dir, ec);
+            err << "error: " << error << "\n";
+            if (result.group_code) return result.group_code;
+            return result.over_budget ? kExitBadInput : kExitOutputError;
+        }
+        // Step: the summary: the sinks' warnings and files, and the refinement limit if reached.
+        std::string summary;
+        for (const SinkSummary& s : result.summaries) {
+            summary += s.text;
+            if (!settings.quiet)
+                for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
+        }
+        // Hints instead of blanks: an object no frame shows in the camera's view (view_hints.h).
+        if (!settings.quiet && !settings.sharded)
+            for (const std::string& w : outOfViewWarnings(stage, model, frameRange(stage.first, stage.last_excl)))
+                err << "warning: " << w << "\n";
+        if (result.limited_triangles > 0 && !settings.quiet)
+            err << "warning: " << name << ": " << result.limited_triangles
+                << " triangle-frames reached the refinement limit of " << result.max_segments
+                << " segments; the tolerance " << stage.scene.tolerance * unitsPerLightSecond(stage.scene.units) << " "
+                << lengthName(stage.scene.units) << " is not met there (a coarser tolerance or a finer input mesh helps)\n";
+        if (distributed) summary += ", " + std::to_string(group.size()) + " processes shared the frames";
+        if (settings.verbose && !settings.quiet) {
+            // Where the time went (FrameLoopResult): what decides how far more processes help.
+            std::ostringstream t;
+            t.setf(std::ios::fixed);
+            t.precision(1);
+            const double wall = result.loop_seconds > 0 ? result.loop_seconds : 1;
+            auto perFrame = [](double seconds, long long frames) { return 1e3 * seconds / double(std::max(1LL, frames)); };
+            t << name << ": loop " << result.loop_seconds << " s; per frame: cut and encode "
+              << perFrame(result.cut_seconds, result.frames_cut) << " ms (CPU "
+              << perFrame(result.cut_cpu_seconds, result.frames_cut) << " ms; " << result.frames_cut
+              << " frames cut here), write " << perFrame(result.write_seconds, result.frames_written) << " ms (CPU "
+              << perFrame(result.write_cpu_seconds, result.frames_written) << " ms; " << result.frames_written
+              << " frames, " << 100 * result.write_seconds / wall << "% of the loop" << (distributed ? " on rank 0" : "")
+              << ")";
+            t << "; of the writing, the files' assembly " << 1e3 * result.finish_seconds << " ms (CPU "
+              << 1e3 * result.finish_cpu_seconds << " ms)";
+            if (distributed) t << "; rank 0 waited " << result.wait_seconds << " s for other ranks";
+            log << t.str() << "\n";
+        }
+        if (!settings.quiet)
+            log << name << ": " << (settings.sharded ? loop.split.count(stage.first, stage.last_excl) : stage.last_excl - stage.first)
+                << " frames, up to " << result.max_triangles << " triangles" << summary << "\n";
+    }
+    return kExitOk;
+}
+
+}  // namespace apparent

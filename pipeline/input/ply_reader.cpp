@@ -1,0 +1,409 @@
+#include "pipeline/input/ply_reader.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string_view>
+
+#include "pipeline/input/input_file.h"
+#include "pipeline/input/polygon_input.h"
+
+namespace apparent {
+
+namespace {
+
+
+enum class PlyFormat { Ascii, BinaryLittle, BinaryBig };
+enum class ScalarType { Int8, Uint8, Int16, Uint16, Int32, Uint32, Float32, Float64 };
+
+// The names of PLY 1.0 and the sized names most writers use (both are accepted).
+bool parseType(const std::string& s, ScalarType* t) {
+    static const std::pair<const char*, ScalarType> names[] = {
+        {"char", ScalarType::Int8},     {"int8", ScalarType::Int8},       {"uchar", ScalarType::Uint8},
+        {"uint8", ScalarType::Uint8},   {"short", ScalarType::Int16},     {"int16", ScalarType::Int16},
+        {"ushort", ScalarType::Uint16}, {"uint16", ScalarType::Uint16},   {"int", ScalarType::Int32},
+        {"int32", ScalarType::Int32},   {"uint", ScalarType::Uint32},     {"uint32", ScalarType::Uint32},
+        {"float", ScalarType::Float32}, {"float32", ScalarType::Float32}, {"double", ScalarType::Float64},
+        {"float64", ScalarType::Float64}};
+    for (const auto& [name, type] : names)
+        if (s == name) {
+            *t = type;
+            return true;
+        }
+    return false;
+}
+
+size_t typeSize(ScalarType t) {
+    switch (t) {
+        case ScalarType::Int8: case ScalarType::Uint8: return 1;
+        case ScalarType::Int16: case ScalarType::Uint16: return 2;
+        case ScalarType::Int32: case ScalarType::Uint32: case ScalarType::Float32: return 4;
+        case ScalarType::Float64: return 8;
+    }
+    return 1;
+}
+
+bool isIntegral(ScalarType t) { return t != ScalarType::Float32 && t != ScalarType::Float64; }
+
+// Range of an integral type, to refuse ascii values that would wrap in their declared type.
+void integralRange(ScalarType t, double* lo, double* hi) {
+    switch (t) {
+        case ScalarType::Int8: *lo = -128; *hi = 127; return;
+        case ScalarType::Uint8: *lo = 0; *hi = 255; return;
+        case ScalarType::Int16: *lo = -32768; *hi = 32767; return;
+        case ScalarType::Uint16: *lo = 0; *hi = 65535; return;
+        case ScalarType::Int32: *lo = -2147483648.0; *hi = 2147483647.0; return;
+        default: *lo = 0; *hi = 4294967295.0; return;
+    }
+}
+
+struct PlyProperty {
+    std::string name;
+    ScalarType type = ScalarType::Float32;  // the item type for a list
+    bool list = false;
+    ScalarType count_type = ScalarType::Uint8;
+};
+
+struct PlyElement {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> props;
+};
+
+struct PlyHeader {
+    PlyFormat format = PlyFormat::Ascii;
+    std::vector<PlyElement> elements;
+    size_t body_offset = 0;
+};
+
+std::vector<std::string> splitWords(const std::string& line) {
+    std::istringstream ls(line);
+    std::vector<std::string> words;
+    std::string w;
+    while (ls >> w) words.push_back(w);
+    return words;
+}
+
+// Parses the header lines up to `end_header`.
+bool parseHeader(const std::string& bytes, PlyHeader* h, std::string* problem) {
+    size_t pos = 0, line_no = 0;
+    bool has_format = false;
+    for (;;) {
+        const void* nl = pos < bytes.size() ? std::memchr(bytes.data() + pos, '\n', bytes.size() - pos) : nullptr;
+        if (!nl) {
+            *problem = line_no == 0 ? "header: not a PLY file (no 'ply' line)" : "header: no 'end_header' line";
+            return false;
+        }
+        const size_t next = size_t(static_cast<const char*>(nl) - bytes.data()) + 1;
+        std::string line(bytes.data() + pos, next - 1 - pos);
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        pos = next;
+        ++line_no;
+        const std::string where = "header line " + std::to_string(line_no);
+        if (line_no == 1) {
+            if (line != "ply") {
+                *problem = "header: not a PLY file (the first line is not 'ply')";
+                return false;
+            }
+            continue;
+        }
+        const std::vector<std::string> w = splitWords(line);
+        if (w.empty()) continue;
+        if (w[0] == "comment" || w[0] == "obj_info") continue;
+        if (w[0] == "end_header") {
+            if (!has_format) {
+                *problem = "header: no 'format' line";
+                return false;
+            }
+            h->body_offset = pos;
+            return true;
+        }
+        if (w[0] == "format") {
+            if (has_format || w.size() != 3 || w[2] != "1.0") {
+                *problem = where + ": format: expected one 'format ascii|binary_little_endian|binary_big_endian 1.0'";
+                return false;
+            }
+            if (w[1] == "ascii") h->format = PlyFormat::Ascii;
+            else if (w[1] == "binary_little_endian") h->format = PlyFormat::BinaryLittle;
+            else if (w[1] == "binary_big_endian") h->format = PlyFormat::BinaryBig;
+            else {
+                *problem = where + ": format: unknown format '" + w[1] + "' (ascii, binary_little_endian, binary_big_endian)";
+                return false;
+            }
+            has_format = true;
+        } else if (w[0] == "element") {
+            char* end = nullptr;
+            errno = 0;
+            const unsigned long long n = w.size() == 3 && !w[2].empty() && std::isdigit((unsigned char)w[2][0])
+                                             ? std::strtoull(w[2].c_str(), &end, 10)
+                                             : 0;
+            if (w.size() != 3 || !end || *end != '\0' || errno == ERANGE) {
+                *problem = where + ": element: expected 'element NAME COUNT' with a non-negative integer COUNT";
+                return false;
+            }
+            for (const PlyElement& e : h->elements)
+                if (e.name == w[1]) {
+                    *problem = where + ": element " + w[1] + ": defined twice";
+                    return false;
+                }
+            h->elements.push_back({w[1], uint64_t(n), {}});
+        } else if (w[0] == "property") {
+            if (h->elements.empty()) {
+                *problem = where + ": property: before any 'element' line";
+                return false;
+            }
+            PlyProperty p;
+            bool ok;
+            if (w.size() >= 2 && w[1] == "list") {
+                ok = w.size() == 5 && parseType(w[2], &p.count_type) && isIntegral(p.count_type) && parseType(w[3], &p.type);
+                p.list = true;
+                if (ok) p.name = w[4];
+            } else {
+                ok = w.size() == 3 && parseType(w[1], &p.type);
+                if (ok) p.name = w[2];
+            }
+            if (!ok) {
+                *problem = where + ": property: expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME' "
+                                   "(integer COUNT_TYPE; types char uchar short ushort int uint float double or int8 ... float64)";
+                return false;
+            }
+            for (const PlyProperty& q : h->elements.back().props)
+                if (q.name == p.name) {
+                    *problem = where + ": property " + p.name + ": defined twice in element " + h->elements.back().name;
+                    return false;
+                }
+            h->elements.back().props.push_back(p);
+        } else {
+            *problem = where + ": unknown keyword '" + w[0] + "'";
+            return false;
+        }
+    }
+}
+
+// Reads the values of the body, ascii or binary, one at a time.
+class BodyCursor {
+public:
+    BodyCursor(const std::string& bytes, size_t offset, PlyFormat format)
+        : p_(bytes.data() + offset), end_(bytes.data() + bytes.size()), format_(format) {}
+
+    size_t remaining() const { return size_t(end_ - p_); }
+
+    // Reads one value of type t into *v. Returns false with a problem when the file ends or the value is malformed.
+    bool read(ScalarType t, double* v, std::string* problem) {
+        if (format_ == PlyFormat::Ascii) return readAscii(t, v, problem);
+        const size_t n = typeSize(t);
+        if (remaining() < n) {
+            *problem = "the file ends early";
+            return false;
+        }
+        unsigned char b[8];
+        std::memcpy(b, p_, n);
+        p_ += n;
+        const bool little_host = [] {
+            const uint16_t one = 1;
+            unsigned char c;
+            std::memcpy(&c, &one, 1);
+            return c == 1;
+        }();
+        if ((format_ == PlyFormat::BinaryLittle) != little_host)
+            for (size_t i = 0; i < n / 2; ++i) std::swap(b[i], b[n - 1 - i]);
+        switch (t) {
+            case ScalarType::Int8: { int8_t x; std::memcpy(&x, b, 1); *v = x; break; }
+            case ScalarType::Uint8: { uint8_t x; std::memcpy(&x, b, 1); *v = x; break; }
+            case ScalarType::Int16: { int16_t x; std::memcpy(&x, b, 2); *v = x; break; }
+            case ScalarType::Uint16: { uint16_t x; std::memcpy(&x, b, 2); *v = x; break; }
+            case ScalarType::Int32: { int32_t x; std::memcpy(&x, b, 4); *v = x; break; }
+            case ScalarType::Uint32: { uint32_t x; std::memcpy(&x, b, 4); *v = x; break; }
+            case ScalarType::Float32: { float x; std::memcpy(&x, b, 4); *v = x; break; }
+            case ScalarType::Float64: { double x; std::memcpy(&x, b, 8); *v = x; break; }
+        }
+        return true;
+    }
+
+private:
+    bool readAscii(ScalarType t, double* v, std::string* problem) {
+        while (p_ < end_ && std::isspace((unsigned char)*p_)) ++p_;
+        const char* start = p_;
+        while (p_ < end_ && !std::isspace((unsigned char)*p_)) ++p_;
+        if (p_ == start) {
+            *problem = "the file ends early";
+            return false;
+        }
+        std::string_view token(start, size_t(p_ - start));
+        if (token.size() > 64) {
+            *problem = "value too long";
+            return false;
+        }
+        const std::string_view shown = token;
+        if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+        const char* const token_end = token.data() + token.size();
+        if (isIntegral(t)) {
+            long long x = 0;
+            const auto r = std::from_chars(token.data(), token_end, x);
+            double lo, hi;
+            integralRange(t, &lo, &hi);
+            if (r.ec != std::errc() || r.ptr != token_end || double(x) < lo || double(x) > hi) {
+                *problem = "'" + std::string(shown) + "' is not an integer in [" + std::to_string((long long)lo) + ", " +
+                           std::to_string((long long)hi) + "]";
+                return false;
+            }
+            *v = double(x);
+        } else {
+            double x = 0;
+            const auto r = std::from_chars(token.data(), token_end, x);
+            if (r.ec != std::errc() || r.ptr != token_end || !std::isfinite(x) ||
+                (t == ScalarType::Float32 && std::fabs(x) > 3.4e38)) {
+                *problem = "'" + std::string(shown) + "' is not a finite number";
+                return false;
+            }
+            *v = x;
+        }
+        return true;
+    }
+    const char* p_;
+    const char* end_;
+    PlyFormat format_;
+};
+
+// Checks the header and every value of the body, keeping the vertices and faces.
+Status scanPly(const std::string& path, const std::string& bytes, const MeshLimits& limits, ScannedMesh* scan) {
+    PlyHeader h;
+    std::string problem;
+    if (!parseHeader(bytes, &h, &problem)) return Status::failure(path + ": " + problem);
+    auto fail = [&](const std::string& field, const std::string& what) { return Status::failure(path + ": " + field + ": " + what); };
+
+    // Step: the elements we need, with the properties the mesh needs.
+    const PlyElement* vertex = nullptr;
+    const PlyElement* face = nullptr;
+    for (const PlyElement& e : h.elements) {
+        if (e.name == "vertex") vertex = &e;
+        if (e.name == "face") face = &e;
+    }
+    if (!vertex) return fail("header", "no 'element vertex'");
+    if (!face) return fail("header", "no 'element face' (a point cloud has no surface)");
+    for (const char* axis : {"x", "y", "z"}) {
+        bool found = false;
+        for (const PlyProperty& p : vertex->props) found = found || (p.name == axis && !p.list);
+        if (!found) return fail("element vertex", std::string("no scalar property '") + axis + "'");
+    }
+    int index_prop = -1;
+    for (size_t i = 0; i < face->props.size(); ++i)
+        if (face->props[i].list && (face->props[i].name == "vertex_indices" || face->props[i].name == "vertex_index")) {
+            if (!isIntegral(face->props[i].type)) return fail("element face", face->props[i].name + ": indices must be of an integer type");
+            index_prop = int(i);
+        }
+    if (index_prop < 0) return fail("element face", "no list property 'vertex_indices' (or 'vertex_index')");
+    // An apparent frame read back (exporters/ply.h): its objects' indices are not read.
+    for (const PlyProperty& p : vertex->props)
+        if (p.name == "object" && !p.list)
+            scan->warnings.push_back("element vertex: property 'object' ignored (the objects' indices of an apparent "
+                                     "frame): the file is one object here");
+
+    // Step: counts against the limits and against the file size, before anything is allocated.
+    if (vertex->count > limits.max_vertices)
+        return fail("element vertex", std::to_string(vertex->count) + " vertices, more than the limit of " +
+                                          std::to_string(limits.max_vertices) + " (raise with --max-vertices)");
+    if (face->count > limits.max_faces)
+        return fail("element face", std::to_string(face->count) + " faces, more than the limit of " +
+                                        std::to_string(limits.max_faces) + " (raise with --max-faces)");
+    const size_t body = bytes.size() - h.body_offset;
+    uint64_t needed = 0;
+    for (const PlyElement& e : h.elements) {
+        // The smallest row: binary, every scalar plus every list's count; ascii, one digit and one separator each.
+        uint64_t row = 0;
+        for (const PlyProperty& p : e.props)
+            row += h.format == PlyFormat::Ascii ? 2 : typeSize(p.list ? p.count_type : p.type);
+        if (row == 0 && e.count > 0) return fail("element " + e.name, "has rows but no properties");
+        if (row > 0 && e.count > (body - std::min<uint64_t>(needed, body)) / row)
+            return fail("element " + e.name, std::to_string(e.count) + " rows need at least " +
+                                                 std::to_string(row) + " bytes each, more than the file holds (" +
+                                                 std::to_string(body) + " bytes after the header)");
+        needed += e.count * row;
+    }
+    // Step: every value of the body, in file order, the vertices and faces kept as read.
+    auto& positions = scan->mesh.positions;
+    auto& triangles = scan->mesh.triangles;
+    positions.resize(size_t(vertex->count));  // bounded by the file size above
+    std::vector<int> vertex_axis(vertex->props.size(), -1);  // 0, 1, 2 for x, y, z; -1 for other properties
+    for (size_t pi = 0; pi < vertex->props.size(); ++pi)
+        for (int a = 0; a < 3; ++a)
+            if (!vertex->props[pi].list && vertex->props[pi].name == "xyz"[a] + std::string()) vertex_axis[pi] = a;
+    BodyCursor cur(bytes, h.body_offset, h.format);
+    std::vector<uint32_t> face_indices, sorted;
+    for (const PlyElement& e : h.elements) {
+        const bool is_vertex = &e == vertex, is_face = &e == face;
+        for (uint64_t row = 0; row < e.count; ++row) {
+            for (size_t pi = 0; pi < e.props.size(); ++pi) {
+                const PlyProperty& p = e.props[pi];
+                // Built only for a message: "face[3].vertex_indices".
+                auto field = [&] { return e.name + "[" + std::to_string(row) + "]." + p.name; };
+                double v = 0;
+                if (!cur.read(p.list ? p.count_type : p.type, &v, &problem)) return fail(field(), problem);
+                if (!p.list) {
+                    if (is_vertex && vertex_axis[pi] >= 0) {
+                        if (!(std::isfinite(v) && std::fabs(v) <= 3.0e38))
+                            return fail(field(), "not a finite number within float range (|x| <= 3e38)");
+                        mesh4d::Vec3& q = positions[size_t(row)];
+                        (vertex_axis[pi] == 0 ? q.x : vertex_axis[pi] == 1 ? q.y : q.z) = v;
+                    }
+                    continue;
+                }
+                // A list: its count, then its items (each item takes at least one byte).
+                if (v < 0 || v > double(cur.remaining()))
+                    return fail(field(), "list count " + std::to_string((long long)v) +
+                                             " is negative or longer than the rest of the file");
+                const size_t n = size_t(v);
+                const bool indices = is_face && int(pi) == index_prop;
+                if (indices) face_indices.clear();
+                for (size_t k = 0; k < n; ++k) {
+                    double item = 0;
+                    if (!cur.read(p.type, &item, &problem)) return fail(field() + "[" + std::to_string(k) + "]", problem);
+                    if (!indices) continue;
+                    if (!(item >= 0 && item < double(vertex->count)))
+                        return fail(field() + "[" + std::to_string(k) + "]", "index " + std::to_string((long long)item) +
+                                                                           " is out of range (" + std::to_string(vertex->count) + " vertices)");
+                    face_indices.push_back(uint32_t(item));
+                }
+                if (!indices) continue;
+                // Step: the face itself, as OpenMesh would take it.
+                if (n < 3) return fail(field(), "a face needs at least 3 vertices, got " + std::to_string(n));
+                sorted.assign(face_indices.begin(), face_indices.end());
+                std::sort(sorted.begin(), sorted.end());
+                if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+                    ++scan->repeated_index;
+                    continue;
+                }
+                if (triangles.size() + n - 2 > limits.max_faces)
+                    return fail(field(), "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
+                if (n > 3) scan->polygons.emplace_back(uint32_t(triangles.size()), uint32_t(n));
+                for (size_t k = 1; k + 1 < n; ++k)
+                    triangles.push_back({face_indices[0], face_indices[k], face_indices[k + 1]});
+            }
+        }
+    }
+    if (vertex->count == 0) return fail("element vertex", "no vertices");
+    if (triangles.empty()) return fail("element face", "no usable faces");
+    return Status::success();
+}
+
+}  // namespace
+
+Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
+    // Step: read the whole file (size-limited) and scan it: the bytes are read once.
+    std::string text;
+    if (Status s = readRegularFile(path, limits.max_file_bytes, &text, "mesh file"); !s.ok) return s;
+    ScannedMesh scan;
+    if (Status s = scanPly(path, text, limits, &scan); !s.ok) return s;
+    std::string().swap(text);
+    return finishScannedMesh(std::move(scan), path, mesh, warnings);
+}
+
+}  // namespace apparent

@@ -1,0 +1,144 @@
+#include "pipeline/input/polygon_input.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <OpenMesh/Core/IO/importer/ImporterT.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include "pipeline/input/mesh_check.h"
+
+namespace apparent {
+
+namespace {
+
+struct DoubleTraits : OpenMesh::DefaultTraits {
+    typedef OpenMesh::Vec3d Point;
+    typedef OpenMesh::Vec3d Normal;
+};
+typedef OpenMesh::TriMesh_ArrayKernelT<DoubleTraits> ImportMesh;
+
+// One corner's view of its triangle: the edge opposite the corner, in the triangle's orientation.
+struct LinkEdge {
+    uint32_t from, to;
+};
+
+// The link edges around one vertex form a single path or a single cycle, every `from` and every
+// `to` distinct (each directed mesh edge at the vertex used once). Sorts `link` by `from`.
+bool singleFan(LinkEdge* link, size_t n, std::vector<uint32_t>* tos) {
+    if (n <= 1) return true;
+    std::sort(link, link + n, [](const LinkEdge& a, const LinkEdge& b) { return a.from < b.from; });
+    tos->resize(n);
+    for (size_t i = 0; i < n; ++i) (*tos)[i] = link[i].to;
+    std::sort(tos->begin(), tos->end());
+    for (size_t i = 1; i < n; ++i)
+        if (link[i].from == link[i - 1].from || (*tos)[i] == (*tos)[i - 1]) return false;
+    // A path starts at a `from` that is no edge's `to`; with distinct ends there is at most one
+    // such start in a single fan, none in a closed one.
+    size_t start = n;
+    for (size_t i = 0; i < n; ++i)
+        if (!std::binary_search(tos->begin(), tos->end(), link[i].from)) {
+            if (start != n) return false;
+            start = i;
+        }
+    if (start == n) start = 0;
+    // Walk from the start; the fan is single when the walk covers every edge.
+    size_t steps = 0, at = start;
+    for (;;) {
+        ++steps;
+        const uint32_t next = link[at].to;
+        const LinkEdge* it = std::lower_bound(link, link + n, next, [](const LinkEdge& e, uint32_t v) { return e.from < v; });
+        if (it == link + n || it->from != next || size_t(it - link) == start) break;
+        at = size_t(it - link);
+        if (steps > n) return false;
+    }
+    return steps == n;
+}
+
+// The scanned faces through OpenMesh's importer, as its OBJ and PLY readers add them.
+void importWithOpenMesh(const ScannedMesh& scan, mesh4d::RestMesh* out) {
+    omerr().disable();
+    omlog().disable();
+    ImportMesh om;
+    OpenMesh::IO::ImporterT<ImportMesh> importer(om);
+    const auto& positions = scan.mesh.positions;
+    const auto& triangles = scan.mesh.triangles;
+    om.reserve(positions.size(), 3 * triangles.size(), triangles.size());
+    for (const auto& p : positions) importer.add_vertex(OpenMesh::Vec3d(p.x, p.y, p.z));
+    std::vector<OpenMesh::VertexHandle> face;
+    size_t next_polygon = 0;
+    for (size_t f = 0; f < triangles.size();) {
+        face.clear();
+        size_t corners = 3;
+        if (next_polygon < scan.polygons.size() && scan.polygons[next_polygon].first == f)
+            corners = scan.polygons[next_polygon++].second;
+        // A fan (v0, v[k], v[k+1]) gives back the polygon's corners in order.
+        face.emplace_back(int(triangles[f][0]));
+        face.emplace_back(int(triangles[f][1]));
+        for (size_t k = 0; k + 2 < corners; ++k) face.emplace_back(int(triangles[f + k][2]));
+        importer.add_face(face);
+        f += corners - 2;
+    }
+    out->positions.clear();
+    out->triangles.clear();
+    out->positions.reserve(om.n_vertices());
+    for (auto v : om.vertices()) {
+        const auto& p = om.point(v);
+        out->positions.push_back({p[0], p[1], p[2]});
+    }
+    out->triangles.reserve(om.n_faces());
+    for (auto f : om.faces()) {
+        std::array<uint32_t, 3> tri{};
+        int c = 0;
+        for (auto v : om.fv_range(f))
+            if (c < 3) tri[c++] = uint32_t(v.idx());
+        out->triangles.push_back(tri);
+    }
+}
+
+}  // namespace
+
+bool addsAsGiven(const mesh4d::RestMesh& mesh) {
+    const size_t nv = mesh.positions.size();
+    // Step: the link edges of every vertex, grouped by vertex (counting sort).
+    std::vector<uint32_t> offset(nv + 1, 0);
+    for (const auto& t : mesh.triangles)
+        for (uint32_t v : t) ++offset[v + 1];
+    for (size_t v = 0; v < nv; ++v) offset[v + 1] += offset[v];
+    std::vector<LinkEdge> link(offset[nv]);
+    {
+        std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
+        for (const auto& t : mesh.triangles)
+            for (int c = 0; c < 3; ++c) link[fill[t[c]]++] = {t[(c + 1) % 3], t[(c + 2) % 3]};
+    }
+    // Step: one fan per vertex.
+    std::vector<uint32_t> tos;
+    for (size_t v = 0; v < nv; ++v)
+        if (!singleFan(link.data() + offset[v], offset[v + 1] - offset[v], &tos)) return false;
+    return true;
+}
+
+Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
+    const size_t file_vertices = scan.mesh.positions.size();
+    const size_t scanned_triangles = scan.mesh.triangles.size();
+    warnings->polygons_triangulated += scan.polygons.size();
+    warnings->degenerate_dropped += scan.repeated_index;
+    warnings->other.insert(warnings->other.end(), scan.warnings.begin(), scan.warnings.end());
+    if (addsAsGiven(scan.mesh)) {
+        *mesh = std::move(scan.mesh);
+    } else {
+        importWithOpenMesh(scan, mesh);
+        for (const auto& tri : mesh->triangles)
+            if (tri[0] >= file_vertices || tri[1] >= file_vertices || tri[2] >= file_vertices) ++warnings->nonmanifold_split;
+        if (mesh->triangles.size() < scanned_triangles)
+            return Status::failure(path + ": OpenMesh dropped " + std::to_string(scanned_triangles - mesh->triangles.size()) +
+                                   " of " + std::to_string(scanned_triangles) + " triangles (malformed faces)");
+    }
+    warnings->degenerate_dropped += dropDegenerateTriangles(mesh);
+    if (mesh->triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
+    return Status::success();
+}
+
+}  // namespace apparent

@@ -1,0 +1,48 @@
+// What the OBJ and PLY readers share: the vertices and faces their own single-pass scanners read
+// and checked, turned into a RestMesh exactly as OpenMesh's importer would build it, without
+// paying for OpenMesh's half-edge construction when it would change nothing.
+//
+// OpenMesh (OpenMesh::IO::ImporterT) adds faces one by one; a face that would make an edge or a
+// vertex non-manifold gets copies of its vertices (appended after the file's vertices). When the
+// triangles already form an oriented manifold (every directed edge used once, the triangles
+// around each vertex one fan), OpenMesh adds every face as given, so the scanned mesh is kept
+// as is. Otherwise the scanned vertices and faces are replayed through OpenMesh's importer and
+// its result taken, with the vertices it had to copy counted as a warning. Either way
+// positions stay double, as the scanners parsed them.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mesh4d/extrude.h"
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/status.h"
+
+namespace apparent {
+
+// What a scanner read, in file order.
+struct ScannedMesh {
+    // Positions as parsed; faces fan-triangulated about their first corner, (v0, v[k], v[k+1]),
+    // as OpenMesh's triangle mesh does; faces with a repeated index already left out.
+    mesh4d::RestMesh mesh;
+    // Faces with more than 3 corners: (first triangle, corner count), in order.
+    std::vector<std::pair<uint32_t, uint32_t>> polygons;
+    size_t repeated_index = 0;  // faces left out for a repeated index (OpenMesh drops them too)
+    std::vector<std::string> warnings;  // the scanner's own, for MeshWarnings::other
+};
+
+// True when OpenMesh's importer would add every triangle of `mesh` as it is: each directed edge
+// occurs at most once and the triangles around each vertex form a single fan (open or closed).
+// Linear in the number of triangles (a few small sorts per vertex).
+bool addsAsGiven(const mesh4d::RestMesh& mesh);
+
+// The RestMesh of a scanned file: `scan` as is when addsAsGiven, else OpenMesh's importer's result
+// (non-manifold faces given their own vertices: counted; faces it could not add at all: refused,
+// "mesh.obj: OpenMesh dropped 2 of 10 triangles (malformed faces)"). Then zero-area triangles are
+// dropped with CGAL's exact predicate and counted; none left is an error.
+Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings);
+
+}  // namespace apparent

@@ -1,0 +1,68 @@
+// One frame cut into memory at any camera time, without sinks or files (the Python module,
+// python/_apparent.cpp; issue 34). The frame loop (pipeline/run/frame_loop.h) cuts its frames with the
+// same function, cutFrameAt, so a frame cut here at frameTime(k) holds the arrays the command's
+// frame k holds, value for value.
+#pragma once
+
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "exporters/frame_mesh.h"
+#include "pipeline/stage/mirror.h"
+#include "pipeline/stage/stage.h"
+
+namespace apparent {
+
+// The frame loop's per-frame step: every world cut with `view` (objects in parallel, each with its
+// own tolerance from stage.tolerances; an object outside the camera's view left empty when
+// `cull_view`), the light factors added when `light_factors`, then the mirrors' reflections
+// appended. `frame->objects` is replaced; t_c and index are the caller's.
+void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, const MirrorReflections& reflections,
+                const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings, bool cull_view,
+                bool light_factors, ExportFrame* frame);
+
+// The 4D worlds of one model built once over the stage's frame range [first, last_excl) (as the
+// frame loop builds them), then cut at any finite camera time. A time outside that range's first
+// and last frame times is cut from histories built for it alone, as the frame loop builds them for
+// a scene whose frames are one frame at that time ({start: t, fps: the scene's}: frame 0 at t), after
+// the checks loadStage applies to such a range (checkViewedTime, checkObjectMotion for the model;
+// their lines name that frame 0); the last kSpansKept of those are kept, keyed by the time.
+// cut() is const and may be called from several threads at once.
+class FrameCutter {
+public:
+    static constexpr size_t kSpansKept = 8;
+
+    // `stage` must outlive the cutter. Builds the worlds and the mirrors' reflections.
+    FrameCutter(const Stage& stage, Model model);
+    ~FrameCutter();
+
+    // The frame at camera time t_c (seconds), with light factors, the per-frame triangle budget of
+    // the frame loop (defaultFrameTriangleBudget unless max_frame_triangles > 0). False with one
+    // line when t_c is not finite, when the histories for a time outside the range fail the
+    // command's checks, or when the frame passes the budget.
+    bool cut(double t_c, long long max_frame_triangles, ExportFrame* frame, std::string* error) const;
+
+    // Names (objects, then the reflections) and colours, as the sinks are told.
+    const SequenceInfo& info() const { return info_; }
+    double firstTime() const { return t_first_; }
+    double lastTime() const { return t_last_; }
+
+private:
+    struct Histories;  // the worlds and reflections over one span of camera times
+    // The histories that cover t_c: the frame range's, or those built (or kept) for t_c alone.
+    std::shared_ptr<const Histories> historiesFor(double t_c, std::string* error) const;
+
+    const Stage& stage_;
+    Model model_;
+    std::shared_ptr<const Histories> range_;
+    SequenceInfo info_;
+    double t_first_ = 0, t_last_ = 0;
+    mutable std::mutex mutex_;
+    mutable std::deque<std::pair<double, std::shared_ptr<const Histories>>> spans_;  // newest last
+};
+
+}  // namespace apparent
