@@ -17,6 +17,7 @@
 
 #include "exporters/frame_sink.h"
 #include "pipeline/run/distribute.h"
+#include "pipeline/stage/frame_cut.h"
 #include "pipeline/stage/stage.h"
 #include "pipeline/stage/worlds.h"
 
@@ -42,17 +43,6 @@ private:
     long long limit_;
     long long written_ = 0;
 };
-
-// Triangles one frame may hold (objects and reflections together) unless --max-triangles says
-// otherwise: 4 x the scene's input triangles (objects x (1 + mirrors); vertex mode's frame holds at
-// most the input plus the pieces of clipped triangles, which this covers), and never less than
-// kMinFrameTriangleBudget, so that refinement has room. The budget bounds memory: the frame loop
-// holds at most threads + 1 frames, and a refined frame costs a few hundred bytes per
-// output triangle at its peak (measured: `/usr/bin/time -f %M` on a budget-stopped run,
-// docs/HOSTILE_INPUT.md), so a run the default budget stops on a small input stays under 500 MB on the
-// 2-core machine those figures come from.
-constexpr long long kMinFrameTriangleBudget = 500'000;
-long long defaultFrameTriangleBudget(const Stage& stage);
 
 struct FrameLoopSettings {
     int threads = 0;         // worker threads; 0: all cores
@@ -94,10 +84,6 @@ struct FrameLoopResult {
     double finish_seconds = 0, finish_cpu_seconds = 0;
     long long frames_cut = 0, frames_written = 0;
 };
-
-// What the sinks are told about the sequence of `model`: objects (then the reflections, see
-// MirrorReflections::describe), camera, fps, tolerance, scene file.
-SequenceInfo sequenceInfo(const Stage& stage, Model model);
 
 // Runs frames [stage.first, stage.last_excl) of `model` into `sinks` (in that order per frame).
 // Returns false with one line (naming the file) when an output cannot be written or the budget is

@@ -8,11 +8,53 @@
 #include "mesh4d/check.h"
 #include "mesh4d/light_factors.h"
 #include "pipeline/input/scene_fields.h"
-#include "pipeline/run/frame_loop.h"
 #include "pipeline/stage/physics.h"
 #include "pipeline/stage/worlds.h"
 
 namespace apparent {
+
+long long defaultFrameTriangleBudget(const Stage& stage) {
+    long long input = 0;
+    for (const PreparedObject& o : stage.objects) input += (long long)o.rest.triangles.size();
+    input *= 1 + (long long)stage.mirrors.size();
+    return std::max(kMinFrameTriangleBudget, 4 * input);
+}
+
+SequenceInfo sequenceInfo(const Stage& stage, Model model) {
+    const Scene& scene = stage.scene;
+    SequenceInfo info;
+    info.model = modelName(model);
+    const double u = unitsPerLightSecond(scene.units);  // the outputs' lengths (cutFrameAt)
+    info.tolerance = scene.tolerance * u;
+    info.units = unitsText(scene.units);
+    info.fps = scene.frames.fps;
+    info.scene_path = scene.path;
+    for (size_t i = 0; i < stage.objects.size(); ++i) {
+        ExportObject o;
+        o.name = stage.objects[i].spec.name;
+        o.base_color = objectBaseColor(stage.objects, i);
+        o.metallic = stage.objects[i].spec.material.metallic;
+        o.roughness = stage.objects[i].spec.material.roughness;
+        o.emissive = stage.objects[i].spec.material.emissive;
+        if (stage.objects[i].look) {
+            o.look = stage.objects[i].look;
+            o.rest = std::make_shared<const mesh4d::RestMesh>(stage.objects[i].rest);
+        }
+        info.objects.push_back(o);
+    }
+    info.camera.position = scene.camera.position * u;
+    info.camera.look_at = scene.camera.look_at * u;
+    info.camera.up = scene.camera.up;
+    info.camera.fov_deg = scene.camera.fov_deg;
+    if (scene.camera.orthographic()) info.camera.width = scene.camera.width;
+    info.light.point = scene.light.kind == LightSpec::Kind::Point;
+    info.light.position = scene.light.position * u;
+    info.light.direction = scene.light.direction;
+    info.light.ambient = scene.light.ambient;
+    info.light.key_direction = scene.light.key_direction;
+    info.light.key_weight = scene.light.key_weight;
+    return info;
+}
 
 void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, const MirrorReflections& reflections,
                 const mesh4d::ViewSurface& view, const mesh4d::SliceSettings& settings, bool cull_view,

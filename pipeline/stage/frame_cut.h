@@ -17,6 +17,21 @@
 
 namespace apparent {
 
+// Triangles one frame may hold (objects and reflections together) unless --max-triangles says
+// otherwise: 4 x the scene's input triangles (objects x (1 + mirrors); vertex mode's frame holds at
+// most the input plus the pieces of clipped triangles, which this covers), and never less than
+// kMinFrameTriangleBudget, so that refinement has room. The budget bounds memory: the frame loop
+// holds at most threads + 1 frames, and a refined frame costs a few hundred bytes per
+// output triangle at its peak (measured: `/usr/bin/time -f %M` on a budget-stopped run,
+// docs/HOSTILE_INPUT.md), so a run the default budget stops on a small input stays under 500 MB on the
+// 2-core machine those figures come from.
+constexpr long long kMinFrameTriangleBudget = 500'000;
+long long defaultFrameTriangleBudget(const Stage& stage);
+
+// What the sinks are told about the sequence of `model`: objects (then the reflections, see
+// MirrorReflections::describe), camera, fps, tolerance, scene file.
+SequenceInfo sequenceInfo(const Stage& stage, Model model);
+
 // The frame loop's per-frame step: every world cut with `view` (objects in parallel, each with its
 // own tolerance from stage.tolerances; an object outside the camera's view left empty when
 // `cull_view`), the light factors added when `light_factors`, then the mirrors' reflections
