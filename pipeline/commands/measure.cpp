@@ -4,9 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <ostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
 
 #include "mesh4d/angles.h"
+#include "pipeline/commands/command.h"
 #include "pipeline/input/scene_fields.h"
 #include "pipeline/stage/frame_cut.h"
 
@@ -212,5 +217,49 @@ int measure(const MeasureSettings& settings, std::ostream& out, std::ostream& er
     }
     return kExitOk;
 }
+
+
+// ---- The command: `apparent measure` ----
+
+namespace {
+
+class MeasureCommand : public Command {
+public:
+    CLI::App* add(CLI::App* app) override {
+        cmd = app->add_subcommand(
+            "measure", "Measure the apparent shapes: extent, the rotation of faces about the view's up axis, outline roundness");
+        cmd->add_option("scene", mss.stage.scene_path, "Scene file (JSON or glTF)")->required();
+        cmd->add_option("--model", measure_model_text, "Model, comma list or all (default: the scene's model)");
+        cmd->add_option("--frames", measure_frames_text, "A:B measures frames A..B-1 (default: 5 frames spread over the scene)");
+        cmd->add_option("--marker", mss.marker, "An object whose apparent position is given relative to the others' outlines");
+        cmd->add_flag("--quiet,-q", mss.quiet, "Only the table");
+        addStageLimits(cmd, &mss.stage);
+        cmd->footer(
+            "Prints per model, frame and object (tab-separated): apparent points, the image extent (orthographic: scene\n"
+            "units on the image plane; perspective: the tangent plane at distance 1), the lab bounding box, the rotation\n"
+            "about the view's up axis fitted to the projected areas of the faces (degrees; residual; scale, 1 for a pure\n"
+            "turn), the outline's largest radius (rim) and roundness (largest over smallest radius). With --marker NAME,\n"
+            "NAME's position as a fraction of each other object's rim radius. docs/PICTURES.md, \"Measuring a picture\".");
+        return cmd;
+    }
+
+    int run(std::ostream& out, std::ostream& err) override {
+        if (std::string message; !parseModelList(measure_model_text, &mss.stage, &message)) return usageError(err, message);
+        if (!measure_frames_text.empty() && !parseFrames(measure_frames_text, &mss.stage.frame_from, &mss.stage.frame_to))
+            return usageError(err, "--frames: '" + measure_frames_text + "' is not A:B with 0 <= A < B");
+        mss.has_frames = !measure_frames_text.empty();
+        mss.stage.quiet = mss.quiet;
+        return guarded([&] { return measure(mss, out, err); }, err);
+    }
+
+private:
+    MeasureSettings mss;
+    std::string measure_model_text, measure_frames_text;
+    CLI::App* cmd = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> measureCommand() { return std::make_unique<MeasureCommand>(); }
 
 }  // namespace apparent

@@ -6,12 +6,16 @@
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
+#include <memory>
 #include <ostream>
 #include <sstream>
+#include <string>
 
+#include <CLI/CLI.hpp>
 #include <tbb/task_arena.h>
 
 #include "exporters/video.h"
+#include "pipeline/commands/command.h"
 #include "pipeline/run/distribute.h"
 #include "pipeline/stage/view_hints.h"
 
@@ -138,5 +142,75 @@ int raytrace(const RaytraceSettings& settings, std::ostream& log_out, std::ostre
     }
     return kExitOk;
 }
+
+
+// ---- The command: `apparent raytrace` ----
+
+namespace {
+
+class RaytraceCommand : public Command {
+public:
+    CLI::App* add(CLI::App* app) override {
+        cmd = app->add_subcommand("raytrace", "Ray-trace the 4D histories into PNG frames DIR/<model>/frame_NNNNN.png and/or an MP4 video");
+        cmd->add_option("scene", ts.stage.scene_path, "Scene file (JSON or glTF)")->required();
+        cmd->add_option("--out", ts.out_dir, "Output folder (created if missing)")->capture_default_str();
+        cmd->add_option("--model", trace_model_text, "instant|finite|relativistic|contracted|all, or a comma list");
+        cmd->add_option("--size", trace_size_text, "Image size WxH (default 480x270)");
+        cmd->add_option("--frames", trace_frames_text, "A:B traces global frames A..B-1");
+        cmd->add_option("--threads", ts.threads, "Worker threads (0: all cores)")->capture_default_str();
+        cmd->add_option("--video", ts.video_path,
+                        "Also (or, without --out, only) an H.264 MP4 of the frames at the scene's fps, one model; needs ffmpeg");
+        cmd->add_option("--shade", trace_shade_text,
+                        "plain (default) or doppler: colours shifted by the Doppler factor and scaled by the "
+                        "searchlight factor, as render --shade doppler bakes them");
+        cmd->add_option("--samples", ts.samples,
+                        "Rays per pixel, a square (1, 4, 9, ..., 256): the centres of a grid of equal strata, "
+                        "averaged in linear light; 1: one ray through the pixel centre")
+            ->capture_default_str();
+        cmd->add_option("--gate", ts.gate,
+                        "The Vienna experiment's gated camera (finite, relativistic): exposures of light-path slices "
+                        "DEPTH deep (scene units), each showing the objects at its own time");
+        cmd->add_flag("--quiet,-q", ts.quiet, "No summary, no progress");
+        addStageLimits(cmd, &ts.stage);
+        cmd->add_option("--max-slab-memory", ts.max_slab_memory,
+                        "Memory for one window of time slabs (spinning, accelerated, keyframed objects), bytes; "
+                        "a frame that needs more is refused before they are built")
+            ->capture_default_str();
+        cmd->footer(
+            "Examples:\n"
+            "  apparent raytrace data/scenes/flanges.json --out frames --model all --frames 80:120\n"
+            "  apparent raytrace data/scenes/terrell_cube.json --model relativistic --video cube.mp4\n"
+            "--video needs the ffmpeg program in PATH. Progress goes to stderr unless --quiet.");
+        return cmd;
+    }
+
+    int run(std::ostream& out, std::ostream& err) override {
+        if (std::string message; !parseModelList(trace_model_text, &ts.stage, &message)) return usageError(err, message);
+        if (!trace_size_text.empty() && !parseSize(trace_size_text, &ts.width, &ts.height))
+            return usageError(err, "--size: '" + trace_size_text + "' is not WxH with W and H in 1..16384");
+        if (!trace_frames_text.empty() && !parseFrames(trace_frames_text, &ts.stage.frame_from, &ts.stage.frame_to))
+            return usageError(err, "--frames: '" + trace_frames_text + "' is not A:B with 0 <= A < B");
+        if (!trace_shade_text.empty() && trace_shade_text != "plain" && trace_shade_text != "doppler")
+            return usageError(err, "--shade: unknown shading '" + trace_shade_text + "' (plain, doppler)");
+        ts.shade_doppler = trace_shade_text == "doppler";
+        if (samplesSide(ts.samples) == 0) return usageError(err, samplesProblem(ts.samples));
+        if (ts.threads < 0 || ts.threads > kMaxThreads) return usageError(err, threadsProblem(ts.threads));
+        if (ts.stage.max_frames <= 0) return usageError(err, "--max-frames: must be positive");
+        if (ts.max_slab_memory < kTraceBytesPerPrism)
+            return usageError(err, "--max-slab-memory: " + std::to_string(ts.max_slab_memory) + " bytes, less than one prism's " +
+                         std::to_string(kTraceBytesPerPrism));
+        ts.write_png = ts.video_path.empty() || cmd->count("--out") > 0;
+        return guarded([&] { return raytrace(ts, out, err); }, err);
+    }
+
+private:
+    RaytraceSettings ts;
+    std::string trace_model_text, trace_size_text, trace_frames_text, trace_shade_text;
+    CLI::App* cmd = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> raytraceCommand() { return std::make_unique<RaytraceCommand>(); }
 
 }  // namespace apparent

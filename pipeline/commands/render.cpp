@@ -6,12 +6,19 @@
 #include <memory>
 #include <ostream>
 #include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
 
 #include "exporters/obj.h"
 #include "exporters/ply.h"
+#include "pipeline/commands/command.h"
 #include "pipeline/input/json_limits.h"
 #include "pipeline/input/mesh_check.h"
+#include "pipeline/input/scene_fields.h"
+#include "pipeline/run/shard_header.h"
 #include "pipeline/run/shards.h"
+#include "pipeline/stage/frame_cut.h"
 #include "pipeline/stage/view_hints.h"
 
 namespace apparent {
@@ -282,5 +289,185 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
     }
     return kExitOk;
 }
+
+
+// ---- The command: `apparent render` ----
+
+namespace {
+
+constexpr const char* kRenderFooter =
+    "Models:\n"
+    "  instant       infinite light speed: every object where it is at the frame time\n"
+    "  finite        finite light speed, Galilean objects (classical aberration only)\n"
+    "  relativistic  finite light speed, Lorentz-boosted objects (what special relativity shows)\n"
+    "  contracted    the Lorentz-contracted shape at the frame time (measured, never seen)\n"
+    "Outputs in DIR:\n"
+    "  <model>.glb                      one animated glTF holding every frame (STEP scale channels)\n"
+    "  <model>/frame_NNNNN.ply|.obj     per frame, all objects; PLY vertex 'quality' = emission time\n"
+    "Exit codes: 0 success, 1 internal error, 2 bad usage or bad input, 3 output could not be written.";
+
+class RenderCommand : public Command {
+public:
+    CLI::App* add(CLI::App* app) override {
+        cmd = app->add_subcommand("render", "Render a scene's apparent shapes into DIR");
+        cmd->add_option("scene", rs.stage.scene_path,
+                        "Scene file: JSON (.json, README 'Scene format') or glTF (.gltf or .glb with object "
+                        "fields in node extras, README 'Scenes in glTF')")
+            ->required();
+        cmd->add_option("--out", rs.out_dir, "Output folder (created if missing)")->capture_default_str();
+        cmd->add_option("--model", model_text,
+                        "instant|finite|relativistic|contracted|all, or a comma list (default: the scene's model)");
+        cmd->add_option("--format", format_text, "Comma list of glb, ply, obj")->capture_default_str();
+        cmd->add_option("--tolerance", tolerance_text,
+                        "Largest distance between output and exact apparent surface (overrides the scene's): "
+                        "T light-seconds; Fx, F times each object's bounding-box diagonal (default 1e-3x); "
+                        "or 'vertex': exact vertices joined by straight edges, no refinement");
+        cmd->add_option("--attribute-tolerance", attribute_tolerance_text,
+                        "Also bound the parametric error, each output point against the exact image of its own "
+                        "rest point (where a texture or an emission time lands): A light-seconds or Fx; default: "
+                        "none, only the distance --tolerance is bounded (faces that contain the velocity stay "
+                        "coarse inside)");
+        cmd->add_option("--frames", frames_text, "A:B renders global frames A..B-1 (either end may be omitted)");
+        cmd->add_option("--compress", compress_text,
+                        "Compression of the .glb's frame meshes: draco (KHR_draco_mesh_compression; Blender reads "
+                        "it), meshopt (EXT_meshopt_compression + KHR_mesh_quantization, smallest; web viewers) or "
+                        "none (default)");
+        cmd->add_flag("--draco", rs.glb.draco, "Same as --compress draco");
+        cmd->add_option("--meshopt-bits", rs.glb.meshopt_bits,
+                        "meshopt position bits over each frame's extent (2-16; default: a step following the "
+                        "tolerance, 14 bits in vertex mode)");
+        cmd->add_option("--attributes", attributes_text,
+                        "Comma list of extra per-vertex .glb attributes: doppler (_DOPPLER, received over emitted "
+                        "frequency), proper_time (_PROPER_TIME, the object's clock at emission); PLY frames always "
+                        "hold both");
+        cmd->add_option("--shade", shade_text,
+                        "plain (default: each material's colour) or doppler (COLOR_0 per vertex: the base colour "
+                        "shifted by the Doppler factor and brightened by the searchlight factor; README 'Doppler "
+                        "colours')");
+        cmd->add_option("--draco-bits", rs.glb.position_bits, "Draco position quantization bits (1-30)")
+            ->capture_default_str();
+        cmd->add_option("--draco-texcoord-bits", rs.glb.texcoord_bits,
+                        "Draco texture-coordinate quantization bits (1-30; input glTF TEXCOORD_0)")
+            ->capture_default_str();
+        cmd->add_option("--threads", rs.threads, "Worker threads for the frame loop (0: all cores); "
+                        "output is byte-identical for any count")->capture_default_str();
+        cmd->add_flag("--cull-view", rs.cull_view,
+                      "Leave objects wholly outside the camera's view empty in that frame (faster; "
+                      "the files then show only what the camera sees)");
+        cmd->add_flag("--quiet,-q", rs.quiet, "No progress or summary");
+        cmd->add_flag("--verbose,-v", rs.verbose, "Mesh topology and export precision");
+        cmd->add_option("--max-vertices", max_vertices, "Refuse meshes with more vertices")->capture_default_str();
+        cmd->add_option("--max-faces", max_faces, "Refuse meshes with more faces")->capture_default_str();
+        cmd->add_option("--max-file-bytes", max_file_bytes, "Refuse mesh files (and glTF buffers) larger than this")
+            ->capture_default_str();
+        cmd->add_option("--max-triangles", rs.max_frame_triangles,
+                        "Stop with exit code 2 when one frame's refinement would make more triangles than this "
+                        "(a --tolerance too fine for the scene); default: 4 x the scene's input triangles "
+                        "(objects x (1 + mirrors)), at least " + std::to_string(kMinFrameTriangleBudget));
+        cmd->add_option("--max-output-bytes", rs.max_output_bytes,
+                        "Stop with exit code 3 before the outputs would exceed this many bytes in all "
+                        "(estimated from the first frames before writing anything; 0: no limit)")
+            ->capture_default_str();
+        cmd->add_option("--shard", shard_text,
+                        "I/N: render part I (0..N-1) of N of the frames, as one task of a job array: frames k "
+                        "with k - first = I mod N; PLY/OBJ frames to their final names, the .glb's frames into "
+                        "DIR/shards/<model>.I-of-N.shard for 'apparent merge DIR'");
+        addStageLimits(cmd, &rs.stage);
+        cmd->footer(kRenderFooter);
+        return cmd;
+    }
+
+    int run(std::ostream& out, std::ostream& err) override {
+        if (!shard_text.empty()) {
+            if (!parseShard(shard_text, &rs.shard))
+                return usageError(err, "--shard: '" + shard_text + "' is not I/N with 0 <= I < N <= " + std::to_string(kMaxShards));
+            rs.sharded = true;
+        }
+        if (std::string message; !parseModelList(model_text, &rs.stage, &message)) return usageError(err, message);
+        rs.formats.clear();
+        {
+            const std::vector<std::string>& known = outputFormats();
+            std::string names;  // "ply, obj, glb"
+            for (const std::string& n : known) names += (names.empty() ? "" : ", ") + n;
+            std::stringstream ss(format_text);
+            std::string item;
+            while (std::getline(ss, item, ',')) {
+                if (std::find(known.begin(), known.end(), item) == known.end())
+                    return usageError(err, "--format: unknown format '" + item + "' (" + names + ")");
+                if (std::find(rs.formats.begin(), rs.formats.end(), item) == rs.formats.end()) rs.formats.push_back(item);
+            }
+            if (rs.formats.empty()) return usageError(err, "--format: no format given (" + names + ")");
+        }
+        if (!tolerance_text.empty()) {
+            if (!parseTolerance(tolerance_text, &rs.stage.tolerance, &rs.stage.tolerance_relative))
+                return usageError(err, "--tolerance: '" + tolerance_text +
+                             "' is neither a positive number of light-seconds, a fraction of each object's size such as "
+                             "1e-3x, nor 'vertex'");
+            rs.stage.has_tolerance = true;
+        }
+        if (!attribute_tolerance_text.empty() &&
+            (!parseTolerance(attribute_tolerance_text, &rs.stage.attribute_tolerance, &rs.stage.attribute_tolerance_relative) ||
+             (rs.stage.attribute_tolerance <= 0 && rs.stage.attribute_tolerance_relative <= 0)))
+            return usageError(err, "--attribute-tolerance: '" + attribute_tolerance_text +
+                         "' is neither a positive number of light-seconds nor a fraction of each object's size such as 1e-3x");
+        if (!frames_text.empty() && !parseFrames(frames_text, &rs.stage.frame_from, &rs.stage.frame_to))
+            return usageError(err, "--frames: '" + frames_text + "' is not A:B with 0 <= A < B");
+        if (!compress_text.empty()) {
+            if (compress_text != "draco" && compress_text != "meshopt" && compress_text != "none")
+                return usageError(err, "--compress: unknown compression '" + compress_text + "' (draco, meshopt, none)");
+            if (rs.glb.draco && compress_text != "draco")
+                return usageError(err, "--draco and --compress " + compress_text + " contradict each other");
+            rs.glb.draco = compress_text == "draco";
+            rs.glb.meshopt = compress_text == "meshopt";
+        }
+        if (!attributes_text.empty()) {
+            std::stringstream ss(attributes_text);
+            std::string item;
+            while (std::getline(ss, item, ',')) {
+                if (item == "doppler") rs.glb.doppler = true;
+                else if (item == "proper_time") rs.glb.proper_time = true;
+                else return usageError(err, "--attributes: unknown attribute '" + item + "' (doppler, proper_time)");
+            }
+        }
+        if (!shade_text.empty()) {
+            if (shade_text != "plain" && shade_text != "doppler")
+                return usageError(err, "--shade: unknown shading '" + shade_text + "' (plain, doppler)");
+            rs.glb.shade_doppler = shade_text == "doppler";
+            if (rs.glb.shade_doppler && std::find(rs.formats.begin(), rs.formats.end(), "glb") == rs.formats.end())
+                return usageError(err, "--shade doppler: colours go into the .glb only (add glb to --format; the PLY frames hold "
+                             "the doppler factor itself)");
+        }
+        if (rs.glb.meshopt_bits != 0 && (rs.glb.meshopt_bits < 2 || rs.glb.meshopt_bits > 16))
+            return usageError(err, "--meshopt-bits: " + std::to_string(rs.glb.meshopt_bits) + " is outside 2..16");
+        if (rs.glb.meshopt_bits != 0 && !rs.glb.meshopt) return usageError(err, "--meshopt-bits needs --compress meshopt");
+        if (rs.glb.position_bits < 1 || rs.glb.position_bits > 30)
+            return usageError(err, "--draco-bits: " + std::to_string(rs.glb.position_bits) + " is outside 1..30");
+        if (rs.glb.texcoord_bits < 1 || rs.glb.texcoord_bits > 30)
+            return usageError(err, "--draco-texcoord-bits: " + std::to_string(rs.glb.texcoord_bits) + " is outside 1..30");
+        if (cmd->count("--draco-texcoord-bits") > 0 && !rs.glb.draco)
+            return usageError(err, "--draco-texcoord-bits needs --compress draco");
+        if (rs.threads < 0 || rs.threads > kMaxThreads) return usageError(err, threadsProblem(rs.threads));
+        if (rs.max_frame_triangles < 0) return usageError(err, "--max-triangles: must be 0 (the default budget) or positive");
+        if (max_vertices <= 0 || max_faces <= 0 || rs.stage.max_frames <= 0 || max_file_bytes <= 0)
+            return usageError(err, "--max-vertices, --max-faces, --max-frames and --max-file-bytes must be positive");
+        if (rs.max_output_bytes < 0) return usageError(err, "--max-output-bytes: must be positive, or 0 for no limit");
+        rs.stage.limits.max_vertices = size_t(max_vertices);
+        rs.stage.limits.max_faces = size_t(max_faces);
+        rs.stage.limits.max_file_bytes = size_t(max_file_bytes);
+        return guarded([&] { return render(rs, out, err); }, err);
+    }
+
+private:
+    RenderSettings rs;
+    std::string model_text, format_text = "glb", frames_text, tolerance_text, attribute_tolerance_text, compress_text,
+        attributes_text, shade_text, shard_text;
+    long long max_vertices = (long long)rs.stage.limits.max_vertices, max_faces = (long long)rs.stage.limits.max_faces,
+              max_file_bytes = (long long)rs.stage.limits.max_file_bytes;
+    CLI::App* cmd = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> renderCommand() { return std::make_unique<RenderCommand>(); }
 
 }  // namespace apparent

@@ -7,9 +7,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
+#include <memory>
 #include <ostream>
 #include <sstream>
+#include <string>
 #include <unistd.h>
+
+#include <CLI/CLI.hpp>
 
 #include "exporters/atomic_file.h"
 #include "exporters/gltf.h"
@@ -17,6 +21,7 @@
 #include "mesh4d/motion/worldline.h"
 #include "mesh4d/refine/measure.h"
 #include "mesh4d/refine/subdivide.h"
+#include "pipeline/commands/command.h"
 #include "pipeline/run/frame_loop.h"
 #include "pipeline/stage/physics.h"
 #include "pipeline/stage/worlds.h"
@@ -317,5 +322,71 @@ int trade(const TradeSettings& settings, std::ostream& out, std::ostream& err) {
     if (!settings.quiet) err << "wrote " << csv_path << " and " << settings.out_dir << "/trade.png\n";
     return kExitOk;
 }
+
+
+// ---- The command: `apparent trade` ----
+
+namespace {
+
+class TradeCommand : public Command {
+public:
+    CLI::App* add(CLI::App* app) override {
+        cmd = app->add_subcommand(
+            "trade", "Measure error against time and size on a scene: vertex mode, uniform subdivision, a ladder of tolerances");
+        cmd->add_option("scene", trs.stage.scene_path, "Scene file (JSON or glTF)")->required();
+        cmd->add_option("--out", trs.out_dir, "Folder for trade.csv, trade.png and trade.gp (created if missing)")
+            ->capture_default_str();
+        cmd->add_option("--model", trade_model_text, "finite|relativistic (default: the scene's model)");
+        cmd->add_option("--frames", trade_frames_text, "A:B measures frames A..B-1 (default: 5 frames spread over the scene)");
+        cmd->add_option("--levels", trs.levels, "Uniform subdivision levels 1..N to compare")->capture_default_str();
+        cmd->add_option("--tolerances", trade_tolerances_text,
+                        "Comma list of tolerances relative to the largest moving object's size (default 1e-1,3e-2,...,1e-4)");
+        cmd->add_option("--max-triangles", trs.max_triangles, "Skip rows with more output triangles per frame")
+            ->capture_default_str();
+        cmd->add_flag("--quiet,-q", trs.quiet, "Only the table");
+        addStageLimits(cmd, &trs.stage);
+        cmd->footer(
+            "Prints, for each row: the measured two-sided error to the exact apparent surface (sampled as the tests do),\n"
+            "output triangles per frame, cut and .glb-conversion time per frame (one thread, its CPU time) and .glb bytes\n"
+            "per frame; "
+            "writes DIR/trade.csv and, with gnuplot, DIR/trade.png. Names the tolerance with the least time for vertex\n"
+            "mode's error and for a tenth of it. Size: the largest moving object's bounding-box diagonal.");
+        return cmd;
+    }
+
+    int run(std::ostream& out, std::ostream& err) override {
+        if (std::string message; !parseModelList(trade_model_text, &trs.stage, &message)) return usageError(err, message);
+        if (!trade_frames_text.empty() && !parseFrames(trade_frames_text, &trs.stage.frame_from, &trs.stage.frame_to))
+            return usageError(err, "--frames: '" + trade_frames_text + "' is not A:B with 0 <= A < B");
+        trs.has_frames = !trade_frames_text.empty();
+        trs.stage.quiet = trs.quiet;
+        if (trs.levels < 0 || trs.levels > 8) return usageError(err, "--levels: must be in 0..8");
+        if (trs.max_triangles <= 0) return usageError(err, "--max-triangles: must be positive");
+        std::stringstream ss(trade_tolerances_text);
+        std::string item;
+        while (!trade_tolerances_text.empty() && std::getline(ss, item, ',')) {
+            size_t used = 0;
+            double t = 0;
+            try {
+                t = std::stod(item, &used);
+            } catch (...) {
+                used = 0;
+            }
+            if (used != item.size() || !(t > 0) || !(t < 1e3))
+                return usageError(err, "--tolerances: '" + item + "' is not a positive number (a fraction of the object size)");
+            trs.tolerances_rel.push_back(t);
+        }
+        return guarded([&] { return trade(trs, out, err); }, err);
+    }
+
+private:
+    TradeSettings trs;
+    std::string trade_model_text, trade_frames_text, trade_tolerances_text;
+    CLI::App* cmd = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> tradeCommand() { return std::make_unique<TradeCommand>(); }
 
 }  // namespace apparent
