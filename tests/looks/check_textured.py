@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Checks a .glb that `apparent render` made of tests/looks/make_textured_box.py's box (standard library only).
 
-usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ [--shade-doppler]
+usage: check_textured.py OUT.glb INPUT PX PY PZ VX VY VZ RX RY RZ [--shade-doppler]
+  INPUT: make_textured_box.py's .glb, or make_textured_obj.py's EXPECTED.json (the OBJ box: its
+  materials must equal the JSON's whole, the image the PNG file's bytes; it has no COLOR_0).
   P the box's position at t = 0, V its velocity (relativistic model, t0 = 0), R its rotation_deg (X then
   Y then Z). For every vertex of every frame: its rest point follows from its position and emission time
   in closed form (the inverse Lorentz boost of the uniform motion, then the inverse rotation), lies on a
@@ -13,6 +15,7 @@ usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ [--shade-d
 """
 import json
 import math
+import os
 import struct
 import sys
 
@@ -65,20 +68,29 @@ def rot_xyz(deg):
 
 def main(out, inp, p, v, r, shade=False):
     doc, binary = read_glb(out)
-    idoc, ibin = read_glb(inp)
     fails = []
-    # Materials: the input's, in first-use order (here the input's order), factors equal.
-    if [m.get("pbrMetallicRoughness") for m in doc["materials"]] != [m.get("pbrMetallicRoughness") for m in idoc["materials"]]:
-        fails.append("materials differ: %s" % doc["materials"])
+    colors = True
+    if inp.endswith(".json"):
+        # make_textured_obj.py's EXPECTED.json: the whole materials, the image file, no COLOR_0.
+        expected = json.load(open(inp))
+        if doc["materials"] != expected["materials"]:
+            fails.append("materials differ: %s" % doc["materials"])
+        want_image = open(os.path.join(os.path.dirname(inp), expected["image"]), "rb").read()
+        colors = expected.get("colors", True)
+    else:
+        idoc, ibin = read_glb(inp)
+        # Materials: the input's, in first-use order (here the input's order), factors equal.
+        if [m.get("pbrMetallicRoughness") for m in doc["materials"]] != [m.get("pbrMetallicRoughness") for m in idoc["materials"]]:
+            fails.append("materials differ: %s" % doc["materials"])
+        ivi = idoc["bufferViews"][idoc["images"][0]["bufferView"]]
+        want_image = ibin[ivi.get("byteOffset", 0):ivi.get("byteOffset", 0) + ivi["byteLength"]]
     if len(doc.get("images", [])) != 1:
         fails.append("images: %d, expected 1" % len(doc.get("images", [])))
     else:
         iv = doc["bufferViews"][doc["images"][0]["bufferView"]]
         image = binary[iv.get("byteOffset", 0):iv.get("byteOffset", 0) + iv["byteLength"]]
-        ivi = idoc["bufferViews"][idoc["images"][0]["bufferView"]]
-        if image != ibin[ivi.get("byteOffset", 0):ivi.get("byteOffset", 0) + ivi["byteLength"]]:
+        if image != want_image:
             fails.append("the image's bytes differ from the input's")
-    views_of_image = sum(1 for v_ in doc["bufferViews"] if v_["byteLength"] == ivi["byteLength"])
     R = rot_xyz(r)
     b2 = sum(x * x for x in v)
     g = 1 / math.sqrt(1 - b2)
@@ -95,7 +107,9 @@ def main(out, inp, p, v, r, shade=False):
             pos = accessor(doc, binary, prim["attributes"]["POSITION"])
             tim = accessor(doc, binary, prim["attributes"]["_EMISSION_TIME"])
             uv = accessor(doc, binary, prim["attributes"]["TEXCOORD_0"])
-            col = accessor(doc, binary, prim["attributes"]["COLOR_0"])
+            col = accessor(doc, binary, prim["attributes"]["COLOR_0"]) if colors else None
+            if not colors and "COLOR_0" in prim["attributes"]:
+                fails.append("COLOR_0 where the input has none")
             dop = accessor(doc, binary, prim["attributes"]["_DOPPLER"]) if shade else None
             used = sorted({i for (i,) in accessor(doc, binary, prim["indices"])})
             for k in used:
@@ -119,7 +133,7 @@ def main(out, inp, p, v, r, shade=False):
                     colour = [w * x for w, x in zip(modulation(d), colour)]
                     shifted += max(abs(a - b) for a, b in zip(colour, unshifted)) > 0.05
                 worst_uv = max(worst_uv, abs(uv[k][0] - want[0]), abs(uv[k][1] - want[1]),
-                               *(abs(col[k][i] - colour[i]) for i in range(3)))
+                               *(abs(col[k][i] - colour[i]) for i in range(3 if colors else 0)))
                 checked += 1
     print("%s: %d vertices checked, rest points within %.2e of the box, texture coordinates and colours within %.2e "
           "of the closed form; %d materials, %d images" % (out, checked, worst_rest, worst_uv, len(doc["materials"]),
