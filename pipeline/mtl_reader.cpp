@@ -46,7 +46,7 @@ Status parseMtl(const std::string& path, const std::string& text, std::vector<Mt
                 std::vector<std::string>* warnings) {
     materials->clear();
     std::set<std::string> unknown, names;
-    std::string map_options, twice;
+    std::string map_options, twice, not_utf8;
     bool skipping = false;  // inside a second definition of a name (the first is kept)
     size_t line_no = 0;
     const char* const end = text.data() + text.size();
@@ -62,8 +62,10 @@ Status parseMtl(const std::string& path, const std::string& text, std::vector<Mt
             return Status::failure(path + ":" + std::to_string(line_no) + ": " + std::string(key) + ": " + problem);
         };
         if (key == "newmtl") {
-            const std::string name(restOfLine(p, eol).substr(0, 256));
-            if (name.empty()) return fail("a material needs a name");
+            // The rest of the line (Blender writes "newmtl " and "usemtl " for no material: a name too).
+            const std::string written(restOfLine(p, eol).substr(0, 256));
+            const std::string name = utf8Replaced(written);
+            if (name != written && not_utf8.empty()) not_utf8 = "line " + std::to_string(line_no);
             skipping = !names.insert(name).second;
             if (skipping) {
                 if (twice.empty()) twice = "'" + name + "' (line " + std::to_string(line_no) + ")";
@@ -154,8 +156,16 @@ Status parseMtl(const std::string& path, const std::string& text, std::vector<Mt
     }
     if (!map_options.empty())
         warnings->push_back(path + ": map_Kd options ignored (" + map_options + "): the texture is used as it is, repeated");
+    if (!not_utf8.empty())
+        warnings->push_back(path + ": material names that are not UTF-8 (first at " + not_utf8 +
+                            "): their bad bytes read as U+FFFD (usemtl names are read so too)");
     if (!twice.empty()) warnings->push_back(path + ": material " + twice + " defined again: the first definition is kept");
     return Status::success();
+}
+
+std::string utf8Replaced(const std::string& text) {
+    using json = nlohmann::json;
+    return json::parse(json(text).dump(-1, ' ', false, json::error_handler_t::replace)).get<std::string>();
 }
 
 std::string mtlMaterialJson(const MtlMaterial& m, int texture, std::vector<std::string>* extensions) {

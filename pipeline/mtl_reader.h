@@ -1,6 +1,7 @@
 // Wavefront .mtl material libraries (an OBJ's `mtllib`), read as glTF materials (issue 35).
 //
-// Read: `newmtl NAME` (the rest of the line), `Kd r [g b]` (baseColorFactor rgb; one number is grey),
+// Read: `newmtl NAME` (the rest of the line; may be empty, as Blender writes it; bytes that are not
+// UTF-8 read as U+FFFD, with a warning), `Kd r [g b]` (baseColorFactor rgb; one number is grey),
 // `d a` or `Tr t` (alpha a = d, or 1 - t; alphaMode BLEND when < 1), `Ke r [g b]` (emissiveFactor;
 // components above 1 are divided by the largest, which becomes KHR_materials_emissive_strength),
 // `Pr` and `Pm` (roughnessFactor, metallicFactor: the PBR extension of the format) and `map_Kd`
@@ -35,6 +36,9 @@ struct MtlMaterial {
 // map options, a name defined twice: the first kept) go to `warnings`, each starting with `path`.
 Status parseMtl(const std::string& path, const std::string& text, std::vector<MtlMaterial>* materials,
                 std::vector<std::string>* warnings);
+
+// `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD (glTF text is UTF-8).
+std::string utf8Replaced(const std::string& text);
 
 // The glTF material JSON (dump() form) of `m`: name, doubleSided true, pbrMetallicRoughness
 // (baseColorFactor [Kd, alpha], metallicFactor, roughnessFactor, baseColorTexture {"index":

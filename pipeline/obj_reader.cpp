@@ -186,7 +186,7 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             while (p < eol && isBlank(*p)) ++p;
             const char* e = eol;
             while (e > p && isBlank(e[-1])) --e;
-            const std::string name(p, std::min<size_t>(size_t(e - p), 256));
+            const std::string name = utf8Replaced(std::string(p, std::min<size_t>(size_t(e - p), 256)));
             auto [it, fresh] = name_index.try_emplace(name, int(parts->names.size()));
             if (fresh) parts->names.push_back(name);
             current = it->second;
@@ -300,7 +300,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         if (!seen.insert(file).second) continue;
         std::string text;
         bool read = false;
-        const std::string where = path + ":" + std::to_string(line) + ": mtllib";
+        const std::string where = "line " + std::to_string(line) + ": mtllib";
         if (Status s = readConfined(where, "material library", file, folders, limits, warnings, &text, &read); !s.ok)
             return s;
         if (!read) continue;
@@ -345,7 +345,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         texture_of_file[file] = -1;
         std::string bytes;
         bool read = false;
-        const std::string where = f.library + ":" + std::to_string(f.material.line) + ": " + f.material.name + ": map_Kd";
+        const std::string where = f.library + ": material '" + f.material.name + "' (line " + std::to_string(f.material.line) + "): map_Kd";
         if (Status s = readConfined(where, "texture", file, folders, limits, warnings, &bytes, &read); !s.ok || !read) return s;
         const std::string type = sniffImage(bytes);
         if (type.empty()) {
@@ -353,7 +353,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
             return Status::success();
         }
         if (look->samplers.empty()) look->samplers.push_back(R"({"wrapS":10497,"wrapT":10497})");  // REPEAT
-        look->images.push_back({type, std::filesystem::path(file).filename().string(), std::vector<unsigned char>(bytes.begin(), bytes.end())});
+        look->images.push_back({type, utf8Replaced(std::filesystem::path(file).filename().string()), std::vector<unsigned char>(bytes.begin(), bytes.end())});
         *index = texture_of_file[file] = int(look->textures.size());
         look->textures.push_back(R"({"sampler":0,"source":)" + std::to_string(look->images.size() - 1) + "}");
         return Status::success();

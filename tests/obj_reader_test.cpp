@@ -174,6 +174,14 @@ TEST(MtlReader, FieldsAndTheStatedMapping) {
     EXPECT_EQ(w[0], "a.mtl: keywords not read (no glTF counterpart here): Ka, illum");
     EXPECT_NE(w[1].find("map_Kd options ignored (line 9)"), std::string::npos) << w[1];
     EXPECT_NE(w[2].find("'one two' (line 16) defined again"), std::string::npos) << w[2];
+    // An empty name (Blender's "no material") is a name; bytes that are not UTF-8 read as U+FFFD.
+    w.clear();
+    ASSERT_TRUE(parseMtl("c.mtl", "newmtl \nKd 0.5\nnewmtl Terraind\xe6k\n", &m, &w).ok);
+    ASSERT_EQ(m.size(), 2u);
+    EXPECT_EQ(m[0].name, "");
+    EXPECT_EQ(m[1].name, "Terraind\xef\xbf\xbdk");
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("c.mtl: material names that are not UTF-8 (first at line 3)"), std::string::npos) << w[0];
     // A large Ns is clamped at 900 (roughness 0); no Ns and no Pr: roughness 1.
     ASSERT_TRUE(parseMtl("b.mtl", "newmtl a\nNs 5000\nnewmtl b\n", &m, &w).ok);
     EXPECT_EQ(m[0].roughness, 0);
@@ -218,7 +226,6 @@ TEST(MtlReader, BadNumbersNameFileLineAndField) {
         {"newmtl a\nPr 0.1 0.2\n", "m.mtl:2: Pr: expected 1 number in [0, 1], got '0.1 0.2'"},
         {"Kd 1 1 1\n", "m.mtl:1: Kd: comes before any newmtl"},
         {"newmtl a\nmap_Kd\n", "m.mtl:2: map_Kd: names no file"},
-        {"newmtl\n", "m.mtl:1: newmtl: a material needs a name"},
     };
     for (const auto& [text, expected] : cases) {
         std::vector<MtlMaterial> m;
@@ -270,7 +277,7 @@ TEST(ObjReader, NoDefinedMaterialMeansNoLook) {
     std::shared_ptr<const SurfaceLook> look;
     ASSERT_TRUE(readObj(obj, {}, &m, &w, &look).ok);
     EXPECT_FALSE(look);
-    EXPECT_TRUE(hasLine(w, "m.obj:1: mtllib: material library " + (f.dir / "missing.mtl").string() + " not found"));
+    EXPECT_TRUE(hasLine(w, "line 1: mtllib: material library " + (f.dir / "missing.mtl").string() + " not found"));
     EXPECT_TRUE(hasLine(w, "1 usemtl materials not kept (no library defines them): the object has one colour"));
     EXPECT_TRUE(hasLine(w, "1 vt texture coordinates not kept"));
 }
