@@ -227,11 +227,14 @@ std::string sniffImage(const std::string& b) {
 // Where an OBJ's libraries and textures may be read from (obj_reader.h).
 class ObjFolders {
 public:
-    ObjFolders(const std::string& obj_path, bool allow_outside) : allow_outside_(allow_outside) {
+    ObjFolders(const std::string& obj_path, const MeshLimits& limits) : allow_outside_(limits.allow_outside) {
         namespace fs = std::filesystem;
         std::error_code ec;
-        const fs::path folder = fs::path(obj_path).parent_path();
-        roots_.push_back((folder.empty() ? fs::path(".") : folder).string());
+        for (const std::string& file : {obj_path, limits.scene_path}) {
+            if (file.empty()) continue;
+            const fs::path folder = fs::path(file).parent_path();
+            roots_.push_back((folder.empty() ? fs::path(".") : folder).string());
+        }
         roots_.push_back(fs::current_path(ec).string());
     }
     bool allows(const std::string& path) const {
@@ -259,7 +262,7 @@ Status readConfined(const std::string& where, const std::string& what, const std
     std::error_code ec;
     if (!folders.allows(file)) {
         warnings->other.push_back(where + ": " + what + " " + file +
-                                  " is outside the OBJ's folder and the working folder: not opened (allow with --allow-outside)");
+                                  " is outside the folders a mesh may be read from: not opened (allow with --allow-outside)");
         return Status::success();
     }
     if (!std::filesystem::exists(file, ec)) {
@@ -288,7 +291,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         return Status::success();
     }
     // Step: the libraries, each read once; a name's first definition wins.
-    const ObjFolders folders(path, limits.allow_outside);
+    const ObjFolders folders(path, limits);
     struct Found {
         MtlMaterial material;
         std::string library;

@@ -13,8 +13,9 @@
 // The look (issue 35; exporters/surface_look.h), when asked for: the libraries named by `mtllib`
 // (relative to the OBJ's folder) are read (pipeline/mtl_reader.h), and so are the images their
 // `map_Kd` name (relative to the library's folder, PNG or JPEG: others dropped with a warning),
-// when the resolved path (".." and symlinks followed) lies inside the OBJ's folder or the working
-// folder, or anywhere with MeshLimits::allow_outside. A path outside, or a missing file: one
+// when the resolved path (".." and symlinks followed) lies inside the folders a mesh path may use
+// (the scene's folder, MeshLimits::scene_path, or the working folder) or the OBJ's own folder, or
+// anywhere with MeshLimits::allow_outside. A path outside, or a missing file: one
 // warning, not opened; a file that is not regular or is larger than max_file_bytes: refused (an
 // error), as for the mesh itself. Each triangle gets the material its face's `usemtl` names, the
 // materials numbered in first-use order; a face without one, or whose name no library defines

@@ -238,13 +238,13 @@ std::string gltfWithExtras(const std::string& extras) {
 }  // namespace
 
 // Issue 15, item 1, and issue 35: an OBJ's material library, and the textures it names, are opened
-// only inside the OBJ's folder or the working folder (a path leaving them: one warning each, never
+// only inside the scene's folder, the OBJ's folder or the working folder (a path leaving them: one warning each, never
 // opened); one inside that is a FIFO or larger than --max-file-bytes is refused before it is read (no
 // hang); a FIFO or a device given as any input is refused before it is read.
 TEST(HostileInput, MaterialLibrariesStayInsideAndOnlyRegularFilesAreRead) {
     Sandbox box;
     fs::create_directories(box / "s");
-    // Outside s/ (the OBJ's folder and the working folder): FIFOs, so opening one would fail the run.
+    // Outside s/ (the scene's and the OBJ's folder, and the working folder): FIFOs, so opening one would fail the run.
     ::mkfifo((box / "outside.mtl").c_str(), 0600);
     ::mkfifo((box / "outside.png").c_str(), 0600);
     std::ofstream(box / "s/inside.mtl") << "newmtl red\nKd 1 0 0\nmap_Kd ../outside.png\n";
@@ -256,9 +256,9 @@ TEST(HostileInput, MaterialLibrariesStayInsideAndOnlyRegularFilesAreRead) {
     CommandResult r = apparentRun({"render", scene, "--out", (box / "out").string()});
     EXPECT_EQ(r.code, 0) << r.err;
     for (const std::string& file : {std::string("/dev/zero"), std::string("/etc/passwd"), std::string("outside.mtl")})
-        EXPECT_NE(r.err.find(file + " is outside the OBJ's folder and the working folder: not opened"), std::string::npos)
+        EXPECT_NE(r.err.find(file + " is outside the folders a mesh may be read from: not opened"), std::string::npos)
             << file << "\n" << r.err;
-    EXPECT_NE(r.err.find("map_Kd: texture " + (box / "s/../outside.png").string() + " is outside the OBJ's folder"),
+    EXPECT_NE(r.err.find("map_Kd: texture " + (box / "s/../outside.png").string() + " is outside the folders a mesh"),
               std::string::npos)
         << r.err;
     // Inside, but a FIFO; or larger than the limit: refused with one line, exit 2.

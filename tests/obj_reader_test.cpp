@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/input_file.h"
 #include "pipeline/mesh_check.h"
 #include "pipeline/mtl_reader.h"
 #include "pipeline/obj_reader.h"
@@ -407,4 +408,34 @@ TEST(ObjReader, DiffuseMapsBecomeTextures) {
     EXPECT_EQ(texture(2), -1);
     EXPECT_EQ(texture(3), 0);  // the same file again
     EXPECT_TRUE(hasLine(w, "c.bmp is not PNG or JPEG (the texture is dropped)"));
+}
+
+// A library may lie where a mesh may: in the scene's folder (MeshLimits::scene_path) beside the OBJ's
+// own; outside them it is not opened (one warning) unless allow_outside.
+TEST(ObjReader, LibrariesAreReadFromTheFoldersAMeshMayUse) {
+    LookFolder f("folders");
+    f.write("materials/m.mtl", "newmtl a\nKd 0 1 0\n");
+    const std::string obj =
+        f.write("meshes/m.obj", "mtllib ../materials/m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+    const std::string library = (f.dir / "meshes/../materials/m.mtl").string();
+    mesh4d::RestMesh m;
+    std::shared_ptr<const SurfaceLook> look;
+    MeshLimits limits;
+    if (!resolvesInside(library, std::filesystem::current_path().string())) {  // else the working folder allows it
+        MeshWarnings w;
+        ASSERT_TRUE(readObj(obj, limits, &m, &w, &look).ok);
+        EXPECT_FALSE(look);
+        EXPECT_TRUE(hasLine(w, "line 1: mtllib: material library " + library +
+                                   " is outside the folders a mesh may be read from: not opened (allow with --allow-outside)"))
+            << ::testing::PrintToString(w.lines());
+    }
+    for (const bool allow : {false, true}) {
+        limits.scene_path = allow ? std::string() : (f.dir / "scene.json").string();
+        limits.allow_outside = allow;
+        MeshWarnings w;
+        ASSERT_TRUE(readObj(obj, limits, &m, &w, &look).ok);
+        ASSERT_TRUE(look) << allow;
+        EXPECT_EQ(nlohmann::json::parse(look->materials[0])["pbrMetallicRoughness"]["baseColorFactor"],
+                  nlohmann::json::parse("[0,1,0,1]"));
+    }
 }
