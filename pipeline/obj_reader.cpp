@@ -69,7 +69,7 @@ constexpr uint32_t kNoTexcoord = std::numeric_limits<uint32_t>::max();
 struct ObjLookParts {
     std::vector<double> uv;                          // vt: u, v (file order)
     std::vector<std::array<uint32_t, 3>> corner_uv;  // per scanned triangle (kNoTexcoord: none); empty: no corner has one
-    std::vector<int> usemtl;                         // per scanned triangle: index into `names` (-1: none)
+    std::vector<int> usemtl;                         // per scanned triangle: index into `names` (-1: none); empty: no usemtl
     std::vector<std::string> names;                  // usemtl names in first-use order
     std::vector<std::pair<std::string, size_t>> libraries;  // mtllib file names as written, and their line
     size_t mtllib_lines = 0;
@@ -173,7 +173,7 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             }
             for (size_t k = 1; k + 1 < idx.size(); ++k) {
                 triangles.push_back({idx[0], idx[k], idx[k + 1]});
-                parts->usemtl.push_back(current);
+                if (current >= 0 || !parts->usemtl.empty()) parts->usemtl.push_back(current);
                 if (corners_uv) parts->corner_uv.push_back({tex[0], tex[k], tex[k + 1]});
             }
         } else if (key == "mtllib") {
@@ -190,6 +190,7 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             auto [it, fresh] = name_index.try_emplace(name, int(parts->names.size()));
             if (fresh) parts->names.push_back(name);
             current = it->second;
+            if (parts->usemtl.empty()) parts->usemtl.assign(triangles.size(), -1);  // kept from the first usemtl on
         } else if (key == "vt") {
             // u [v [w]]: v defaults to 0, w is not used.
             double uv[2] = {0, 0};
