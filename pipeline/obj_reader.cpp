@@ -445,7 +445,11 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     std::string().swap(text);  // the text is no longer needed: give its memory back before the mesh grows
     std::shared_ptr<SurfaceLook> look;
     if (look_out) {
-        if (Status s = buildObjLook(path, limits, parts, &scan, warnings, &look); !s.ok) return s;
+        if (Status s = buildObjLook(path, limits, parts, &scan, warnings, &look); !s.ok) {
+            // A library's or an image's own message ("m.mtl:2: Kd: ..."), after the mesh it serves.
+            if (s.message.rfind(path, 0) != 0) s.message = path + ": " + s.message;
+            return s;
+        }
     } else {
         if (parts.mtllib_lines)
             warnings->other.push_back(std::to_string(parts.mtllib_lines) + " mtllib lines ignored (material libraries are not read)");

@@ -17,7 +17,8 @@
 // (the scene's folder, MeshLimits::scene_path, or the working folder) or the OBJ's own folder, or
 // anywhere with MeshLimits::allow_outside. A path outside, or a missing file: one
 // warning, not opened; a file that is not regular or is larger than max_file_bytes: refused (an
-// error), as for the mesh itself. Each triangle gets the material its face's `usemtl` names, the
+// error), as for the mesh itself. Errors start with the OBJ's path, then the library's or image's
+// own message ("m.obj: m.mtl:2: Kd: ..."). Each triangle gets the material its face's `usemtl` names, the
 // materials numbered in first-use order; a face without one, or whose name no library defines
 // (one warning naming them), gets glTF's default material (white, double-sided). When no face's
 // name is defined the object has no look (one warning) and keeps one colour, as before. `vt` are

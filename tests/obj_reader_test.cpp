@@ -352,7 +352,8 @@ TEST(ObjReader, LookErrorsNameTheLine) {
     f.write("m.mtl", "newmtl a\nKd 2 0 0\n");
     f.write("ok.mtl", "newmtl a\n");
     const std::pair<std::string, std::string> cases[] = {
-        {"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n", "m.mtl:2: Kd: expected 1 or 3 numbers"},
+        {"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n", "m.obj: " + (f.dir / "m.mtl").string() + ":2: Kd: expected 1 or 3 numbers"},
+        {"mtllib .\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n", "m.obj: " + (f.dir / ".").string() + ": is a folder, not a regular file (refused)"},
         {"mtllib ok.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl a\nf 1/1 2/2 3/1\n",
          "m.obj:7: f: texture coordinate index in '2/2' is out of range (1 vt so far)"},
         {"mtllib ok.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl a\nf 1/x 2/1 3/1\n",
@@ -367,6 +368,7 @@ TEST(ObjReader, LookErrorsNameTheLine) {
         const Status st = readObj(obj, {}, &m, &w, &look);
         EXPECT_FALSE(st.ok) << text;
         EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+        EXPECT_EQ(st.message.rfind(obj, 0), 0u) << st.message;  // starts with the OBJ's path
         EXPECT_EQ(st.message.find('\n'), std::string::npos) << st.message;
     }
     // Without a look the texture indices are not read: the same bad index loads.
