@@ -174,7 +174,8 @@ std::string mtlMaterialJson(const MtlMaterial& m, int texture, std::vector<std::
                 {"metallicFactor", m.metallic},
                 {"roughnessFactor", m.roughness}};
     if (texture >= 0) pbr["baseColorTexture"] = {{"index", texture}};
-    json mat = {{"name", m.name}, {"doubleSided", true}, {"pbrMetallicRoughness", pbr}};
+    json mat = {{"doubleSided", true}, {"pbrMetallicRoughness", pbr}};
+    if (!m.name.empty()) mat["name"] = m.name;
     // Step: emission; glTF's factor stops at 1, the rest is KHR_materials_emissive_strength.
     const double strongest = std::max({m.emissive[0], m.emissive[1], m.emissive[2]});
     if (strongest > 0) {

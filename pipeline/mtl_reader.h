@@ -40,7 +40,7 @@ Status parseMtl(const std::string& path, const std::string& text, std::vector<Mt
 // `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD (glTF text is UTF-8).
 std::string utf8Replaced(const std::string& text);
 
-// The glTF material JSON (dump() form) of `m`: name, doubleSided true, pbrMetallicRoughness
+// The glTF material JSON (dump() form) of `m`: name (none when empty), doubleSided true, pbrMetallicRoughness
 // (baseColorFactor [Kd, alpha], metallicFactor, roughnessFactor, baseColorTexture {"index":
 // `texture`} when `texture` >= 0), emissiveFactor when non-zero, alphaMode BLEND when alpha < 1.
 // Adds the extensions it uses to `extensions` (once each).

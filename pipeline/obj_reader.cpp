@@ -254,8 +254,8 @@ std::string besideFile(const std::string& from_file, std::string name) {
     return (folder / name).string();
 }
 
-// Reads a library or an image `file` named at `where` if the rules allow: false (with one warning)
-// when it lies outside the allowed folders or does not exist; refused (an error) when it is not a
+// Reads a library or an image `file` named at `where` if the rules allow: `*read` false (with one
+// warning) when it lies outside the allowed folders or does not exist; refused (an error) when it is not a
 // regular file or is larger than the limit.
 Status readConfined(const std::string& where, const std::string& what, const std::string& file, const ObjFolders& folders,
                     const MeshLimits& limits, MeshWarnings* warnings, std::string* bytes, bool* read) {
@@ -333,7 +333,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
     }
     if (missing_count)
         warnings->other.push_back(std::to_string(missing_count) + " usemtl materials not in the libraries (" + missing +
-                                  (missing_count > 5 ? ", ..." : "") + "): their faces get glTF's default material (white)");
+                                  (missing_count > 5 ? ", ..." : "") + "): their faces get a white material");
     auto look = std::make_shared<SurfaceLook>();
     // Step: the materials in first-use order (-1: faces without one), each texture's image read once.
     std::map<int, uint32_t> out_index;
@@ -369,7 +369,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         auto [it, fresh] = out_index.try_emplace(key, uint32_t(look->materials.size()));
         if (fresh) {
             if (key < 0) {
-                look->materials.push_back(R"({"doubleSided":true})");
+                look->materials.push_back(mtlMaterialJson(MtlMaterial{}, -1, &look->extensions));  // no fields, no name
             } else {
                 int tex = -1;
                 if (Status s = texture(*by_name[size_t(key)], &tex); !s.ok) return s;

@@ -20,7 +20,7 @@
 // error), as for the mesh itself. Errors start with the OBJ's path, then the library's or image's
 // own message ("m.obj: m.mtl:2: Kd: ..."). Each triangle gets the material its face's `usemtl` names, the
 // materials numbered in first-use order; a face without one, or whose name no library defines
-// (one warning naming them), gets glTF's default material (white, double-sided). When no face's
+// (one warning naming them), gets a material without fields or name (white, metallic 0, rough 1). When no face's
 // name is defined the object has no look (one warning) and keeps one colour, as before. `vt` are
 // kept when a material is: TEXCOORD_0 = (u, 1 - v) (OBJ's v axis points up, glTF's down); a
 // position used with two different `vt` becomes one vertex per `vt` (copies of the position,

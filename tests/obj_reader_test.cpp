@@ -238,7 +238,7 @@ TEST(MtlReader, BadNumbersNameFileLineAndField) {
 }
 
 // usemtl groups become per-triangle materials in first-use order; faces without one, or whose name
-// the library lacks, get glTF's default material.
+// the library lacks, get a white material without a name.
 TEST(ObjReader, UsemtlGroupsBecomeTriangleMaterials) {
     LookFolder f("groups");
     f.write("lib/m.mtl", "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\nPm 1\nnewmtl unused\n");
@@ -254,7 +254,9 @@ TEST(ObjReader, UsemtlGroupsBecomeTriangleMaterials) {
     ASSERT_EQ(m.triangles.size(), 5u);
     EXPECT_EQ(look->triangle_material, (std::vector<uint32_t>{0, 1, 2, 0, 1}));
     ASSERT_EQ(look->materials.size(), 3u);
-    EXPECT_EQ(look->materials[0], R"({"doubleSided":true})");
+    EXPECT_EQ(nlohmann::json::parse(look->materials[0]),
+              nlohmann::json::parse(R"({"doubleSided":true,"pbrMetallicRoughness":{"baseColorFactor":[1,1,1,1],
+                                       "metallicFactor":0,"roughnessFactor":1}})"));
     const auto blue = nlohmann::json::parse(look->materials[1]);
     EXPECT_EQ(blue["name"], "blue");
     EXPECT_EQ(blue["pbrMetallicRoughness"]["baseColorFactor"], nlohmann::json::parse("[0,0,1,1]"));
