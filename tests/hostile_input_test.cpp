@@ -237,19 +237,49 @@ std::string gltfWithExtras(const std::string& extras) {
 
 }  // namespace
 
-// Issue 15, item 1: an OBJ's material library is never opened (nothing uses materials), wherever
-// it points; a FIFO or a device given as any input is refused before it is read (no hang).
-TEST(HostileInput, MaterialLibrariesAreNeverReadAndOnlyRegularFilesAre) {
+// Issue 15, item 1, and issue 35: an OBJ's material library, and the textures it names, are opened
+// only inside the scene's folder, the OBJ's folder or the working folder (a path leaving them: one warning each, never
+// opened); one inside that is a FIFO or larger than --max-file-bytes is refused before it is read (no
+// hang); a FIFO or a device given as any input is refused before it is read.
+TEST(HostileInput, MaterialLibrariesStayInsideAndOnlyRegularFilesAreRead) {
     Sandbox box;
     fs::create_directories(box / "s");
-    ::mkfifo((box / "s/pipe.mtl").c_str(), 0600);  // opening it for reading would block forever
-    std::ofstream(box / "s/m.obj") << "mtllib ../../../../../../../../dev/zero\nmtllib pipe.mtl\nmtllib /etc/passwd\n"
+    // Outside s/ (the scene's and the OBJ's folder, and the working folder): FIFOs, so opening one would fail the run.
+    ::mkfifo((box / "outside.mtl").c_str(), 0600);
+    ::mkfifo((box / "outside.png").c_str(), 0600);
+    std::ofstream(box / "s/inside.mtl") << "newmtl red\nKd 1 0 0\nmap_Kd ../outside.png\n";
+    std::ofstream(box / "s/m.obj") << "mtllib ../../../../../../../../dev/zero\nmtllib /etc/passwd ../outside.mtl\n"
+                                   << "mtllib inside.mtl\nusemtl red\n"
                                    << testio::readBytes(source("data/fixtures/tetra.obj"));
     const std::string scene = writeScene(box / "s", "m.obj");
     fs::current_path(box / "s");
     CommandResult r = apparentRun({"render", scene, "--out", (box / "out").string()});
     EXPECT_EQ(r.code, 0) << r.err;
-    EXPECT_NE(r.err.find("m.obj: 3 mtllib lines ignored (material libraries are not read)"), std::string::npos) << r.err;
+    for (const std::string& file : {std::string("/dev/zero"), std::string("/etc/passwd"), std::string("outside.mtl")})
+        EXPECT_NE(r.err.find(file + " is outside the folders a mesh may be read from: not opened"), std::string::npos)
+            << file << "\n" << r.err;
+    EXPECT_NE(r.err.find("map_Kd: texture " + (box / "s/../outside.png").string() + " is outside the folders a mesh"),
+              std::string::npos)
+        << r.err;
+    // Inside, but a FIFO; or larger than the limit: refused with one line, exit 2.
+    ::mkfifo((box / "s/pipe.mtl").c_str(), 0600);
+    std::ofstream(box / "s/p.obj") << "mtllib pipe.mtl\nusemtl a\n" << testio::readBytes(source("data/fixtures/tetra.obj"));
+    std::ofstream(box / "s/big.mtl") << "newmtl a\n" << std::string(8000, '#') << "\n";
+    std::ofstream(box / "s/b.obj") << "mtllib big.mtl\nusemtl a\n" << testio::readBytes(source("data/fixtures/tetra.obj"));
+    const std::vector<std::pair<std::vector<std::string>, std::string>> refused = {
+        {{"render", writeScene(box / "s", "p.obj")}, "pipe.mtl: is a FIFO, not a regular file (refused)"},
+        {{"render", writeScene(box / "s", "b.obj"), "--max-file-bytes", "4000"},
+         "big.mtl: 8010 bytes, larger than the limit of 4000 bytes (raise with --max-file-bytes)"},
+    };
+    for (const auto& [args, expected] : refused) {
+        std::vector<std::string> a = args;
+        a.insert(a.end(), {"--out", (box / "out3").string()});
+        r = apparentRun(a);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(box / "out3"));
 
     // Non-regular inputs: a FIFO mesh, a device mesh (outside allowed), a FIFO scene, a folder.
     ::mkfifo((box / "s/f.obj").c_str(), 0600);

@@ -35,10 +35,10 @@ Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* o
         // No glTF before the '#': the '#' is part of an OBJ's own path.
         std::string whole = path.substr(path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
         for (char& c : whole) c = char(std::tolower((unsigned char)c));
-        if (whole == ".obj") return readObj(path, limits, &out->mesh, warnings);
+        if (whole == ".obj") return readObj(path, limits, &out->mesh, warnings, &out->look);
         return Status::failure(path + ": '#NodeName' selects a node of a glTF file only");
     }
-    if (ext == ".obj") return readObj(path, limits, &out->mesh, warnings);
+    if (ext == ".obj") return readObj(path, limits, &out->mesh, warnings, &out->look);
     if (ext == ".ply") return readPly(path, limits, &out->mesh, warnings);
     return Status::failure(path + ": unknown mesh format '" + ext + "' (use .obj, .ply, .gltf or .glb)");
 }

@@ -30,6 +30,9 @@ struct MeshLimits {
     // the current working folder, unless this is set (--allow-outside). glTF buffer URIs stay
     // confined to the glTF file's folder either way.
     bool allow_outside = false;
+    // The scene file naming the mesh: an OBJ's material libraries and textures may also lie in its
+    // folder (empty: only the OBJ's folder and the working folder; pipeline/obj_reader.h).
+    std::string scene_path;
 };
 
 struct LoadedMesh {

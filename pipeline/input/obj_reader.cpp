@@ -4,9 +4,14 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <numeric>
 #include <set>
 
 #include "pipeline/input/input_file.h"
+#include "pipeline/input/mtl_reader.h"
 #include "pipeline/input/polygon_input.h"
 
 namespace apparent {
@@ -44,12 +49,41 @@ bool parseIndex(std::string_view token, long* out) {
     return !head.empty() && r.ec == std::errc() && r.ptr == head.data() + head.size() && *out != 0;
 }
 
-// Reads `text` line by line into `scan`, checking everything as it goes.
+// A face corner's texture coordinate index: the integer between the first and the second '/'
+// (0: none, as in "i" and "i//n"; false: not an integer).
+bool parseTexIndex(std::string_view token, long* out) {
+    *out = 0;
+    const size_t slash = token.find('/');
+    if (slash == std::string_view::npos) return true;
+    std::string_view t = token.substr(slash + 1);
+    t = t.substr(0, t.find('/'));
+    if (t.empty()) return true;
+    if (t.size() > 1 && t[0] == '+' && t[1] != '-') t.remove_prefix(1);
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), *out);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size() && *out != 0;
+}
+
+constexpr uint32_t kNoTexcoord = std::numeric_limits<uint32_t>::max();
+
+// What the scanner gathers for the look, beside the mesh.
+struct ObjLookParts {
+    std::vector<double> uv;                          // vt: u, v (file order)
+    std::vector<std::array<uint32_t, 3>> corner_uv;  // per scanned triangle (kNoTexcoord: none); empty: no corner has one
+    std::vector<int> usemtl;                         // per scanned triangle: index into `names` (-1: none); empty: no usemtl
+    std::vector<std::string> names;                  // usemtl names in first-use order
+    std::vector<std::pair<std::string, size_t>> libraries;  // mtllib file names as written, and their line
+    size_t mtllib_lines = 0;
+    std::string bad_uv;  // the first corner whose vt index is malformed or out of range
+};
+
+// Reads `text` line by line into `scan` and `parts`, checking everything as it goes.
 Status scanObj(const std::string& path, const std::string& text, const MeshLimits& limits, ScannedMesh* scan,
-               MeshWarnings* warnings) {
-    size_t mtllibs = 0, line_no = 0, faces = 0, texcoords = 0;
-    std::set<std::string> materials;  // usemtl names
-    std::vector<uint32_t> idx, sorted;
+               ObjLookParts* parts, MeshWarnings* warnings) {
+    size_t line_no = 0, faces = 0;
+    int current = -1;         // the usemtl in force (index into parts->names)
+    bool corners_uv = false;  // a corner had a texture coordinate: parts->corner_uv is kept from then on
+    std::map<std::string, int> name_index;
+    std::vector<uint32_t> idx, sorted, tex;
     // UTF-16 (a byte-order mark, or NUL bytes among the first characters, as Windows tools write
     // it): every line would read as garbage and the file as "no vertices".
     const size_t prefix = std::min<size_t>(text.size(), 64);
@@ -91,6 +125,7 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             positions.push_back(q);
         } else if (key == "f") {
             idx.clear();
+            tex.clear();
             const long n = long(positions.size());
             for (std::string_view tok = nextToken(&p, eol); !tok.empty(); tok = nextToken(&p, eol)) {
                 long i = 0;
@@ -100,6 +135,16 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
                     return fail("f: vertex index " + std::to_string(i) + " is out of range (valid 1.." + std::to_string(n) +
                                 " so far, or -1..-" + std::to_string(n) + ")");
                 idx.push_back(uint32_t(resolved - 1));
+                // The texture coordinate: checked against the vt lines so far, an error only if kept.
+                long t = 0;
+                const long nt = long(parts->uv.size() / 2);
+                const bool good = parseTexIndex(tok, &t);
+                const long rt = t > 0 ? t : nt + 1 + t;
+                if (good && t != 0 && rt >= 1 && rt <= nt) tex.push_back(uint32_t(rt - 1));
+                else tex.push_back(kNoTexcoord);
+                if ((!good || (t != 0 && (rt < 1 || rt > nt))) && parts->bad_uv.empty())
+                    parts->bad_uv = path + ":" + std::to_string(line_no) + ": f: texture coordinate index in '" +
+                                    std::string(tok) + "' is " + (good ? "out of range (" + std::to_string(nt) + " vt so far)" : "malformed");
             }
             ++face_no;
             if (idx.size() < 3) return fail("f: a face needs at least 3 vertices, got " + std::to_string(idx.size()));
@@ -121,24 +166,43 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
             if (++faces > limits.max_faces)
                 return fail("f: more than " + std::to_string(limits.max_faces) + " faces (raise with --max-faces)");
             if (idx.size() > 3) scan->polygons.emplace_back(uint32_t(triangles.size()), uint32_t(idx.size()));
-            for (size_t k = 1; k + 1 < idx.size(); ++k) triangles.push_back({idx[0], idx[k], idx[k + 1]});
+            const bool any_uv = std::any_of(tex.begin(), tex.end(), [](uint32_t t) { return t != kNoTexcoord; });
+            if (any_uv && !corners_uv) {
+                corners_uv = true;
+                parts->corner_uv.assign(triangles.size(), {kNoTexcoord, kNoTexcoord, kNoTexcoord});
+            }
+            for (size_t k = 1; k + 1 < idx.size(); ++k) {
+                triangles.push_back({idx[0], idx[k], idx[k + 1]});
+                if (current >= 0 || !parts->usemtl.empty()) parts->usemtl.push_back(current);
+                if (corners_uv) parts->corner_uv.push_back({tex[0], tex[k], tex[k + 1]});
+            }
         } else if (key == "mtllib") {
-            ++mtllibs;
+            // Step: library names (OBJ separates them by blanks).
+            ++parts->mtllib_lines;
+            for (std::string_view tok = nextToken(&p, eol); !tok.empty(); tok = nextToken(&p, eol))
+                if (parts->libraries.size() < 64) parts->libraries.emplace_back(std::string(tok.substr(0, 4096)), line_no);
         } else if (key == "usemtl") {
-            const std::string_view name = nextToken(&p, eol);
-            materials.insert(std::string(name.substr(0, std::min<size_t>(name.size(), 256))));
+            // The rest of the line is the name (.mtl names may hold blanks: newmtl reads them so too).
+            while (p < eol && isBlank(*p)) ++p;
+            const char* e = eol;
+            while (e > p && isBlank(e[-1])) --e;
+            const std::string name = utf8Replaced(std::string(p, std::min<size_t>(size_t(e - p), 256)));
+            auto [it, fresh] = name_index.try_emplace(name, int(parts->names.size()));
+            if (fresh) parts->names.push_back(name);
+            current = it->second;
+            if (parts->usemtl.empty()) parts->usemtl.assign(triangles.size(), -1);  // kept from the first usemtl on
         } else if (key == "vt") {
-            ++texcoords;
+            // u [v [w]]: v defaults to 0, w is not used.
+            double uv[2] = {0, 0};
+            std::string_view tok = nextToken(&p, eol);
+            for (int c = 0; c < 2 && (c == 0 || !tok.empty()); ++c, tok = nextToken(&p, eol))
+                if (!parseCoordinate(tok, &uv[c]))
+                    return fail("vt: expected 1 to 3 finite numbers within float range (|x| <= 3e38), got '" + line() + "'");
+            if (parts->uv.size() / 2 >= limits.max_vertices)
+                return fail("vt: more than " + std::to_string(limits.max_vertices) + " texture coordinates (raise with --max-vertices)");
+            parts->uv.insert(parts->uv.end(), {uv[0], uv[1]});
         }
     }
-    if (mtllibs)
-        warnings->other.push_back(std::to_string(mtllibs) + " mtllib lines ignored (material libraries are not read)");
-    if (!materials.empty())
-        warnings->other.push_back(std::to_string(materials.size()) +
-                                  " usemtl materials not kept: the object has one colour (give it a colour or material "
-                                  "in the scene, or convert the file to glTF, whose materials are kept)");
-    if (texcoords)
-        warnings->other.push_back(std::to_string(texcoords) + " vt texture coordinates not kept (glTF's TEXCOORD_0 are)");
     if (positions.empty()) return Status::failure(path + ": no vertices ('v' lines)");
     if (faces == 0)
         return Status::failure(path + ": no usable faces ('f' lines)" +
@@ -152,15 +216,285 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
     return Status::success();
 }
 
+// "image/png" or "image/jpeg" from a file's first bytes; empty for anything else.
+std::string sniffImage(const std::string& b) {
+    static const char png[8] = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
+    if (b.size() >= 8 && std::memcmp(b.data(), png, 8) == 0) return "image/png";
+    if (b.size() >= 3 && (unsigned char)b[0] == 0xff && (unsigned char)b[1] == 0xd8 && (unsigned char)b[2] == 0xff)
+        return "image/jpeg";
+    return "";
+}
+
+// Where an OBJ's libraries and textures may be read from (obj_reader.h).
+class ObjFolders {
+public:
+    ObjFolders(const std::string& obj_path, const MeshLimits& limits) : allow_outside_(limits.allow_outside) {
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        for (const std::string& file : {obj_path, limits.scene_path}) {
+            if (file.empty()) continue;
+            const fs::path folder = fs::path(file).parent_path();
+            roots_.push_back((folder.empty() ? fs::path(".") : folder).string());
+        }
+        roots_.push_back(fs::current_path(ec).string());
+    }
+    bool allows(const std::string& path) const {
+        return allow_outside_ || std::any_of(roots_.begin(), roots_.end(), [&](const std::string& r) { return resolvesInside(path, r); });
+    }
+
+private:
+    bool allow_outside_;
+    std::vector<std::string> roots_;
+};
+
+// `name` as written in `from_file` (an OBJ or a .mtl), resolved against that file's folder ('\' read as '/').
+std::string besideFile(const std::string& from_file, std::string name) {
+    std::replace(name.begin(), name.end(), '\\', '/');
+    const std::filesystem::path folder = std::filesystem::path(from_file).parent_path();
+    return (folder / name).string();
+}
+
+// Reads a library or an image `file` named at `where` if the rules allow: `*read` false (with one
+// warning) when it lies outside the allowed folders or does not exist; refused (an error) when it is not a
+// regular file or is larger than the limit.
+Status readConfined(const std::string& where, const std::string& what, const std::string& file, const ObjFolders& folders,
+                    const MeshLimits& limits, MeshWarnings* warnings, std::string* bytes, bool* read) {
+    *read = false;
+    std::error_code ec;
+    if (!folders.allows(file)) {
+        warnings->other.push_back(where + ": " + what + " " + file +
+                                  " is outside the folders a mesh may be read from: not opened (allow with --allow-outside)");
+        return Status::success();
+    }
+    if (!std::filesystem::exists(file, ec)) {
+        warnings->other.push_back(where + ": " + what + " " + file + " not found");
+        return Status::success();
+    }
+    if (Status s = readRegularFile(file, limits.max_file_bytes, bytes, what.c_str()); !s.ok) return s;
+    *read = true;
+    return Status::success();
+}
+
+// The look of a scanned OBJ (obj_reader.h): its libraries read, its materials in first-use order,
+// their textures, and its texture coordinates with the vertices split where a position has two.
+// Null when no face's usemtl names a material the libraries define.
+Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookParts& parts, ScannedMesh* scan,
+                    MeshWarnings* warnings, std::shared_ptr<SurfaceLook>* out) {
+    out->reset();
+    const size_t vt_count = parts.uv.size() / 2;
+    auto notKept = [&] {
+        if (vt_count) warnings->other.push_back(std::to_string(vt_count) + " vt texture coordinates not kept (no material uses them)");
+    };
+    if (parts.names.empty()) {
+        if (parts.mtllib_lines)
+            warnings->other.push_back(std::to_string(parts.mtllib_lines) + " mtllib lines not read (no face has a usemtl)");
+        notKept();
+        return Status::success();
+    }
+    // Step: the libraries, each read once; a name's first definition wins.
+    const ObjFolders folders(path, limits);
+    struct Found {
+        MtlMaterial material;
+        std::string library;
+    };
+    std::map<std::string, Found> defined;
+    std::set<std::string> seen;
+    for (const auto& [name, line] : parts.libraries) {
+        const std::string file = besideFile(path, name);
+        if (!seen.insert(file).second) continue;
+        std::string text;
+        bool read = false;
+        const std::string where = "line " + std::to_string(line) + ": mtllib";
+        if (Status s = readConfined(where, "material library", file, folders, limits, warnings, &text, &read); !s.ok)
+            return s;
+        if (!read) continue;
+        std::vector<MtlMaterial> materials;
+        if (Status s = parseMtl(file, text, &materials, &warnings->other); !s.ok) return s;
+        for (MtlMaterial& m : materials) {
+            const std::string name = m.name;
+            defined.try_emplace(name, Found{std::move(m), file});
+        }
+    }
+    if (parts.libraries.empty()) warnings->other.push_back("usemtl without an mtllib line: no material library to read");
+    // Step: the names no library defines: their faces keep the default look.
+    std::vector<const Found*> by_name(parts.names.size(), nullptr);
+    std::string missing;
+    size_t missing_count = 0;
+    for (size_t n = 0; n < parts.names.size(); ++n) {
+        auto it = defined.find(parts.names[n]);
+        if (it != defined.end()) by_name[n] = &it->second;
+        else if (++missing_count <= 5) missing += (missing.empty() ? "'" : ", '") + parts.names[n] + "'";
+    }
+    if (std::all_of(by_name.begin(), by_name.end(), [](const Found* f) { return !f; })) {
+        warnings->other.push_back(std::to_string(parts.names.size()) +
+                                  " usemtl materials not kept (no library defines them): the object has one colour");
+        notKept();
+        return Status::success();
+    }
+    if (missing_count)
+        warnings->other.push_back(std::to_string(missing_count) + " usemtl materials not in the libraries (" + missing +
+                                  (missing_count > 5 ? ", ..." : "") + "): their faces get a white material");
+    auto look = std::make_shared<SurfaceLook>();
+    // Step: the materials in first-use order (-1: faces without one), each texture's image read once.
+    std::map<int, uint32_t> out_index;
+    std::map<std::string, int> texture_of_file;
+    auto texture = [&](const Found& f, int* index) -> Status {
+        *index = -1;
+        if (f.material.diffuse_map.empty()) return Status::success();
+        const std::string file = besideFile(f.library, f.material.diffuse_map);
+        if (auto it = texture_of_file.find(file); it != texture_of_file.end()) {
+            *index = it->second;
+            return Status::success();
+        }
+        texture_of_file[file] = -1;
+        std::string bytes;
+        bool read = false;
+        const std::string where = f.library + ": material '" + f.material.name + "' (line " + std::to_string(f.material.line) + "): map_Kd";
+        if (Status s = readConfined(where, "texture", file, folders, limits, warnings, &bytes, &read); !s.ok || !read) return s;
+        const std::string type = sniffImage(bytes);
+        if (type.empty()) {
+            warnings->other.push_back(where + ": " + file + " is not PNG or JPEG (the texture is dropped)");
+            return Status::success();
+        }
+        if (look->samplers.empty()) look->samplers.push_back(R"({"wrapS":10497,"wrapT":10497})");  // REPEAT
+        look->images.push_back({type, utf8Replaced(std::filesystem::path(file).filename().string()), std::vector<unsigned char>(bytes.begin(), bytes.end())});
+        *index = texture_of_file[file] = int(look->textures.size());
+        look->textures.push_back(R"({"sampler":0,"source":)" + std::to_string(look->images.size() - 1) + "}");
+        return Status::success();
+    };
+    std::vector<uint32_t> material_of(scan->mesh.triangles.size());
+    for (size_t t = 0; t < material_of.size(); ++t) {
+        const int n = parts.usemtl[t];
+        const int key = n >= 0 && by_name[size_t(n)] ? n : -1;
+        auto [it, fresh] = out_index.try_emplace(key, uint32_t(look->materials.size()));
+        if (fresh) {
+            if (key < 0) {
+                look->materials.push_back(mtlMaterialJson(MtlMaterial{}, -1, &look->extensions));  // no fields, no name
+            } else {
+                int tex = -1;
+                if (Status s = texture(*by_name[size_t(key)], &tex); !s.ok) return s;
+                look->materials.push_back(mtlMaterialJson(by_name[size_t(key)]->material, tex, &look->extensions));
+            }
+        }
+        material_of[t] = it->second;
+    }
+    look->triangle_material = std::move(material_of);
+    // Step: the texture coordinates, a position given a vertex per distinct vt it has (glTF's v axis
+    // points down: TEXCOORD_0 = (u, 1 - v)); corners without one get (0, 0).
+    if (!parts.bad_uv.empty()) {
+        if (vt_count) return Status::failure(parts.bad_uv);
+        warnings->other.push_back("face corners name texture coordinates but the file has no vt lines: none kept");
+    }
+    if (!parts.corner_uv.empty()) {
+        // Equal (u, v) pairs written twice are one texture coordinate: each index to its first.
+        std::map<std::pair<double, double>, uint32_t> first_of;
+        std::vector<uint32_t> same(vt_count);
+        for (size_t k = 0; k < vt_count; ++k)
+            same[k] = first_of.try_emplace({parts.uv[2 * k], parts.uv[2 * k + 1]}, uint32_t(k)).first->second;
+        for (auto& corners : parts.corner_uv)
+            for (uint32_t& vt : corners)
+                if (vt != kNoTexcoord) vt = same[vt];
+        auto& positions = scan->mesh.positions;
+        const size_t file_vertices = positions.size();
+        std::vector<uint32_t> vt_of(file_vertices, kNoTexcoord);
+        std::map<std::pair<uint32_t, uint32_t>, uint32_t> split;
+        std::vector<uint32_t> vertex_vt;  // for the copies
+        for (size_t t = 0; t < scan->mesh.triangles.size(); ++t)
+            for (int c = 0; c < 3; ++c) {
+                uint32_t& v = scan->mesh.triangles[t][size_t(c)];
+                const uint32_t vt = parts.corner_uv[t][size_t(c)];
+                if (vt_of[v] == kNoTexcoord) vt_of[v] = vt;
+                if (vt_of[v] == vt) continue;
+                auto [it, fresh] = split.try_emplace({v, vt}, uint32_t(positions.size()));
+                if (fresh) {
+                    if (positions.size() >= limits.max_vertices)
+                        return Status::failure(path + ": more than " + std::to_string(limits.max_vertices) +
+                                               " vertices once split at texture seams (raise with --max-vertices)");
+                    positions.push_back(positions[v]);
+                    vertex_vt.push_back(vt);
+                }
+                v = it->second;
+            }
+        vt_of.insert(vt_of.end(), vertex_vt.begin(), vertex_vt.end());
+        look->texcoord.assign(2 * positions.size(), 0.0);
+        for (size_t v = 0; v < positions.size(); ++v)
+            if (vt_of[v] != kNoTexcoord) {
+                look->texcoord[2 * v] = parts.uv[2 * size_t(vt_of[v])];
+                look->texcoord[2 * v + 1] = 1 - parts.uv[2 * size_t(vt_of[v]) + 1];
+            }
+        if (!split.empty())
+            warnings->other.push_back(std::to_string(split.size()) +
+                                      " vertices copied at texture seams (a position with more than one vt)");
+    } else if (vt_count) {
+        warnings->other.push_back(std::to_string(vt_count) + " vt texture coordinates not kept (no face corner uses one)");
+    }
+    *out = std::move(look);
+    return Status::success();
+}
+
 }  // namespace
 
-Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
+Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+               std::shared_ptr<const SurfaceLook>* look_out) {
+    if (look_out) look_out->reset();
     std::string text;
     if (Status s = readRegularFile(path, limits.max_file_bytes, &text, "mesh file"); !s.ok) return s;
     ScannedMesh scan;
-    if (Status s = scanObj(path, text, limits, &scan, warnings); !s.ok) return s;
+    ObjLookParts parts;
+    if (Status s = scanObj(path, text, limits, &scan, &parts, warnings); !s.ok) return s;
     std::string().swap(text);  // the text is no longer needed: give its memory back before the mesh grows
-    return finishScannedMesh(std::move(scan), path, mesh, warnings);
+    std::shared_ptr<SurfaceLook> look;
+    if (look_out) {
+        if (Status s = buildObjLook(path, limits, parts, &scan, warnings, &look); !s.ok) {
+            // A library's or an image's own message ("m.mtl:2: Kd: ..."), after the mesh it serves.
+            if (s.message.rfind(path, 0) != 0) s.message = path + ": " + s.message;
+            return s;
+        }
+    } else {
+        if (parts.mtllib_lines)
+            warnings->other.push_back(std::to_string(parts.mtllib_lines) + " mtllib lines ignored (material libraries are not read)");
+        if (!parts.names.empty())
+            warnings->other.push_back(std::to_string(parts.names.size()) + " usemtl materials not kept: the object has one colour");
+        if (!parts.uv.empty()) warnings->other.push_back(std::to_string(parts.uv.size() / 2) + " vt texture coordinates not kept");
+    }
+    if (!look) return finishScannedMesh(std::move(scan), path, mesh, warnings);
+    // Step: the mesh made as for any OBJ, the look following its triangles and the vertices
+    // OpenMesh copies (a copy takes its original's attributes: found by its triangle's corners).
+    const std::vector<std::array<uint32_t, 3>> scanned = scan.mesh.triangles;
+    const size_t scanned_vertices = scan.mesh.positions.size();
+    std::vector<int> origin(scanned.size());
+    std::iota(origin.begin(), origin.end(), 0);
+    if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, &origin); !s.ok) return s;
+    std::vector<uint32_t> vertex_origin(mesh->positions.size());
+    std::iota(vertex_origin.begin(), vertex_origin.end(), 0u);
+    if (mesh->positions.size() > scanned_vertices)
+        for (size_t t = 0; t < mesh->triangles.size(); ++t) {
+            const auto& out = mesh->triangles[t];
+            const auto& in = scanned[size_t(origin[t])];
+            for (int r = 0; r < 3; ++r) {
+                bool same = true;
+                for (int c = 0; c < 3 && same; ++c) {
+                    const mesh4d::Vec3& a = mesh->positions[out[size_t(c)]];
+                    const mesh4d::Vec3& b = mesh->positions[in[size_t((c + r) % 3)]];
+                    same = a.x == b.x && a.y == b.y && a.z == b.z;
+                }
+                if (!same) continue;
+                for (int c = 0; c < 3; ++c)
+                    if (out[size_t(c)] >= scanned_vertices) vertex_origin[out[size_t(c)]] = in[size_t((c + r) % 3)];
+                break;
+            }
+        }
+    std::vector<uint32_t> triangle_material(mesh->triangles.size());
+    for (size_t t = 0; t < triangle_material.size(); ++t) triangle_material[t] = look->triangle_material[size_t(origin[t])];
+    look->triangle_material = std::move(triangle_material);
+    if (!look->texcoord.empty()) {
+        std::vector<double> texcoord(2 * mesh->positions.size());
+        for (size_t v = 0; v < mesh->positions.size(); ++v)
+            for (int k = 0; k < 2; ++k) texcoord[2 * v + size_t(k)] = look->texcoord[2 * size_t(vertex_origin[v]) + size_t(k)];
+        look->texcoord = std::move(texcoord);
+    }
+    *look_out = std::move(look);
+    return Status::success();
 }
 
 }  // namespace apparent

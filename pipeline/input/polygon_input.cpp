@@ -120,7 +120,8 @@ bool addsAsGiven(const mesh4d::RestMesh& mesh) {
     return true;
 }
 
-Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
+Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+                         std::vector<int>* per_triangle) {
     const size_t file_vertices = scan.mesh.positions.size();
     const size_t scanned_triangles = scan.mesh.triangles.size();
     warnings->polygons_triangulated += scan.polygons.size();
@@ -136,7 +137,7 @@ Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::Re
             return Status::failure(path + ": OpenMesh dropped " + std::to_string(scanned_triangles - mesh->triangles.size()) +
                                    " of " + std::to_string(scanned_triangles) + " triangles (malformed faces)");
     }
-    warnings->degenerate_dropped += dropDegenerateTriangles(mesh);
+    warnings->degenerate_dropped += dropDegenerateTriangles(mesh, per_triangle);
     if (mesh->triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
     return Status::success();
 }

@@ -42,7 +42,9 @@ bool addsAsGiven(const mesh4d::RestMesh& mesh);
 // The RestMesh of a scanned file: `scan` as is when addsAsGiven, else OpenMesh's importer's result
 // (non-manifold faces given their own vertices: counted; faces it could not add at all: refused,
 // "mesh.obj: OpenMesh dropped 2 of 10 triangles (malformed faces)"). Then zero-area triangles are
-// dropped with CGAL's exact predicate and counted; none left is an error.
-Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings);
+// dropped with CGAL's exact predicate and counted; none left is an error. `per_triangle` (one value
+// per scanned triangle), when given, follows the triangles kept (OpenMesh keeps their order).
+Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+                         std::vector<int>* per_triangle = nullptr);
 
 }  // namespace apparent

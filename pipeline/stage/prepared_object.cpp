@@ -67,7 +67,9 @@ Status prepareObjects(const Scene& scene, const MeshLimits& limits, std::vector<
                                        (spec.mesh_text.empty() ? spec.mesh_path : spec.mesh_text) + "\" not found (" + file + ")");
             LoadedMesh mesh;
             MeshWarnings warnings;
-            if (Status s = readMesh(spec.mesh_path, limits, &mesh, &warnings); !s.ok) return s;
+            MeshLimits mesh_limits = limits;
+            mesh_limits.scene_path = scene.path;  // where an OBJ's libraries may also lie
+            if (Status s = readMesh(spec.mesh_path, mesh_limits, &mesh, &warnings); !s.ok) return s;
             if (!quiet)
                 for (const std::string& w : warnings.lines()) log << "warning: " << spec.mesh_path << ": " << w << "\n";
             it = cache.emplace(spec.mesh_path, std::move(mesh)).first;

@@ -2,12 +2,16 @@
 // ".ply", ".gltf" or ".glb"): the input bytes become a mesh file read through readMesh, the
 // dispatch the command uses, with small limits so that a valid header cannot ask for gigabytes.
 // A reader must return ok with finite positions and in-range triangles, or an error of one line
-// that starts with the path. For .gltf and .glb the same bytes are also read as a scene.
+// that starts with the path. For .gltf and .glb the same bytes are also read as a scene; for .obj
+// also as a .mtl material library (pipeline/mtl_reader.h).
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <string>
+#include <vector>
 
 #include "pipeline/input/mesh_input.h"
+#include "pipeline/input/mtl_reader.h"
 #include "pipeline/input/scene.h"
 #include "tests/fuzz/fuzz_input.h"
 
@@ -43,6 +47,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         for (const auto& p : mesh.mesh.positions) check(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
         for (const auto& t : mesh.mesh.triangles)
             for (uint32_t i : t) check(i < mesh.mesh.positions.size());
+    }
+    if (std::string(APPARENT_FUZZ_EXT) == ".obj") {
+        // The same bytes as an OBJ's material library: parsed, or one line naming it; every
+        // material's glTF JSON formed (names made UTF-8).
+        std::vector<apparent::MtlMaterial> materials;
+        std::vector<std::string> mtl_warnings, extensions;
+        const std::string text(reinterpret_cast<const char*>(data), size);
+        const apparent::Status mtl = apparent::parseMtl("input.mtl", text, &materials, &mtl_warnings);
+        checkStatus(mtl, "input.mtl");
+        if (mtl.ok)
+            for (const apparent::MtlMaterial& m : materials) check(!apparent::mtlMaterialJson(m, 0, &extensions).empty());
     }
     if (apparent::isGltfPath(path)) {
         apparent::Scene scene;

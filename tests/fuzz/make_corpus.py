@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the seed corpora of the fuzz harnesses (tests/fuzz) into OUT/<target>/:
 scene  the shipped scenes and scene fixtures (data/scenes, data/fixtures);
-obj    data/meshes, data/fixtures and Debian's assimp-testmodels OBJ files;
+obj    data/meshes, data/fixtures and Debian's assimp-testmodels OBJ and .mtl files (the harness reads
+       each input as both);
 ply    data/fixtures/ply and assimp-testmodels PLY files;
 gltf   data/fixtures/gltf, data/scenes/flanges.gltf, tests/data/gltf-samples and
        assimp-testmodels .gltf files, each with its external buffers inlined as data: URIs
@@ -71,7 +72,7 @@ def main():
     d = lambda *p: os.path.join(ROOT, "data", *p)
     sources = {
         "scene": files([d("scenes", "*.json"), d("fixtures", "*.json")]),
-        "obj": files([d("meshes", "*.obj"), d("fixtures", "*.obj"), ASSIMP + "/**/*.obj"]),
+        "obj": files([d("meshes", "*.obj"), d("fixtures", "*.obj"), ASSIMP + "/**/*.obj", ASSIMP + "/**/*.mtl"]),
         "ply": files([d("fixtures", "ply", "*.ply"), ASSIMP + "/**/*.ply"]),
         "gltf": files([d("fixtures", "gltf", "*.gltf"), d("scenes", "*.gltf"), SAMPLES + "/**/*.gltf", ASSIMP + "/**/*.gltf"]),
         "glb": files([d("scenes", "*.glb"), SAMPLES + "/**/*.glb", ASSIMP + "/**/*.glb"]),

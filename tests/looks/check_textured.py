@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Checks a .glb that `apparent render` made of tests/looks/make_textured_box.py's box (standard library only).
 
-usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ [--shade-doppler | draco POSITION_BITS TEXCOORD_BITS | meshopt] [PLAIN.glb]
+usage: check_textured.py OUT.glb INPUT PX PY PZ VX VY VZ RX RY RZ [--shade-doppler | draco POSITION_BITS TEXCOORD_BITS | meshopt] [PLAIN.glb]
+  INPUT: make_textured_box.py's .glb, or make_textured_obj.py's EXPECTED.json (the OBJ box: its
+  materials must equal the JSON's whole, the image the PNG file's bytes; it has no COLOR_0).
   P the box's position at t = 0, V its velocity (relativistic model, t0 = 0), R its rotation_deg (X then
   Y then Z). For every vertex of every frame: its rest point follows from its position and emission time
   in closed form (the inverse Lorentz boost of the uniform motion, then the inverse rotation), lies on a
@@ -29,6 +31,7 @@ usage: check_textured.py OUT.glb INPUT.glb PX PY PZ VX VY VZ RX RY RZ [--shade-d
 """
 import json
 import math
+import os
 import struct
 import sys
 
@@ -83,9 +86,9 @@ def prim_arrays(doc, binary, prim):
     """A primitive's used vertices: (position, texcoord, colour) each."""
     pos = accessor(doc, binary, prim["attributes"]["POSITION"])
     uv = accessor(doc, binary, prim["attributes"]["TEXCOORD_0"])
-    col = accessor(doc, binary, prim["attributes"]["COLOR_0"])
+    col = accessor(doc, binary, prim["attributes"]["COLOR_0"]) if "COLOR_0" in prim["attributes"] else None
     used = sorted({i for (i,) in accessor(doc, binary, prim["indices"])})
-    return [(pos[k], uv[k], col[k]) for k in used]
+    return [(pos[k], uv[k], col[k] if col else [0.0, 0.0, 0.0]) for k in used]
 
 
 def against_plain(doc, binary, plain, e_p, e_t, e_c):
@@ -127,20 +130,29 @@ def main(out, inp, p, v, r, codec):
     if shade:
         codec = codec[1:]
     doc, binary = read_glb(out)
-    idoc, ibin = read_glb(inp)
     fails = []
-    # Materials: the input's, in first-use order (here the input's order), factors equal.
-    if [m.get("pbrMetallicRoughness") for m in doc["materials"]] != [m.get("pbrMetallicRoughness") for m in idoc["materials"]]:
-        fails.append("materials differ: %s" % doc["materials"])
+    colors = True
+    if inp.endswith(".json"):
+        # make_textured_obj.py's EXPECTED.json: the whole materials, the image file, no COLOR_0.
+        expected = json.load(open(inp))
+        if doc["materials"] != expected["materials"]:
+            fails.append("materials differ: %s" % doc["materials"])
+        want_image = open(os.path.join(os.path.dirname(inp), expected["image"]), "rb").read()
+        colors = expected.get("colors", True)
+    else:
+        idoc, ibin = read_glb(inp)
+        # Materials: the input's, in first-use order (here the input's order), factors equal.
+        if [m.get("pbrMetallicRoughness") for m in doc["materials"]] != [m.get("pbrMetallicRoughness") for m in idoc["materials"]]:
+            fails.append("materials differ: %s" % doc["materials"])
+        ivi = idoc["bufferViews"][idoc["images"][0]["bufferView"]]
+        want_image = ibin[ivi.get("byteOffset", 0):ivi.get("byteOffset", 0) + ivi["byteLength"]]
     if len(doc.get("images", [])) != 1:
         fails.append("images: %d, expected 1" % len(doc.get("images", [])))
     else:
         iv = doc["bufferViews"][doc["images"][0]["bufferView"]]
         image = binary[iv.get("byteOffset", 0):iv.get("byteOffset", 0) + iv["byteLength"]]
-        ivi = idoc["bufferViews"][idoc["images"][0]["bufferView"]]
-        if image != ibin[ivi.get("byteOffset", 0):ivi.get("byteOffset", 0) + ivi["byteLength"]]:
+        if image != want_image:
             fails.append("the image's bytes differ from the input's")
-    views_of_image = sum(1 for v_ in doc["bufferViews"] if v_["byteLength"] == ivi["byteLength"])
     R = rot_xyz(r)
     b2 = sum(x * x for x in v)
     g = 1 / math.sqrt(1 - b2)
@@ -171,7 +183,9 @@ def main(out, inp, p, v, r, codec):
             bound_uv = max(bound_uv, 1e-4 + moved + max(e_t, e_c))
             tim = accessor(doc, binary, prim["attributes"]["_EMISSION_TIME"])
             uv = accessor(doc, binary, prim["attributes"]["TEXCOORD_0"])
-            col = accessor(doc, binary, prim["attributes"]["COLOR_0"])
+            col = accessor(doc, binary, prim["attributes"]["COLOR_0"]) if colors else None
+            if not colors and "COLOR_0" in prim["attributes"]:
+                fails.append("COLOR_0 where the input has none")
             dop = accessor(doc, binary, prim["attributes"]["_DOPPLER"]) if shade else None
             used = sorted({i for (i,) in accessor(doc, binary, prim["indices"])})
             for k in used:
@@ -195,7 +209,7 @@ def main(out, inp, p, v, r, codec):
                     unshifted = colour
                     colour = [w * x for w, x in zip(modulation(d), colour)]
                     shifted += max(abs(a - b) for a, b in zip(colour, unshifted)) > 0.05
-                dc = max(abs(col[k][i] - colour[i]) for i in range(3))
+                dc = max((abs(col[k][i] - colour[i]) for i in range(3 if colors else 0)), default=0.0)
                 worst_rest = max(worst_rest, rest)
                 worst_uv = max(worst_uv, du, dc)
                 if rest > 1e-4 + moved or du > 1e-4 + moved + e_t or dc > 1e-4 + moved + e_c:
