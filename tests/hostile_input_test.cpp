@@ -29,6 +29,7 @@
 #include "file_bytes.h"
 #include "file_size_limit.h"
 #include "measured_run.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -45,7 +46,7 @@ using testcli::runMeasured;
 class Sandbox {
 public:
     Sandbox() : cwd_(fs::current_path()) {
-        root_ = fs::temp_directory_path() / ("apparent_hostile_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
+        root_ = testio::tempPath() / ("apparent_hostile_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
         fs::remove_all(root_);
         fs::create_directories(root_);
         root_ = fs::canonical(root_);
@@ -237,7 +238,7 @@ std::string gltfWithExtras(const std::string& extras) {
 
 }  // namespace
 
-// Issue 15, item 1, and issue 35: an OBJ's material library, and the textures it names, are opened
+// An OBJ's material library, and the textures it names, are opened
 // only inside the scene's folder, the OBJ's folder or the working folder (a path leaving them: one warning each, never
 // opened); one inside that is a FIFO or larger than --max-file-bytes is refused before it is read (no
 // hang); a FIFO or a device given as any input is refused before it is read.

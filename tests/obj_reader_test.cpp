@@ -14,6 +14,7 @@
 #include "pipeline/input/mesh_check.h"
 #include "pipeline/input/mtl_reader.h"
 #include "pipeline/input/obj_reader.h"
+#include "temp_dir.h"
 
 using namespace apparent;
 
@@ -49,7 +50,7 @@ TEST(ObjReader, PolygonsAreTriangulatedAndCounted) {
 
 // What an OBJ gives that is not kept is said: its materials (usemtl) and texture coordinates (vt).
 TEST(ObjReader, MaterialsAndTextureCoordinatesNotKeptAreNamed) {
-    const std::string path = (std::filesystem::temp_directory_path() / "apparent_obj_usemtl.obj").string();
+    const std::string path = (testio::tempPath() / "apparent_obj_usemtl.obj").string();
     std::ofstream(path) << "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\n"
                            "usemtl red\nf 1/1 2/2 3/3\nusemtl blue\nf 1/1 3/3 4/2\nusemtl red\nf 1 4 2\n";
     mesh4d::RestMesh m;
@@ -107,7 +108,7 @@ TEST(ObjReader, TruncatedPrefixesNeverCrash) {
     std::stringstream ss;
     ss << in.rdbuf();
     const std::string text = ss.str();
-    const auto dir = std::filesystem::temp_directory_path() / ("apparent_trunc_" + std::to_string(::getpid()));
+    const auto dir = testio::tempPath() / ("apparent_trunc_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const std::string path = (dir / "prefix.obj").string();
     for (size_t n = 0; n <= text.size(); ++n) {
@@ -121,7 +122,7 @@ TEST(ObjReader, TruncatedPrefixesNeverCrash) {
     std::filesystem::remove_all(dir);
 }
 
-// ---- The look: .mtl libraries, usemtl groups, vt (issue 35) ----
+// ---- The look: .mtl libraries, usemtl groups, vt ----
 
 namespace {
 
@@ -129,7 +130,7 @@ namespace {
 struct LookFolder {
     std::filesystem::path dir;
     explicit LookFolder(const std::string& name)
-        : dir(std::filesystem::temp_directory_path() / ("apparent_objlook_" + name + "_" + std::to_string(::getpid()))) {
+        : dir(testio::tempPath() / ("apparent_objlook_" + name + "_" + std::to_string(::getpid()))) {
         std::filesystem::remove_all(dir);
         std::filesystem::create_directories(dir);
     }
@@ -264,7 +265,7 @@ TEST(ObjReader, UsemtlGroupsBecomeTriangleMaterials) {
     EXPECT_EQ(nlohmann::json::parse(look->materials[2])["name"], "red");
     EXPECT_TRUE(look->texcoord.empty() && look->images.empty());
     EXPECT_TRUE(hasLine(w, "1 usemtl materials not in the libraries ('nowhere')")) << ::testing::PrintToString(w.lines());
-    // Without asking for the look: counted, not read (as before issue 35).
+    // Without asking for the look: counted, not read.
     MeshWarnings w2;
     ASSERT_TRUE(readObj(obj, {}, &m, &w2).ok);
     EXPECT_TRUE(hasLine(w2, "1 mtllib lines ignored"));

@@ -1,5 +1,5 @@
 # Checks a .blend saved by scripts/blender_import.py from a --compress draco .glb of tests/looks/make_textured_box.py's
-# box (issue 35: Draco keeps the look): Blender's importer decoded every frame mesh's TEXCOORD_0 and COLOR_0 and
+# box (Draco keeps the look): Blender's importer decoded every frame mesh's TEXCOORD_0 and COLOR_0 and
 # kept the three materials, the textured one with the input's image.
 #
 #   blender -b OUT.blend --python-exit-code 1 --python tests/blender/check_look.py

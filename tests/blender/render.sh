@@ -38,7 +38,7 @@ failed=0
 [ "${PIPESTATUS[0]}" = 0 ] || failed=1
 [ -n "$keep" ] && mkdir -p "$keep" && cp "$tmp"/out/render*.png "$keep"/
 
-# Step: a textured model's look through Draco (issue 35): make_textured_box.py's box with COLOR_0 at 0.9c imported
+# Step: a textured model's look through Draco: make_textured_box.py's box with COLOR_0 at 0.9c imported
 # with its UVs, colours and three materials (check_look.py); the box without COLOR_0 near the camera rendered, its
 # texture's red, green and blue texels in the picture (tests/looks/texels.js).
 python3 "$src/tests/looks/make_textured_box.py" "$tmp/box.glb" "$tmp/texture.png" || exit 2

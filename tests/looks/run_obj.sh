@@ -3,7 +3,8 @@
 # so every corner is split by its texture coordinates) rendered at 0.9c, at the default tolerance, in
 # vertex mode and at rest: each .glb passes the Khronos glTF-Validator, and check_textured.py finds the
 # .mtl's materials as docs/INPUT.md maps them, the PNG's bytes once, and every vertex's TEXCOORD_0 equal
-# to the closed form at its rest point. Shards merged give the one process's bytes.
+# to the closed form at its rest point. Shards merged give the one process's bytes; --compress draco and
+# meshopt keep the look, decoded as three.js decodes them, within the codecs' stated bounds.
 # Usage: run_obj.sh APPARENT_BINARY SOURCE_DIR
 set -euo pipefail
 apparent=$1
@@ -35,4 +36,14 @@ for i in 0 1; do
 done
 "$apparent" merge "$out/shard" --quiet
 cmp "$out/refined/relativistic.glb" "$out/shard/relativistic.glb" || { echo "FAIL: shards differ from one process"; exit 1; }
+# The OBJ's look through both codecs, decoded as three.js decodes them, within the codecs' bounds.
+for c in draco meshopt; do
+  "$apparent" render "$out/in/scene_relativistic.json" --out "$out/$c" --compress $c --quiet
+  (cd "$src" && node tests/looks/decode_glb.js "$out/$c/relativistic.glb" "$out/$c/decoded.glb" &&
+    node tests/validators/validate_gltf.js "$out/$c/relativistic.glb")
+done
+python3 "$src/tests/looks/check_textured.py" "$out/draco/decoded.glb" "$expected" -2 0.3 -4 0.9 0 0 20 30 0 \
+  draco 14 12 "$out/refined/relativistic.glb"
+python3 "$src/tests/looks/check_textured.py" "$out/meshopt/decoded.glb" "$expected" -2 0.3 -4 0.9 0 0 20 30 0 \
+  meshopt "$out/refined/relativistic.glb"
 echo "looks (OBJ): ok"
