@@ -465,8 +465,11 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     std::vector<int> origin(scanned.size());
     std::iota(origin.begin(), origin.end(), 0);
     if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, &origin); !s.ok) return s;
-    std::vector<uint32_t> vertex_origin(mesh->positions.size());
-    std::iota(vertex_origin.begin(), vertex_origin.end(), 0u);
+    // A copy no triangle uses (OpenMesh copies the corners of a face it cannot add, and that face
+    // may then be dropped) keeps kNoOrigin: its attributes are never read, and are zero.
+    constexpr uint32_t kNoOrigin = UINT32_MAX;
+    std::vector<uint32_t> vertex_origin(mesh->positions.size(), kNoOrigin);
+    std::iota(vertex_origin.begin(), vertex_origin.begin() + std::ptrdiff_t(std::min(scanned_vertices, vertex_origin.size())), 0u);
     if (mesh->positions.size() > scanned_vertices)
         for (size_t t = 0; t < mesh->triangles.size(); ++t) {
             const auto& out = mesh->triangles[t];
@@ -490,7 +493,8 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     if (!look->texcoord.empty()) {
         std::vector<double> texcoord(2 * mesh->positions.size());
         for (size_t v = 0; v < mesh->positions.size(); ++v)
-            for (int k = 0; k < 2; ++k) texcoord[2 * v + size_t(k)] = look->texcoord[2 * size_t(vertex_origin[v]) + size_t(k)];
+            if (vertex_origin[v] != kNoOrigin)
+                for (int k = 0; k < 2; ++k) texcoord[2 * v + size_t(k)] = look->texcoord[2 * size_t(vertex_origin[v]) + size_t(k)];
         look->texcoord = std::move(texcoord);
     }
     *look_out = std::move(look);
