@@ -9,20 +9,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/input/text_scan.h"
+
 namespace apparent {
 
 namespace {
-
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-std::string_view nextToken(const char** p, const char* end) {
-    const char* s = *p;
-    while (s < end && isBlank(*s)) ++s;
-    const char* e = s;
-    while (e < end && !isBlank(*e)) ++e;
-    *p = e;
-    return std::string_view(s, size_t(e - s));
-}
 
 // The rest of the line, blanks trimmed at both ends.
 std::string_view restOfLine(const char* p, const char* end) {

@@ -13,22 +13,11 @@
 #include "pipeline/input/input_file.h"
 #include "pipeline/input/mtl_reader.h"
 #include "pipeline/input/polygon_input.h"
+#include "pipeline/input/text_scan.h"
 
 namespace apparent {
 
 namespace {
-
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-// The next whitespace-separated token of [*p, end), advancing *p past it; empty at the line's end.
-std::string_view nextToken(const char** p, const char* end) {
-    const char* s = *p;
-    while (s < end && isBlank(*s)) ++s;
-    const char* e = s;
-    while (e < end && !isBlank(*e)) ++e;
-    *p = e;
-    return std::string_view(s, size_t(e - s));
-}
 
 // A coordinate: the whole token a finite number within float range (the exports are float32).
 bool parseCoordinate(std::string_view token, double* out) {
