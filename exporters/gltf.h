@@ -108,8 +108,10 @@ struct GlbOptions {
     bool shade_doppler = false;
     // Set by the .glb writer from the sequence's objects (withMeshoptLooks), not by the command
     // line: with meshopt, the vertex record has slots for the looks' COLOR_0 and TEXCOORD_0
-    // (an object whose look the file carries, surface_look.h).
+    // (an object whose look the file carries, surface_look.h), and for TEXCOORD_1 when such a
+    // look has that set.
     bool meshopt_looks = false;
+    bool meshopt_texcoord1 = false;
 };
 
 struct GlbStats {
@@ -117,8 +119,9 @@ struct GlbStats {
     size_t bytes_without_draco = 0;   // with Draco or meshopt: size of the same file without it (0 otherwise)
     double max_float_error = 0;       // largest |float32 - double| over exported positions, light-seconds
     double max_quantization_error = 0;  // Draco, meshopt: largest position quantization error bound, light-seconds
-    // Draco: largest TEXCOORD_0 quantization error bound (texture coordinate units; 0 without any,
-    // and with meshopt, whose TEXCOORD_0 is the plain file's float32); whether any primitive has one.
+    // Draco: largest TEXCOORD_0 or TEXCOORD_1 quantization error bound (texture coordinate units; 0
+    // without any, and with meshopt, whose texture coordinates are the plain file's float32);
+    // whether any primitive has them.
     double max_texcoord_error = 0;
     bool texcoords = false;
     bool meshopt_range_clamped = false;  // meshopt: a frame's step had to grow to fit int16

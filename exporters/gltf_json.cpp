@@ -70,7 +70,7 @@ void Text::string(std::string_view s) {
 }
 
 const char* attributeName(int a) {
-    static const char* const names[kAttributes] = {"COLOR_0",  "NORMAL",         "POSITION",     "TEXCOORD_0",
+    static const char* const names[kAttributes] = {"COLOR_0",  "NORMAL",         "POSITION",     "TEXCOORD_0", "TEXCOORD_1",
                                                    "_DOPPLER", "_EMISSION_TIME", "_PROPER_TIME"};
     return names[a];
 }

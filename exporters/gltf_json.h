@@ -74,7 +74,7 @@ private:
 };
 
 // glTF vertex attributes, in the byte order of their names (so written in index order).
-enum Attribute { kColor0, kNormal, kPosition, kTexcoord0, kDoppler, kEmissionTime, kProperTime, kAttributes };
+enum Attribute { kColor0, kNormal, kPosition, kTexcoord0, kTexcoord1, kDoppler, kEmissionTime, kProperTime, kAttributes };
 const char* attributeName(int a);
 
 struct Accessor {

@@ -20,12 +20,21 @@ std::array<double, 3> restBarycentric(const Vec3& a, const Vec3& b, const Vec3& 
 }
 
 void interpolateLook(const SurfaceLook& look, const mesh4d::RestMesh& rest_mesh, const mesh4d::ApparentMesh& mesh,
-                     std::vector<double>* texcoord, std::vector<double>* color) {
+                     VertexLook* out) {
     const size_t nv = mesh.positions.size();
-    const bool uv = !look.texcoord.empty(), rgba = !look.color.empty();
-    texcoord->assign(uv ? 2 * nv : 0, 0.0);
-    color->assign(rgba ? 4 * nv : 0, 0.0);
-    if ((!uv && !rgba) || mesh.rest_points.size() != nv || mesh.source_triangles.size() != mesh.triangles.size())
+    // Step: each attribute the look has, with its components per vertex.
+    struct Channel {
+        const std::vector<double>* in;
+        std::vector<double>* out;
+        size_t per;
+    };
+    std::vector<Channel> channels;
+    for (Channel c : {Channel{&look.texcoord, &out->texcoord, 2}, Channel{&look.texcoord1, &out->texcoord1, 2},
+                      Channel{&look.color, &out->color, 4}}) {
+        c.out->assign(c.in->empty() ? 0 : c.per * nv, 0.0);
+        if (!c.in->empty()) channels.push_back(c);
+    }
+    if (channels.empty() || mesh.rest_points.size() != nv || mesh.source_triangles.size() != mesh.triangles.size())
         return;
     // Step: each vertex from the first triangle that uses it (on a shared edge both agree).
     std::vector<bool> done(nv, false);
@@ -37,18 +46,13 @@ void interpolateLook(const SurfaceLook& look, const mesh4d::RestMesh& rest_mesh,
             const std::array<double, 3> l =
                 restBarycentric(rest_mesh.positions[rest[0]], rest_mesh.positions[rest[1]],
                                 rest_mesh.positions[rest[2]], mesh.rest_points[v]);
-            for (int c = 0; uv && c < 2; ++c) {
-                double s = 0;
-                for (int k = 0; k < 3; ++k)
-                    if (l[size_t(k)] != 0) s += l[size_t(k)] * look.texcoord[2 * rest[size_t(k)] + size_t(c)];
-                (*texcoord)[2 * v + size_t(c)] = s;
-            }
-            for (int c = 0; rgba && c < 4; ++c) {
-                double s = 0;
-                for (int k = 0; k < 3; ++k)
-                    if (l[size_t(k)] != 0) s += l[size_t(k)] * look.color[4 * rest[size_t(k)] + size_t(c)];
-                (*color)[4 * v + size_t(c)] = s;
-            }
+            for (const Channel& ch : channels)
+                for (size_t c = 0; c < ch.per; ++c) {
+                    double s = 0;
+                    for (int k = 0; k < 3; ++k)
+                        if (l[size_t(k)] != 0) s += l[size_t(k)] * (*ch.in)[ch.per * rest[size_t(k)] + c];
+                    (*ch.out)[ch.per * v + c] = s;
+                }
         }
     }
 }

@@ -49,7 +49,7 @@ struct FrameData {
     std::vector<int32_t> object;            // N: index into object_names
     // N x 2 and N x 4: the input's TEXCOORD_0 and COLOR_0 at each point (exporters/surface_look.h);
     // NaN for the points of objects whose file has none.
-    std::vector<double> texcoords, colors;
+    std::vector<double> texcoords, texcoords1, colors;
     std::vector<int64_t> triangles;         // M x 3
 };
 
@@ -172,13 +172,14 @@ private:
                 d->object.push_back(int32_t(k));
             }
             // The object's look at each point, interpolated on its rest triangle.
-            std::vector<double> uv, rgba;
+            apparent::VertexLook at;
             const apparent::ExportObject* o = k < info.objects.size() ? &info.objects[k] : nullptr;
-            if (o && o->look && o->rest) apparent::interpolateLook(*o->look, *o->rest, part, &uv, &rgba);
-            if (uv.size() != 2 * part.positions.size()) uv.assign(2 * part.positions.size(), NAN);
-            if (rgba.size() != 4 * part.positions.size()) rgba.assign(4 * part.positions.size(), NAN);
-            d->texcoords.insert(d->texcoords.end(), uv.begin(), uv.end());
-            d->colors.insert(d->colors.end(), rgba.begin(), rgba.end());
+            if (o && o->look && o->rest) apparent::interpolateLook(*o->look, *o->rest, part, &at);
+            for (auto [from, to, per] : {std::tuple{&at.texcoord, &d->texcoords, 2}, std::tuple{&at.texcoord1, &d->texcoords1, 2},
+                                         std::tuple{&at.color, &d->colors, 4}}) {
+                if (from->size() != size_t(per) * part.positions.size()) from->assign(size_t(per) * part.positions.size(), NAN);
+                to->insert(to->end(), from->begin(), from->end());
+            }
             // As the PLY: triangles with a repeated corner (zero area) are left out.
             for (const auto& t : part.triangles) {
                 if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
@@ -239,6 +240,7 @@ PYBIND11_MODULE(_apparent, m) {
         .def_property_readonly("doppler", [](const FrameData& d) { return asArray(d.doppler, 1); })
         .def_property_readonly("proper_time", [](const FrameData& d) { return asArray(d.proper_time, 1); })
         .def_property_readonly("texcoords", [](const FrameData& d) { return asArray(d.texcoords, 2); })
+        .def_property_readonly("texcoords1", [](const FrameData& d) { return asArray(d.texcoords1, 2); })
         .def_property_readonly("colors", [](const FrameData& d) { return asArray(d.colors, 4); });
 
     py::class_<SceneHandle>(m, "SceneHandle")

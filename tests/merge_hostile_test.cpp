@@ -47,7 +47,7 @@ struct ShardLayout {
     std::vector<std::pair<size_t, size_t>> records;  // each frame record: its start and its length in all
     size_t end = 0;                                  // the end record's start
     explicit ShardLayout(const std::string& b) {
-        size_t at = 17 + 5 * 8;  // "apparent shard 3\n", fingerprint, part, parts, first, last
+        size_t at = 17 + 5 * 8;  // "apparent shard 4\n", fingerprint, part, parts, first, last
         auto skipString = [&] { at += 8 + size_t(getU64(b, at)); };
         model = at;
         skipString();

@@ -92,6 +92,10 @@ gltfjson::Primitive GlbBuilder::plainPrimitive(const PrimitiveData& d, int share
         at[gltfjson::kTexcoord0] = addAccessor(addView(d, d.texcoords, r.texcoords, kArray), kFloat, false, nv);
         accessors.back().vec2 = true;
     }
+    if (d.has(d.texcoords1, r.texcoords1)) {
+        at[gltfjson::kTexcoord1] = addAccessor(addView(d, d.texcoords1, r.texcoords1, kArray), kFloat, false, nv);
+        accessors.back().vec2 = true;
+    }
     if (!d.part_first.empty() && part_indices) {
         // One index view, one accessor per material's part.
         const int view = addView(d, d.indices, r.indices, kElements);
@@ -131,6 +135,10 @@ gltfjson::Primitive GlbBuilder::meshoptPrimitive(const PrimitiveData& d, const M
             addNormalized(vview, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true, nv, at0 + size_t(layout.color));
     if (layout.texcoord >= 0 && d.has(d.texcoords, d.remote.texcoords)) {
         at[gltfjson::kTexcoord0] = addAccessor(vview, kFloat, false, nv, at0 + size_t(layout.texcoord));
+        accessors.back().vec2 = true;
+    }
+    if (layout.texcoord1 >= 0 && d.has(d.texcoords1, d.remote.texcoords1)) {
+        at[gltfjson::kTexcoord1] = addAccessor(vview, kFloat, false, nv, at0 + size_t(layout.texcoord1));
         accessors.back().vec2 = true;
     }
     prim.indices = indices;
@@ -187,6 +195,10 @@ bool GlbBuilder::dracoPrimitive(const PrimitiveData& d, gltfjson::Primitive* pri
         at[gltfjson::kTexcoord0] = addAccessor(-1, kFloat, false, n_points);
         accessors.back().vec2 = true;
     }
+    if (c.ids[7] >= 0) {
+        at[gltfjson::kTexcoord1] = addAccessor(-1, kFloat, false, n_points);
+        accessors.back().vec2 = true;
+    }
     prim->indices = addAccessor(-1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false, size_t(p ? p->faces : c.faces) * 3);
     if (p) {
         const FileSpan& r = d.remote.draco;
@@ -196,11 +208,11 @@ bool GlbBuilder::dracoPrimitive(const PrimitiveData& d, gltfjson::Primitive* pri
         prim->draco_view = d.remote.on ? addView(d.remote.draco, 0) : addView(c.bytes.data(), c.bytes.size(), 0);
     }
     // The Draco ids in DracoCoded's order: POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME,
-    // COLOR_0, TEXCOORD_0.
-    static constexpr int kOrder[7] = {gltfjson::kPosition,  gltfjson::kNormal,     gltfjson::kEmissionTime,
-                                      gltfjson::kDoppler,   gltfjson::kProperTime, gltfjson::kColor0,
-                                      gltfjson::kTexcoord0};
-    for (int i = 0; i < 7; ++i) prim->draco_ids[size_t(kOrder[i])] = c.ids[i];
+    // COLOR_0, TEXCOORD_0, TEXCOORD_1.
+    static constexpr int kOrder[DracoCoded::kIds] = {gltfjson::kPosition,   gltfjson::kNormal,    gltfjson::kEmissionTime,
+                                                     gltfjson::kDoppler,    gltfjson::kProperTime, gltfjson::kColor0,
+                                                     gltfjson::kTexcoord0, gltfjson::kTexcoord1};
+    for (int i = 0; i < DracoCoded::kIds; ++i) prim->draco_ids[size_t(kOrder[i])] = c.ids[i];
     return true;
 }
 

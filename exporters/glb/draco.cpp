@@ -21,7 +21,7 @@ struct MeshCoded {
     uint64_t points = 0, faces = 0;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double quantization_error = 0, texcoord_error = 0;
-    int32_t ids[7] = {-1, -1, -1, -1, -1, -1, -1};
+    int32_t ids[DracoCoded::kIds] = {-1, -1, -1, -1, -1, -1, -1, -1};
 };
 
 // Codes the vertices `vertices` of `d` (each once, in this order; all of them when `vertices` is
@@ -50,6 +50,7 @@ bool encodeMesh(const PrimitiveData& d, const std::vector<uint32_t>* vertices, c
     const int tau = d.proper_time.empty() ? -1 : addAttribute(draco::GeometryAttribute::GENERIC, 1, d.proper_time.data());
     const int col = d.colors.empty() ? -1 : addAttribute(draco::GeometryAttribute::COLOR, 3, d.colors.data());
     const int tex = d.texcoords.empty() ? -1 : addAttribute(draco::GeometryAttribute::TEX_COORD, 2, d.texcoords.data());
+    const int tex1 = d.texcoords1.empty() ? -1 : addAttribute(draco::GeometryAttribute::TEX_COORD, 2, d.texcoords1.data());
     auto at = [&](uint32_t i) { return draco::PointIndex(local ? (*local)[i] : i); };
     for (size_t f = 0; f < 3 * count; f += 3) dm.AddFace({at(tri[f]), at(tri[f + 1]), at(tri[f + 2])});
 
@@ -58,6 +59,7 @@ bool encodeMesh(const PrimitiveData& d, const std::vector<uint32_t>* vertices, c
     enc.SetAttributeQuantization(pos, options.position_bits);
     enc.SetAttributeQuantization(nrm, options.normal_bits);
     if (tex >= 0) enc.SetAttributeQuantization(tex, options.texcoord_bits);
+    if (tex1 >= 0) enc.SetAttributeQuantization(tex1, options.texcoord_bits);
     enc.SetSpeedOptions(5, 5);
     enc.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
     draco::EncoderBuffer buf;
@@ -80,6 +82,8 @@ bool encodeMesh(const PrimitiveData& d, const std::vector<uint32_t>* vertices, c
     };
     out->quantization_error = halfStep(largestRange(d.positions, 3), options.position_bits);
     if (tex >= 0) out->texcoord_error = halfStep(largestRange(d.texcoords, 2), options.texcoord_bits);
+    if (tex1 >= 0)
+        out->texcoord_error = std::max(out->texcoord_error, halfStep(largestRange(d.texcoords1, 2), options.texcoord_bits));
 
     // Step: decode it again; the accessors must describe what a reader will get.
     draco::DecoderBuffer db;
@@ -99,8 +103,8 @@ bool encodeMesh(const PrimitiveData& d, const std::vector<uint32_t>* vertices, c
     }
     out->points = back->num_points();
     out->faces = back->num_faces();
-    const int ids[7] = {pos, nrm, emt, dop, tau, col, tex};
-    for (int a = 0; a < 7; ++a) out->ids[a] = ids[a] >= 0 ? int32_t(dm.attribute(ids[a])->unique_id()) : -1;
+    const int ids[DracoCoded::kIds] = {pos, nrm, emt, dop, tau, col, tex, tex1};
+    for (int a = 0; a < DracoCoded::kIds; ++a) out->ids[a] = ids[a] >= 0 ? int32_t(dm.attribute(ids[a])->unique_id()) : -1;
     bytes->insert(bytes->end(), buf.data(), buf.data() + buf.size());
     return true;
 }
@@ -119,7 +123,7 @@ void encodeDraco(const PrimitiveData& d, const GlbOptions& options, DracoCoded* 
         out->faces = m.faces;
         std::copy(m.lo, m.lo + 3, out->lo);
         std::copy(m.hi, m.hi + 3, out->hi);
-        std::copy(m.ids, m.ids + 7, out->ids);
+        std::copy(m.ids, m.ids + DracoCoded::kIds, out->ids);
         out->quantization_error = m.quantization_error;
         out->texcoord_error = m.texcoord_error;
         return;
@@ -141,7 +145,7 @@ void encodeDraco(const PrimitiveData& d, const GlbOptions& options, DracoCoded* 
         part.faces = m.faces;
         std::copy(m.lo, m.lo + 3, part.lo);
         std::copy(m.hi, m.hi + 3, part.hi);
-        std::copy(m.ids, m.ids + 7, out->ids);
+        std::copy(m.ids, m.ids + DracoCoded::kIds, out->ids);
         out->quantization_error = std::max(out->quantization_error, m.quantization_error);
         out->texcoord_error = std::max(out->texcoord_error, m.texcoord_error);
         out->points += m.points;

@@ -44,10 +44,11 @@ struct DracoCoded {
     uint64_t points = 0, faces = 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     // Draco unique ids of POSITION, NORMAL, _EMISSION_TIME, _DOPPLER, _PROPER_TIME, COLOR_0,
-    // TEXCOORD_0 (-1: absent).
-    int32_t ids[7] = {-1, -1, -1, -1, -1, -1, -1};
+    // TEXCOORD_0, TEXCOORD_1 (-1: absent).
+    static constexpr int kIds = 8;
+    int32_t ids[kIds] = {-1, -1, -1, -1, -1, -1, -1, -1};
     double quantization_error = 0;
-    double texcoord_error = 0;  // TEXCOORD_0's bound (gltf.h), 0 without
+    double texcoord_error = 0;  // the texture coordinates' bound (gltf.h), 0 without
     struct Part {
         uint64_t offset = 0, length = 0;  // in `bytes`
         uint64_t points = 0, faces = 0;
@@ -68,7 +69,7 @@ struct PrimitiveData {
     // --shade doppler: COLOR_0, linear RGB (mesh4d/doppler_colour.h); else the input's COLOR_0
     // (surface_look.h, RGB) when it has one; else empty.
     std::vector<float> colors;
-    std::vector<float> texcoords;  // the input's TEXCOORD_0 (surface_look.h; plain files only); else empty
+    std::vector<float> texcoords, texcoords1;  // the input's TEXCOORD_0 and _1 (surface_look.h); else empty
     // The object's triangles grouped by material (plain files of an object with a look): part p
     // is indices [3 part_first[p], 3 part_first[p + 1]) in material part_material[p] of the look;
     // empty: one part, the object's one material.
@@ -87,7 +88,7 @@ struct PrimitiveData {
     // are then empty (draco.bytes too; the rest of DracoCoded is filled).
     struct Remote {
         bool on = false;
-        FileSpan positions, normals, emission, doppler, proper_time, colors, texcoords, indices, draco;
+        FileSpan positions, normals, emission, doppler, proper_time, colors, texcoords, texcoords1, indices, draco;
         FileSpan ordered;  // meshopt frames of two objects or more (for a partly shared index stream)
         uint64_t vertices = 0, index_count = 0, packed_vertices = 0, ordered_count = 0;
         double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // POSITION's bounds (of the float32 values)
@@ -95,7 +96,8 @@ struct PrimitiveData {
     } remote;
     // Empties the float32 arrays and the index list (an object the frame does not show).
     void clearArrays() {
-        for (auto* v : {&positions, &normals, &emission, &doppler, &proper_time, &colors, &texcoords}) v->clear();
+        for (auto* v : {&positions, &normals, &emission, &doppler, &proper_time, &colors, &texcoords, &texcoords1})
+            v->clear();
         indices.clear();
         part_first.clear();
         part_material.clear();
@@ -141,7 +143,8 @@ constexpr size_t kMeshoptViewJsonBytes = 200;
 
 // The meshopt vertex record (gltf.h): int16 x, y, z, 0 | float32 emission time, then with
 // --attributes float32 _DOPPLER and/or _PROPER_TIME, with --shade doppler or the looks' COLOR_0
-// uint16 (normalized) R, G, B, 0, with the looks float32 TEXCOORD_0 u, v; the same for every frame
+// uint16 (normalized) R, G, B, 0, with the looks float32 TEXCOORD_0 u, v, and float32 TEXCOORD_1
+// u, v when a carried look has that set; the same for every frame
 // of a sequence (an offset < 0: not in the record). The looks' slots are there when any object's
 // look is carried, whether or not it has texture coordinates or colours (zeros then): the layout
 // must follow from what every process of a sequence knows (a shard's header carries the looks'
@@ -152,9 +155,10 @@ struct MeshoptLayout {
         if (o.proper_time) { proper_time = int(stride); stride += 4; }
         if (o.shade_doppler || o.meshopt_looks) { color = int(stride); stride += 8; }
         if (o.meshopt_looks) { texcoord = int(stride); stride += 8; }
+        if (o.meshopt_looks && o.meshopt_texcoord1) { texcoord1 = int(stride); stride += 8; }
     }
     size_t stride = 12;
-    int doppler = -1, proper_time = -1, color = -1, texcoord = -1;
+    int doppler = -1, proper_time = -1, color = -1, texcoord = -1, texcoord1 = -1;
 };
 
 // `options` with GlbOptions::meshopt_looks set when the file is meshopt's and carries any of

@@ -88,6 +88,7 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
                     std::memcpy(v + layout.color, rgb, 8);
                 }
                 if (layout.texcoord >= 0 && !d->texcoords.empty()) std::memcpy(v + layout.texcoord, &d->texcoords[2 * i], 8);
+                if (layout.texcoord1 >= 0 && !d->texcoords1.empty()) std::memcpy(v + layout.texcoord1, &d->texcoords1[2 * i], 8);
             }
             return x;
         },
@@ -106,7 +107,11 @@ double packMeshopt(PrimitiveData* d, const std::vector<double>& rel, double step
 
 GlbOptions withMeshoptLooks(const GlbOptions& options, const SequenceInfo& info) {
     GlbOptions o = options;
-    for (const ExportObject& object : info.objects) o.meshopt_looks = o.meshopt_looks || (o.meshopt && carriesLook(o, object));
+    for (const ExportObject& object : info.objects)
+        if (o.meshopt && carriesLook(o, object)) {
+            o.meshopt_looks = true;
+            o.meshopt_texcoord1 = o.meshopt_texcoord1 || object.look->has_texcoord1;
+        }
     return o;
 }
 

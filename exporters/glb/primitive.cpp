@@ -24,12 +24,15 @@ constexpr double kCreaseDeg = 30.0;
 void lookArrays(const mesh4d::ApparentMesh& m, const ExportObject& object, const mesh4d::CreaseMap& map, bool shade,
                 PrimitiveData* d) {
     const SurfaceLook& look = *object.look;
-    std::vector<double> uv, rgba;
-    interpolateLook(look, *object.rest, m, &uv, &rgba);
+    VertexLook vertex_look;
+    interpolateLook(look, *object.rest, m, &vertex_look);
+    const std::vector<double>& rgba = vertex_look.color;
     const size_t nv = map.source.size();
-    d->texcoords.resize(uv.empty() ? 0 : 2 * nv);
-    for (size_t k = 0; k < d->texcoords.size() / 2; ++k)
-        for (size_t c = 0; c < 2; ++c) d->texcoords[2 * k + c] = float(uv[2 * map.source[k] + c]);
+    for (auto [uv, out] : {std::pair{&vertex_look.texcoord, &d->texcoords}, std::pair{&vertex_look.texcoord1, &d->texcoords1}}) {
+        out->resize(uv->empty() ? 0 : 2 * nv);
+        for (size_t k = 0; k < out->size() / 2; ++k)
+            for (size_t c = 0; c < 2; ++c) (*out)[2 * k + c] = float((*uv)[2 * map.source[k] + c]);
+    }
     // With --shade doppler the modulation W(D) (toPrimitive's COLOR_0) times the input's colour.
     if (!rgba.empty()) {
         d->colors.resize(3 * nv);
@@ -162,6 +165,7 @@ void toPrimitive(const mesh4d::ApparentMesh& m, const double origin[3], double s
         std::memcpy(d->indices.data() + 3 * r.begin(), map->triangles.data() + r.begin(), r.size() * sizeof(map->triangles[0]));
     });
     d->texcoords.clear();
+    d->texcoords1.clear();
     d->part_first.clear();
     d->part_material.clear();
     if (carriesLook(options, object) && object.rest && m.source_triangles.size() == m.triangles.size() &&

@@ -158,7 +158,7 @@ bool getDracoFacts(FrameBytesIn* in, DracoCoded* dc, uint64_t length) {
     bool ok = in->get(&dc->points) && in->get(&dc->faces);
     for (int c = 0; ok && c < 3; ++c) ok = in->get(&dc->lo[c]);
     for (int c = 0; ok && c < 3; ++c) ok = in->get(&dc->hi[c]);
-    for (int a = 0; ok && a < 7; ++a) ok = in->get(&dc->ids[a]);
+    for (int a = 0; ok && a < DracoCoded::kIds; ++a) ok = in->get(&dc->ids[a]);
     uint64_t parts = 0;
     ok = ok && in->get(&dc->quantization_error) && in->get(&dc->texcoord_error) && in->get(&parts) && parts <= length;
     uint64_t end = 0;
@@ -272,6 +272,7 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
         static const std::vector<uint32_t> none;
         piece(meshopt && shown > 1 && p.ordered ? *p.ordered : none);  // a partly shared stream is made from them
         piece(p.texcoords);
+        piece(p.texcoords1);
     }
     piece(target_encoded[0]);
     piece(target_encoded[1]);
@@ -296,7 +297,7 @@ std::string GlbSequenceWriter::encodeByReference(const ExportFrame& f, const Glb
     for (int i = 0; i < 3; ++i) putSpan(&out, spans[k++]);
     out.put(uint64_t(d.data.size()));
     for (const PrimitiveData& p : d.data) {
-        for (int i = 0; i < 10; ++i) putSpan(&out, spans[k++]);
+        for (int i = 0; i < 11; ++i) putSpan(&out, spans[k++]);
         uint64_t hash[2] = {0, 0};
         indexHash(p.indices, hash);
         std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
@@ -371,7 +372,7 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
         PrimitiveData::Remote& r = p.remote;
         r.on = true;
         for (FileSpan* s : {&r.positions, &r.normals, &r.emission, &r.doppler, &r.proper_time, &r.colors, &r.indices,
-                            &r.draco, &r.ordered, &r.texcoords})
+                            &r.draco, &r.ordered, &r.texcoords, &r.texcoords1})
             ok = ok && getSpan(&in, s);
         ok = ok && in.get(&r.vertices) && in.get(&r.index_count) && in.get(&r.packed_vertices) &&
              in.get(&r.ordered_count);
@@ -388,10 +389,11 @@ bool GlbSequenceWriter::addByReference(const std::string& bytes, std::string* er
         auto optional = [nv](const FileSpan& s, uint64_t per) { return s.length == 0 || s.length == per * nv; };
         ok = ok && r.positions.length == 12 * nv && r.normals.length == 12 * nv && r.emission.length == 4 * nv &&
              optional(r.doppler, 4) && optional(r.proper_time, 4) && optional(r.colors, 12) && optional(r.texcoords, 8) &&
+             optional(r.texcoords1, 8) &&
              r.indices.length == 4 * r.index_count && r.index_count % 3 == 0 &&
              (r.ordered.length == 0 || r.ordered.length == 4 * r.ordered_count);
         for (const FileSpan* s : {&r.positions, &r.normals, &r.emission, &r.doppler, &r.proper_time, &r.colors,
-                                  &r.indices, &r.draco, &r.ordered, &r.texcoords})
+                                  &r.indices, &r.draco, &r.ordered, &r.texcoords, &r.texcoords1})
             if (ok && s->length > 0) {
                 ok = frameSource(s->source) >= 0;
                 impl_->use(*s);
@@ -444,7 +446,8 @@ std::string GlbSequenceWriter::encode(const ExportFrame& f, const GlbFrameData& 
     out.putVector(d.meshopt.first);
     out.put(uint64_t(d.data.size()));
     for (const PrimitiveData& p : d.data) {
-        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords,
+                                &p.texcoords1})
             out.putVector(*v);
         out.putVector(p.indices);
         out.putVector(p.part_first);
@@ -499,7 +502,8 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
     if (ok) d.data.resize(size_t(primitives));
     for (size_t o = 0; ok && o < d.data.size(); ++o) {
         PrimitiveData& p = d.data[o];
-        for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
+        for (auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords,
+                                &p.texcoords1})
             ok = ok && in.getVector(v);
         uint8_t has_ordered = 0;
         ok = ok && in.getVector(&p.indices) && in.getVector(&p.part_first) && in.getVector(&p.part_material) &&
@@ -516,11 +520,15 @@ bool GlbSequenceWriter::addEncoded(const std::string& bytes, std::string* error)
         ok = ok && in.getVector(&dc.bytes) && getDracoFacts(&in, &dc, dc.bytes.size()) &&
              (dc.parts.empty() || dc.parts.size() == p.part_material.size());
         // What add() writes as it is: finite attributes (a NaN gives an invalid accessor).
-        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords})
+        for (const auto* v : {&p.positions, &p.normals, &p.emission, &p.doppler, &p.proper_time, &p.colors, &p.texcoords,
+                                &p.texcoords1})
             ok = ok && std::all_of(v->begin(), v->end(), [](float x) { return std::isfinite(x); });
         // What add() indexes by: whole vertices, indices within them, the meshopt stream's offsets.
         const size_t nv = p.emission.size();
+        auto optional = [nv](const std::vector<float>& v, size_t per) { return v.empty() || v.size() == per * nv; };
         ok = ok && p.positions.size() == 3 * nv && p.normals.size() == 3 * nv && p.indices.size() % 3 == 0 &&
+             optional(p.doppler, 1) && optional(p.proper_time, 1) && optional(p.colors, 3) &&
+             optional(p.texcoords, 2) && optional(p.texcoords1, 2) &&
              std::all_of(p.indices.begin(), p.indices.end(), [nv](uint32_t i) { return i < nv; }) &&
              p.packed.size() % record == 0 &&
              (!p.ordered || std::all_of(p.ordered->begin(), p.ordered->end(),

@@ -214,7 +214,7 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
                 }
                 stats->max_quantization_error = std::max(stats->max_quantization_error, c.quantization_error);
                 stats->max_texcoord_error = std::max(stats->max_texcoord_error, c.texcoord_error);
-                stats->texcoords = stats->texcoords || c.ids[6] >= 0;
+                stats->texcoords = stats->texcoords || c.ids[6] >= 0 || c.ids[7] >= 0;
                 shown[o] = true;
                 continue;
             } else if (compression == Compression::draco) {
@@ -225,12 +225,13 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
                 }
                 stats->max_quantization_error = std::max(stats->max_quantization_error, qerr);
                 stats->max_texcoord_error = std::max(stats->max_texcoord_error, data[o].draco.texcoord_error);
-                stats->texcoords = stats->texcoords || data[o].draco.ids[6] >= 0;
+                stats->texcoords = stats->texcoords || data[o].draco.ids[6] >= 0 || data[o].draco.ids[7] >= 0;
             } else if (compression == Compression::meshopt && !meshopt_parts[o].empty()) {
                 // Step: one primitive per material, sharing the vertices (never the indices).
                 prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
                                           meshopt_indices[o]);
-                stats->texcoords = stats->texcoords || prim.attributes[gltfjson::kTexcoord0] >= 0;
+                stats->texcoords = stats->texcoords || prim.attributes[gltfjson::kTexcoord0] >= 0 ||
+                                  prim.attributes[gltfjson::kTexcoord1] >= 0;
                 prev = Previous();
                 shown[o] = true;
                 for (size_t p = 0; p < meshopt_parts[o].size(); ++p) {
@@ -243,7 +244,8 @@ bool SequenceModel::addFrame(const ExportFrame& f, const std::vector<PrimitiveDa
             } else if (compression == Compression::meshopt) {
                 prim = b.meshoptPrimitive(data[o], layout, meshopt->stride, vview, nview, meshopt->first[o],
                                           shared[o] >= 0 ? shared[o] : meshopt_indices[o]);
-                stats->texcoords = stats->texcoords || prim.attributes[gltfjson::kTexcoord0] >= 0;
+                stats->texcoords = stats->texcoords || prim.attributes[gltfjson::kTexcoord0] >= 0 ||
+                                  prim.attributes[gltfjson::kTexcoord1] >= 0;
             } else if (!data[o].part_first.empty()) {
                 // Step: one primitive per material, sharing the vertices (never the indices).
                 std::vector<int> parts;

@@ -96,8 +96,10 @@ private:
                 fail(at + ".index: out of range (" + std::to_string(doc_.looks["textures"].size()) + " textures)");
                 continue;
             }
-            if (!(set.is_number_integer() && set.get<long long>() == 0)) {
-                warn(at + ": uses a texture coordinate set other than TEXCOORD_0 (dropped)");
+            const long long s = set.is_number_integer() ? set.get<long long>() : -1;
+            if (s != 0 && !(s == 1 && look_->has_texcoord1)) {
+                warn(at + ": uses texture coordinate set " + set.dump() +
+                     (s == 1 ? ", which its meshes do not have" : "; TEXCOORD_0 and TEXCOORD_1 are carried") + " (dropped)");
                 drop.push_back(key);
                 continue;
             }
@@ -189,12 +191,16 @@ Status buildGltfLook(const std::string& path, const GltfDocument& doc, GltfLookP
     out->reset();
     const bool any_material = std::any_of(parts.triangle_material.begin(), parts.triangle_material.end(),
                                           [](int m) { return m >= 0; });
-    if (!any_material && parts.texcoord.empty() && parts.color.empty()) return Status::success();
+    if (!any_material && parts.texcoord.empty() && parts.texcoord1.empty() && parts.color.empty())
+        return Status::success();
     auto look = std::make_shared<SurfaceLook>();
     // Step: the attributes over every vertex (later primitives without them: (0, 0) and white).
-    if (!parts.texcoord.empty()) parts.texcoord.resize(2 * vertices, 0.0);
+    for (std::vector<double>* uv : {&parts.texcoord, &parts.texcoord1})
+        if (!uv->empty()) uv->resize(2 * vertices, 0.0);
     if (!parts.color.empty()) parts.color.resize(4 * vertices, 1.0);
     look->texcoord = std::move(parts.texcoord);
+    look->texcoord1 = std::move(parts.texcoord1);
+    look->has_texcoord1 = !look->texcoord1.empty();
     look->color = std::move(parts.color);
     // Step: the materials in first-use order, with what they reach.
     LookBuilder builder(path, doc, warnings, look.get());

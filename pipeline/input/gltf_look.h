@@ -6,8 +6,8 @@
 // textures, alpha mode and cutoff, double-sidedness, name), textureInfo's KHR_texture_transform
 // and the material extensions three.js and the Khronos validator read (KHR_materials_*); images
 // given as PNG or JPEG bytes. Dropped, with one warning each naming what: other extensions, texture
-// references to a set other than TEXCOORD_0, textures whose image is not PNG or JPEG or could not
-// be read. Refused (one line naming the file and the glTF path): references out of range.
+// references to a set other than TEXCOORD_0 and TEXCOORD_1 (or to TEXCOORD_1 where the meshes have
+// none), textures whose image is not PNG or JPEG or could not be read. Refused (one line naming the file and the glTF path): references out of range.
 #pragma once
 
 #include <memory>
@@ -20,11 +20,11 @@
 
 namespace apparent {
 
-// What the reader gathers per primitive: TEXCOORD_0 (u, v per vertex) and COLOR_0 (R, G, B, A)
-// for the vertices up to the last primitive that had them, and the glTF material of each triangle
-// (-1: none).
+// What the reader gathers per primitive: TEXCOORD_0 and TEXCOORD_1 (u, v per vertex) and COLOR_0
+// (R, G, B, A) for the vertices up to the last primitive that had them, and the glTF material of
+// each triangle (-1: none).
 struct GltfLookParts {
-    std::vector<double> texcoord, color;
+    std::vector<double> texcoord, texcoord1, color;
     std::vector<int> triangle_material;
 };
 

@@ -170,13 +170,13 @@ private:
         return true;
     }
 
-    // The primitive's TEXCOORD_0 and COLOR_0 (for its `nv` vertices, just added) and the material of
+    // The primitive's TEXCOORD_0, TEXCOORD_1 and COLOR_0 (for its `nv` vertices, just added) and the material of
     // its `nt` triangles, into the look (gltf_look.h); primitives without them get (0, 0), white
     // and glTF's default material.
     bool addLook(const tinygltf::Primitive& prim, const std::string& where, size_t nv, size_t nt) {
         look_.triangle_material.insert(look_.triangle_material.end(), nt, prim.material);
         for (const auto& [name, accessor] : prim.attributes) {
-            const bool uv = name == "TEXCOORD_0", rgba = name == "COLOR_0";
+            const bool uv = name == "TEXCOORD_0" || name == "TEXCOORD_1", rgba = name == "COLOR_0";
             if (!uv && !rgba) {
                 if (name != "POSITION" && name != "NORMAL" && name != "TANGENT") ignored_attributes_.insert(name);
                 continue;
@@ -194,7 +194,7 @@ private:
                                                                " differs from POSITION's " + std::to_string(nv));
             for (double v : values)
                 if (!std::isfinite(v)) return fail(where + ".attributes." + name, "a value is not finite");
-            std::vector<double>& to = uv ? look_.texcoord : look_.color;
+            std::vector<double>& to = !uv ? look_.color : name == "TEXCOORD_0" ? look_.texcoord : look_.texcoord1;
             const size_t per = uv ? 2 : 4, first = out_->mesh.positions.size() - nv;
             to.resize(per * first, uv ? 0.0 : 1.0);  // earlier primitives without it
             for (size_t i = 0; i < nv; ++i)
@@ -389,7 +389,7 @@ Status readGltf(const std::string& path_and_node, const MeshLimits& limits, Load
     warnings->degenerate_dropped += dropDegenerateTriangles(&out->mesh, &look.triangle_material);
     if (out->mesh.triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
     for (const std::string& name : reader.ignoredAttributes())
-        warnings->other.push_back("attribute " + name + ": not carried to the outputs (TEXCOORD_0 and COLOR_0 are)");
+        warnings->other.push_back("attribute " + name + ": not carried to the outputs (TEXCOORD_0, TEXCOORD_1 and COLOR_0 are)");
     return buildGltfLook(path, *doc, std::move(look), out->mesh.positions.size(), warnings, &out->look);
 }
 

@@ -14,7 +14,7 @@
 
 namespace apparent {
 
-const std::string kShardMagic = "apparent shard 3\n";
+const std::string kShardMagic = "apparent shard 4\n";
 
 void putShardU64(std::string* out, uint64_t v) {
     for (int i = 0; i < 8; ++i) out->push_back(char((v >> (8 * i)) & 0xff));  // little-endian
@@ -159,8 +159,9 @@ void getSequence(ShardReader* in, SequenceInfo* info, GlbOptions* o, std::string
 }
 
 // The objects' looks (exporters/surface_look.h) as the .glb needs them: per distinct look its
-// materials, textures and samplers (JSON text), images and extensions, then per object the index
-// of its look + 1 (0: none). The per-vertex arrays stay with the frames.
+// materials, textures and samplers (JSON text), images and extensions and whether it has
+// TEXCOORD_1, then per object the index of its look + 1 (0: none). The per-vertex arrays stay
+// with the frames.
 void putLooks(std::string* out, const SequenceInfo& info) {
     std::vector<const SurfaceLook*> looks;
     for (const ExportObject& e : info.objects)
@@ -177,6 +178,7 @@ void putLooks(std::string* out, const SequenceInfo& info) {
             putString(out, im.name);
             putString(out, std::string(im.bytes.begin(), im.bytes.end()));
         }
+        putU64(out, l->has_texcoord1 ? 1 : 0);
     }
     for (const ExportObject& e : info.objects)
         putU64(out, e.look ? uint64_t(std::find(looks.begin(), looks.end(), e.look.get()) - looks.begin()) + 1 : 0);
@@ -189,14 +191,17 @@ nlohmann::json parseObject(const std::string& text) {
     return j.is_object() ? j : nlohmann::json();
 }
 
-// Every textureInfo ("...Texture": {"index": i}) below `j` refers to one of `textures`.
-bool textureInfosWithin(const nlohmann::json& j, size_t textures) {
+// Every textureInfo ("...Texture": {"index": i, "texCoord": s}) below `j` refers to one of
+// `textures` and to a texture coordinate set below `sets`.
+bool textureInfosWithin(const nlohmann::json& j, size_t textures, long long sets) {
     for (const auto& [key, value] : j.items()) {
         if (!value.is_object()) continue;
         if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index")) {
             const nlohmann::json& i = value["index"];
             if (!i.is_number_integer() || i.get<long long>() < 0 || uint64_t(i.get<long long>()) >= textures) return false;
-        } else if (!textureInfosWithin(value, textures)) {
+            const nlohmann::json s = value.value("texCoord", nlohmann::json(0));
+            if (!s.is_number_integer() || s.get<long long>() < 0 || s.get<long long>() >= sets) return false;
+        } else if (!textureInfosWithin(value, textures, sets)) {
             return false;
         }
     }
@@ -234,11 +239,15 @@ void getLooks(ShardReader* in, SequenceInfo* info, std::string* problem) {
             if (in->ok && !nameProblem(im.name).empty()) fail(at + ".images[" + std::to_string(c) + "].name", nameProblem(im.name));
             look->images.push_back(std::move(im));
         }
+        const uint64_t texcoord1 = in->u64();
+        if (in->ok && texcoord1 > 1) fail(at + ".texcoord1", std::to_string(texcoord1) + " is not 0 or 1");
+        look->has_texcoord1 = texcoord1 == 1;
         // Step: the JSON the .glb takes as it is: objects, references within the lists.
         for (size_t m = 0; in->ok && problem->empty() && m < look->materials.size(); ++m) {
             const nlohmann::json j = parseObject(look->materials[m]);
-            if (j.is_null() || !textureInfosWithin(j, look->textures.size()))
-                fail(at + ".materials[" + std::to_string(m) + "]", "not a JSON object whose textures are among the look's");
+            if (j.is_null() || !textureInfosWithin(j, look->textures.size(), look->has_texcoord1 ? 2 : 1))
+                fail(at + ".materials[" + std::to_string(m) + "]",
+                     "not a JSON object whose textures and texture coordinate sets are among the look's");
             else look->materials[m] = j.dump();
         }
         for (size_t t = 0; in->ok && problem->empty() && t < look->textures.size(); ++t) {

@@ -1,9 +1,10 @@
 // The header of a job-array shard file (pipeline/run/shards.h) and the reader of its fields: written
 // by a shard's sink, read back by `merge` as untrusted input. The file is the magic line
-// "apparent shard 3", then little-endian fields: the fingerprint, part, parts, first and last
+// "apparent shard 4", then little-endian fields: the fingerprint, part, parts, first and last
 // frame (exclusive), the sequence (model, tolerance, fps, scene path, the objects' names, colours,
 // material factors and mirrors, the camera, the .glb options, the light, the objects' looks: materials, textures,
-// samplers as JSON objects whose references stay within the look, PNG or JPEG images), then one
+// samplers as JSON objects whose references stay within the look, PNG or JPEG images, whether it
+// has TEXCOORD_1), then one
 // record per frame (tag 1, length, the frame encoded whole: GlbSequenceWriter::encode) and the end
 // record (tag 2, the frame count).
 // Every field read is checked as the scene's and the command line's are: names against the

@@ -65,6 +65,7 @@ class Frame:
       doppler        N float64, Doppler factor of that light (received / emitted frequency)
       proper_time    N float64, the object's own clock at emission, seconds
       texcoords      N x 2 float64, the input's TEXCOORD_0 at each point (NaN where its file has none)
+      texcoords1     N x 2 float64, the input's TEXCOORD_1 likewise
       colors         N x 4 float64, the input's COLOR_0, linear RGBA (NaN where its file has none)
       camera_time    the camera time (s); model: the model's name; objects: the object names
     """
@@ -80,6 +81,7 @@ class Frame:
         self.doppler = data.doppler
         self.proper_time = data.proper_time
         self.texcoords = data.texcoords
+        self.texcoords1 = data.texcoords1
         self.colors = data.colors
 
     def object_mesh(self, name):

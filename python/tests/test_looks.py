@@ -1,6 +1,6 @@
-"""Frame.texcoords and Frame.colors (issue 35): the input's TEXCOORD_0 and COLOR_0 at every point of a
-cut, against the closed form at the point's rest point (tests/looks/make_textured_box.py: on face a of
-the unit box, u = q_b + 0.5, v = q_c + 0.5, COLOR_0 = (u, v, 0.25, 1)), the rest point found from the
+"""Frame.texcoords, texcoords1 and colors (issue 35): the input's TEXCOORD_0, TEXCOORD_1 and COLOR_0 at
+every point of a cut, against the closed form at the point's rest point (tests/looks/make_textured_box.py:
+on face a of the unit box, u = q_b + 0.5, v = q_c + 0.5, TEXCOORD_1 = (v, 1 - u), COLOR_0 = (u, v, 0.25, 1)), the rest point found from the
 point and its emission time by the inverse boost of the uniform motion, independently of the cut."""
 import math
 import os
@@ -30,6 +30,9 @@ def test_texcoords_and_colors_follow_the_rest_points(tmp_path):
     assert mine.any() and (~mine).any()
     # The other object's file has no look: NaN.
     assert np.isnan(frame.texcoords[~mine]).all() and np.isnan(frame.colors[~mine]).all()
+    assert np.isnan(frame.texcoords1[~mine]).all()
+    for values in (frame.texcoords, frame.texcoords1, frame.colors):  # NaN would pass the max() below
+        assert not np.isnan(values[mine]).any()
     g = 1 / math.sqrt(1 - v @ v)
     x = frame.positions[mine] - p
     t = frame.emission_time[mine]
@@ -43,7 +46,9 @@ def test_texcoords_and_colors_follow_the_rest_points(tmp_path):
         # so they match one of them.
         best = min(max(abs(frame.texcoords[mine][k, 0] - (q[k, b] + 0.5)), abs(frame.texcoords[mine][k, 1] - (q[k, c] + 0.5)),
                        abs(frame.colors[mine][k, 0] - (q[k, b] + 0.5)), abs(frame.colors[mine][k, 1] - (q[k, c] + 0.5)),
-                       abs(frame.colors[mine][k, 2] - 0.25), abs(frame.colors[mine][k, 3] - 1.0))
+                       abs(frame.colors[mine][k, 2] - 0.25), abs(frame.colors[mine][k, 3] - 1.0),
+                       abs(frame.texcoords1[mine][k, 0] - (q[k, c] + 0.5)),
+                       abs(frame.texcoords1[mine][k, 1] - (0.5 - q[k, b])))
                    for a in on for b, c in [[i for i in range(3) if i != a]])
         worst = max(worst, best)
     print("texcoords and colours within %.1e of the closed form at %d points" % (worst, len(q)))

@@ -7,9 +7,10 @@ usage: check_textured.py OUT.glb INPUT PX PY PZ VX VY VZ RX RY RZ [--shade-doppl
   P the box's position at t = 0, V its velocity (relativistic model, t0 = 0), R its rotation_deg (X then
   Y then Z). For every vertex of every frame: its rest point follows from its position and emission time
   in closed form (the inverse Lorentz boost of the uniform motion, then the inverse rotation), lies on a
-  face of the unit box, and its TEXCOORD_0 and COLOR_0 must be the face's closed form at that point
-  (make_textured_box.py), within 1e-4; the primitive's material must be the face's. The
-  materials, their count and factors equal the input's, the texture's image is the input's bytes, once.
+  face of the unit box, and its TEXCOORD_0, TEXCOORD_1 (where the input has it) and COLOR_0 must be
+  the face's closed form at that point (make_textured_box.py), within 1e-4; the primitive's material
+  must be the face's. The materials, their count, factors and occlusion textures equal the input's,
+  the texture's image is the input's bytes, once.
   --shade-doppler (a render with --shade doppler --attributes doppler): COLOR_0 must be the modulation
   W(D) of docs/DOPPLER.md at the vertex's _DOPPLER (the band model computed here) times that closed form.
   A compressed file, decoded to a plain one by decode_glb.js, is checked within the codec's stated bounds
@@ -27,7 +28,8 @@ usage: check_textured.py OUT.glb INPUT PX PY PZ VX VY VZ RX RY RZ [--shade-doppl
   With PLAIN.glb (the same render without compression) the attributes' own quantization is checked
   apart from the positions': each decoded vertex's plain twin is the nearest vertex of the same frame
   and material in the plain file (within sqrt(3) e_p + 1e-6), and its TEXCOORD_0 must lie within
-  e_t + 1e-6 of the twin's, its COLOR_0 within e_c + 1e-6.
+  e_t + 1e-6 of the twin's, its COLOR_0 within e_c + 1e-6 (TEXCOORD_1 is checked against the
+  closed form only).
 """
 import json
 import math
@@ -132,6 +134,7 @@ def main(out, inp, p, v, r, codec):
     doc, binary = read_glb(out)
     fails = []
     colors = True
+    texcoord1 = False
     if inp.endswith(".json"):
         # make_textured_obj.py's EXPECTED.json: the whole materials, the image file, no COLOR_0.
         expected = json.load(open(inp))
@@ -142,8 +145,10 @@ def main(out, inp, p, v, r, codec):
     else:
         idoc, ibin = read_glb(inp)
         # Materials: the input's, in first-use order (here the input's order), factors equal.
-        if [m.get("pbrMetallicRoughness") for m in doc["materials"]] != [m.get("pbrMetallicRoughness") for m in idoc["materials"]]:
-            fails.append("materials differ: %s" % doc["materials"])
+        for key in ("pbrMetallicRoughness", "occlusionTexture"):
+            if [m.get(key) for m in doc["materials"]] != [m.get(key) for m in idoc["materials"]]:
+                fails.append("materials differ (%s): %s" % (key, doc["materials"]))
+        texcoord1 = any("TEXCOORD_1" in p["attributes"] for m in idoc["meshes"] for p in m["primitives"])
         ivi = idoc["bufferViews"][idoc["images"][0]["bufferView"]]
         want_image = ibin[ivi.get("byteOffset", 0):ivi.get("byteOffset", 0) + ivi["byteLength"]]
     if len(doc.get("images", [])) != 1:
@@ -161,7 +166,7 @@ def main(out, inp, p, v, r, codec):
     bound_uv = bound_rest = 0.0
     doppler_range = [math.inf, -math.inf]
     shifted = 0  # vertices whose colour the shift changed by more than 0.05 (the check is not idle)
-    checked = 0
+    checked = checked1 = 0
     for node in doc["nodes"]:
         if "mesh" not in node:
             continue
@@ -183,6 +188,9 @@ def main(out, inp, p, v, r, codec):
             bound_uv = max(bound_uv, 1e-4 + moved + max(e_t, e_c))
             tim = accessor(doc, binary, prim["attributes"]["_EMISSION_TIME"])
             uv = accessor(doc, binary, prim["attributes"]["TEXCOORD_0"])
+            if texcoord1 and "TEXCOORD_1" not in prim["attributes"]:
+                fails.append("TEXCOORD_1 missing in a primitive of %s" % node["name"])
+            uv1 = accessor(doc, binary, prim["attributes"]["TEXCOORD_1"]) if "TEXCOORD_1" in prim["attributes"] else None
             col = accessor(doc, binary, prim["attributes"]["COLOR_0"]) if colors else None
             if not colors and "COLOR_0" in prim["attributes"]:
                 fails.append("COLOR_0 where the input has none")
@@ -202,6 +210,9 @@ def main(out, inp, p, v, r, codec):
                 b, c = [a for a in range(3) if a != axis]
                 want = (q[b] + 0.5, q[c] + 0.5)
                 du = max(abs(uv[k][0] - want[0]), abs(uv[k][1] - want[1]))
+                if uv1:
+                    checked1 += 1
+                    du = max(du, abs(uv1[k][0] - want[1]), abs(uv1[k][1] - (1 - want[0])))
                 colour = [min(1, max(0, want[0])), min(1, max(0, want[1])), 0.25]
                 if shade:
                     d = dop[k][0]
@@ -220,6 +231,8 @@ def main(out, inp, p, v, r, codec):
     print("%s: %d vertices checked, rest points within %.2e of the box (bound %.2e), texture coordinates and colours "
           "within %.2e of the closed form (bound %.2e); %d materials, %d images" %
           (out, checked, worst_rest, bound_rest, worst_uv, bound_uv, len(doc["materials"]), len(doc.get("images", []))))
+    if texcoord1:
+        print("  TEXCOORD_1 checked at %d vertices" % checked1)
     if shade:
         print("  COLOR_0 the modulation W(D) times the input's colour, D from %.4f to %.4f; %d vertices shifted by "
               "more than 0.05" % (*doppler_range, shifted))

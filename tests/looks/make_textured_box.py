@@ -2,9 +2,11 @@
 """Writes a textured, three-material unit box as a .glb (standard library only), for the look tests.
 
 Faces +-x use material 0 (a 2x2 PNG texture, nearest sampling), faces +-y material 1 (an orange
-factor), faces +-z material 2 (a grey factor, metallic 0.5). Every vertex has TEXCOORD_0 and COLOR_0
-that are linear on its face, so the value at any point q of face a (the axis |q_a| = 0.5) is known in
-closed form: with b < c the two other axes, u = q_b + 0.5, v = q_c + 0.5 and COLOR_0 = (u, v, 0.25, 1).
+factor), faces +-z material 2 (a grey factor, metallic 0.5, the texture as its occlusion map read
+through TEXCOORD_1). Every vertex has TEXCOORD_0, TEXCOORD_1 and COLOR_0 that are linear on its face,
+so the value at any point q of face a (the axis |q_a| = 0.5) is known in closed form: with b < c the
+two other axes, u = q_b + 0.5, v = q_c + 0.5, TEXCOORD_0 = (u, v), TEXCOORD_1 = (v, 1 - u) and
+COLOR_0 = (u, v, 0.25, 1).
 
 usage: make_textured_box.py OUT.glb OUT_TEXTURE.png [--no-colors]
   --no-colors: without COLOR_0 (the texture's own colours show, for the screenshot test)
@@ -56,13 +58,14 @@ def main(out_glb, out_png, colors=True):
         return len(views) - 1
 
     for material, axis in enumerate((0, 1, 2)):
-        pos, uv, col, idx = [], [], [], []
+        pos, uv, uv1, col, idx = [], [], [], [], []
         for sign in (1, -1):
             verts, tris = face(axis, sign)
             base = len(pos)
             for q, t in verts:
                 pos.append(q)
                 uv.append(t)
+                uv1.append((t[1], 1 - t[0]))
                 col.append((t[0], t[1], 0.25, 1.0))
             idx += [base + i for tri in tris for i in tri]
         flat = lambda rows: [x for r in rows for x in r]
@@ -76,7 +79,9 @@ def main(out_glb, out_png, colors=True):
                           "count": len(col), "type": "VEC4"})
         accessors.append({"bufferView": view(struct.pack("<%dH" % len(idx), *idx), 34963), "componentType": 5123,
                           "count": len(idx), "type": "SCALAR"})
-        attributes = {"POSITION": a_pos, "TEXCOORD_0": a_pos + 1}
+        accessors.append({"bufferView": view(struct.pack("<%df" % (2 * len(uv1)), *flat(uv1)), 34962), "componentType": 5126,
+                          "count": len(uv1), "type": "VEC2"})
+        attributes = {"POSITION": a_pos, "TEXCOORD_0": a_pos + 1, "TEXCOORD_1": a_pos + 4}
         if colors:
             attributes["COLOR_0"] = a_pos + 2
         primitives.append({"attributes": attributes,
@@ -91,7 +96,8 @@ def main(out_glb, out_png, colors=True):
             {"name": "orange", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.4, 0.05, 1.0], "metallicFactor": 0.0,
                                                         "roughnessFactor": 0.7}},
             {"name": "grey", "doubleSided": True, "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0],
-                                                                           "metallicFactor": 0.5}},
+                                                                           "metallicFactor": 0.5},
+             "occlusionTexture": {"index": 0, "texCoord": 1}},
         ],
         "textures": [{"source": 0, "sampler": 0}],
         "samplers": [{"magFilter": 9728, "minFilter": 9728}],

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A textured, three-material box with vertex colours (make_textured_box.py) rendered at 0.9c: at the
 # default tolerance, in vertex mode, and at rest in the instant model; each .glb passes the Khronos
-# glTF-Validator and check_textured.py (every vertex's TEXCOORD_0 and COLOR_0 equal the closed form
+# glTF-Validator and check_textured.py (every vertex's TEXCOORD_0, TEXCOORD_1 and COLOR_0 equal the closed form
 # at its rest point, the materials and the image are the input's, the image once; with --shade
 # doppler COLOR_0 is the modulation at the vertex's Doppler factor times that closed form). With --compress
 # draco and meshopt the same, decoded (decode_glb.js), within the codecs' stated bounds; shards and
@@ -176,15 +176,17 @@ done
 "$apparent" merge "$out/shard" --quiet
 cmp "$out/refined/relativistic.glb" "$out/shard/relativistic.glb" || { echo "FAIL: shards differ from one process"; exit 1; }
 # A shard is input too: a look whose material is not a JSON object, or whose texture reference
-# leaves the look, is refused by merge with the field named.
-for tamper in 'b"{\"name\":\"textured\"", b"[\"name\":\"textured\""' 'b"{\"index\":0}", b"{\"index\":7}"'; do
+# leaves the look or reads a texture coordinate set the look does not have, is refused by merge
+# with the field named.
+for tamper in 'b"{\"name\":\"textured\"", b"[\"name\":\"textured\""' 'b"{\"index\":0}", b"{\"index\":7}"' \
+  'b"\"texCoord\":1", b"\"texCoord\":2"'; do
   rm -rf "$out/bad" && mkdir -p "$out/bad/shards"
   cp "$out/shard/shards/"* "$out/bad/shards/" 2>/dev/null || { "$apparent" render "$out/scene_relativistic.json" --out "$out/bad" --shard 0/2 --quiet; }
   for f in "$out/bad/shards/"*; do
     python3 -c "import sys; p=sys.argv[1]; b=open(p,'rb').read(); a,c=$tamper; assert a in b, p; open(p,'wb').write(b.replace(a,c,1))" "$f"
   done
   if "$apparent" merge "$out/bad" 2> "$out/bad.err"; then echo "FAIL: merge took a tampered look"; exit 1; fi
-  grep -q "looks\[0\]\.materials\[0\]" "$out/bad.err" || { echo "FAIL: merge's message:"; cat "$out/bad.err"; exit 1; }
+  grep -q "looks\[0\]\.materials\[[0-2]\]" "$out/bad.err" || { echo "FAIL: merge's message:"; cat "$out/bad.err"; exit 1; }
 done
 timeout 300 mpirun --oversubscribe -n 3 "$apparent" render "$out/scene_relativistic.json" --out "$out/mpi" --quiet
 cmp "$out/refined/relativistic.glb" "$out/mpi/relativistic.glb" || { echo "FAIL: MPI ranks differ from one process"; exit 1; }
@@ -199,4 +201,36 @@ for c in draco meshopt; do
     --compress $c --quiet
   cmp "$out/$c-refined/relativistic.glb" "$out/mpi-$c/relativistic.glb" || { echo "FAIL: $c MPI ranks differ"; exit 1; }
 done
+# Texture coordinate sets beyond the two carried: the box with a TEXCOORD_2 and its occlusion map read
+# through it, and the box without TEXCOORD_1 whose occlusion map reads TEXCOORD_1: one warning each
+# naming the attribute and the material's texture, which is dropped; the output stays valid.
+python3 - "$out/box.glb" "$out/set2.glb" "$out/noset1.glb" <<'PY'
+import json, struct, sys
+b = open(sys.argv[1], "rb").read()
+n = struct.unpack_from("<I", b, 12)[0]
+doc, rest = json.loads(b[20:20 + n]), b[20 + n:]
+def write(path, d):
+    js = json.dumps(d, separators=(",", ":")).encode()
+    js += b" " * (-len(js) % 4)
+    open(path, "wb").write(struct.pack("<III", 0x46546C67, 2, 20 + len(js) + len(rest)) +
+                           struct.pack("<II", len(js), 0x4E4F534A) + js + rest)
+set2 = json.loads(json.dumps(doc))
+for p in set2["meshes"][0]["primitives"]:
+    p["attributes"]["TEXCOORD_2"] = p["attributes"]["TEXCOORD_1"]
+set2["materials"][2]["occlusionTexture"]["texCoord"] = 2
+write(sys.argv[2], set2)
+for p in doc["meshes"][0]["primitives"]:
+    del p["attributes"]["TEXCOORD_1"]
+write(sys.argv[3], doc)
+PY
+for variant in set2 noset1; do
+  sed "s/box.glb/$variant.glb/" "$out/scene_relativistic.json" > "$out/$variant.json"
+  "$apparent" render "$out/$variant.json" --out "$out/$variant" 2> "$out/$variant.err" > /dev/null
+  (cd "$src" && node tests/validators/validate_gltf.js "$out/$variant/relativistic.glb")
+done
+grep -q "attribute TEXCOORD_2: not carried to the outputs (TEXCOORD_0, TEXCOORD_1 and COLOR_0 are)" "$out/set2.err" &&
+  grep -q "materials\[2\].occlusionTexture: uses texture coordinate set 2; TEXCOORD_0 and TEXCOORD_1 are carried (dropped)" \
+    "$out/set2.err" &&
+  grep -q "materials\[2\].occlusionTexture: uses texture coordinate set 1, which its meshes do not have (dropped)" \
+    "$out/noset1.err" || { echo "FAIL: texture coordinate set warnings:"; cat "$out/set2.err" "$out/noset1.err"; exit 1; }
 echo "looks: ok"
