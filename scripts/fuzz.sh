@@ -38,7 +38,8 @@ cmake --build "$build" -j "$jobs" --target $(printf 'fuzz_%s ' "${targets[@]}") 
 
 rm -rf "$build/fuzz-seeds" "$build/fuzz-work"
 python3 tests/fuzz/make_corpus.py "$build/fuzz-seeds" 65536
-# Shards: the committed shards of the tetra fixture (plain, Draco, meshopt with attributes).
+# Shards: the committed shards of the tetra fixture (plain, Draco, meshopt with attributes) and of
+# tests/looks' textured box (meshopt: a look with materials, an image and TEXCOORD_1).
 mkdir -p "$build/fuzz-seeds/shard"
 cp tests/fuzz/shard_seeds/*.shard "$build/fuzz-seeds/shard/"
 
