@@ -11,6 +11,7 @@
 #include <set>
 
 #include "pipeline/input/input_file.h"
+#include "pipeline/input/look_files.h"
 #include "pipeline/input/mtl_reader.h"
 #include "pipeline/input/polygon_input.h"
 #include "pipeline/input/text_scan.h"
@@ -205,65 +206,6 @@ Status scanObj(const std::string& path, const std::string& text, const MeshLimit
     return Status::success();
 }
 
-// "image/png" or "image/jpeg" from a file's first bytes; empty for anything else.
-std::string sniffImage(const std::string& b) {
-    static const char png[8] = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
-    if (b.size() >= 8 && std::memcmp(b.data(), png, 8) == 0) return "image/png";
-    if (b.size() >= 3 && (unsigned char)b[0] == 0xff && (unsigned char)b[1] == 0xd8 && (unsigned char)b[2] == 0xff)
-        return "image/jpeg";
-    return "";
-}
-
-// Where an OBJ's libraries and textures may be read from (obj_reader.h).
-class ObjFolders {
-public:
-    ObjFolders(const std::string& obj_path, const MeshLimits& limits) : allow_outside_(limits.allow_outside) {
-        namespace fs = std::filesystem;
-        std::error_code ec;
-        for (const std::string& file : {obj_path, limits.scene_path}) {
-            if (file.empty()) continue;
-            const fs::path folder = fs::path(file).parent_path();
-            roots_.push_back((folder.empty() ? fs::path(".") : folder).string());
-        }
-        roots_.push_back(fs::current_path(ec).string());
-    }
-    bool allows(const std::string& path) const {
-        return allow_outside_ || std::any_of(roots_.begin(), roots_.end(), [&](const std::string& r) { return resolvesInside(path, r); });
-    }
-
-private:
-    bool allow_outside_;
-    std::vector<std::string> roots_;
-};
-
-// `name` as written in `from_file` (an OBJ or a .mtl), resolved against that file's folder ('\' read as '/').
-std::string besideFile(const std::string& from_file, std::string name) {
-    std::replace(name.begin(), name.end(), '\\', '/');
-    const std::filesystem::path folder = std::filesystem::path(from_file).parent_path();
-    return (folder / name).string();
-}
-
-// Reads a library or an image `file` named at `where` if the rules allow: `*read` false (with one
-// warning) when it lies outside the allowed folders or does not exist; refused (an error) when it is not a
-// regular file or is larger than the limit.
-Status readConfined(const std::string& where, const std::string& what, const std::string& file, const ObjFolders& folders,
-                    const MeshLimits& limits, MeshWarnings* warnings, std::string* bytes, bool* read) {
-    *read = false;
-    std::error_code ec;
-    if (!folders.allows(file)) {
-        warnings->other.push_back(where + ": " + what + " " + file +
-                                  " is outside the folders a mesh may be read from: not opened (allow with --allow-outside)");
-        return Status::success();
-    }
-    if (!std::filesystem::exists(file, ec)) {
-        warnings->other.push_back(where + ": " + what + " " + file + " not found");
-        return Status::success();
-    }
-    if (Status s = readRegularFile(file, limits.max_file_bytes, bytes, what.c_str()); !s.ok) return s;
-    *read = true;
-    return Status::success();
-}
-
 // The look of a scanned OBJ (obj_reader.h): its libraries read, its materials in first-use order,
 // their textures, and its texture coordinates with the vertices split where a position has two.
 // Null when no face's usemtl names a material the libraries define.
@@ -281,7 +223,7 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         return Status::success();
     }
     // Step: the libraries, each read once; a name's first definition wins.
-    const ObjFolders folders(path, limits);
+    const LookFolders folders(path, limits);
     struct Found {
         MtlMaterial material;
         std::string library;
@@ -454,28 +396,7 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     std::vector<int> origin(scanned.size());
     std::iota(origin.begin(), origin.end(), 0);
     if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, &origin); !s.ok) return s;
-    // A copy no triangle uses (OpenMesh copies the corners of a face it cannot add, and that face
-    // may then be dropped) keeps kNoOrigin: its attributes are never read, and are zero.
-    constexpr uint32_t kNoOrigin = UINT32_MAX;
-    std::vector<uint32_t> vertex_origin(mesh->positions.size(), kNoOrigin);
-    std::iota(vertex_origin.begin(), vertex_origin.begin() + std::ptrdiff_t(std::min(scanned_vertices, vertex_origin.size())), 0u);
-    if (mesh->positions.size() > scanned_vertices)
-        for (size_t t = 0; t < mesh->triangles.size(); ++t) {
-            const auto& out = mesh->triangles[t];
-            const auto& in = scanned[size_t(origin[t])];
-            for (int r = 0; r < 3; ++r) {
-                bool same = true;
-                for (int c = 0; c < 3 && same; ++c) {
-                    const mesh4d::Vec3& a = mesh->positions[out[size_t(c)]];
-                    const mesh4d::Vec3& b = mesh->positions[in[size_t((c + r) % 3)]];
-                    same = a.x == b.x && a.y == b.y && a.z == b.z;
-                }
-                if (!same) continue;
-                for (int c = 0; c < 3; ++c)
-                    if (out[size_t(c)] >= scanned_vertices) vertex_origin[out[size_t(c)]] = in[size_t((c + r) % 3)];
-                break;
-            }
-        }
+    const std::vector<uint32_t> vertex_origin = scannedVertexOf(*mesh, scanned, scanned_vertices, origin);
     std::vector<uint32_t> triangle_material(mesh->triangles.size());
     for (size_t t = 0; t < triangle_material.size(); ++t) triangle_material[t] = look->triangle_material[size_t(origin[t])];
     look->triangle_material = std::move(triangle_material);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 
 #include <OpenMesh/Core/IO/importer/ImporterT.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
@@ -140,6 +141,30 @@ Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::Re
     warnings->degenerate_dropped += dropDegenerateTriangles(mesh, per_triangle);
     if (mesh->triangles.empty()) return Status::failure(path + ": every triangle is degenerate (zero area)");
     return Status::success();
+}
+
+std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::vector<std::array<uint32_t, 3>>& triangles,
+                                      size_t scanned_vertices, const std::vector<int>& per_triangle) {
+    std::vector<uint32_t> origin(mesh.positions.size(), kNoOrigin);
+    std::iota(origin.begin(), origin.begin() + std::ptrdiff_t(std::min(scanned_vertices, origin.size())), 0u);
+    if (mesh.positions.size() > scanned_vertices)
+        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            const auto& out = mesh.triangles[t];
+            const auto& in = triangles[size_t(per_triangle[t])];
+            for (int r = 0; r < 3; ++r) {
+                bool same = true;
+                for (int c = 0; c < 3 && same; ++c) {
+                    const mesh4d::Vec3& a = mesh.positions[out[size_t(c)]];
+                    const mesh4d::Vec3& b = mesh.positions[in[size_t((c + r) % 3)]];
+                    same = a.x == b.x && a.y == b.y && a.z == b.z;
+                }
+                if (!same) continue;
+                for (int c = 0; c < 3; ++c)
+                    if (out[size_t(c)] >= scanned_vertices) origin[out[size_t(c)]] = in[size_t((c + r) % 3)];
+                break;
+            }
+        }
+    return origin;
 }
 
 }  // namespace apparent

@@ -11,6 +11,7 @@
 // positions stay double, as the scanners parsed them.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -46,5 +47,18 @@ bool addsAsGiven(const mesh4d::RestMesh& mesh);
 // per scanned triangle), when given, follows the triangles kept (OpenMesh keeps their order).
 Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
                          std::vector<int>* per_triangle = nullptr);
+
+// A vertex of finishScannedMesh's result that no scanned vertex gives (scannedVertexOf).
+constexpr uint32_t kNoOrigin = UINT32_MAX;
+
+// The scanned vertex each vertex of `mesh` is or copies, so that per-vertex attributes follow the
+// vertices OpenMesh copies. `mesh` is finishScannedMesh's result for the scanned `triangles` of
+// `scanned_vertices` vertices, `per_triangle` (as finishScannedMesh left it) the scanned triangle
+// each of its triangles came from. The file's vertices are themselves; a copy is found by its
+// triangle's corners (the scanned triangle's corners at equal positions, in one of its three
+// rotations). A copy no triangle uses (OpenMesh copies the corners of a face it cannot add, and that
+// face may then be dropped) is kNoOrigin: its attributes are never read.
+std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::vector<std::array<uint32_t, 3>>& triangles,
+                                      size_t scanned_vertices, const std::vector<int>& per_triangle);
 
 }  // namespace apparent
