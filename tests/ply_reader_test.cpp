@@ -66,7 +66,7 @@ TEST(PlyReader, PolygonsAndDegenerateFacesAreCounted) {
 }
 
 // Our own exporter's PLY (binary, double x y z quality and the object index) must read back vertex
-// for vertex, as one object: the `object` property ignored with a warning.
+// for vertex, as one object: the `object` property ignored with its warning, `quality` named in another.
 TEST(PlyReader, ExporterOutputReadsBack) {
     ExportFrame frame;
     mesh4d::ApparentMesh a;
@@ -94,8 +94,9 @@ TEST(PlyReader, ExporterOutputReadsBack) {
     EXPECT_EQ(m.triangles.size(), 5u);
     EXPECT_DOUBLE_EQ(m.positions[5].x, 10.0);
     EXPECT_DOUBLE_EQ(m.positions[3].z, 2.0);
-    ASSERT_EQ(w.other.size(), 1u);
+    ASSERT_EQ(w.other.size(), 2u);
     EXPECT_NE(w.other[0].find("element vertex: property 'object' ignored"), std::string::npos) << w.other[0];
+    EXPECT_EQ(w.other[1], "element vertex: property quality ignored");
     fs::remove_all(dir);
 }
 

@@ -39,7 +39,7 @@ Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* o
         return Status::failure(path + ": '#NodeName' selects a node of a glTF file only");
     }
     if (ext == ".obj") return readObj(path, limits, &out->mesh, warnings, &out->look);
-    if (ext == ".ply") return readPly(path, limits, &out->mesh, warnings);
+    if (ext == ".ply") return readPly(path, limits, &out->mesh, warnings, &out->look);
     return Status::failure(path + ": unknown mesh format '" + ext + "' (use .obj, .ply, .gltf or .glb)");
 }
 

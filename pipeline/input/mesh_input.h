@@ -39,7 +39,7 @@ struct LoadedMesh {
     mesh4d::RestMesh mesh;
     bool has_color = false;               // the file gave a base colour (glTF material)
     std::array<double, 4> color{1, 1, 1, 1};
-    // Texture coordinates, vertex colours and materials (glTF inputs; null: none), parallel to
+    // Texture coordinates, vertex colours and materials (glTF, OBJ and PLY inputs; null: none), parallel to
     // `mesh`'s vertices and triangles.
     std::shared_ptr<const SurfaceLook> look;
 };

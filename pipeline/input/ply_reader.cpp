@@ -10,10 +10,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <memory>
+#include <numeric>
 #include <sstream>
 #include <string_view>
 
 #include "pipeline/input/input_file.h"
+#include "pipeline/input/look_files.h"
+#include "pipeline/input/mtl_reader.h"
 #include "pipeline/input/polygon_input.h"
 
 namespace apparent {
@@ -82,6 +87,7 @@ struct PlyHeader {
     PlyFormat format = PlyFormat::Ascii;
     std::vector<PlyElement> elements;
     size_t body_offset = 0;
+    std::vector<std::pair<std::string, size_t>> texture_files;  // `comment TextureFile NAME`: NAME and its line
 };
 
 std::vector<std::string> splitWords(const std::string& line) {
@@ -117,6 +123,13 @@ bool parseHeader(const std::string& bytes, PlyHeader* h, std::string* problem) {
         }
         const std::vector<std::string> w = splitWords(line);
         if (w.empty()) continue;
+        if (w[0] == "comment" && w.size() >= 3 && w[1] == "TextureFile") {
+            // The name is the rest of the line (it may hold blanks).
+            const size_t at = line.find("TextureFile") + std::strlen("TextureFile");
+            const size_t first = line.find_first_not_of(" \t", at), last = line.find_last_not_of(" \t");
+            h->texture_files.emplace_back(line.substr(first, last + 1 - first), line_no);
+            continue;
+        }
         if (w[0] == "comment" || w[0] == "obj_info") continue;
         if (w[0] == "end_header") {
             if (!has_format) {
@@ -273,8 +286,61 @@ private:
     PlyFormat format_;
 };
 
-// Checks the header and every value of the body, keeping the vertices and faces.
-Status scanPly(const std::string& path, const std::string& bytes, const MeshLimits& limits, ScannedMesh* scan) {
+// The sRGB-encoded value s in [0, 1] made linear (ply_reader.h, IEC 61966-2-1).
+double srgbToLinear(double s) { return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4); }
+
+// A value as a message shows it.
+std::string shown(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
+// What a vertex property is read for.
+enum Role { kOther = -1, kX, kY, kZ, kRed, kGreen, kBlue, kAlpha, kU, kV };
+
+// The look's parts as the vertices give them (ply_reader.h), per file vertex.
+struct PlyLookParts {
+    std::vector<double> color;     // linear R, G, B, A; empty: the file has no colours
+    std::vector<double> texcoord;  // glTF's (u, 1 - v); empty: the file has no texture coordinates
+    std::vector<std::pair<std::string, size_t>> texture_files;  // from the header
+};
+
+// The first spelling whose properties are all scalar properties of `e`: their indices, else empty.
+std::vector<size_t> findScalars(const PlyElement& e, std::initializer_list<std::vector<const char*>> spellings) {
+    for (const std::vector<const char*>& names : spellings) {
+        std::vector<size_t> found;
+        for (const char* name : names)
+            for (size_t i = 0; i < e.props.size(); ++i)
+                if (!e.props[i].list && e.props[i].name == name) found.push_back(i);
+        if (found.size() == names.size()) return found;
+    }
+    return {};
+}
+
+// "element vertex: properties nx, ny, nz ignored (...)" for the properties of `e` not read (`read`
+// false), or nothing when every property is read.
+void warnIgnored(const PlyElement& e, const std::vector<bool>& read, std::vector<std::string>* warnings) {
+    std::string names;
+    size_t count = 0;
+    bool normals = false, corners = false;
+    for (size_t i = 0; i < e.props.size(); ++i) {
+        if (read[i]) continue;
+        names += (count++ ? ", " : "") + e.props[i].name;
+        normals = normals || e.props[i].name == "nx" || e.props[i].name == "ny" || e.props[i].name == "nz";
+        corners = corners || (e.props[i].list && e.props[i].name == "texcoord");
+    }
+    if (count == 0) return;
+    std::string why;
+    if (normals) why += "normals are the apparent surface's own";
+    if (corners) why += std::string(why.empty() ? "" : "; ") + "per-corner texcoord lists are not read, per-vertex texture_u texture_v are";
+    warnings->push_back("element " + e.name + ": " + (count > 1 ? "properties " : "property ") + names + " ignored" +
+                        (why.empty() ? "" : " (" + why + ")"));
+}
+
+// Checks the header and every value of the body, keeping the vertices, faces and the look's parts.
+Status scanPly(const std::string& path, const std::string& bytes, const MeshLimits& limits, ScannedMesh* scan,
+               PlyLookParts* parts) {
     PlyHeader h;
     std::string problem;
     if (!parseHeader(bytes, &h, &problem)) return Status::failure(path + ": " + problem);
@@ -301,11 +367,38 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
             index_prop = int(i);
         }
     if (index_prop < 0) return fail("element face", "no list property 'vertex_indices' (or 'vertex_index')");
-    // An apparent frame read back (exporters/ply.h): its objects' indices are not read.
-    for (const PlyProperty& p : vertex->props)
-        if (p.name == "object" && !p.list)
+    // Step: what each vertex property is read for: position, colour (one spelling), texture coordinates (one spelling).
+    std::vector<int> vertex_role(vertex->props.size(), kOther);
+    for (size_t pi = 0; pi < vertex->props.size(); ++pi)
+        for (int a = 0; a < 3; ++a)
+            if (!vertex->props[pi].list && vertex->props[pi].name == "xyz"[a] + std::string()) vertex_role[pi] = kX + a;
+    const std::vector<size_t> rgb = findScalars(*vertex, {{"red", "green", "blue"}, {"diffuse_red", "diffuse_green", "diffuse_blue"}});
+    if (!rgb.empty()) {
+        for (int c = 0; c < 3; ++c) vertex_role[rgb[size_t(c)]] = kRed + c;
+        const bool diffuse = vertex->props[rgb[0]].name == "diffuse_red";
+        const std::vector<size_t> alpha = diffuse ? findScalars(*vertex, {{"diffuse_alpha"}, {"alpha"}}) : findScalars(*vertex, {{"alpha"}});
+        if (!alpha.empty()) vertex_role[alpha[0]] = kAlpha;
+    }
+    const std::vector<size_t> uv = findScalars(*vertex, {{"texture_u", "texture_v"}, {"s", "t"}, {"u", "v"}});
+    if (!uv.empty()) vertex_role[uv[0]] = kU, vertex_role[uv[1]] = kV;
+    // Step: one warning per element for the properties not read; an apparent frame's objects' indices (exporters/ply.h) apart.
+    std::vector<bool> vertex_read(vertex->props.size()), face_read(face->props.size());
+    for (size_t pi = 0; pi < vertex->props.size(); ++pi) {
+        vertex_read[pi] = vertex_role[pi] != kOther || (vertex->props[pi].name == "object" && !vertex->props[pi].list);
+        if (vertex->props[pi].name == "object" && !vertex->props[pi].list)
             scan->warnings.push_back("element vertex: property 'object' ignored (the objects' indices of an apparent "
                                      "frame): the file is one object here");
+    }
+    face_read[size_t(index_prop)] = true;
+    warnIgnored(*vertex, vertex_read, &scan->warnings);
+    warnIgnored(*face, face_read, &scan->warnings);
+    std::string others;
+    for (const PlyElement& e : h.elements)
+        if (&e != vertex && &e != face) others += (others.empty() ? "" : ", ") + e.name;
+    if (!others.empty())
+        scan->warnings.push_back(std::string(others.find(',') == std::string::npos ? "element " : "elements ") + others +
+                                 " ignored (vertex and face are read)");
+    parts->texture_files = h.texture_files;
 
     // Step: counts against the limits and against the file size, before anything is allocated.
     if (vertex->count > limits.max_vertices)
@@ -332,10 +425,8 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
     auto& positions = scan->mesh.positions;
     auto& triangles = scan->mesh.triangles;
     positions.resize(size_t(vertex->count));  // bounded by the file size above
-    std::vector<int> vertex_axis(vertex->props.size(), -1);  // 0, 1, 2 for x, y, z; -1 for other properties
-    for (size_t pi = 0; pi < vertex->props.size(); ++pi)
-        for (int a = 0; a < 3; ++a)
-            if (!vertex->props[pi].list && vertex->props[pi].name == "xyz"[a] + std::string()) vertex_axis[pi] = a;
+    if (!rgb.empty()) parts->color.assign(4 * size_t(vertex->count), 1.0);  // alpha 1 unless given
+    if (!uv.empty()) parts->texcoord.assign(2 * size_t(vertex->count), 0.0);
     BodyCursor cur(bytes, h.body_offset, h.format);
     std::vector<uint32_t> face_indices, sorted;
     for (const PlyElement& e : h.elements) {
@@ -348,12 +439,25 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
                 double v = 0;
                 if (!cur.read(p.list ? p.count_type : p.type, &v, &problem)) return fail(field(), problem);
                 if (!p.list) {
-                    if (is_vertex && vertex_axis[pi] >= 0) {
+                    const int role = is_vertex ? vertex_role[pi] : kOther;
+                    if (role == kOther) continue;
+                    if (role <= kZ || role >= kU) {
                         if (!(std::isfinite(v) && std::fabs(v) <= 3.0e38))
                             return fail(field(), "not a finite number within float range (|x| <= 3e38)");
                         mesh4d::Vec3& q = positions[size_t(row)];
-                        (vertex_axis[pi] == 0 ? q.x : vertex_axis[pi] == 1 ? q.y : q.z) = v;
+                        if (role == kX) q.x = v;
+                        else if (role == kY) q.y = v;
+                        else if (role == kZ) q.z = v;
+                        else parts->texcoord[2 * size_t(row) + size_t(role - kU)] = role == kU ? v : 1 - v;
+                        continue;
                     }
+                    // A colour: an integer over its type's largest value, a float as it is; within [0, 1].
+                    double top = 1, lo = 0;
+                    if (isIntegral(p.type)) integralRange(p.type, &lo, &top);
+                    if (!(std::isfinite(v) && v >= 0 && v <= top))
+                        return fail(field(), shown(v) + " is not a colour value in [0, " + shown(top) + "]");
+                    const double s = v / top;
+                    parts->color[4 * size_t(row) + size_t(role - kRed)] = role == kAlpha ? s : srgbToLinear(s);
                     continue;
                 }
                 // A list: its count, then its items (each item takes at least one byte).
@@ -394,16 +498,90 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
     return Status::success();
 }
 
+// The look of a scanned PLY (ply_reader.h): its colours and texture coordinates, the one material,
+// and the TextureFile's image when it can be read. Null when the vertices have neither.
+Status buildPlyLook(const std::string& path, const MeshLimits& limits, const PlyLookParts& parts, MeshWarnings* warnings,
+                    std::shared_ptr<SurfaceLook>* out) {
+    out->reset();
+    auto where = [&](size_t k) { return "header line " + std::to_string(parts.texture_files[k].second) + ": comment TextureFile"; };
+    if (parts.texcoord.empty()) {
+        if (!parts.texture_files.empty())
+            warnings->other.push_back(where(0) + " " + parts.texture_files[0].first +
+                                      " ignored (no vertex texture coordinates: texture_u texture_v, s t or u v)");
+        if (parts.color.empty()) return Status::success();
+    }
+    auto look = std::make_shared<SurfaceLook>();
+    look->color = parts.color;
+    look->texcoord = parts.texcoord;
+    // Step: the texture, the first TextureFile (one material per PLY), read as an OBJ's map_Kd is.
+    int texture = -1;
+    if (!parts.texcoord.empty() && !parts.texture_files.empty()) {
+        if (parts.texture_files.size() > 1)
+            warnings->other.push_back(std::to_string(parts.texture_files.size() - 1) + " more TextureFile comments after " +
+                                      where(0) + " ignored (one texture per PLY is read)");
+        const std::string file = besideFile(path, parts.texture_files[0].first);
+        std::string bytes;
+        bool read = false;
+        if (Status s = readConfined(where(0), "texture", file, LookFolders(path, limits), limits, warnings, &bytes, &read); !s.ok)
+            return s;
+        const std::string type = read ? sniffImage(bytes) : "";
+        if (read && type.empty()) warnings->other.push_back(where(0) + ": " + file + " is not PNG or JPEG (the texture is dropped)");
+        if (!type.empty()) {
+            look->samplers.push_back(R"({"wrapS":10497,"wrapT":10497})");  // REPEAT
+            look->images.push_back({type, utf8Replaced(std::filesystem::path(file).filename().string()),
+                                    std::vector<unsigned char>(bytes.begin(), bytes.end())});
+            look->textures.push_back(R"({"sampler":0,"source":0})");
+            texture = 0;
+        }
+    }
+    look->materials.push_back(mtlMaterialJson(MtlMaterial{}, texture, &look->extensions));
+    *out = std::move(look);
+    return Status::success();
+}
+
 }  // namespace
 
-Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings) {
+Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+               std::shared_ptr<const SurfaceLook>* look_out) {
+    if (look_out) look_out->reset();
     // Step: read the whole file (size-limited) and scan it: the bytes are read once.
     std::string text;
     if (Status s = readRegularFile(path, limits.max_file_bytes, &text, "mesh file"); !s.ok) return s;
     ScannedMesh scan;
-    if (Status s = scanPly(path, text, limits, &scan); !s.ok) return s;
+    PlyLookParts parts;
+    if (Status s = scanPly(path, text, limits, &scan, &parts); !s.ok) return s;
     std::string().swap(text);
-    return finishScannedMesh(std::move(scan), path, mesh, warnings);
+    std::shared_ptr<SurfaceLook> look;
+    if (look_out) {
+        if (Status s = buildPlyLook(path, limits, parts, warnings, &look); !s.ok) {
+            // The image's own message, after the mesh it serves.
+            if (s.message.rfind(path, 0) != 0) s.message = path + ": " + s.message;
+            return s;
+        }
+    } else if (!parts.color.empty() || !parts.texcoord.empty()) {
+        warnings->other.push_back("vertex colours and texture coordinates not kept");
+    }
+    if (!look) return finishScannedMesh(std::move(scan), path, mesh, warnings);
+    // Step: the mesh made as for any PLY, the attributes following the vertices OpenMesh copies.
+    const std::vector<std::array<uint32_t, 3>> scanned = scan.mesh.triangles;
+    const size_t scanned_vertices = scan.mesh.positions.size();
+    std::vector<int> origin(scanned.size());
+    std::iota(origin.begin(), origin.end(), 0);
+    if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, &origin); !s.ok) return s;
+    const std::vector<uint32_t> vertex_origin = scannedVertexOf(*mesh, scanned, scanned_vertices, origin);
+    auto follow = [&](std::vector<double>* values, size_t per_vertex) {
+        if (values->empty()) return;
+        std::vector<double> out(per_vertex * mesh->positions.size());
+        for (size_t v = 0; v < mesh->positions.size(); ++v)
+            if (vertex_origin[v] != kNoOrigin)
+                for (size_t k = 0; k < per_vertex; ++k) out[per_vertex * v + k] = (*values)[per_vertex * vertex_origin[v] + k];
+        *values = std::move(out);
+    };
+    follow(&look->color, 4);
+    follow(&look->texcoord, 2);
+    look->triangle_material.assign(mesh->triangles.size(), 0);
+    *look_out = std::move(look);
+    return Status::success();
 }
 
 }  // namespace apparent

@@ -12,10 +12,38 @@
 // bytes in binary files). Errors are one line, "mesh.ply: field: problem", for example
 // "mesh.ply: face[3].vertex_indices[2]: index 9 is out of range (8 vertices)". Faces with a
 // repeated index are dropped and counted as degenerate, polygons triangulated (a fan) and counted.
-// Other properties are skipped; an apparent PLY frame's per-vertex `object` index
-// (exporters/ply.h) with a warning: the frame is read as one object.
+//
+// The look (issue 35; exporters/surface_look.h), when asked for:
+// - Vertex colours: `red green blue` (or `diffuse_red diffuse_green diffuse_blue`), and `alpha` when
+//   given (else 1), scalar properties of any type. An integer type is normalised by its type's
+//   largest value (uchar / 255, ushort / 65535, char / 127, ...), a float type taken as it is; the
+//   value must lie in [0, 1] (a negative integer, a float outside [0, 1] or not finite: an error
+//   naming the row and property, "mesh.ply: vertex[3].red: 1.5 is not a colour value in [0, 1]").
+//   PLY colours are display values (sRGB-encoded, as MeshLab shows them) and glTF's COLOR_0 is
+//   linear, so R, G and B are decoded with the sRGB transfer function (IEC 61966-2-1:1999, the
+//   inverse of its encoding), s the normalised value:
+//     linear = s / 12.92                      for s <= 0.04045
+//     linear = ((s + 0.055) / 1.055)^2.4      above
+//   (0 -> 0, 0.04045 -> 0.0031308, 0.5 -> 0.21404, 1 -> 1); alpha stays as it is (linear).
+// - Texture coordinates: `texture_u texture_v`, `s t` or `u v` (the first pair the vertex has;
+//   finite, within float range). MeshLab's reader (vcglib, wrap/io_trimesh/import_ply.h) stores
+//   texture_u/texture_v and s/t unchanged as a vertex's (u, v), as its OBJ reader
+//   (wrap/io_trimesh/import_obj.h) stores `vt`: a PLY's v points up as OBJ's does, and glTF's down,
+//   so TEXCOORD_0 = (u, 1 - v) as for OBJ (obj_reader.h).
+// - The image: a header line `comment TextureFile NAME` (MeshLab's convention; NAME the rest of the
+//   line, relative to the PLY's folder), read under the rules of pipeline/input/look_files.h (only
+//   inside the allowed folders, a regular file within the size limit, PNG or JPEG; otherwise one
+//   warning and no texture), when the vertices have texture coordinates (else one warning). Only the
+//   first such line is read (later ones: one warning).
+// The object then has one material (white, metallic 0, roughness 1, double-sided, the image as its
+// baseColorTexture when read), on every triangle; vertices OpenMesh copies keep their original's values.
+// Every other property of `vertex` and `face` is named in one warning per element ("element vertex:
+// properties nx, ny, nz, quality ignored (normals are the apparent surface's own)"), other elements in
+// one more; an apparent PLY frame's per-vertex `object` index (exporters/ply.h) has its own
+// warning: the frame is read as one object.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "mesh4d/extrude.h"
@@ -24,7 +52,10 @@
 
 namespace apparent {
 
-// Reads a PLY file into a rest-frame triangle mesh (no transform applied).
-Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings);
+// Reads a PLY file into a rest-frame triangle mesh (no transform applied), and its look into `look`
+// when given (null when it has none; without `look` colours and texture coordinates are named in a
+// warning, not kept).
+Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+               std::shared_ptr<const SurfaceLook>* look = nullptr);
 
 }  // namespace apparent

@@ -1,0 +1,405 @@
+// A PLY's look (pipeline/input/ply_reader.h): vertex colours of every integer and float type made
+// linear against the sRGB closed form computed by hand here, alpha as it is, texture coordinates of
+// each spelling as glTF's (u, 1 - v), the TextureFile image read under the look's file rules,
+// values out of range refused naming the row and property, one warning per element for the
+// properties not read; then a coloured PLY rendered at rest gives COLOR_0 equal to its linear
+// colours vertex for vertex.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <sys/stat.h>
+
+#include <tiny_gltf.h>
+
+#include "pipeline/input/mesh_input.h"
+#include "pipeline/input/ply_reader.h"
+#include "file_bytes.h"
+#include "run_command.h"
+#include "temp_dir.h"
+
+using namespace apparent;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A folder of its own for one test's files.
+struct PlyFolder {
+    fs::path dir;
+    explicit PlyFolder(const std::string& name) : dir(testio::tempPath() / ("ply_look_" + name)) {
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+    }
+    std::string write(const std::string& name, const std::string& text) const {
+        std::ofstream(dir / name, std::ios::binary) << text;
+        return (dir / name).string();
+    }
+};
+
+// An ascii triangle whose vertices have `props` (header lines) and `values` (one row per vertex, after x y z).
+std::string triangle(const std::string& props, const std::array<std::string, 3>& values, const std::string& comments = "") {
+    return "ply\nformat ascii 1.0\n" + comments + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n" +
+           props + "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 " + values[0] + "\n1 0 0 " +
+           values[1] + "\n0 1 0 " + values[2] + "\n3 0 1 2\n";
+}
+
+struct Read {
+    Status status;
+    mesh4d::RestMesh mesh;
+    MeshWarnings warnings;
+    std::shared_ptr<const SurfaceLook> look;
+};
+
+Read readLook(const std::string& path, const MeshLimits& limits = {}) {
+    Read r;
+    r.status = readPly(path, limits, &r.mesh, &r.warnings, &r.look);
+    return r;
+}
+
+// The sRGB decoding written out: s / 12.92 up to 0.04045, ((s + 0.055) / 1.055)^2.4 above.
+double decoded(double s) { return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4); }
+
+bool hasLine(const MeshWarnings& w, const std::string& text) {
+    for (const std::string& l : w.lines())
+        if (l.find(text) != std::string::npos) return true;
+    return false;
+}
+
+}  // namespace
+
+// uchar levels 0, 10 (below the knee: 10/255 = 0.0392), 128 and 255; the closed form's values at
+// 0, 0.5 and 1 by hand (0.5 -> ((0.555 / 1.055)^2.4 = 0.21404114048223255).
+TEST(PlyLook, UcharColoursAreDecodedFromSrgb) {
+    PlyFolder f("uchar");
+    const Read r = readLook(f.write("t.ply", triangle("property uchar red\nproperty uchar green\nproperty uchar blue\n",
+                                                        {"0 10 128", "255 0 0", "0 255 10"})));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.look->color.size(), 12u);
+    EXPECT_EQ(r.look->color[0], 0.0);
+    EXPECT_NEAR(r.look->color[1], 10.0 / 255 / 12.92, 1e-15);
+    EXPECT_NEAR(r.look->color[2], std::pow((128.0 / 255 + 0.055) / 1.055, 2.4), 1e-15);
+    EXPECT_NEAR(r.look->color[2], 0.2158605001138992, 1e-12);  // 128/255 = 0.50196
+    EXPECT_EQ(r.look->color[3], 1.0);  // no alpha: opaque
+    EXPECT_EQ(r.look->color[4], 1.0);
+    EXPECT_EQ(r.look->color[9], 1.0);
+    EXPECT_NEAR(r.look->color[10], 10.0 / 255 / 12.92, 1e-15);
+    EXPECT_TRUE(r.look->texcoord.empty());
+    ASSERT_EQ(r.look->materials.size(), 1u);
+    EXPECT_EQ(r.look->triangle_material, (std::vector<uint32_t>{0}));
+    EXPECT_TRUE(r.warnings.lines().empty());
+}
+
+// Float colours taken as they are: 0, 0.5, 1 and 0.02 (below the knee); alpha 0.25 stays linear.
+TEST(PlyLook, FloatColoursAndAlpha) {
+    PlyFolder f("float");
+    const Read r = readLook(f.write("t.ply", triangle("property float red\nproperty float green\nproperty float blue\nproperty float alpha\n",
+                                                        {"0 0.5 1 0.25", "0.02 1 0 1", "0 0 0 0"})));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    EXPECT_EQ(r.look->color[0], 0.0);
+    EXPECT_NEAR(r.look->color[1], 0.21404114048223255, 1e-12);
+    EXPECT_EQ(r.look->color[2], 1.0);
+    EXPECT_EQ(r.look->color[3], 0.25);
+    EXPECT_NEAR(r.look->color[4], 0.02 / 12.92, 1e-15);
+    EXPECT_EQ(r.look->color[7], 1.0);
+    EXPECT_EQ(r.look->color[11], 0.0);
+}
+
+// ushort over 65535 (32768 -> 0.500008 -> just above the value at 0.5), uchar alpha over 255, and the
+// diffuse_ spelling; binary little-endian.
+TEST(PlyLook, UshortDiffuseSpellingAndBinary) {
+    PlyFolder f("ushort");
+    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        "property float z\nproperty ushort diffuse_red\nproperty ushort diffuse_green\nproperty ushort "
+                        "diffuse_blue\nproperty uchar alpha\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    auto put = [&](const void* p, size_t n) { bytes.append(static_cast<const char*>(p), n); };
+    const float xyz[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const uint16_t rgb[3][3] = {{0, 32768, 65535}, {65535, 0, 0}, {1000, 2000, 3000}};
+    const uint8_t alpha[3] = {255, 51, 0};
+    for (int v = 0; v < 3; ++v) {
+        put(xyz[v], 12);
+        put(rgb[v], 6);
+        put(&alpha[v], 1);
+    }
+    const uint8_t n = 3;
+    const int32_t idx[3] = {0, 1, 2};
+    put(&n, 1);
+    put(idx, 12);
+    const Read r = readLook(f.write("t.ply", bytes));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    EXPECT_EQ(r.look->color[0], 0.0);
+    EXPECT_NEAR(r.look->color[1], decoded(32768.0 / 65535), 1e-15);
+    EXPECT_GT(r.look->color[1], 0.21404114048223255);
+    EXPECT_LT(r.look->color[1], 0.2141);
+    EXPECT_EQ(r.look->color[2], 1.0);
+    EXPECT_EQ(r.look->color[3], 1.0);
+    EXPECT_NEAR(r.look->color[7], 0.2, 1e-15);  // 51 / 255
+    EXPECT_NEAR(r.look->color[8], 1000.0 / 65535 / 12.92, 1e-15);  // 0.0153: below the knee
+    EXPECT_EQ(r.look->color[11], 0.0);
+}
+
+TEST(PlyLook, ColoursOutOfRangeAreRefused) {
+    PlyFolder f("range");
+    const std::pair<std::string, std::string> cases[] = {
+        {triangle("property float red\nproperty float green\nproperty float blue\n", {"0 0 0", "1.5 0 0", "0 0 0"}),
+         "t.ply: vertex[1].red: 1.5 is not a colour value in [0, 1]"},
+        {triangle("property float red\nproperty float green\nproperty float blue\n", {"0 0 0", "0 0 0", "0 0 -0.25"}),
+         "t.ply: vertex[2].blue: -0.25 is not a colour value in [0, 1]"},
+        {triangle("property char red\nproperty char green\nproperty char blue\n", {"0 -3 0", "0 0 0", "0 0 0"}),
+         "t.ply: vertex[0].green: -3 is not a colour value in [0, 127]"},
+        {triangle("property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float alpha\n", {"0 0 0 1", "0 0 0 2", "0 0 0 0"}),
+         "t.ply: vertex[1].alpha: 2 is not a colour value in [0, 1]"},
+        {triangle("property float red\nproperty float green\nproperty float blue\n", {"0 0 0", "0 inf 0", "0 0 0"}),
+         "t.ply: vertex[1].green: 'inf' is not a finite number"},
+        {triangle("property float s\nproperty float t\n", {"0 0", "0 nan", "0 0"}), "t.ply: vertex[1].t: 'nan' is not a finite number"},
+    };
+    for (const auto& [text, expected] : cases) {
+        const Read r = readLook(f.write("t.ply", text));
+        EXPECT_FALSE(r.status.ok) << expected;
+        EXPECT_NE(r.status.message.find(expected), std::string::npos) << r.status.message;
+        EXPECT_EQ(r.status.message.find('\n'), std::string::npos) << r.status.message;
+    }
+    // A NaN in a binary float colour (ascii cannot spell one as a number).
+    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        "property float z\nproperty float red\nproperty float green\nproperty float blue\nelement face 1\n"
+                        "property list uchar int vertex_indices\nend_header\n";
+    const float rows[3][6] = {{0, 0, 0, 0, 0, 0}, {1, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, std::nanf("")}};
+    bytes.append(reinterpret_cast<const char*>(rows), sizeof rows);
+    const uint8_t n = 3;
+    const int32_t idx[3] = {0, 1, 2};
+    bytes.append(reinterpret_cast<const char*>(&n), 1);
+    bytes.append(reinterpret_cast<const char*>(idx), 12);
+    const Read r = readLook(f.write("t.ply", bytes));
+    EXPECT_NE(r.status.message.find("t.ply: vertex[2].blue: nan is not a colour value in [0, 1]"), std::string::npos)
+        << r.status.message;
+}
+
+// Each spelling of the texture coordinates, as glTF's (u, 1 - v).
+TEST(PlyLook, TextureCoordinatesOfEachSpelling) {
+    PlyFolder f("uv");
+    for (const std::string names : {"texture_u texture_v", "s t", "u v"}) {
+        const std::string a = names.substr(0, names.find(' ')), b = names.substr(names.find(' ') + 1);
+        const Read r = readLook(f.write("t.ply", triangle("property float " + a + "\nproperty float " + b + "\n",
+                                                            {"0.25 0.125", "1 0", "0 1"})));
+        ASSERT_TRUE(r.status.ok) << r.status.message;
+        ASSERT_TRUE(r.look) << names;
+        EXPECT_EQ(r.look->texcoord, (std::vector<double>{0.25, 0.875, 1, 1, 0, 0})) << names;
+        EXPECT_TRUE(r.look->color.empty());
+        EXPECT_TRUE(r.look->images.empty());
+        EXPECT_TRUE(r.warnings.lines().empty()) << names;
+    }
+}
+
+// MeshLab's `comment TextureFile NAME`: the image beside the PLY becomes the material's texture,
+// its bytes as they are; outside the folders, missing, not an image, or without texture
+// coordinates: one warning and no texture.
+TEST(PlyLook, TextureFileIsReadUnderTheLookRules) {
+    PlyFolder f("texture");
+    const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + "rest of a picture";
+    f.write("skin.png", png);
+    f.write("notes.png", "not an image");
+    const std::string uv = "property float texture_u\nproperty float texture_v\n";
+    const std::array<std::string, 3> rows{"0 0", "1 0", "0 1"};
+    Read r = readLook(f.write("t.ply", triangle(uv, rows, "comment TextureFile skin.png\ncomment TextureFile other.png\n")));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.look->images.size(), 1u);
+    EXPECT_EQ(r.look->images[0].mime_type, "image/png");
+    EXPECT_EQ(r.look->images[0].name, "skin.png");
+    EXPECT_EQ(std::string(r.look->images[0].bytes.begin(), r.look->images[0].bytes.end()), png);
+    ASSERT_EQ(r.look->textures.size(), 1u);
+    ASSERT_EQ(r.look->materials.size(), 1u);
+    EXPECT_NE(r.look->materials[0].find(R"("baseColorTexture":{"index":0})"), std::string::npos) << r.look->materials[0];
+    EXPECT_TRUE(hasLine(r.warnings, "1 more TextureFile comments after header line 3: comment TextureFile ignored")) << r.warnings.lines()[0];
+    // Each way the image is not used, with its warning.
+    const std::pair<std::string, std::string> cases[] = {
+        {triangle(uv, rows, "comment TextureFile ../outside.png\n"), "is outside the folders a mesh may be read from"},
+        {triangle(uv, rows, "comment TextureFile missing.png\n"), "missing.png not found"},
+        {triangle(uv, rows, "comment TextureFile notes.png\n"), "notes.png is not PNG or JPEG (the texture is dropped)"},
+        {triangle("property uchar red\nproperty uchar green\nproperty uchar blue\n", {"1 2 3", "1 2 3", "1 2 3"},
+                  "comment TextureFile skin.png\n"),
+         "header line 3: comment TextureFile skin.png ignored (no vertex texture coordinates"},
+    };
+    std::ofstream(f.dir.parent_path() / "outside.png", std::ios::binary) << png;
+    MeshLimits limits;
+    limits.scene_path = (f.dir / "scene.json").string();
+    for (const auto& [text, expected] : cases) {
+        r = readLook(f.write("t.ply", text), limits);
+        ASSERT_TRUE(r.status.ok) << r.status.message;
+        ASSERT_TRUE(r.look);
+        EXPECT_TRUE(r.look->images.empty()) << expected;
+        EXPECT_EQ(r.look->materials[0].find("baseColorTexture"), std::string::npos);
+        EXPECT_TRUE(hasLine(r.warnings, expected)) << expected << "\n" << (r.warnings.lines().empty() ? "" : r.warnings.lines()[0]);
+    }    // A FIFO, or an image over the size limit: refused as a mesh file is, one line after the PLY's path.
+    ASSERT_EQ(::mkfifo((f.dir / "pipe.png").c_str(), 0600), 0);
+    r = readLook(f.write("t.ply", triangle(uv, rows, "comment TextureFile pipe.png\n")));
+    EXPECT_NE(r.status.message.find("t.ply: " + (f.dir / "pipe.png").string() + ": is a FIFO, not a regular file (refused)"),
+              std::string::npos) << r.status.message;
+    limits.max_file_bytes = 400;
+    f.write("big.png", png + std::string(500, 'x'));
+    r = readLook(f.write("t.ply", triangle(uv, rows, "comment TextureFile big.png\n")), limits);
+    EXPECT_NE(r.status.message.find("big.png: 525 bytes, larger than the limit of 400 bytes"), std::string::npos) << r.status.message;
+    EXPECT_EQ(r.status.message.rfind((f.dir / "t.ply").string(), 0), 0u) << r.status.message;
+}
+
+// Every property not read is named, once per element; other elements in one more line.
+TEST(PlyLook, PropertiesNotReadAreNamedOnce) {
+    PlyFolder f("ignored");
+    const std::string text =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
+        "property float ny\nproperty float nz\nproperty float quality\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nproperty uchar diffuse_red\nproperty uchar diffuse_green\nproperty uchar diffuse_blue\n"
+        "element face 1\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\n"
+        "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+        "0 0 0 0 0 1 0.5 1 2 3 4 5 6\n1 0 0 0 0 1 0.5 1 2 3 4 5 6\n0 1 0 0 0 1 0.5 1 2 3 4 5 6\n"
+        "3 0 1 2 6 0 0 1 0 0 1\n0 1\n";
+    const Read r = readLook(f.write("t.ply", text));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    EXPECT_EQ(r.warnings.lines(),
+              (std::vector<std::string>{
+                  "element vertex: properties nx, ny, nz, quality, diffuse_red, diffuse_green, diffuse_blue ignored "
+                  "(normals are the apparent surface's own)",
+                  "element face: property texcoord ignored (per-corner texcoord lists are not read, per-vertex "
+                  "texture_u texture_v are)",
+                  "element edge ignored (vertex and face are read)"}));
+    ASSERT_TRUE(r.look);
+    EXPECT_NEAR(r.look->color[0], decoded(1.0 / 255), 1e-15);  // red green blue, the first spelling
+}
+
+// Vertices OpenMesh copies (a triangle given twice, once each way round) keep their original's
+// colour and texture coordinate.
+TEST(PlyLook, LookFollowsOpenMeshCopies) {
+    PlyFolder f("copies");
+    const std::string text =
+        "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+        "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float s\nproperty float t\n"
+        "element face 3\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0 255 0 0 0.25 0.5\n1 0 0 0 0 0 1 0\n0 1 0 0 0 0 0 1\n-1 0 0 0 0 0 1 0\n0 -1 0 0 0 0 0 1\n3 0 1 2\n3 0 3 4\n3 0 4 3\n";
+    const Read r = readLook(f.write("t.ply", text));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    EXPECT_GT(r.mesh.positions.size(), 5u) << "OpenMesh copied no vertex: the test does not test the copies";
+    ASSERT_EQ(r.look->color.size(), 4 * r.mesh.positions.size());
+    ASSERT_EQ(r.look->texcoord.size(), 2 * r.mesh.positions.size());
+    EXPECT_EQ(r.look->triangle_material, (std::vector<uint32_t>{0, 0, 0}));
+    size_t at_origin = 0;
+    for (const auto& t : r.mesh.triangles)
+        for (uint32_t v : t)
+            if (r.mesh.positions[v].x == 0 && r.mesh.positions[v].y == 0) {
+                ++at_origin;
+                EXPECT_EQ(r.look->color[4 * v], 1.0);
+                EXPECT_EQ(r.look->color[4 * v + 1], 0.0);
+                EXPECT_EQ(r.look->texcoord[2 * v], 0.25);
+                EXPECT_EQ(r.look->texcoord[2 * v + 1], 0.5);
+            }
+    EXPECT_EQ(at_origin, 3u);
+}
+
+// readMesh keeps the look; a PLY without colours or texture coordinates has none (its outputs as before).
+TEST(PlyLook, ReadMeshKeepsTheLookAndPlainFilesHaveNone) {
+    PlyFolder f("dispatch");
+    LoadedMesh m;
+    MeshWarnings w;
+    ASSERT_TRUE(readMesh(f.write("t.ply", triangle("property uchar red\nproperty uchar green\nproperty uchar blue\n",
+                                                   {"1 2 3", "1 2 3", "1 2 3"})), {}, &m, &w).ok);
+    EXPECT_TRUE(m.look);
+    LoadedMesh plain;
+    ASSERT_TRUE(readMesh(std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/ply/tetra_ascii.ply", {}, &plain, &w).ok);
+    EXPECT_FALSE(plain.look);
+}
+
+namespace {
+
+std::vector<float> floats(const tinygltf::Model& model, int accessor, int comps) {
+    const tinygltf::Accessor& a = model.accessors[size_t(accessor)];
+    const tinygltf::BufferView& v = model.bufferViews[size_t(a.bufferView)];
+    std::vector<float> out(a.count * size_t(comps));
+    std::memcpy(out.data(), model.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset, out.size() * 4);
+    return out;
+}
+
+}  // namespace
+
+// A coloured tetrahedron (uchar colours) rendered in `instant` at speed 0: every .glb vertex lies at
+// an input vertex (the crease split copies vertices, never moves them), and its COLOR_0 is that
+// vertex's colour decoded here from sRGB, within float32 rounding.
+TEST(PlyLook, RenderAtRestWritesTheLinearColoursVertexForVertex) {
+    PlyFolder f("render");
+    const double xyz[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const int rgb[4][3] = {{255, 0, 10}, {0, 128, 0}, {7, 200, 255}, {64, 64, 64}};
+    std::string text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 4\n"
+                       "property list uchar int vertex_indices\nend_header\n";
+    for (int v = 0; v < 4; ++v)
+        text += std::to_string(xyz[v][0]) + " " + std::to_string(xyz[v][1]) + " " + std::to_string(xyz[v][2]) + " " +
+                std::to_string(rgb[v][0]) + " " + std::to_string(rgb[v][1]) + " " + std::to_string(rgb[v][2]) + "\n";
+    text += "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    f.write("tetra.ply", text);
+    f.write("scene.json", R"({"camera": {"position": [0.3, 0.3, 4], "look_at": [0.3, 0.3, 0], "fov_deg": 60},
+        "frames": {"start": 0, "end": 1, "fps": 1}, "model": "instant", "tolerance": "vertex",
+        "objects": [{"mesh": "tetra.ply", "position": [0, 0, 0], "velocity": [0, 0, 0]}]})");
+    const testcli::CommandResult run = testcli::apparentRun(
+        {"render", (f.dir / "scene.json").string(), "--out", (f.dir / "out").string(), "--frames", "0:1", "--quiet"});
+    ASSERT_EQ(run.code, 0) << run.err;
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (f.dir / "out/instant.glb").string())) << err;
+    size_t checked = 0;
+    std::set<int> seen;
+    for (const tinygltf::Node& node : model.nodes) {
+        if (node.mesh < 0) continue;
+        std::array<double, 3> origin{0, 0, 0};
+        for (size_t k = 0; k < node.translation.size(); ++k) origin[k] = node.translation[k];
+        for (const tinygltf::Primitive& prim : model.meshes[size_t(node.mesh)].primitives) {
+            ASSERT_TRUE(prim.attributes.count("COLOR_0"));
+            const auto pos = floats(model, prim.attributes.at("POSITION"), 3);
+            const auto col = floats(model, prim.attributes.at("COLOR_0"), 3);
+            ASSERT_EQ(pos.size(), col.size());
+            for (size_t i = 0; i < pos.size() / 3; ++i) {
+                int found = -1;
+                for (int v = 0; v < 4; ++v) {
+                    bool same = true;
+                    for (int c = 0; c < 3; ++c) same = same && std::fabs(origin[size_t(c)] + pos[3 * i + size_t(c)] - xyz[v][c]) < 1e-6;
+                    if (same) found = v;
+                }
+                ASSERT_GE(found, 0) << "a vertex at no input vertex";
+                seen.insert(found);
+                for (int c = 0; c < 3; ++c) {
+                    const double s = rgb[found][c] / 255.0;
+                    const double linear = s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+                    EXPECT_NEAR(col[3 * i + size_t(c)], linear, 1e-7) << "vertex " << found << " channel " << c;
+                }
+                ++checked;
+            }
+        }
+    }
+    EXPECT_EQ(seen.size(), 4u);
+    EXPECT_GE(checked, 4u);
+}
+
+// Third-party files (Debian's assimp-testmodels): VCGLIB's float colours with alpha, and Blender's
+// `s t` per vertex, as the files give them.
+TEST(PlyLook, ThirdPartyColoursAndTextureCoordinates) {
+    const std::string root = "/usr/share/assimp/models/PLY/";
+    ASSERT_TRUE(fs::exists(root)) << "install Debian's assimp-testmodels (scripts/setup.sh does)";
+    Read r = readLook(root + "float-color.ply");  // every vertex "0 0 1 1"
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    EXPECT_EQ(r.look->color, (std::vector<double>{0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1}));
+    r = readLook(root + "cube_uv.ply");
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.look->texcoord.size(), 48u);
+    // Vertices 0 to 3 of the file: s t = 0 0, 1 0, 1 1, 0 1.
+    EXPECT_EQ(std::vector<double>(r.look->texcoord.begin(), r.look->texcoord.begin() + 8),
+              (std::vector<double>{0, 1, 1, 1, 1, 0, 0, 0}));
+    EXPECT_TRUE(r.look->color.empty());
+}
