@@ -403,3 +403,21 @@ TEST(PlyLook, ThirdPartyColoursAndTextureCoordinates) {
               (std::vector<double>{0, 1, 1, 1, 1, 0, 0, 0}));
     EXPECT_TRUE(r.look->color.empty());
 }
+
+// The committed fixture (data/fixtures/ply/make_fixtures.py): binary uchar colours with alpha, s t,
+// and a TextureFile that is not there.
+TEST(PlyLook, BinaryFixtureWithAlphaAndMissingTexture) {
+    const Read r = readLook(std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/ply/look_tetra.ply");
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.mesh.positions.size(), 4u);
+    EXPECT_EQ(r.look->color[0], 1.0);
+    EXPECT_NEAR(r.look->color[2], 10.0 / 255 / 12.92, 1e-15);
+    EXPECT_NEAR(r.look->color[5], decoded(128.0 / 255), 1e-15);
+    EXPECT_NEAR(r.look->color[7], 128.0 / 255, 1e-15);  // alpha as it is
+    EXPECT_EQ(r.look->color[11], 0.0);
+    EXPECT_EQ(r.look->texcoord, (std::vector<double>{0, 1, 1, 1, 0, 0, 0.5, 0.5}));
+    EXPECT_TRUE(r.look->images.empty());
+    EXPECT_TRUE(hasLine(r.warnings, "header line 4: comment TextureFile: texture"));
+    EXPECT_TRUE(hasLine(r.warnings, "skin.png not found"));
+}
