@@ -500,7 +500,7 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
 
 // The look of a scanned PLY (ply_reader.h): its colours and texture coordinates, the one material,
 // and the TextureFile's image when it can be read. Null when the vertices have neither.
-Status buildPlyLook(const std::string& path, const MeshLimits& limits, const PlyLookParts& parts, MeshWarnings* warnings,
+Status buildPlyLook(const std::string& path, const MeshLimits& limits, PlyLookParts& parts, MeshWarnings* warnings,
                     std::shared_ptr<SurfaceLook>* out) {
     out->reset();
     auto where = [&](size_t k) { return "header line " + std::to_string(parts.texture_files[k].second) + ": comment TextureFile"; };
@@ -511,11 +511,11 @@ Status buildPlyLook(const std::string& path, const MeshLimits& limits, const Ply
         if (parts.color.empty()) return Status::success();
     }
     auto look = std::make_shared<SurfaceLook>();
-    look->color = parts.color;
-    look->texcoord = parts.texcoord;
+    look->color = std::move(parts.color);
+    look->texcoord = std::move(parts.texcoord);
     // Step: the texture, the first TextureFile (one material per PLY), read as an OBJ's map_Kd is.
     int texture = -1;
-    if (!parts.texcoord.empty() && !parts.texture_files.empty()) {
+    if (!look->texcoord.empty() && !parts.texture_files.empty()) {
         if (parts.texture_files.size() > 1)
             warnings->other.push_back(std::to_string(parts.texture_files.size() - 1) + " more TextureFile comments after " +
                                       where(0) + " ignored (one texture per PLY is read)");
