@@ -3,7 +3,7 @@
 // dispatch the command uses, with small limits so that a valid header cannot ask for gigabytes.
 // A reader must return ok with finite positions and in-range triangles, or an error of one line
 // that starts with the path. For .gltf and .glb the same bytes are also read as a scene; for .obj
-// also as a .mtl material library (pipeline/mtl_reader.h).
+// also as a .mtl material library (pipeline/mtl_reader.h); for .ply the look must be well formed.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -47,6 +47,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         for (const auto& p : mesh.mesh.positions) check(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
         for (const auto& t : mesh.mesh.triangles)
             for (uint32_t i : t) check(i < mesh.mesh.positions.size());
+    }
+    if (st.ok && mesh.look && std::string(APPARENT_FUZZ_EXT) == ".ply") {
+        // A PLY's look (pipeline/input/ply_reader.h): parallel to the mesh, one material, colours in
+        // [0, 1], texture coordinates finite.
+        const apparent::SurfaceLook& look = *mesh.look;
+        const size_t n = mesh.mesh.positions.size();
+        check(look.color.empty() || look.color.size() == 4 * n);
+        check(look.texcoord.empty() || look.texcoord.size() == 2 * n);
+        check(look.hasAttributes() && look.materials.size() == 1);
+        check(look.triangle_material.size() == mesh.mesh.triangles.size());
+        for (uint32_t m : look.triangle_material) check(m == 0);
+        for (double c : look.color) check(c >= 0 && c <= 1);
+        for (double t : look.texcoord) check(std::isfinite(t));
     }
     if (std::string(APPARENT_FUZZ_EXT) == ".obj") {
         // The same bytes as an OBJ's material library: parsed, or one line naming it; every
