@@ -85,10 +85,36 @@ bool FrameSink::addEncoded(long long index, const EncodedOutput&, std::vector<st
     return false;
 }
 
-FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize,
-                             bool light_factors)
-    : dir_(std::move(dir)), extension_(std::move(extension)), write_(write), serialize_(serialize),
-      light_factors_(light_factors) {}
+bool writeUncommitted(AtomicOutput* out, const std::string& bytes, std::string* error) {
+    if (out->fd() < 0) {
+        *error = out->openError();
+        return false;
+    }
+    const iovec whole{const_cast<char*>(bytes.data()), bytes.size()};
+    size_t done = 0;
+    std::string why;
+    if (!writeWhole(out->fd(), &whole, 1, &why, &done)) {
+        *error = out->finalPath() + ": cannot write (" + std::to_string(done) + " of " + std::to_string(bytes.size()) +
+                 " bytes written): " + why;
+        return false;
+    }
+    if (::fsync(out->fd()) != 0) {
+        *error = out->finalPath() + ": cannot write: " + std::strerror(errno);
+        return false;
+    }
+    return true;
+}
+
+bool writeFrameFile(FrameSerializer serialize, const std::string& path, const ExportFrame& frame,
+                    const SequenceInfo& info, std::string* error) {
+    thread_local std::string bytes;  // kept between frames: no reallocation while frames do not grow
+    serialize(frame, info, &bytes);
+    AtomicOutput out(path);
+    return writeUncommitted(&out, bytes, error) && out.commit(error);
+}
+
+FrameFileSink::FrameFileSink(std::string dir, std::string extension, FrameSerializer serialize, bool light_factors)
+    : dir_(std::move(dir)), extension_(std::move(extension)), serialize_(serialize), light_factors_(light_factors) {}
 
 std::string FrameFileSink::path(long long k) const {
     return (std::filesystem::path(dir_) / (frameName(k) + "." + extension_)).string();
@@ -107,8 +133,30 @@ PendingOutput FrameFileSink::pending(const ExportFrame& frame) { return {leastFr
 bool FrameFileSink::add(const ExportFrame& frame, const PreparedFrame*, std::vector<std::string>* completed,
                         std::string* error) {
     const std::string p = path(frame.index);
-    if (!write_(p, frame, info_, error)) return false;
+    serialize_(frame, info_, &bytes_);
+    auto out = std::make_unique<AtomicOutput>(p);
+    if (!writeUncommitted(out.get(), bytes_, error)) return false;
+    if (holding_) {
+        held_[frame.index] = std::move(out);
+        return true;
+    }
+    if (!out->commit(error)) return false;
     completed->push_back(p);
+    return true;
+}
+
+void FrameFileSink::holdCommits(bool on) {
+    holding_ = on;
+    if (!on) held_.clear();  // AtomicOutput removes an uncommitted temporary file
+}
+
+bool FrameFileSink::commitHeld(long long index, std::vector<std::string>* completed, std::string* error) {
+    auto it = held_.find(index);
+    if (it == held_.end()) return true;
+    const std::unique_ptr<AtomicOutput> out = std::move(it->second);
+    held_.erase(it);
+    if (!out->commit(error)) return false;
+    completed->push_back(out->finalPath());
     return true;
 }
 

@@ -27,18 +27,27 @@
 #pragma once
 
 #include <string>
+#include <map>
+#include <memory>
 #include <vector>
 
 #include "exporters/frame_sink.h"
 
 namespace apparent {
 
-// Writes `frame` of the sequence `info` to `path` (through a temporary name); false with a message
-// naming the file.
-using FrameWriter = bool (*)(const std::string& path, const ExportFrame& frame, const SequenceInfo& info,
-                             std::string* error);
-// The file's bytes for `frame` (what FrameWriter writes): the frame as another process sends it.
+class AtomicOutput;
+
+// The file's bytes for `frame` of the sequence `info` (the frame as another process sends it, too).
 using FrameSerializer = void (*)(const ExportFrame& frame, const SequenceInfo& info, std::string* bytes);
+
+// Writes `bytes` whole to `out`'s temporary file (writeWhole: past the page cache when large, else
+// buffered after its blocks are reserved) and fsyncs it, every call checked; not committed. False
+// with a message naming the final path.
+bool writeUncommitted(AtomicOutput* out, const std::string& bytes, std::string* error);
+
+// Writes `frame` to `path` through a temporary name: serialize, writeUncommitted, commit.
+bool writeFrameFile(FrameSerializer serialize, const std::string& path, const ExportFrame& frame,
+                    const SequenceInfo& info, std::string* error);
 
 // What both frame files say of their frame, one line each without the line break, in this order:
 // "units: U" (when the frame's units are not light-seconds), "model: M" and "scene: PATH" (when
@@ -60,8 +69,7 @@ std::string frameObjectName(const SequenceInfo& info, size_t i);
 class FrameFileSink final : public FrameSink {
 public:
     // `light_factors`: whether `write` reads the frames' light factors (FrameSink::readsLightFactors).
-    FrameFileSink(std::string dir, std::string extension, FrameWriter write, FrameSerializer serialize,
-                  bool light_factors = true);
+    FrameFileSink(std::string dir, std::string extension, FrameSerializer serialize, bool light_factors = true);
     bool begin(const SequenceInfo& info, std::string* error) override;
     PendingOutput pending(const ExportFrame& frame) override;
     long long estimate(const ExportFrame& frame) const override { return leastFrameBytes(frame); }
@@ -78,6 +86,9 @@ public:
     void dropEncoded(long long first, long long last_excl) override;
     bool readsLightFactors() const override { return light_factors_; }
     bool readsRestPoints() const override { return false; }  // PLY and OBJ write neither
+    bool canHoldCommits() const override { return true; }
+    void holdCommits(bool on) override;
+    bool commitHeld(long long index, std::vector<std::string>* completed, std::string* error) override;
     ~FrameFileSink() override;
 
 private:
@@ -86,9 +97,11 @@ private:
     int sent_slot_ = -1;                            // a rank: its last frame's name, for its interrupt cleanup
     std::string dir_, extension_;
     SequenceInfo info_;  // the sequence's, from begin() or beginEncoding()
-    FrameWriter write_;
     FrameSerializer serialize_;
     bool light_factors_;
+    std::string bytes_;  // a frame file's bytes, kept between frames (no reallocation while they do not grow)
+    bool holding_ = false;
+    std::map<long long, std::unique_ptr<AtomicOutput>> held_;  // written, not yet committed
 };
 
 // Each rank of a run whose ranks write frame files (above): from now on an interrupt (SIGINT,

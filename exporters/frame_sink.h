@@ -83,6 +83,18 @@ public:
     // once prepared, so the frames it holds at once (the first ones, for the output estimate) do
     // not keep them. The default: yes.
     virtual bool readsRestPoints() const { return true; }
+    // Frames taken before the loop has estimated the output's size (the first few, for
+    // --max-output-bytes: nothing may appear under a final name before the estimate fits). While
+    // holdCommits(true), add() writes the files it would complete but leaves them under their
+    // temporary names and reports none; commitHeld(index) renames frame `index`'s into place and
+    // names them in `completed`; holdCommits(false) ends that and removes what was never committed.
+    // Whether the sink can (a sink whose files appear only in finish() has nothing to hold); the
+    // default: no, and the loop then keeps those frames whole in memory until the estimate.
+    virtual bool canHoldCommits() const { return false; }
+    virtual void holdCommits(bool /*on*/) {}
+    virtual bool commitHeld(long long /*index*/, std::vector<std::string>* /*completed*/, std::string* /*error*/) {
+        return true;
+    }
 
     // Frames across processes. On the process that cuts frames without writing: what begin() sets
     // up for prepare() and encode(), nothing written (the default: nothing).

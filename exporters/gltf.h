@@ -220,6 +220,7 @@ public:
     bool readsLightFactors() const override { return options_.doppler || options_.proper_time || options_.shade_doppler; }
     // Only where it carries an object's look (surface_look.h: plain files).
     bool readsRestPoints() const override { return reads_rest_points_; }
+    bool canHoldCommits() const override { return true; }  // the file appears in finish() only
     // Frames across processes: GlbSequenceWriter::encode and addEncoded.
     bool beginEncoding(const SequenceInfo& info, std::string* error) override { return begin(info, error); }
     EncodedOutput encode(const ExportFrame& frame, const PreparedFrame* prepared) const override;

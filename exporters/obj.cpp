@@ -107,15 +107,11 @@ void serializeObj(const ExportFrame& frame, const SequenceInfo& info, std::strin
 }
 
 bool writeObj(const std::string& path, const ExportFrame& frame, const SequenceInfo& info, std::string* error) {
-    thread_local std::string all;  // kept between frames: no reallocation while frames do not grow
-    serializeObj(frame, info, &all);
-    // Step: written with every error checked (exporters/atomic_file.h).
-    AtomicOutput out(path);
-    return out.commitBytes(all, error);
+    return writeFrameFile(serializeObj, path, frame, info, error);
 }
 
 std::unique_ptr<FrameSink> objSink(std::string dir) {
-    return std::make_unique<FrameFileSink>(std::move(dir), "obj", writeObj, serializeObj, /*light_factors=*/false);
+    return std::make_unique<FrameFileSink>(std::move(dir), "obj", serializeObj, /*light_factors=*/false);
 }
 
 }  // namespace apparent

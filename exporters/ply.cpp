@@ -138,32 +138,11 @@ void serializePly(const ExportFrame& frame, const SequenceInfo& info, std::strin
 }
 
 bool writePly(const std::string& path, const ExportFrame& frame, const SequenceInfo& info, std::string* error) {
-    thread_local std::string bytes;  // kept between frames: no reallocation while frames do not grow
-    serializePly(frame, info, &bytes);
-    // Step: written whole (writeWhole: past the page cache when large, else buffered after its
-    // blocks are reserved), with every write, fsync and close checked, then renamed into place.
-    AtomicOutput out(path);
-    if (out.fd() < 0) {
-        *error = out.openError();
-        return false;
-    }
-    const iovec whole{bytes.data(), bytes.size()};
-    size_t done = 0;
-    std::string why;
-    if (!writeWhole(out.fd(), &whole, 1, &why, &done)) {
-        *error = path + ": cannot write (" + std::to_string(done) + " of " + std::to_string(bytes.size()) +
-                 " bytes written): " + why;
-        return false;
-    }
-    if (::fsync(out.fd()) != 0) {
-        *error = path + ": cannot write: " + std::strerror(errno);
-        return false;
-    }
-    return out.commit(error);
+    return writeFrameFile(serializePly, path, frame, info, error);
 }
 
 std::unique_ptr<FrameSink> plySink(std::string dir) {
-    return std::make_unique<FrameFileSink>(std::move(dir), "ply", writePly, serializePly);
+    return std::make_unique<FrameFileSink>(std::move(dir), "ply", serializePly);
 }
 
 }  // namespace apparent

@@ -274,34 +274,94 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         result->write_seconds += since(write_start);
         result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
     };
-    // Before the first write: the output size estimated from the first kEstimateFrames frames
-    // (held back until then), scaled to the whole run. A frame past --max-triangles is reported
-    // by deliverOne instead.
+    // Before the first file appears: the output size estimated from the first kEstimateFrames
+    // frames, scaled to the whole run. When every sink can hold its commits (FrameSink::
+    // canHoldCommits) and the frames are this process's own, those frames are taken as they come,
+    // their files left under temporary names until the estimate fits, so that none waits whole in
+    // memory and each reuses the buffers of the one before; otherwise they are held back whole
+    // until then. A frame past --max-triangles is reported by deliverOne instead.
     constexpr size_t kEstimateFrames = 4;
-    std::vector<WorkPtr> held;
+    struct Held {
+        WorkPtr work;  // held back whole; null: taken, its commits held
+        long long index = 0;
+        double estimate = 0;
+        std::vector<PendingOutput> pending;  // per sink, as pending() said before add()
+    };
+    std::vector<Held> held;
     bool estimated = false;
+    const bool hold_commits = !settings.distributed && std::all_of(sinks.begin(), sinks.end(), [](const FrameSink* s) {
+                                  return s->canHoldCommits();
+                              });
+    struct EndHolding {
+        const std::vector<FrameSink*>& sinks;
+        bool on;
+        ~EndHolding() {
+            for (FrameSink* s : sinks)
+                if (on) s->holdCommits(false);  // what was never committed goes
+        }
+    } end_holding{sinks, hold_commits};
+    for (FrameSink* s : sinks)
+        if (hold_commits) s->holdCommits(true);
+    // A frame taken with its commits held: add() now, the budget's checks at commitOne().
+    auto takeOne = [&](const WorkPtr& w, Held* h) {
+        const Clock::time_point write_start = Clock::now();
+        const double cpu_start = threadCpuSeconds();
+        const ExportFrame& frame = w->frame;
+        result->max_triangles = std::max(result->max_triangles, frame.triangleCount());
+        for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
+        for (size_t s = 0; s < sinks.size(); ++s) {
+            std::vector<std::string> none;  // holding: nothing completes
+            h->pending.push_back(sinks[s]->pending(frame));
+            if (!sinks[s]->add(frame, w->prepared[s].get(), &none, error)) {
+                stop = true;
+                return;
+            }
+        }
+        result->write_seconds += since(write_start);
+        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
+    };
+    auto commitOne = [&](const Held& h) {
+        if (stop) return;
+        const Clock::time_point write_start = Clock::now();
+        const double cpu_start = threadCpuSeconds();
+        for (size_t s = 0; s < sinks.size(); ++s) {
+            std::vector<std::string> completed;
+            bool done = budget->fits(h.pending[s].bytes, h.pending[s].name, error) &&
+                        sinks[s]->commitHeld(h.index, &completed, error);
+            for (size_t c = 0; done && c < completed.size(); ++c) done = budget->count(completed[c], error);
+            if (!done) {
+                stop = true;
+                return;
+            }
+        }
+        progress.update(++delivered);
+        result->write_seconds += since(write_start);
+        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
+    };
     auto deliver = [&](WorkPtr w) {
         if (stop) return;
         // A frame past the budget ends the run at once (nothing held is written).
         if (estimated || w->over_budget) return deliverOne(w);
-        held.push_back(std::move(w));
+        Held& h = held.emplace_back();
+        h.index = w->frame.index;
+        for (size_t s = 0; s < sinks.size(); ++s)
+            h.estimate += double(w->encoded ? w->encoded->sinks[s].estimate : sinks[s]->estimate(w->frame));
+        if (hold_commits && !w->encoded) takeOne(w, &h);
+        else h.work = std::move(w);
+        if (stop) return;
         if (held.size() < kEstimateFrames && held.size() < size_t(delivered_total)) return;
         estimated = true;
         double bytes = 0;
-        bool too_many = false;
-        for (const WorkPtr& h : held) {
-            too_many = too_many || h->over_budget;
-            for (size_t s = 0; s < sinks.size(); ++s)
-                bytes += double(h->encoded ? h->encoded->sinks[s].estimate : sinks[s]->estimate(h->frame));
-        }
-        if (too_many) bytes = 0;
+        for (const Held& k : held) bytes += k.estimate;
         const double whole = bytes / double(held.size()) * double(delivered_total) * double(settings.models_left);
         if (!budget->fitsEstimate(whole, (long long)held.size(), delivered_total, error)) {
             stop = true;
             return;
         }
-        for (const WorkPtr& h : held) deliverOne(h);
+        for (const Held& k : held) k.work ? deliverOne(k.work) : commitOne(k);
         held.clear();
+        for (FrameSink* s : sinks)
+            if (hold_commits) s->holdCommits(false);
     };
     // MPI rank 0: the frames of other ranks before frame `until`, received in order and delivered.
     long long remote_next = first;

@@ -81,6 +81,7 @@ public:
     void setFinishCheck(OutputCheck check) override { check_ = std::move(check); }
     bool readsLightFactors() const override { return glb_.readsLightFactors(); }
     bool readsRestPoints() const override { return glb_.readsRestPoints(); }
+    bool canHoldCommits() const override { return true; }  // the shard appears in finish() only
 
 private:
     bool write(const std::string& bytes, std::string* error) {
