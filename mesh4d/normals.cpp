@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstring>
 
+#if !defined(APPARENT_NO_TBB)
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#endif
 
 #include "angles.h"
 #if !defined(APPARENT_NO_LANES)
@@ -21,6 +23,30 @@ Vec3 unitOr(const Vec3& v, const Vec3& fallback) {
 }
 
 constexpr size_t kGrain = 16384;  // elements per parallel task
+
+// body(begin, end) over [0, n) in blocks of about kGrain, in parallel; without TBB (the WebAssembly
+// build, APPARENT_NO_TBB) as one block. The blocks' work is independent: the same results.
+template <class Body>
+void forBlocks(size_t n, const Body& body) {
+#if defined(APPARENT_NO_TBB)
+    body(size_t(0), n);
+#else
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain),
+                      [&](const tbb::blocked_range<size_t>& r) { body(r.begin(), r.end()); });
+#endif
+}
+// Whether body(begin, end, init) holds on every block (body returns init && its own test).
+template <class Body>
+bool allBlocks(size_t n, bool init, const Body& body) {
+#if defined(APPARENT_NO_TBB)
+    return body(size_t(0), n, init);
+#else
+    return tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, n, kGrain), init,
+        [&](const tbb::blocked_range<size_t>& r, bool all) { return body(r.begin(), r.end(), all); },
+        [](bool a, bool b) { return a && b; });
+#endif
+}
 
 // v / |v| and |v| (length), |v| as libstdc++'s std::hypot(x, y, z) computes norm(): a sqrt((x/a)^2 +
 // (y/a)^2 + (z/a)^2) with a the largest magnitude (0 when a is 0; v / 1 then).
@@ -156,19 +182,16 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
     // compares the triangles with the last call's (adjacency reuse), when the counts match.
     w->area.resize(nf);
     const bool may_be_same = w->vertices == nv && w->triangles.size() == nf && w->start.size() == nv + 1;
-    const bool same = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, nf, kGrain), may_be_same,
-        [&](const tbb::blocked_range<size_t>& r, bool equal) {
-            const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
-            const Vec3* const pos = mesh.positions.data();
-            Vec3* const area = w->area.data();
-            for (size_t f = r.begin(); f < r.end(); ++f) {
-                const auto& t = tri[f];
-                area[f] = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
-            }
-            return equal && std::memcmp(w->triangles.data() + r.begin(), tri + r.begin(), r.size() * sizeof(tri[0])) == 0;
-        },
-        [](bool a, bool b) { return a && b; });
+    const bool same = allBlocks(nf, may_be_same, [&](size_t begin, size_t end, bool equal) {
+        const std::array<uint32_t, 3>* const tri = mesh.triangles.data();
+        const Vec3* const pos = mesh.positions.data();
+        Vec3* const area = w->area.data();
+        for (size_t f = begin; f < end; ++f) {
+            const auto& t = tri[f];
+            area[f] = cross(pos[t[1]] - pos[t[0]], pos[t[2]] - pos[t[0]]);
+        }
+        return equal && std::memcmp(w->triangles.data() + begin, tri + begin, (end - begin) * sizeof(tri[0])) == 0;
+    });
     if (!same) {
         w->unsplit = false;
         w->vertices = nv;
@@ -204,9 +227,7 @@ void creaseSplitMap(const ApparentMesh& mesh, double crease_deg, CreaseMap* out,
         out->normals.resize(nv);
         normal = out->normals.data();
     }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        pass.run(r.begin(), r.end(), order, uniform, normal);
-    });
+    forBlocks(nv, [&](size_t begin, size_t end) { pass.run(begin, end, order, uniform, normal); });
     size_t used = 0;
     for (size_t v = 0; v < nv; ++v) used += uniform[v];
     const bool unsplit = used == nv;

@@ -35,6 +35,7 @@ if [ "$mode" = test ]; then
   packages+=(python3-pytest)  # ctest python_module runs python/tests
   packages+=(jupyter-nbconvert python3-ipykernel python3-matplotlib)  # ctest python_notebooks executes examples/*.ipynb
   packages+=(git)  # ctest repository_stands_alone reads the tracked files (tests/repository/stands_alone.sh)
+  packages+=(emscripten)  # ctest wasm_parity: mesh4d/ compiled to WebAssembly, against the native build (tests/wasm)
   command -v node >/dev/null 2>&1 || packages+=(nodejs)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi

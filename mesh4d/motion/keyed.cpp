@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mesh4d/elliptic.h"
 #include "mesh4d/motion/motion.h"
 
 namespace mesh4d {
@@ -63,7 +64,7 @@ double arcClock(const SpeedWave& w, double pa, double pb) {
     if (!(top > 0)) return 0;
     const double kk = std::min(1.0, std::sqrt(2 * w.B / top));
     const double shift = w.phi0 + 3.14159265358979323846;
-    return 2 * std::sqrt(top) * (std::ellint_2(kk, 0.5 * (pb - shift)) - std::ellint_2(kk, 0.5 * (pa - shift)));
+    return 2 * std::sqrt(top) * (ellipticE(kk, 0.5 * (pb - shift)) - ellipticE(kk, 0.5 * (pa - shift)));
 }
 
 // q's clock over [a, b] (absolute s) within segment j.

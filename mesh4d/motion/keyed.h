@@ -34,7 +34,7 @@
 //     |dY/ds|^2 = |u|^2 + w^2 rho^2 + 2 w rho (u . e(phi)),   phi = w (s - s_k),
 // (u the segment's velocity in F_V, w its turn rate, rho q's distance from the turn axis, e a unit
 // vector turning with q), A + B cos(phi - phi0), whose integral is an incomplete elliptic integral
-// of the second kind: closed form per segment (std::ellint_2), sqrt(1 - |u|^2) ds without a turn.
+// of the second kind: closed form per segment (mesh4d/elliptic.h), sqrt(1 - |u|^2) ds without a turn.
 // Galilean: tau = s.
 // Speeds: every rest point must be slower than light in F_V (the same condition as in the lab);
 // maxKeyedSpeed gives the largest speed of a point over a segment's arc in closed form (a cosine's

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "mesh4d/elliptic.h"
 #include "mesh4d/extrude.h"
 #include "mesh4d/motion/kinds.h"
 
@@ -61,14 +62,6 @@ double lockedRadius(const Ring& r, const Vec3& q) {
 // A fixed body's point q: its distance from the axis direction through the origin (the part of q in
 // the orbit's plane).
 double planeRadius(const Ring& r, const Vec3& q) { return norm(q - r.k * dot(r.k, q)); }
-
-// E(phi | k) for any phi: E(phi + n pi) = E(phi) + 2 n E(k), E odd.
-double ellipticE(double k, double phi) {
-    const double n = std::nearbyint(phi / kPi);
-    const double rest = phi - n * kPi;
-    const double e = std::ellint_2(k, std::fabs(rest));
-    return 2 * n * std::comp_ellint_2(k) + (rest < 0 ? -e : e);
-}
 
 Local orbitLocal(const Motion& m, double s, const Vec3& q) {
     const Ring r = ringOf(m);
