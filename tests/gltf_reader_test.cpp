@@ -284,3 +284,65 @@ TEST(GltfReader, DracoAttributeIdMissingFromThePayloadIsRefused) {
         << st.message;
     fs::remove_all(dir);
 }
+
+// A .gltf whose texture is a file beside it (assimp-testmodels' BoxTexcoords: one PNG, two texture
+// coordinate sets, the metallic-roughness texture read through TEXCOORD_1): the image's bytes are
+// the file's, both sets are kept, and nothing is dropped.
+TEST(GltfReader, ExternalImagesAreReadBesideTheFile) {
+    const fs::path dir = kAssimp / "BoxTexcoords-glTF";
+    LoadedMesh m;
+    MeshWarnings w;
+    const Status st = load((dir / "boxTexcoords.gltf").string(), &m, &w);
+    ASSERT_TRUE(st.ok) << st.message;
+    ASSERT_TRUE(m.look);
+    ASSERT_EQ(m.look->images.size(), 1u);
+    std::ifstream png(dir / "texture.png", std::ios::binary);
+    const std::vector<unsigned char> want((std::istreambuf_iterator<char>(png)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(m.look->images[0].bytes, want);
+    EXPECT_EQ(m.look->images[0].mime_type, "image/png");
+    EXPECT_EQ(m.look->texcoord.size(), 2 * m.mesh.positions.size());
+    EXPECT_EQ(m.look->texcoord1.size(), 2 * m.mesh.positions.size());
+    ASSERT_EQ(m.look->materials.size(), 1u);
+    EXPECT_NE(m.look->materials[0].find("\"metallicRoughnessTexture\":{\"index\":0,\"texCoord\":1}"), std::string::npos)
+        << m.look->materials[0];
+    for (const std::string& line : w.lines()) ADD_FAILURE() << "unexpected warning: " << line;
+}
+
+// An image URI that leaves the glTF file's folder is refused with its path named, as a buffer's is:
+// textually ("../", absolute) before anything is read, and a symlink out of the folder once resolved.
+TEST(GltfReader, ImageUrisStayInTheFilesFolder) {
+    const fs::path dir = testio::tempPath() / ("apparent_gltf_images_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "model");
+    const fs::path src = kAssimp / "BoxTexcoords-glTF";
+    fs::copy_file(src / "boxTexcoords.bin", dir / "model/boxTexcoords.bin");
+    fs::copy_file(src / "texture.png", dir / "texture.png");
+    std::ifstream in(src / "boxTexcoords.gltf");
+    nlohmann::json j = nlohmann::json::parse(in);
+    auto write = [&](const std::string& uri) {
+        j["images"][0]["uri"] = uri;
+        std::ofstream(dir / "model/box.gltf") << j.dump();
+        LoadedMesh m;
+        return load((dir / "model/box.gltf").string(), &m);
+    };
+    Status st = write("../texture.png");
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("images[0].uri: '../texture.png' leaves the glTF file's folder (refused)"), std::string::npos)
+        << st.message;
+    st = write((dir / "texture.png").string());
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("images[0].uri: '" + (dir / "texture.png").string() + "' is not a relative path"),
+              std::string::npos)
+        << st.message;
+    fs::create_symlink(dir / "texture.png", dir / "model/link.png");
+    st = write("link.png");
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("images: URI"), std::string::npos) << st.message;
+    EXPECT_NE(st.message.find("link.png' is outside the glTF file's folder (refused)"), std::string::npos) << st.message;
+    // Inside the folder: read.
+    fs::copy_file(dir / "texture.png", dir / "model/texture.png");
+    LoadedMesh m;
+    st = write("texture.png");
+    ASSERT_TRUE(st.ok) << st.message;
+    fs::remove_all(dir);
+}

@@ -130,10 +130,23 @@ bool extractJson(const std::string& path, const std::vector<unsigned char>& byte
     return true;
 }
 
-// Buffer URIs must stay inside the glTF file's folder: no absolute paths, no other scheme than
-// data:, no ".." that climbs out (checked on the percent-decoded text, as tinygltf decodes it).
-bool checkBufferUris(const nlohmann::json& j, std::string* problem) {
-    auto buffers = j.find("buffers");
+// Whether an entry of `array` ("images", "buffers") names the file `path` resolves to by its uri.
+bool referencedBy(const nlohmann::json& j, const char* array, const std::string& path) {
+    auto list = j.find(array);
+    if (list == j.end() || !list->is_array()) return false;
+    const std::string name = fs::path(path).filename().string();
+    for (const auto& e : *list)
+        if (e.is_object() && e.contains("uri") && e["uri"].is_string() &&
+            fs::path(e["uri"].get<std::string>()).filename().string() == name)
+            return true;
+    return false;
+}
+
+// Buffer and image URIs must stay inside the glTF file's folder: no absolute paths, no other
+// scheme than data:, no ".." that climbs out (checked on the percent-decoded text, as tinygltf
+// decodes it).
+bool checkFileUris(const nlohmann::json& j, const char* array, std::string* problem) {
+    auto buffers = j.find(array);
     if (buffers == j.end() || !buffers->is_array()) return true;
     for (size_t i = 0; i < buffers->size(); ++i) {
         const auto& b = (*buffers)[i];
@@ -150,7 +163,7 @@ bool checkBufferUris(const nlohmann::json& j, std::string* problem) {
                 uri += raw[k];
             }
         }
-        const std::string where = "buffers[" + std::to_string(i) + "].uri";
+        const std::string where = std::string(array) + "[" + std::to_string(i) + "].uri";
         const auto colon = uri.find(':'), slash = uri.find('/');
         const bool scheme = colon != std::string::npos && (slash == std::string::npos || colon < slash);
         if (uri.empty() || uri[0] == '/' || uri[0] == '\\' || scheme) {
@@ -217,7 +230,7 @@ bool bufferBytes(const nlohmann::json& j, size_t index, const std::vector<unsign
         const auto comma = uri.find(";base64,");
         return comma != std::string::npos && decodeBase64(uri.substr(comma + 8), out);
     }
-    // Relative file (checkBufferUris has refused textual escapes): confined after resolving
+    // Relative file (checkFileUris has refused textual escapes): confined after resolving
     // symlinks too, and only a regular file (else left to tinygltf's confined callbacks to refuse).
     const fs::path p = root / uri;
     if (!resolvesInside(p.string(), root.string())) return false;
@@ -389,7 +402,7 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
             return Status::failure(path + ": asset.version: glTF 1.0 is not supported; convert with "
                                           "'npx gltf-pipeline -i IN -o OUT.glb' (it upgrades 1.0 to 2.0) or re-export as glTF 2.0");
     }
-    if (!checkBufferUris(j, &problem) || !checkDracoReferences(j, &problem) ||
+    if (!checkFileUris(j, "buffers", &problem) || !checkFileUris(j, "images", &problem) || !checkDracoReferences(j, &problem) ||
         !checkDracoPayloads(j, bytes, binary, canonical.parent_path(), limits.max_file_bytes, &problem))
         return Status::failure(path + ": " + problem);
 
@@ -403,7 +416,8 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
     const bool ok = binary ? loader.LoadBinaryFromMemory(model, &err, &warn, bytes.data(), unsigned(bytes.size()), base_dir)
                            : loader.LoadASCIIFromString(model, &err, &warn, json_text.c_str(), unsigned(json_text.size()), base_dir);
     if (!conf.violation.empty())
-        return Status::failure(path + ": buffers: URI '" + conf.violation + "' is outside the glTF file's folder (refused)");
+        return Status::failure(path + ": " + (referencedBy(j, "images", conf.violation) ? "images" : "buffers") + ": URI '" +
+                               conf.violation + "' is outside the glTF file's folder (refused)");
     if (!ok) return Status::failure(path + ": tinygltf: " + (err.empty() ? std::string("could not load the file") : firstLine(err)));
     if (!warn.empty()) doc->warnings.push_back("tinygltf: " + firstLine(warn));
     // Step: keep the extras as written (see GltfDocument).
