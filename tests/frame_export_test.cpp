@@ -128,8 +128,10 @@ TEST(FrameExport, GlbFrameBoundsAreThoseOfItsFloatPositions) {
     SequenceInfo info;
     info.model = "relativistic";
     info.fps = 10;
-    info.objects.push_back({"a", {0.8, 0.8, 0.8, 1}, -1, ""});
-    info.objects.push_back({"b", {0.5, 0.5, 0.5, 1}, -1, ""});
+    info.objects.resize(2);
+    info.objects[0].name = "a";
+    info.objects[1].name = "b";
+    info.objects[1].base_color = {0.5, 0.5, 0.5, 1};
     const fs::path dir = testio::tempPath() / ("apparent_glb_bounds_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::string bytes[2];

@@ -308,7 +308,10 @@ TEST(FrameObjects, EncodedFramesAreTheOneProcessBytes) {
     SequenceInfo info;
     info.model = "finite";
     info.scene_path = "scenes/two.json";
-    info.objects = {{"a b", {0.8, 0.8, 0.8, 1}, -1, ""}, {"c", {0.5, 0.5, 0.5, 1}, -1, ""}};
+    info.objects.resize(2);
+    info.objects[0].name = "a b";
+    info.objects[1].name = "c";
+    info.objects[1].base_color = {0.5, 0.5, 0.5, 1};
     ExportFrame frame;
     frame.index = 7;
     frame.t_c = 0.1 + 7.0 / 3;

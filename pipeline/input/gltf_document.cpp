@@ -407,7 +407,7 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
         return Status::failure(path + ": " + problem);
 
     // Step: parse with tinygltf, file access confined to the glTF file's folder.
-    Confinement conf{canonical.parent_path(), limits.max_file_bytes, {}, {}};
+    Confinement conf{canonical.parent_path(), limits.max_file_bytes, {}, {}, {}};
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&confinedExists, &confinedExpand, &confinedRead, &refuseWrite, &conf});
     loader.SetImageLoader(&keepImageBytes, nullptr);
