@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <sys/stat.h>
 
@@ -225,7 +226,7 @@ TEST(PlyLook, TextureFileIsReadUnderTheLookRules) {
         {triangle(uv, rows, "comment TextureFile notes.png\n"), "notes.png is not PNG or JPEG (the texture is dropped)"},
         {triangle("property uchar red\nproperty uchar green\nproperty uchar blue\n", {"1 2 3", "1 2 3", "1 2 3"},
                   "comment TextureFile skin.png\n"),
-         "header line 3: comment TextureFile skin.png ignored (no vertex texture coordinates"},
+         "header line 3: comment TextureFile skin.png ignored (no texture coordinates"},
     };
     std::ofstream(f.dir.parent_path() / "outside.png", std::ios::binary) << png;
     MeshLimits limits;
@@ -256,18 +257,17 @@ TEST(PlyLook, PropertiesNotReadAreNamedOnce) {
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
         "property float ny\nproperty float nz\nproperty float quality\nproperty uchar red\nproperty uchar green\n"
         "property uchar blue\nproperty uchar diffuse_red\nproperty uchar diffuse_green\nproperty uchar diffuse_blue\n"
-        "element face 1\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\n"
+        "element face 1\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\nproperty uchar flags\n"
         "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
         "0 0 0 0 0 1 0.5 1 2 3 4 5 6\n1 0 0 0 0 1 0.5 1 2 3 4 5 6\n0 1 0 0 0 1 0.5 1 2 3 4 5 6\n"
-        "3 0 1 2 6 0 0 1 0 0 1\n0 1\n";
+        "3 0 1 2 6 0 0 1 0 0 1 7\n0 1\n";
     const Read r = readLook(f.write("t.ply", text));
     ASSERT_TRUE(r.status.ok) << r.status.message;
     EXPECT_EQ(r.warnings.lines(),
               (std::vector<std::string>{
                   "element vertex: properties nx, ny, nz, quality, diffuse_red, diffuse_green, diffuse_blue ignored "
                   "(normals are the apparent surface's own)",
-                  "element face: property texcoord ignored (per-corner texcoord lists are not read, per-vertex "
-                  "texture_u texture_v are)",
+                  "element face: property flags ignored",
                   "element edge ignored (vertex and face are read)"}));
     ASSERT_TRUE(r.look);
     EXPECT_NEAR(r.look->color[0], decoded(1.0 / 255), 1e-15);  // red green blue, the first spelling
@@ -420,4 +420,270 @@ TEST(PlyLook, BinaryFixtureWithAlphaAndMissingTexture) {
     EXPECT_TRUE(r.look->images.empty());
     EXPECT_TRUE(hasLine(r.warnings, "header line 4: comment TextureFile: texture"));
     EXPECT_TRUE(hasLine(r.warnings, "skin.png not found"));
+}
+
+namespace {
+
+// A unit cube whose six quads carry MeshLab's per-corner `texcoord` lists (and uchar colours
+// red green blue = 255 x, 255 y, 255 z, so linear colour = position). Vertex i = x + 2y + 4z; face
+// f lies on the plane of axis a = f / 2 at coordinate f % 2, wound outwards. Its corners' (u, v) in
+// the file, by closed form: u = (2f + p[(a + 1) % 3]) / 16, v = p[(a + 2) % 3], so no two faces
+// share a coordinate and each vertex, on three faces, becomes three: 24 vertices.
+// `texnumber` (when not empty) is added as an int face property, `comments` to the header.
+const int kCubeFace[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+
+std::array<double, 2> cubeUv(int f, const double p[3]) {
+    const int a = f / 2;
+    return {(2 * f + p[(a + 1) % 3]) / 16, p[(a + 2) % 3]};
+}
+
+std::string cornerCube(const std::string& comments = "", const std::vector<int>& texnumber = {},
+                       const std::string& extra_vertex_props = "") {
+    std::string text = "ply\nformat ascii 1.0\n" + comments +
+                       "element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\n" + extra_vertex_props +
+                       "element face 6\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\n" +
+                       (texnumber.empty() ? "" : "property int texnumber\n") + "end_header\n";
+    for (int i = 0; i < 8; ++i) {
+        const int x = i & 1, y = (i >> 1) & 1, z = (i >> 2) & 1;
+        text += std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + " " + std::to_string(255 * x) + " " +
+                std::to_string(255 * y) + " " + std::to_string(255 * z) + (extra_vertex_props.empty() ? "" : " 0.5 0.5") + "\n";
+    }
+    std::ostringstream rows;
+    rows.precision(17);
+    for (int f = 0; f < 6; ++f) {
+        rows << "4";
+        for (int k = 0; k < 4; ++k) rows << " " << kCubeFace[f][k];
+        rows << " 8";
+        for (int k = 0; k < 4; ++k) {
+            const int i = kCubeFace[f][k];
+            const double p[3] = {double(i & 1), double((i >> 1) & 1), double((i >> 2) & 1)};
+            const auto uv = cubeUv(f, p);
+            rows << " " << uv[0] << " " << uv[1];
+        }
+        if (!texnumber.empty()) rows << " " << texnumber[size_t(f)];
+        rows << "\n";
+    }
+    return text + rows.str();
+}
+
+}  // namespace
+
+// The cube's corners: 24 vertices (8 + 16 copies, each at its original's position exactly), each
+// corner's texcoord the closed form's (u, 1 - v) for its face, its colour its position's.
+TEST(PlyLook, CornerTexcoordsSplitTheVerticesAtSeams) {
+    PlyFolder f("corner");
+    const Read r = readLook(f.write("cube.ply", cornerCube()));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.mesh.positions.size(), 24u);
+    ASSERT_EQ(r.mesh.triangles.size(), 12u);
+    ASSERT_EQ(r.look->texcoord.size(), 48u);
+    ASSERT_EQ(r.look->color.size(), 96u);
+    EXPECT_EQ(r.look->triangle_material, std::vector<uint32_t>(12, 0));
+    EXPECT_TRUE(hasLine(r.warnings, "16 vertices copied at texture seams")) << r.warnings.lines().size();
+    EXPECT_EQ(r.warnings.polygons_triangulated, 6u);
+    std::set<uint32_t> used;
+    for (size_t t = 0; t < 12; ++t) {
+        const int face = int(t / 2);  // a quad's fan: two triangles, in file order
+        for (uint32_t v : r.mesh.triangles[t]) {
+            used.insert(v);
+            const mesh4d::Vec3& q = r.mesh.positions[v];
+            const double p[3] = {q.x, q.y, q.z};
+            // The position is a corner of this face.
+            bool corner = false;
+            for (int k = 0; k < 4; ++k) {
+                const int i = kCubeFace[face][k];
+                corner = corner || (p[0] == (i & 1) && p[1] == ((i >> 1) & 1) && p[2] == ((i >> 2) & 1));
+            }
+            EXPECT_TRUE(corner) << "triangle " << t << " vertex " << v;
+            const auto uv = cubeUv(face, p);
+            EXPECT_EQ(r.look->texcoord[2 * v], uv[0]) << "face " << face << " vertex " << v;
+            EXPECT_EQ(r.look->texcoord[2 * v + 1], 1 - uv[1]) << "face " << face << " vertex " << v;
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(r.look->color[4 * v + size_t(c)], p[c]) << "vertex " << v;
+            EXPECT_EQ(r.look->color[4 * v + 3], 1.0);
+        }
+    }
+    EXPECT_EQ(used.size(), 24u);
+}
+
+// Two triangles on a square (0 1 2 and 0 2 3) sharing the diagonal 0-2: vertex 2's coordinate agrees
+// across it and vertex 0's does not, so by hand 4 + 1 = 5 vertices; the texcoord list written
+// before the indices, as doubles behind a ushort count; per-vertex u v given too: the corners win, one warning.
+TEST(PlyLook, CornerTexcoordsWinOverPerVertexOnesAndMayComeFirst) {
+    PlyFolder f("corner_order");
+    const std::string text =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+        "property float u\nproperty float v\nelement face 2\nproperty list ushort double texcoord\n"
+        "property list uchar uint vertex_indices\nend_header\n"
+        "0 0 0 9 9\n1 0 0 9 9\n1 1 0 9 9\n0 1 0 9 9\n"
+        "6 0 0 1 0 1 1 3 0 1 2\n"
+        "6 0.5 0 1 1 0 1 3 0 2 3\n";
+    const Read r = readLook(f.write("sq.ply", text));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.mesh.positions.size(), 5u);
+    EXPECT_EQ(r.mesh.positions[4].x, 0.0);
+    EXPECT_EQ(r.mesh.positions[4].y, 0.0);
+    EXPECT_EQ(r.look->texcoord, (std::vector<double>{0, 1, 1, 1, 1, 0, 0, 0, 0.5, 1}));
+    EXPECT_EQ(r.mesh.triangles[1], (std::array<uint32_t, 3>{4, 2, 3}));
+    EXPECT_TRUE(r.look->color.empty());
+    EXPECT_TRUE(hasLine(r.warnings, "element vertex: per-vertex texture coordinates ignored (the faces' per-corner texcoord lists are read)"));
+    EXPECT_TRUE(hasLine(r.warnings, "1 vertices copied at texture seams"));
+}
+
+// A list of the wrong length, a value that is not finite (ascii and binary), integer values, and a
+// texnumber naming no texture: one line naming the file, the face row and the property.
+TEST(PlyLook, CornerTexcoordErrors) {
+    PlyFolder f("corner_bad");
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                             "element face 2\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\n";
+    const std::string verts = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 6 0 0 1 0 0 1\n";
+    const std::pair<std::string, std::string> cases[] = {
+        {head + verts + "3 0 2 1 4 0 0 1 0\n", "face[1].texcoord: 4 values for a face of 3 vertices (a u v pair per vertex: 6)"},
+        {head + verts + "3 0 2 1 8 0 0 1 0 0 1 0 0\n", "face[1].texcoord: 8 values for a face of 3 vertices"},
+        {head + verts + "3 0 2 1 6 0 0 1 nan 0 1\n", "face[1].texcoord[3]: 'nan' is not a finite number"},
+        {head + verts + "3 0 2 1 6 0 0 1 1e39 0 1\n", "face[1].texcoord[3]: '1e39' is not a finite number"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+         "property list uchar int vertex_indices\nproperty list uchar int texcoord\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 6 0 0 1 0 0 1\n",
+         "element face: texcoord: values must be of type float or double"},
+        {"ply\nformat ascii 1.0\ncomment TextureFile a.png\ncomment TextureFile b.png\nelement vertex 3\nproperty float x\n"
+         "property float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+         "property list uchar float texcoord\nproperty int texnumber\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+         "3 0 1 2 6 0 0 1 0 0 1 1\n3 0 2 1 6 0 0 1 0 0 1 2\n",
+         "face[1].texnumber: 2 names no texture (2 TextureFile comments; 0 to 1)"},
+        {head.substr(0, head.size() - 1) + "\nproperty int texnumber\n" + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 6 0 0 1 0 0 1 0\n3 0 2 1 6 0 0 1 0 0 1 1\n",
+         "face[1].texnumber: 1 names no texture (0 TextureFile comments; 0 to 0)"},
+    };
+    for (const auto& [text, expected] : cases) {
+        const Read r = readLook(f.write("bad.ply", text));
+        EXPECT_FALSE(r.status.ok) << expected;
+        EXPECT_EQ(r.status.message.rfind((f.dir / "bad.ply").string() + ": " + expected, 0), 0u) << r.status.message;
+        EXPECT_EQ(r.status.message.find('\n'), std::string::npos);
+    }
+    // Binary little-endian: a NaN float among the values.
+    std::string bin = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                      "element face 1\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\nend_header\n";
+    auto put = [&](const void* p, size_t n) { bin.append(static_cast<const char*>(p), n); };
+    const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    put(xyz, sizeof xyz);
+    const unsigned char three = 3, six = 6;
+    const int32_t idx[3] = {0, 1, 2};
+    put(&three, 1);
+    put(idx, sizeof idx);
+    put(&six, 1);
+    const float uv[6] = {0, 0, 1, std::nanf(""), 0, 1};
+    put(uv, sizeof uv);
+    const Read r = readLook(f.write("bad.ply", bin));
+    EXPECT_EQ(r.status.message, (f.dir / "bad.ply").string() + ": face[0].texcoord[3]: not a finite number within float range (|x| <= 3e38)");
+}
+
+// MeshLab's several textures: `texnumber` picks each face's TextureFile, one material (and image)
+// per TextureFile, in their order; one texture with every texnumber 0: read as without it.
+TEST(PlyLook, TexnumberPicksOneMaterialPerTextureFile) {
+    PlyFolder f("texnumber");
+    const std::string png_a = std::string("\x89PNG\r\n\x1a\n", 8) + "picture a", png_b = std::string("\x89PNG\r\n\x1a\n", 8) + "picture b";
+    f.write("a.png", png_a);
+    f.write("b.png", png_b);
+    const std::vector<int> texnumber{0, 1, 1, 0, 1, 0};
+    Read r = readLook(f.write("cube.ply", cornerCube("comment TextureFile a.png\ncomment TextureFile b.png\n", texnumber)));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.look->materials.size(), 2u);
+    ASSERT_EQ(r.look->images.size(), 2u);
+    EXPECT_EQ(std::string(r.look->images[0].bytes.begin(), r.look->images[0].bytes.end()), png_a);
+    EXPECT_EQ(std::string(r.look->images[1].bytes.begin(), r.look->images[1].bytes.end()), png_b);
+    EXPECT_NE(r.look->materials[0].find(R"("baseColorTexture":{"index":0})"), std::string::npos) << r.look->materials[0];
+    EXPECT_NE(r.look->materials[1].find(R"("baseColorTexture":{"index":1})"), std::string::npos) << r.look->materials[1];
+    EXPECT_EQ(r.look->textures, (std::vector<std::string>{R"({"sampler":0,"source":0})", R"({"sampler":0,"source":1})"}));
+    ASSERT_EQ(r.look->triangle_material.size(), 12u);
+    for (size_t t = 0; t < 12; ++t) EXPECT_EQ(r.look->triangle_material[t], uint32_t(texnumber[t / 2])) << t;
+    EXPECT_FALSE(hasLine(r.warnings, "TextureFile"));
+    // One texture, texnumber all 0: as the file without texnumber, silently.
+    r = readLook(f.write("cube.ply", cornerCube("comment TextureFile a.png\n", std::vector<int>(6, 0))));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_EQ(r.look->materials.size(), 1u);
+    ASSERT_EQ(r.look->images.size(), 1u);
+    EXPECT_EQ(r.look->triangle_material, std::vector<uint32_t>(12, 0));
+    EXPECT_EQ(r.warnings.lines(), (std::vector<std::string>{"6 polygons triangulated",
+                                                             "16 vertices copied at texture seams (a vertex with more than one texcoord)"}));
+    // Several TextureFile comments without texnumber: the first alone, one warning.
+    r = readLook(f.write("cube.ply", cornerCube("comment TextureFile a.png\ncomment TextureFile b.png\n")));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_EQ(r.look->materials.size(), 1u);
+    ASSERT_EQ(r.look->images.size(), 1u);
+    EXPECT_TRUE(hasLine(r.warnings, "1 more TextureFile comments after header line 3: comment TextureFile ignored (one texture per PLY is read without a face texnumber)"));
+}
+
+namespace {
+
+std::vector<uint32_t> indices(const tinygltf::Model& model, int accessor) {
+    const tinygltf::Accessor& a = model.accessors[size_t(accessor)];
+    const tinygltf::BufferView& v = model.bufferViews[size_t(a.bufferView)];
+    const unsigned char* at = model.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+    std::vector<uint32_t> out(a.count);
+    for (size_t i = 0; i < a.count; ++i) {
+        if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) std::memcpy(&out[i], at + 4 * i, 4);
+        else if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+            uint16_t s;
+            std::memcpy(&s, at + 2 * i, 2);
+            out[i] = s;
+        } else out[i] = at[i];
+    }
+    return out;
+}
+
+}  // namespace
+
+// The corner-textured cube rendered in `instant` at speed 0: each .glb triangle lies on one face of
+// the cube (the face found from its corners' positions), and each of its corners' TEXCOORD_0 is
+// the closed form's (u, 1 - v) for that face and position, within float32 rounding.
+TEST(PlyLook, RenderAtRestWritesTheCornerTexcoordsVertexForVertex) {
+    PlyFolder f("corner_render");
+    f.write("cube.ply", cornerCube());
+    f.write("scene.json", R"({"camera": {"position": [0.5, 0.5, 4], "look_at": [0.5, 0.5, 0], "fov_deg": 60},
+        "frames": {"start": 0, "end": 1, "fps": 1}, "model": "instant", "tolerance": "vertex",
+        "objects": [{"mesh": "cube.ply", "position": [0, 0, 0], "velocity": [0, 0, 0]}]})");
+    const testcli::CommandResult run = testcli::apparentRun(
+        {"render", (f.dir / "scene.json").string(), "--out", (f.dir / "out").string(), "--frames", "0:1", "--quiet"});
+    ASSERT_EQ(run.code, 0) << run.err;
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (f.dir / "out/instant.glb").string())) << err;
+    size_t checked = 0;
+    std::set<int> faces;
+    for (const tinygltf::Node& node : model.nodes) {
+        if (node.mesh < 0) continue;
+        std::array<double, 3> origin{0, 0, 0};
+        for (size_t k = 0; k < node.translation.size(); ++k) origin[k] = node.translation[k];
+        for (const tinygltf::Primitive& prim : model.meshes[size_t(node.mesh)].primitives) {
+            ASSERT_TRUE(prim.attributes.count("TEXCOORD_0"));
+            ASSERT_GE(prim.indices, 0);
+            const auto pos = floats(model, prim.attributes.at("POSITION"), 3);
+            const auto uv = floats(model, prim.attributes.at("TEXCOORD_0"), 2);
+            const auto tri = indices(model, prim.indices);
+            ASSERT_EQ(pos.size() / 3, uv.size() / 2);
+            for (size_t t = 0; t + 2 < tri.size(); t += 3) {
+                double p[3][3];
+                for (int c = 0; c < 3; ++c)
+                    for (int k = 0; k < 3; ++k) p[c][k] = std::round(origin[size_t(k)] + pos[3 * tri[t + size_t(c)] + size_t(k)]);
+                int face = -1;
+                for (int a = 0; a < 3; ++a)
+                    if (p[0][a] == p[1][a] && p[1][a] == p[2][a]) face = 2 * a + int(p[0][a]);
+                ASSERT_GE(face, 0) << "a triangle on no face of the cube";
+                faces.insert(face);
+                for (int c = 0; c < 3; ++c) {
+                    const size_t v = tri[t + size_t(c)];
+                    for (int k = 0; k < 3; ++k) ASSERT_NEAR(origin[size_t(k)] + pos[3 * v + size_t(k)], p[c][k], 1e-6);
+                    const auto expected = cubeUv(face, p[c]);
+                    EXPECT_NEAR(uv[2 * v], expected[0], 1e-7) << "face " << face;
+                    EXPECT_NEAR(uv[2 * v + 1], 1 - expected[1], 1e-7) << "face " << face;
+                    ++checked;
+                }
+            }
+        }
+    }
+    EXPECT_EQ(faces.size(), 6u);
+    EXPECT_GE(checked, 36u);
 }

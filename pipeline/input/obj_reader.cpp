@@ -53,8 +53,6 @@ bool parseTexIndex(std::string_view token, long* out) {
     return r.ec == std::errc() && r.ptr == t.data() + t.size() && *out != 0;
 }
 
-constexpr uint32_t kNoTexcoord = std::numeric_limits<uint32_t>::max();
-
 // What the scanner gathers for the look, beside the mesh.
 struct ObjLookParts {
     std::vector<double> uv;                          // vt: u, v (file order)
@@ -317,44 +315,11 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         warnings->other.push_back("face corners name texture coordinates but the file has no vt lines: none kept");
     }
     if (!parts.corner_uv.empty()) {
-        // Equal (u, v) pairs written twice are one texture coordinate: each index to its first.
-        std::map<std::pair<double, double>, uint32_t> first_of;
-        std::vector<uint32_t> same(vt_count);
-        for (size_t k = 0; k < vt_count; ++k)
-            same[k] = first_of.try_emplace({parts.uv[2 * k], parts.uv[2 * k + 1]}, uint32_t(k)).first->second;
-        for (auto& corners : parts.corner_uv)
-            for (uint32_t& vt : corners)
-                if (vt != kNoTexcoord) vt = same[vt];
-        auto& positions = scan->mesh.positions;
-        const size_t file_vertices = positions.size();
-        std::vector<uint32_t> vt_of(file_vertices, kNoTexcoord);
-        std::map<std::pair<uint32_t, uint32_t>, uint32_t> split;
-        std::vector<uint32_t> vertex_vt;  // for the copies
-        for (size_t t = 0; t < scan->mesh.triangles.size(); ++t)
-            for (int c = 0; c < 3; ++c) {
-                uint32_t& v = scan->mesh.triangles[t][size_t(c)];
-                const uint32_t vt = parts.corner_uv[t][size_t(c)];
-                if (vt_of[v] == kNoTexcoord) vt_of[v] = vt;
-                if (vt_of[v] == vt) continue;
-                auto [it, fresh] = split.try_emplace({v, vt}, uint32_t(positions.size()));
-                if (fresh) {
-                    if (positions.size() >= limits.max_vertices)
-                        return Status::failure(path + ": more than " + std::to_string(limits.max_vertices) +
-                                               " vertices once split at texture seams (raise with --max-vertices)");
-                    positions.push_back(positions[v]);
-                    vertex_vt.push_back(vt);
-                }
-                v = it->second;
-            }
-        vt_of.insert(vt_of.end(), vertex_vt.begin(), vertex_vt.end());
-        look->texcoord.assign(2 * positions.size(), 0.0);
-        for (size_t v = 0; v < positions.size(); ++v)
-            if (vt_of[v] != kNoTexcoord) {
-                look->texcoord[2 * v] = parts.uv[2 * size_t(vt_of[v])];
-                look->texcoord[2 * v + 1] = 1 - parts.uv[2 * size_t(vt_of[v]) + 1];
-            }
-        if (!split.empty())
-            warnings->other.push_back(std::to_string(split.size()) +
+        std::vector<uint32_t> copied_from;
+        if (Status st = splitAtTextureSeams(path, limits, parts.uv, &parts.corner_uv, scan, &look->texcoord, &copied_from); !st.ok)
+            return st;
+        if (!copied_from.empty())
+            warnings->other.push_back(std::to_string(copied_from.size()) +
                                       " vertices copied at texture seams (a position with more than one vt)");
     } else if (vt_count) {
         warnings->other.push_back(std::to_string(vt_count) + " vt texture coordinates not kept (no face corner uses one)");

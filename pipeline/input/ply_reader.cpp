@@ -303,6 +303,11 @@ enum Role { kOther = -1, kX, kY, kZ, kRed, kGreen, kBlue, kAlpha, kU, kV };
 struct PlyLookParts {
     std::vector<double> color;     // linear R, G, B, A; empty: the file has no colours
     std::vector<double> texcoord;  // glTF's (u, 1 - v); empty: the file has no texture coordinates
+    // The faces' `texcoord` lists: each corner's (u, v) as written, and per scanned triangle its
+    // corners' indices into them; empty: the faces have none.
+    std::vector<double> corner_values;
+    std::vector<std::array<uint32_t, 3>> corner_uv;
+    std::vector<uint32_t> texnumber;  // per scanned triangle, the face's `texnumber`; empty: the faces have none
     std::vector<std::pair<std::string, size_t>> texture_files;  // from the header
 };
 
@@ -323,19 +328,15 @@ std::vector<size_t> findScalars(const PlyElement& e, std::initializer_list<std::
 void warnIgnored(const PlyElement& e, const std::vector<bool>& read, std::vector<std::string>* warnings) {
     std::string names;
     size_t count = 0;
-    bool normals = false, corners = false;
+    bool normals = false;
     for (size_t i = 0; i < e.props.size(); ++i) {
         if (read[i]) continue;
         names += (count++ ? ", " : "") + e.props[i].name;
         normals = normals || e.props[i].name == "nx" || e.props[i].name == "ny" || e.props[i].name == "nz";
-        corners = corners || (e.props[i].list && e.props[i].name == "texcoord");
     }
     if (count == 0) return;
-    std::string why;
-    if (normals) why += "normals are the apparent surface's own";
-    if (corners) why += std::string(why.empty() ? "" : "; ") + "per-corner texcoord lists are not read, per-vertex texture_u texture_v are";
     warnings->push_back("element " + e.name + ": " + (count > 1 ? "properties " : "property ") + names + " ignored" +
-                        (why.empty() ? "" : " (" + why + ")"));
+                        (normals ? " (normals are the apparent surface's own)" : ""));
 }
 
 // Checks the header and every value of the body, keeping the vertices, faces and the look's parts.
@@ -367,6 +368,16 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
             index_prop = int(i);
         }
     if (index_prop < 0) return fail("element face", "no list property 'vertex_indices' (or 'vertex_index')");
+    // Step: the faces' look: MeshLab's per-corner `texcoord` list and per-face `texnumber`.
+    int corner_prop = -1, texnumber_prop = -1;
+    for (size_t i = 0; i < face->props.size(); ++i) {
+        const PlyProperty& p = face->props[i];
+        if (p.list && p.name == "texcoord") {
+            if (isIntegral(p.type)) return fail("element face", "texcoord: values must be of type float or double");
+            corner_prop = int(i);
+        }
+        if (!p.list && p.name == "texnumber") texnumber_prop = int(i);
+    }
     // Step: what each vertex property is read for: position, colour (one spelling), texture coordinates (one spelling).
     std::vector<int> vertex_role(vertex->props.size(), kOther);
     for (size_t pi = 0; pi < vertex->props.size(); ++pi)
@@ -390,6 +401,8 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
                                      "frame): the file is one object here");
     }
     face_read[size_t(index_prop)] = true;
+    if (corner_prop >= 0) face_read[size_t(corner_prop)] = true;
+    if (texnumber_prop >= 0) face_read[size_t(texnumber_prop)] = true;
     warnIgnored(*vertex, vertex_read, &scan->warnings);
     warnIgnored(*face, face_read, &scan->warnings);
     std::string others;
@@ -429,9 +442,14 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
     if (!uv.empty()) parts->texcoord.assign(2 * size_t(vertex->count), 0.0);
     BodyCursor cur(bytes, h.body_offset, h.format);
     std::vector<uint32_t> face_indices, sorted;
+    std::vector<double> face_uv;  // the face row's texcoord list
+    // A face's texnumber names one of the TextureFile comments (0 alone when there is at most one).
+    const double texture_count = double(std::max<size_t>(h.texture_files.size(), 1));
     for (const PlyElement& e : h.elements) {
         const bool is_vertex = &e == vertex, is_face = &e == face;
         for (uint64_t row = 0; row < e.count; ++row) {
+            double texnumber = 0;
+            face_uv.clear();
             for (size_t pi = 0; pi < e.props.size(); ++pi) {
                 const PlyProperty& p = e.props[pi];
                 // Built only for a message: "face[3].vertex_indices".
@@ -439,6 +457,13 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
                 double v = 0;
                 if (!cur.read(p.list ? p.count_type : p.type, &v, &problem)) return fail(field(), problem);
                 if (!p.list) {
+                    if (is_face && int(pi) == texnumber_prop) {
+                        if (!(v >= 0 && v < texture_count && v == std::floor(v)))
+                            return fail(field(), shown(v) + " names no texture (" + std::to_string(h.texture_files.size()) +
+                                                     " TextureFile comments; 0 to " + shown(texture_count - 1) + ")");
+                        texnumber = v;
+                        continue;
+                    }
                     const int role = is_vertex ? vertex_role[pi] : kOther;
                     if (role == kOther) continue;
                     if (role <= kZ || role >= kU) {
@@ -465,31 +490,47 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
                     return fail(field(), "list count " + std::to_string((long long)v) +
                                              " is negative or longer than the rest of the file");
                 const size_t n = size_t(v);
-                const bool indices = is_face && int(pi) == index_prop;
+                const bool indices = is_face && int(pi) == index_prop, corners = is_face && int(pi) == corner_prop;
                 if (indices) face_indices.clear();
                 for (size_t k = 0; k < n; ++k) {
                     double item = 0;
                     if (!cur.read(p.type, &item, &problem)) return fail(field() + "[" + std::to_string(k) + "]", problem);
+                    if (corners) {
+                        if (!(std::isfinite(item) && std::fabs(item) <= 3.0e38))
+                            return fail(field() + "[" + std::to_string(k) + "]", "not a finite number within float range (|x| <= 3e38)");
+                        face_uv.push_back(item);
+                    }
                     if (!indices) continue;
                     if (!(item >= 0 && item < double(vertex->count)))
                         return fail(field() + "[" + std::to_string(k) + "]", "index " + std::to_string((long long)item) +
                                                                            " is out of range (" + std::to_string(vertex->count) + " vertices)");
                     face_indices.push_back(uint32_t(item));
                 }
-                if (!indices) continue;
-                // Step: the face itself, as OpenMesh would take it.
-                if (n < 3) return fail(field(), "a face needs at least 3 vertices, got " + std::to_string(n));
-                sorted.assign(face_indices.begin(), face_indices.end());
-                std::sort(sorted.begin(), sorted.end());
-                if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
-                    ++scan->repeated_index;
-                    continue;
-                }
-                if (triangles.size() + n - 2 > limits.max_faces)
-                    return fail(field(), "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
-                if (n > 3) scan->polygons.emplace_back(uint32_t(triangles.size()), uint32_t(n));
-                for (size_t k = 1; k + 1 < n; ++k)
-                    triangles.push_back({face_indices[0], face_indices[k], face_indices[k + 1]});
+                if (indices && n < 3) return fail(field(), "a face needs at least 3 vertices, got " + std::to_string(n));
+            }
+            if (!is_face) continue;
+            // Step: the face itself, as OpenMesh would take it, once its row is read (texcoord may come before the indices).
+            const size_t n = face_indices.size();
+            const std::string indices_field = "face[" + std::to_string(row) + "]." + face->props[size_t(index_prop)].name;
+            if (corner_prop >= 0 && face_uv.size() != 2 * n)
+                return fail("face[" + std::to_string(row) + "].texcoord",
+                            std::to_string(face_uv.size()) + " values for a face of " + std::to_string(n) +
+                                " vertices (a u v pair per vertex: " + std::to_string(2 * n) + ")");
+            sorted.assign(face_indices.begin(), face_indices.end());
+            std::sort(sorted.begin(), sorted.end());
+            if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+                ++scan->repeated_index;
+                continue;
+            }
+            if (triangles.size() + n - 2 > limits.max_faces)
+                return fail(indices_field, "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
+            if (n > 3) scan->polygons.emplace_back(uint32_t(triangles.size()), uint32_t(n));
+            const uint32_t first_uv = uint32_t(parts->corner_values.size() / 2);
+            parts->corner_values.insert(parts->corner_values.end(), face_uv.begin(), face_uv.end());
+            for (size_t k = 1; k + 1 < n; ++k) {
+                triangles.push_back({face_indices[0], face_indices[k], face_indices[k + 1]});
+                if (corner_prop >= 0) parts->corner_uv.push_back({first_uv, first_uv + uint32_t(k), first_uv + uint32_t(k + 1)});
+                if (texnumber_prop >= 0) parts->texnumber.push_back(uint32_t(texnumber));
             }
         }
     }
@@ -498,43 +539,78 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
     return Status::success();
 }
 
-// The look of a scanned PLY (ply_reader.h): its colours and texture coordinates, the one material,
-// and the TextureFile's image when it can be read. Null when the vertices have neither.
-Status buildPlyLook(const std::string& path, const MeshLimits& limits, PlyLookParts& parts, MeshWarnings* warnings,
-                    std::shared_ptr<SurfaceLook>* out) {
+// The look of a scanned PLY (ply_reader.h): its colours and texture coordinates (the vertices split
+// at the seams of per-corner ones), its materials, and the TextureFile images that can be read.
+// Null when the file has neither colours nor texture coordinates.
+Status buildPlyLook(const std::string& path, const MeshLimits& limits, PlyLookParts& parts, ScannedMesh* scan,
+                    MeshWarnings* warnings, std::shared_ptr<SurfaceLook>* out) {
     out->reset();
     auto where = [&](size_t k) { return "header line " + std::to_string(parts.texture_files[k].second) + ": comment TextureFile"; };
-    if (parts.texcoord.empty()) {
+    const bool corners = !parts.corner_uv.empty();
+    if (corners && !parts.texcoord.empty()) {
+        warnings->other.push_back("element vertex: per-vertex texture coordinates ignored (the faces' per-corner texcoord lists are read)");
+        parts.texcoord.clear();
+    }
+    if (parts.texcoord.empty() && !corners) {
         if (!parts.texture_files.empty())
             warnings->other.push_back(where(0) + " " + parts.texture_files[0].first +
-                                      " ignored (no vertex texture coordinates: texture_u texture_v, s t or u v)");
+                                      " ignored (no texture coordinates: texture_u texture_v, s t or u v per vertex, "
+                                      "or a texcoord list per face)");
         if (parts.color.empty()) return Status::success();
     }
     auto look = std::make_shared<SurfaceLook>();
     look->color = std::move(parts.color);
     look->texcoord = std::move(parts.texcoord);
-    // Step: the texture, the first TextureFile (one material per PLY), read as an OBJ's map_Kd is.
-    int texture = -1;
-    if (!look->texcoord.empty() && !parts.texture_files.empty()) {
-        if (parts.texture_files.size() > 1)
-            warnings->other.push_back(std::to_string(parts.texture_files.size() - 1) + " more TextureFile comments after " +
-                                      where(0) + " ignored (one texture per PLY is read)");
-        const std::string file = besideFile(path, parts.texture_files[0].first);
+    // Step: per-corner coordinates made per vertex as an OBJ's vt are; the colours follow the copies.
+    if (corners) {
+        std::vector<uint32_t> copied_from;
+        if (Status s = splitAtTextureSeams(path, limits, parts.corner_values, &parts.corner_uv, scan, &look->texcoord, &copied_from); !s.ok)
+            return s;
+        if (!look->color.empty())
+            for (uint32_t v : copied_from)
+                for (size_t k = 0; k < 4; ++k) look->color.push_back(look->color[4 * size_t(v) + k]);
+        if (!copied_from.empty())
+            warnings->other.push_back(std::to_string(copied_from.size()) +
+                                      " vertices copied at texture seams (a vertex with more than one texcoord)");
+    }
+    // Step: the textures, each read as an OBJ's map_Kd is: with a face texnumber one material per
+    // TextureFile, else the first one alone (one material per PLY).
+    const bool several = parts.texture_files.size() > 1 && !parts.texnumber.empty();
+    auto readTexture = [&](size_t k, int* texture) -> Status {
+        *texture = -1;
+        const std::string file = besideFile(path, parts.texture_files[k].first);
         std::string bytes;
         bool read = false;
-        if (Status s = readConfined(where(0), "texture", file, LookFolders(path, limits), limits, warnings, &bytes, &read); !s.ok)
+        if (Status s = readConfined(where(k), "texture", file, LookFolders(path, limits), limits, warnings, &bytes, &read); !s.ok)
             return s;
         const std::string type = read ? sniffImage(bytes) : "";
-        if (read && type.empty()) warnings->other.push_back(where(0) + ": " + file + " is not PNG or JPEG (the texture is dropped)");
-        if (!type.empty()) {
-            look->samplers.push_back(R"({"wrapS":10497,"wrapT":10497})");  // REPEAT
-            look->images.push_back({type, utf8Replaced(std::filesystem::path(file).filename().string()),
-                                    std::vector<unsigned char>(bytes.begin(), bytes.end())});
-            look->textures.push_back(R"({"sampler":0,"source":0})");
-            texture = 0;
+        if (read && type.empty()) warnings->other.push_back(where(k) + ": " + file + " is not PNG or JPEG (the texture is dropped)");
+        if (type.empty()) return Status::success();
+        if (look->samplers.empty()) look->samplers.push_back(R"({"wrapS":10497,"wrapT":10497})");  // REPEAT
+        look->images.push_back({type, utf8Replaced(std::filesystem::path(file).filename().string()),
+                                std::vector<unsigned char>(bytes.begin(), bytes.end())});
+        *texture = int(look->textures.size());
+        look->textures.push_back(R"({"sampler":0,"source":)" + std::to_string(look->images.size() - 1) + "}");
+        return Status::success();
+    };
+    if (!look->texcoord.empty() && several) {
+        for (size_t k = 0; k < parts.texture_files.size(); ++k) {
+            int texture = -1;
+            if (Status s = readTexture(k, &texture); !s.ok) return s;
+            look->materials.push_back(mtlMaterialJson(MtlMaterial{}, texture, &look->extensions));
         }
+        look->triangle_material = std::move(parts.texnumber);
+    } else {
+        int texture = -1;
+        if (!look->texcoord.empty() && !parts.texture_files.empty()) {
+            if (parts.texture_files.size() > 1)
+                warnings->other.push_back(std::to_string(parts.texture_files.size() - 1) + " more TextureFile comments after " +
+                                          where(0) + " ignored (one texture per PLY is read without a face texnumber)");
+            if (Status s = readTexture(0, &texture); !s.ok) return s;
+        }
+        look->materials.push_back(mtlMaterialJson(MtlMaterial{}, texture, &look->extensions));
+        look->triangle_material.assign(scan->mesh.triangles.size(), 0);
     }
-    look->materials.push_back(mtlMaterialJson(MtlMaterial{}, texture, &look->extensions));
     *out = std::move(look);
     return Status::success();
 }
@@ -553,16 +629,17 @@ Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     std::string().swap(text);
     std::shared_ptr<SurfaceLook> look;
     if (look_out) {
-        if (Status s = buildPlyLook(path, limits, parts, warnings, &look); !s.ok) {
+        if (Status s = buildPlyLook(path, limits, parts, &scan, warnings, &look); !s.ok) {
             // The image's own message, after the mesh it serves.
             if (s.message.rfind(path, 0) != 0) s.message = path + ": " + s.message;
             return s;
         }
-    } else if (!parts.color.empty() || !parts.texcoord.empty()) {
+    } else if (!parts.color.empty() || !parts.texcoord.empty() || !parts.corner_uv.empty()) {
         warnings->other.push_back("vertex colours and texture coordinates not kept");
     }
     if (!look) return finishScannedMesh(std::move(scan), path, mesh, warnings);
-    // Step: the mesh made as for any PLY, the attributes following the vertices OpenMesh copies.
+    // Step: the mesh made as for any PLY, the attributes following the vertices OpenMesh copies and
+    // the materials the triangles it keeps.
     const std::vector<std::array<uint32_t, 3>> scanned = scan.mesh.triangles;
     const size_t scanned_vertices = scan.mesh.positions.size();
     std::vector<int> origin(scanned.size());
@@ -579,7 +656,9 @@ Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     };
     follow(&look->color, 4);
     follow(&look->texcoord, 2);
-    look->triangle_material.assign(mesh->triangles.size(), 0);
+    std::vector<uint32_t> triangle_material(mesh->triangles.size());
+    for (size_t t = 0; t < triangle_material.size(); ++t) triangle_material[t] = look->triangle_material[size_t(origin[t])];
+    look->triangle_material = std::move(triangle_material);
     *look_out = std::move(look);
     return Status::success();
 }

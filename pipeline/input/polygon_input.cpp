@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include <OpenMesh/Core/IO/importer/ImporterT.hh>
@@ -165,6 +166,52 @@ std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::v
             }
         }
     return origin;
+}
+
+Status splitAtTextureSeams(const std::string& path, const MeshLimits& limits, const std::vector<double>& uv,
+                           std::vector<std::array<uint32_t, 3>>* corner_uv, ScannedMesh* scan, std::vector<double>* texcoord,
+                           std::vector<uint32_t>* copied_from) {
+    // Step: equal (u, v) pairs written twice are one texture coordinate: each index to its first.
+    const size_t uv_count = uv.size() / 2;
+    std::map<std::pair<double, double>, uint32_t> first_of;
+    std::vector<uint32_t> same(uv_count);
+    for (size_t k = 0; k < uv_count; ++k) same[k] = first_of.try_emplace({uv[2 * k], uv[2 * k + 1]}, uint32_t(k)).first->second;
+    for (auto& corners : *corner_uv)
+        for (uint32_t& t : corners)
+            if (t != kNoTexcoord) t = same[t];
+    // Step: a vertex keeps its first coordinate, a copy for each other one.
+    auto& positions = scan->mesh.positions;
+    const size_t file_vertices = positions.size();
+    std::vector<uint32_t> uv_of(file_vertices, kNoTexcoord);
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> split;
+    std::vector<uint32_t> copy_uv;
+    copied_from->clear();
+    for (size_t t = 0; t < scan->mesh.triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c) {
+            uint32_t& v = scan->mesh.triangles[t][size_t(c)];
+            const uint32_t k = (*corner_uv)[t][size_t(c)];
+            if (uv_of[v] == kNoTexcoord) uv_of[v] = k;
+            if (uv_of[v] == k) continue;
+            auto [it, fresh] = split.try_emplace({v, k}, uint32_t(positions.size()));
+            if (fresh) {
+                if (positions.size() >= limits.max_vertices)
+                    return Status::failure(path + ": more than " + std::to_string(limits.max_vertices) +
+                                           " vertices once split at texture seams (raise with --max-vertices)");
+                positions.push_back(positions[v]);
+                copy_uv.push_back(k);
+                copied_from->push_back(v);
+            }
+            v = it->second;
+        }
+    // Step: the coordinates per vertex, v flipped for glTF.
+    uv_of.insert(uv_of.end(), copy_uv.begin(), copy_uv.end());
+    texcoord->assign(2 * positions.size(), 0.0);
+    for (size_t v = 0; v < positions.size(); ++v)
+        if (uv_of[v] != kNoTexcoord) {
+            (*texcoord)[2 * v] = uv[2 * size_t(uv_of[v])];
+            (*texcoord)[2 * v + 1] = 1 - uv[2 * size_t(uv_of[v]) + 1];
+        }
+    return Status::success();
 }
 
 }  // namespace apparent

@@ -61,4 +61,21 @@ constexpr uint32_t kNoOrigin = UINT32_MAX;
 std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::vector<std::array<uint32_t, 3>>& triangles,
                                       size_t scanned_vertices, const std::vector<int>& per_triangle);
 
+// A texture coordinate index no corner has (splitAtTextureSeams).
+constexpr uint32_t kNoTexcoord = UINT32_MAX;
+
+// Texture coordinates given per face corner (an OBJ's `vt` indices, a PLY's `texcoord` lists) made
+// per vertex, as a glTF file gives them. `uv` holds the file's (u, v) pairs, `corner_uv` each of
+// scan's triangles' three indices into them (kNoTexcoord: none, written as (0, 0)); indices of
+// equal pairs are first made one. A vertex whose corners carry different coordinates keeps the
+// first one met (triangles in order, corners in order) and gets one copy of its position (exactly,
+// appended after the vertices) for each other coordinate, those corners renumbered to it, as a
+// glTF file splits its vertices at seams. Fills `texcoord` per vertex with glTF's (u, 1 - v) (the
+// files' v axis points up, glTF's down) and `copied_from` with the vertex each copy copies (in the
+// order appended). Refused, "mesh.obj: more than N vertices once split at texture seams", when the
+// copies pass limits.max_vertices. `corner_uv` is rewritten.
+Status splitAtTextureSeams(const std::string& path, const MeshLimits& limits, const std::vector<double>& uv,
+                           std::vector<std::array<uint32_t, 3>>* corner_uv, ScannedMesh* scan, std::vector<double>* texcoord,
+                           std::vector<uint32_t>* copied_from);
+
 }  // namespace apparent
