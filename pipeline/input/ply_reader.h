@@ -30,13 +30,26 @@
 //   texture_u/texture_v and s/t unchanged as a vertex's (u, v), as its OBJ reader
 //   (wrap/io_trimesh/import_obj.h) stores `vt`: a PLY's v points up as OBJ's does, and glTF's down,
 //   so TEXCOORD_0 = (u, 1 - v) as for OBJ (obj_reader.h).
+// - Per-corner texture coordinates: MeshLab's face list `texcoord` (vcglib's "wedge" coordinates:
+//   u0 v0 u1 v1 ... in the order of vertex_indices; any integer count type, float or double values;
+//   2 per face vertex, finite, within float range, else an error naming the face row, which may
+//   list them before or after its indices). Taken as an OBJ's `vt` per corner: a vertex with
+//   different coordinates on different faces is split (polygon_input.h, splitAtTextureSeams), a
+//   polygon's fan triangles keep their corners' coordinates, TEXCOORD_0 = (u, 1 - v), and the
+//   vertex colours follow the copies. With per-vertex coordinates too, the per-corner ones win
+//   (one warning).
 // - The image: a header line `comment TextureFile NAME` (MeshLab's convention; NAME the rest of the
 //   line, relative to the PLY's folder), read under the rules of pipeline/input/look_files.h (only
 //   inside the allowed folders, a regular file within the size limit, PNG or JPEG; otherwise one
-//   warning and no texture), when the vertices have texture coordinates (else one warning). Only the
-//   first such line is read (later ones: one warning).
+//   warning and no texture), when the file has texture coordinates (else one warning). Only the
+//   first such line is read (later ones: one warning), unless the faces have `texnumber`.
 // The object then has one material (white, metallic 0, roughness 1, double-sided, the image as its
 // baseColorTexture when read), on every triangle; vertices OpenMesh copies keep their original's values.
+// MeshLab's several textures: with more than one TextureFile line and a face scalar `texnumber`,
+// one such material per TextureFile (in line order, each with its own image), each triangle the
+// one its face's texnumber names. A texnumber must be an integer naming a TextureFile (0 alone when
+// there is at most one line; else an error naming the row): with one texture and texnumber 0
+// everywhere, the file reads as without it.
 // Every other property of `vertex` and `face` is named in one warning per element ("element vertex:
 // properties nx, ny, nz, quality ignored (normals are the apparent surface's own)"), other elements in
 // one more; an apparent PLY frame's per-vertex `object` index (exporters/ply.h) has its own
