@@ -689,3 +689,25 @@ TEST(PlyLook, RenderAtRestWritesTheCornerTexcoordsVertexForVertex) {
     EXPECT_EQ(faces.size(), 6u);
     EXPECT_GE(checked, 36u);
 }
+
+// The committed fixture (data/fixtures/ply/make_fixtures.py): binary per-corner coordinates, corner
+// k of every face at (k == 1, k == 2). By hand over the faces (0 2 1), (0 1 3), (0 3 2), (1 2 3):
+// vertex 0 always corner 0 (one coordinate), vertex 1 at corners 2, 1, 0 (three), vertex 2 at
+// 1, 2, 1 (two), vertex 3 at 2, 1, 2 (two): 8 vertices. texnumber f % 2 over two missing images:
+// two materials without texture, one warning each.
+TEST(PlyLook, BinaryCornerFixtureWithTexnumber) {
+    const Read r = readLook(std::string(APPARENT_SOURCE_DIR) + "/data/fixtures/ply/corner_tetra.ply");
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    EXPECT_EQ(r.mesh.positions.size(), 8u);
+    ASSERT_EQ(r.look->texcoord.size(), 16u);
+    EXPECT_EQ(r.look->color.size(), 32u);
+    EXPECT_EQ(r.look->texcoord[0], 0.0);  // vertex 0: (0, 0), flipped
+    EXPECT_EQ(r.look->texcoord[1], 1.0);
+    EXPECT_EQ(r.look->materials.size(), 2u);
+    EXPECT_TRUE(r.look->images.empty());
+    EXPECT_EQ(r.look->triangle_material, (std::vector<uint32_t>{0, 1, 0, 1}));
+    EXPECT_TRUE(hasLine(r.warnings, "a.png not found"));
+    EXPECT_TRUE(hasLine(r.warnings, "b.png not found"));
+    EXPECT_TRUE(hasLine(r.warnings, "4 vertices copied at texture seams"));
+}

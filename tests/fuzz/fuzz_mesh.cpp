@@ -49,15 +49,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             for (uint32_t i : t) check(i < mesh.mesh.positions.size());
     }
     if (st.ok && mesh.look && std::string(APPARENT_FUZZ_EXT) == ".ply") {
-        // A PLY's look (pipeline/input/ply_reader.h): parallel to the mesh, one material, colours in
-        // [0, 1], texture coordinates finite.
+        // A PLY's look (pipeline/input/ply_reader.h): parallel to the mesh, one material (one per
+        // TextureFile with texnumber) that each triangle names, colours in [0, 1], texture coordinates finite.
         const apparent::SurfaceLook& look = *mesh.look;
         const size_t n = mesh.mesh.positions.size();
         check(look.color.empty() || look.color.size() == 4 * n);
         check(look.texcoord.empty() || look.texcoord.size() == 2 * n);
-        check(look.hasAttributes() && look.materials.size() == 1);
+        check(look.hasAttributes() && !look.materials.empty());
         check(look.triangle_material.size() == mesh.mesh.triangles.size());
-        for (uint32_t m : look.triangle_material) check(m == 0);
+        for (uint32_t m : look.triangle_material) check(m < look.materials.size());
         for (double c : look.color) check(c >= 0 && c <= 1);
         for (double t : look.texcoord) check(std::isfinite(t));
     }
