@@ -511,7 +511,7 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
             if (!is_face) continue;
             // Step: the face itself, as OpenMesh would take it, once its row is read (texcoord may come before the indices).
             const size_t n = face_indices.size();
-            const std::string indices_field = "face[" + std::to_string(row) + "]." + face->props[size_t(index_prop)].name;
+            auto indices_field = [&] { return "face[" + std::to_string(row) + "]." + face->props[size_t(index_prop)].name; };
             if (corner_prop >= 0 && face_uv.size() != 2 * n)
                 return fail("face[" + std::to_string(row) + "].texcoord",
                             std::to_string(face_uv.size()) + " values for a face of " + std::to_string(n) +
@@ -523,7 +523,7 @@ Status scanPly(const std::string& path, const std::string& bytes, const MeshLimi
                 continue;
             }
             if (triangles.size() + n - 2 > limits.max_faces)
-                return fail(indices_field, "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
+                return fail(indices_field(), "more than " + std::to_string(limits.max_faces) + " triangles (raise with --max-faces)");
             if (n > 3) scan->polygons.emplace_back(uint32_t(triangles.size()), uint32_t(n));
             const uint32_t first_uv = uint32_t(parts->corner_values.size() / 2);
             parts->corner_values.insert(parts->corner_values.end(), face_uv.begin(), face_uv.end());
@@ -566,6 +566,8 @@ Status buildPlyLook(const std::string& path, const MeshLimits& limits, PlyLookPa
         std::vector<uint32_t> copied_from;
         if (Status s = splitAtTextureSeams(path, limits, parts.corner_values, &parts.corner_uv, scan, &look->texcoord, &copied_from); !s.ok)
             return s;
+        std::vector<double>().swap(parts.corner_values);  // per vertex now: their memory back before the mesh is made
+        std::vector<std::array<uint32_t, 3>>().swap(parts.corner_uv);
         if (!look->color.empty())
             for (uint32_t v : copied_from)
                 for (size_t k = 0; k < 4; ++k) look->color.push_back(look->color[4 * size_t(v) + k]);
@@ -608,8 +610,7 @@ Status buildPlyLook(const std::string& path, const MeshLimits& limits, PlyLookPa
                                           where(0) + " ignored (one texture per PLY is read without a face texnumber)");
             if (Status s = readTexture(0, &texture); !s.ok) return s;
         }
-        look->materials.push_back(mtlMaterialJson(MtlMaterial{}, texture, &look->extensions));
-        look->triangle_material.assign(scan->mesh.triangles.size(), 0);
+        look->materials.push_back(mtlMaterialJson(MtlMaterial{}, texture, &look->extensions));  // triangle_material: readPly
     }
     *out = std::move(look);
     return Status::success();
@@ -656,9 +657,13 @@ Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     };
     follow(&look->color, 4);
     follow(&look->texcoord, 2);
-    std::vector<uint32_t> triangle_material(mesh->triangles.size());
-    for (size_t t = 0; t < triangle_material.size(); ++t) triangle_material[t] = look->triangle_material[size_t(origin[t])];
-    look->triangle_material = std::move(triangle_material);
+    if (look->materials.size() == 1) {
+        look->triangle_material.assign(mesh->triangles.size(), 0);
+    } else {
+        std::vector<uint32_t> triangle_material(mesh->triangles.size());
+        for (size_t t = 0; t < triangle_material.size(); ++t) triangle_material[t] = look->triangle_material[size_t(origin[t])];
+        look->triangle_material = std::move(triangle_material);
+    }
     *look_out = std::move(look);
     return Status::success();
 }

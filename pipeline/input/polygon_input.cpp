@@ -171,11 +171,22 @@ std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::v
 Status splitAtTextureSeams(const std::string& path, const MeshLimits& limits, const std::vector<double>& uv,
                            std::vector<std::array<uint32_t, 3>>* corner_uv, ScannedMesh* scan, std::vector<double>* texcoord,
                            std::vector<uint32_t>* copied_from) {
-    // Step: equal (u, v) pairs written twice are one texture coordinate: each index to its first.
+    // Step: equal (u, v) pairs written twice are one texture coordinate: each index to its first
+    // (sorted by value, then index, so each run of equal pairs starts at its first).
     const size_t uv_count = uv.size() / 2;
-    std::map<std::pair<double, double>, uint32_t> first_of;
-    std::vector<uint32_t> same(uv_count);
-    for (size_t k = 0; k < uv_count; ++k) same[k] = first_of.try_emplace({uv[2 * k], uv[2 * k + 1]}, uint32_t(k)).first->second;
+    std::vector<uint32_t> order(uv_count), same(uv_count);
+    std::iota(order.begin(), order.end(), 0u);
+    auto less = [&](uint32_t a, uint32_t b) {
+        if (uv[2 * a] != uv[2 * b]) return uv[2 * a] < uv[2 * b];
+        if (uv[2 * a + 1] != uv[2 * b + 1]) return uv[2 * a + 1] < uv[2 * b + 1];
+        return a < b;
+    };
+    std::sort(order.begin(), order.end(), less);
+    for (size_t i = 0; i < uv_count; ++i) {
+        const uint32_t k = order[i];
+        const bool run_start = i == 0 || uv[2 * k] != uv[2 * order[i - 1]] || uv[2 * k + 1] != uv[2 * order[i - 1] + 1];
+        same[k] = run_start ? k : same[order[i - 1]];
+    }
     for (auto& corners : *corner_uv)
         for (uint32_t& t : corners)
             if (t != kNoTexcoord) t = same[t];
