@@ -711,3 +711,26 @@ TEST(PlyLook, BinaryCornerFixtureWithTexnumber) {
     EXPECT_TRUE(hasLine(r.warnings, "b.png not found"));
     EXPECT_TRUE(hasLine(r.warnings, "4 vertices copied at texture seams"));
 }
+
+// A quad whose last fan triangle (0 2 3) a triangle before it already holds: OpenMesh keeps the
+// quad's first fan triangle and adds the whole quad again on copies, 4 triangles for 3 scanned (a
+// fuzz_ply finding: the look then read past the scanned triangles). Every vertex keeps the texture
+// coordinate of its position, here s t = x y.
+TEST(PlyLook, LookFollowsAPolygonOpenMeshAddsTwice) {
+    PlyFolder f("added_twice");
+    const std::string text =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        "property float s\nproperty float t\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n3 0 2 3\n4 0 1 2 3\n";
+    const Read r = readLook(f.write("t.ply", text));
+    ASSERT_TRUE(r.status.ok) << r.status.message;
+    ASSERT_TRUE(r.look);
+    ASSERT_EQ(r.mesh.triangles.size(), 4u) << "OpenMesh did not add the quad twice: the test does not test it";
+    ASSERT_EQ(r.look->texcoord.size(), 2 * r.mesh.positions.size());
+    for (const auto& t : r.mesh.triangles)
+        for (uint32_t v : t) {
+            EXPECT_EQ(r.look->texcoord[2 * v], r.mesh.positions[v].x) << v;
+            EXPECT_EQ(r.look->texcoord[2 * v + 1], 1 - r.mesh.positions[v].y) << v;
+        }
+    EXPECT_EQ(r.look->triangle_material, std::vector<uint32_t>(4, 0));
+}

@@ -59,8 +59,13 @@ bool singleFan(LinkEdge* link, size_t n, std::vector<uint32_t>* tos) {
     return steps == n;
 }
 
-// The scanned faces through OpenMesh's importer, as its OBJ and PLY readers add them.
-void importWithOpenMesh(const ScannedMesh& scan, mesh4d::RestMesh* out) {
+// The scanned faces through OpenMesh's importer, as its OBJ and PLY readers add them; `from` gets
+// the scanned triangle each triangle of `out` is. OpenMesh triangulates a polygon as a fan and, when
+// the last fan triangle cannot be added, adds the whole polygon again on copies of its corners,
+// keeping the triangles it did add: a polygon may give more triangles than its fan. Each triangle
+// is therefore matched to its polygon's fan triangle of the same corners (copies read as the
+// corners they copy, in one of the three rotations).
+void importWithOpenMesh(const ScannedMesh& scan, mesh4d::RestMesh* out, std::vector<uint32_t>* from) {
     omerr().disable();
     omlog().disable();
     ImportMesh om;
@@ -70,6 +75,9 @@ void importWithOpenMesh(const ScannedMesh& scan, mesh4d::RestMesh* out) {
     om.reserve(positions.size(), 3 * triangles.size(), triangles.size());
     for (const auto& p : positions) importer.add_vertex(OpenMesh::Vec3d(p.x, p.y, p.z));
     std::vector<OpenMesh::VertexHandle> face;
+    std::vector<uint32_t> copy_of;  // per vertex OpenMesh appends: the file vertex it copies
+    auto fileVertex = [&](int v) { return size_t(v) < positions.size() ? uint32_t(v) : copy_of[size_t(v) - positions.size()]; };
+    from->clear();
     size_t next_polygon = 0;
     for (size_t f = 0; f < triangles.size();) {
         face.clear();
@@ -80,7 +88,26 @@ void importWithOpenMesh(const ScannedMesh& scan, mesh4d::RestMesh* out) {
         face.emplace_back(int(triangles[f][0]));
         face.emplace_back(int(triangles[f][1]));
         for (size_t k = 0; k + 2 < corners; ++k) face.emplace_back(int(triangles[f + k][2]));
+        const size_t vertices_before = om.n_vertices(), faces_before = om.n_faces();
         importer.add_face(face);
+        // Step: the copies it made (of the face's corners, in order), then each new triangle's fan triangle.
+        for (size_t v = vertices_before; v < om.n_vertices(); ++v)
+            copy_of.push_back(uint32_t(face[std::min(v - vertices_before, face.size() - 1)].idx()));
+        for (size_t k = faces_before; k < om.n_faces(); ++k) {
+            std::array<uint32_t, 3> corner{};
+            int c = 0;
+            for (auto v : om.fv_range(OpenMesh::FaceHandle(int(k))))
+                if (c < 3) corner[size_t(c++)] = fileVertex(v.idx());
+            uint32_t match = uint32_t(f);
+            for (size_t t = f; t < f + corners - 2 && match == uint32_t(f); ++t)
+                for (int r = 0; r < 3; ++r)
+                    if (corner[0] == triangles[t][size_t(r)] && corner[1] == triangles[t][size_t((r + 1) % 3)] &&
+                        corner[2] == triangles[t][size_t((r + 2) % 3)]) {
+                        match = uint32_t(t);
+                        break;
+                    }
+            from->push_back(match);
+        }
         f += corners - 2;
     }
     out->positions.clear();
@@ -132,7 +159,13 @@ Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::Re
     if (addsAsGiven(scan.mesh)) {
         *mesh = std::move(scan.mesh);
     } else {
-        importWithOpenMesh(scan, mesh);
+        std::vector<uint32_t> from;
+        importWithOpenMesh(scan, mesh, &from);
+        if (per_triangle) {
+            std::vector<int> kept(from.size());
+            for (size_t t = 0; t < from.size(); ++t) kept[t] = (*per_triangle)[from[t]];
+            *per_triangle = std::move(kept);
+        }
         for (const auto& tri : mesh->triangles)
             if (tri[0] >= file_vertices || tri[1] >= file_vertices || tri[2] >= file_vertices) ++warnings->nonmanifold_split;
         if (mesh->triangles.size() < scanned_triangles)

@@ -44,7 +44,9 @@ bool addsAsGiven(const mesh4d::RestMesh& mesh);
 // (non-manifold faces given their own vertices: counted; faces it could not add at all: refused,
 // "mesh.obj: OpenMesh dropped 2 of 10 triangles (malformed faces)"). Then zero-area triangles are
 // dropped with CGAL's exact predicate and counted; none left is an error. `per_triangle` (one value
-// per scanned triangle), when given, follows the triangles kept (OpenMesh keeps their order).
+// per scanned triangle), when given, follows the triangles kept: each triangle OpenMesh made gets
+// the value of the scanned triangle it is (a polygon OpenMesh adds twice, partly and then on copies,
+// gives two triangles the same value).
 Status finishScannedMesh(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
                          std::vector<int>* per_triangle = nullptr);
 
