@@ -19,6 +19,7 @@
 #include "mesh4d/doppler_colour.h"
 #include "run_command.h"
 #include "temp_dir.h"
+#include "glb_accessors.h"
 
 using testcli::apparentRun;
 using testcli::CommandResult;
@@ -82,8 +83,11 @@ TEST(DopplerColour, BandShiftedByTheRatioOfCentresLandsOnTheOtherBand) {
         }
         // The target channel is the strongest: the colour moved into the other band.
         const auto t = mesh4d::dopplerColour(a, s.d);
-        for (int k = 0; k < 3; ++k)
-            if (k != s.to) EXPECT_GT(t[size_t(s.to)], t[size_t(k)]) << s.from << "->" << s.to;
+        for (int k = 0; k < 3; ++k) {
+            if (k != s.to) {
+                EXPECT_GT(t[size_t(s.to)], t[size_t(k)]) << s.from << "->" << s.to;
+            }
+        }
     }
 }
 
@@ -226,14 +230,7 @@ fs::path freshDir(const std::string& name) {
     return dir;
 }
 
-// Float values of a plain accessor (tightly packed), `comps` per element.
-std::vector<float> floats(const tinygltf::Model& model, int accessor, int comps) {
-    const tinygltf::Accessor& a = model.accessors[size_t(accessor)];
-    const tinygltf::BufferView& v = model.bufferViews[size_t(a.bufferView)];
-    std::vector<float> out(a.count * size_t(comps));
-    std::memcpy(out.data(), model.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset, out.size() * 4);
-    return out;
-}
+using testglb::floats;
 
 }  // namespace
 

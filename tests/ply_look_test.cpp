@@ -25,6 +25,7 @@
 #include "file_bytes.h"
 #include "run_command.h"
 #include "temp_dir.h"
+#include "glb_accessors.h"
 
 using namespace apparent;
 namespace fs = std::filesystem;
@@ -319,13 +320,7 @@ TEST(PlyLook, ReadMeshKeepsTheLookAndPlainFilesHaveNone) {
 
 namespace {
 
-std::vector<float> floats(const tinygltf::Model& model, int accessor, int comps) {
-    const tinygltf::Accessor& a = model.accessors[size_t(accessor)];
-    const tinygltf::BufferView& v = model.bufferViews[size_t(a.bufferView)];
-    std::vector<float> out(a.count * size_t(comps));
-    std::memcpy(out.data(), model.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset, out.size() * 4);
-    return out;
-}
+using testglb::floats;
 
 }  // namespace
 

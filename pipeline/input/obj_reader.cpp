@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <set>
 
 #include "pipeline/input/input_file.h"
@@ -240,8 +239,8 @@ Status buildObjLook(const std::string& path, const MeshLimits& limits, ObjLookPa
         std::vector<MtlMaterial> materials;
         if (Status s = parseMtl(file, text, &materials, &warnings->other); !s.ok) return s;
         for (MtlMaterial& m : materials) {
-            const std::string name = m.name;
-            defined.try_emplace(name, Found{std::move(m), file});
+            const std::string material_name = m.name;
+            defined.try_emplace(material_name, Found{std::move(m), file});
         }
     }
     if (parts.libraries.empty()) warnings->other.push_back("usemtl without an mtllib line: no material library to read");
@@ -356,12 +355,9 @@ Status readObj(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     if (!look) return finishScannedMesh(std::move(scan), path, mesh, warnings);
     // Step: the mesh made as for any OBJ, the look following its triangles and the vertices
     // OpenMesh copies (a copy takes its original's attributes: found by its triangle's corners).
-    const std::vector<std::array<uint32_t, 3>> scanned = scan.mesh.triangles;
-    const size_t scanned_vertices = scan.mesh.positions.size();
-    std::vector<int> origin(scanned.size());
-    std::iota(origin.begin(), origin.end(), 0);
-    if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, &origin); !s.ok) return s;
-    const std::vector<uint32_t> vertex_origin = scannedVertexOf(*mesh, scanned, scanned_vertices, origin);
+    std::vector<int> origin;
+    std::vector<uint32_t> vertex_origin;
+    if (Status s = finishScannedMeshTraced(std::move(scan), path, mesh, warnings, &origin, &vertex_origin); !s.ok) return s;
     std::vector<uint32_t> triangle_material(mesh->triangles.size());
     for (size_t t = 0; t < triangle_material.size(); ++t) triangle_material[t] = look->triangle_material[size_t(origin[t])];
     look->triangle_material = std::move(triangle_material);

@@ -12,7 +12,6 @@
 #include <fstream>
 #include <initializer_list>
 #include <memory>
-#include <numeric>
 #include <sstream>
 #include <string_view>
 
@@ -641,12 +640,9 @@ Status readPly(const std::string& path, const MeshLimits& limits, mesh4d::RestMe
     if (!look) return finishScannedMesh(std::move(scan), path, mesh, warnings);
     // Step: the mesh made as for any PLY, the attributes following the vertices OpenMesh copies and
     // the materials the triangles it keeps.
-    const std::vector<std::array<uint32_t, 3>> scanned = scan.mesh.triangles;
-    const size_t scanned_vertices = scan.mesh.positions.size();
-    std::vector<int> origin(scanned.size());
-    std::iota(origin.begin(), origin.end(), 0);
-    if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, &origin); !s.ok) return s;
-    const std::vector<uint32_t> vertex_origin = scannedVertexOf(*mesh, scanned, scanned_vertices, origin);
+    std::vector<int> origin;
+    std::vector<uint32_t> vertex_origin;
+    if (Status s = finishScannedMeshTraced(std::move(scan), path, mesh, warnings, &origin, &vertex_origin); !s.ok) return s;
     auto follow = [&](std::vector<double>* values, size_t per_vertex) {
         if (values->empty()) return;
         std::vector<double> out(per_vertex * mesh->positions.size());

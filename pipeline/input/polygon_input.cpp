@@ -201,6 +201,17 @@ std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::v
     return origin;
 }
 
+Status finishScannedMeshTraced(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+                               std::vector<int>* triangle_origin, std::vector<uint32_t>* vertex_origin) {
+    const std::vector<std::array<uint32_t, 3>> scanned = scan.mesh.triangles;
+    const size_t scanned_vertices = scan.mesh.positions.size();
+    triangle_origin->resize(scanned.size());
+    std::iota(triangle_origin->begin(), triangle_origin->end(), 0);
+    if (Status s = finishScannedMesh(std::move(scan), path, mesh, warnings, triangle_origin); !s.ok) return s;
+    *vertex_origin = scannedVertexOf(*mesh, scanned, scanned_vertices, *triangle_origin);
+    return Status::success();
+}
+
 Status splitAtTextureSeams(const std::string& path, const MeshLimits& limits, const std::vector<double>& uv,
                            std::vector<std::array<uint32_t, 3>>* corner_uv, ScannedMesh* scan, std::vector<double>* texcoord,
                            std::vector<uint32_t>* copied_from) {

@@ -63,6 +63,12 @@ constexpr uint32_t kNoOrigin = UINT32_MAX;
 std::vector<uint32_t> scannedVertexOf(const mesh4d::RestMesh& mesh, const std::vector<std::array<uint32_t, 3>>& triangles,
                                       size_t scanned_vertices, const std::vector<int>& per_triangle);
 
+// finishScannedMesh for a reader whose look follows the mesh OpenMesh makes: also where each
+// resulting triangle came from (`triangle_origin`, the scanned triangle) and each vertex
+// (`vertex_origin`, scannedVertexOf).
+Status finishScannedMeshTraced(ScannedMesh&& scan, const std::string& path, mesh4d::RestMesh* mesh, MeshWarnings* warnings,
+                               std::vector<int>* triangle_origin, std::vector<uint32_t>* vertex_origin);
+
 // A texture coordinate index no corner has (splitAtTextureSeams).
 constexpr uint32_t kNoTexcoord = UINT32_MAX;
 

@@ -68,6 +68,24 @@ double threadCpuSeconds() {
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+// Adds the wall and CPU time of its scope to the loop's write time (FrameLoopResult), however the
+// scope is left.
+class WriteTime {
+public:
+    explicit WriteTime(FrameLoopResult* r) : r_(r) {}
+    ~WriteTime() {
+        r_->write_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        r_->write_cpu_seconds += threadCpuSeconds() - cpu_;
+    }
+    WriteTime(const WriteTime&) = delete;
+    WriteTime& operator=(const WriteTime&) = delete;
+
+private:
+    FrameLoopResult* r_;
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+    double cpu_ = threadCpuSeconds();
+};
+
 }  // namespace
 
 bool OutputBudget::fitsEstimate(double estimate, long long measured, long long total, std::string* error) const {
@@ -240,8 +258,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     // Sink, in order: the budget checks, then every sink gets the frame.
     auto deliverOne = [&](const WorkPtr& w) {
         if (stop) return;
-        const Clock::time_point write_start = Clock::now();
-        const double cpu_start = threadCpuSeconds();
+        const WriteTime timed(result);
         const ExportFrame& frame = w->frame;
         const EncodedFrame* e = w->encoded.get();
         if (w->over_budget) {
@@ -271,8 +288,6 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             }
         }
         progress.update(++delivered);
-        result->write_seconds += since(write_start);
-        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
     };
     // Before the first file appears: the output size estimated from the first kEstimateFrames
     // frames, scaled to the whole run. When every sink can hold its commits (FrameSink::
@@ -304,8 +319,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         if (hold_commits) s->holdCommits(true);
     // A frame taken with its commits held: add() now, the budget's checks at commitOne().
     auto takeOne = [&](const WorkPtr& w, Held* h) {
-        const Clock::time_point write_start = Clock::now();
-        const double cpu_start = threadCpuSeconds();
+        const WriteTime timed(result);
         const ExportFrame& frame = w->frame;
         result->max_triangles = std::max(result->max_triangles, frame.triangleCount());
         for (const auto& o : frame.objects) result->limited_triangles += o.limited_triangles;
@@ -317,13 +331,10 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
                 return;
             }
         }
-        result->write_seconds += since(write_start);
-        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
     };
     auto commitOne = [&](const Held& h) {
         if (stop) return;
-        const Clock::time_point write_start = Clock::now();
-        const double cpu_start = threadCpuSeconds();
+        const WriteTime timed(result);
         for (size_t s = 0; s < sinks.size(); ++s) {
             std::vector<std::string> completed;
             bool done = budget->fits(h.pending[s].bytes, h.pending[s].name, error) &&
@@ -335,8 +346,6 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             }
         }
         progress.update(++delivered);
-        result->write_seconds += since(write_start);
-        result->write_cpu_seconds += threadCpuSeconds() - cpu_start;
     };
     auto deliver = [&](WorkPtr w) {
         if (stop) return;
@@ -376,11 +385,11 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             const bool received = group.receiveParts(from, &parts, &failed_code, error);
             result->wait_seconds += since(wait_start);
             // Unpacking the frame is rank 0's work on it: counted with its writing.
-            const Clock::time_point unpack_start = Clock::now();
-            const double unpack_cpu = threadCpuSeconds();
-            const bool unpacked = received && frameFromParts(&parts, w->encoded.get(), error);
-            result->write_seconds += since(unpack_start);
-            result->write_cpu_seconds += threadCpuSeconds() - unpack_cpu;
+            bool unpacked = false;
+            {
+                const WriteTime timed(result);
+                unpacked = received && frameFromParts(&parts, w->encoded.get(), error);
+            }
             if (!unpacked) {
                 if (!failed_code) failed_code = 1;
                 stop = true;
