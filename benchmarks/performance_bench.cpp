@@ -146,7 +146,7 @@ void BM_ExportFrame(benchmark::State& state) {
     apparent::SequenceInfo info;
     info.model = "relativistic";
     info.fps = 10;
-    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, -1, ""});
+    info.objects.emplace_back().name = "torus";
     const double cpu0 = processCpuSeconds();
     for (auto _ : state) {
         std::vector<apparent::ExportFrame> frames(1);  // the frame cut into place (a copy is no part of the export)
@@ -183,7 +183,7 @@ void BM_GlbPrepare(benchmark::State& state) {
     apparent::SequenceInfo info;
     info.model = "relativistic";
     info.fps = 10;
-    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, -1, ""});
+    info.objects.emplace_back().name = "torus";
     const fs::path dir = fs::temp_directory_path() / "apparent_perf_prepare";
     apparent::GlbSequenceWriter writer((dir / "f.glb").string(), info, {});  // nothing written: no add()
     const double cpu0 = processCpuSeconds();
@@ -214,7 +214,7 @@ void BM_GlbSequenceFrame(benchmark::State& state) {
     apparent::SequenceInfo info;
     info.model = "relativistic";
     info.fps = 20;
-    info.objects.push_back({"torus", {0.8, 0.8, 0.8, 1}, -1, ""});
+    info.objects.emplace_back().name = "torus";
     long long k = 0;
     double finish_ms = 0, finish_cpu_ms = 0;
     const double cpu0 = processCpuSeconds();
