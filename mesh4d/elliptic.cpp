@@ -10,6 +10,21 @@ namespace mesh4d {
 
 namespace {
 constexpr double kUnitRoundoff = 0x1p-53;
+
+// One duplication step (elliptic.h): lambda from the current x, y, z, then x, y, z and their mean
+// a drawn to (value + lambda) / 4. Returns lambda and sqrt(z) before the step (R_D's sum uses them).
+struct Duplication {
+    double lambda, sqrt_z;
+};
+Duplication duplicate(double* x, double* y, double* z, double* a) {
+    const double sx = std::sqrt(*x), sy = std::sqrt(*y), sz = std::sqrt(*z);
+    const double lambda = sx * sy + sy * sz + sz * sx;
+    *x = 0.25 * (*x + lambda);
+    *y = 0.25 * (*y + lambda);
+    *z = 0.25 * (*z + lambda);
+    *a = 0.25 * (*a + lambda);
+    return {lambda, sz};
+}
 }  // namespace
 
 double carlsonRF(double x, double y, double z) {
@@ -18,12 +33,7 @@ double carlsonRF(double x, double y, double z) {
     double a = a0, scale = 1;  // scale = 4^-m
     // Step: duplicate until the spread is below the series' reach.
     while (scale * q >= std::fabs(a)) {
-        const double sx = std::sqrt(x), sy = std::sqrt(y), sz = std::sqrt(z);
-        const double lambda = sx * sy + sy * sz + sz * sx;
-        x = 0.25 * (x + lambda);
-        y = 0.25 * (y + lambda);
-        z = 0.25 * (z + lambda);
-        a = 0.25 * (a + lambda);
+        duplicate(&x, &y, &z, &a);
         scale *= 0.25;
     }
     // Step: the series.
@@ -39,13 +49,9 @@ double carlsonRD(double x, double y, double z) {
     double a = a0, scale = 1, sum = 0;
     // Step: duplicate, summing the terms each step leaves.
     while (scale * q >= std::fabs(a)) {
-        const double sx = std::sqrt(x), sy = std::sqrt(y), sz = std::sqrt(z);
-        const double lambda = sx * sy + sy * sz + sz * sx;
-        sum += scale / (sz * (z + lambda));
-        x = 0.25 * (x + lambda);
-        y = 0.25 * (y + lambda);
-        z = 0.25 * (z + lambda);
-        a = 0.25 * (a + lambda);
+        const double z_before = z;
+        const Duplication d = duplicate(&x, &y, &z, &a);
+        sum += scale / (d.sqrt_z * (z_before + d.lambda));
         scale *= 0.25;
     }
     // Step: the series.

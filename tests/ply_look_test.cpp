@@ -45,6 +45,16 @@ struct PlyFolder {
     }
 };
 
+// Renders f's scene.json (the instant model, frame 0) and reads its .glb back into `model`.
+void renderAtRest(const PlyFolder& f, tinygltf::Model* model) {
+    const testcli::CommandResult run = testcli::apparentRun(
+        {"render", (f.dir / "scene.json").string(), "--out", (f.dir / "out").string(), "--frames", "0:1", "--quiet"});
+    ASSERT_EQ(run.code, 0) << run.err;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadBinaryFromFile(model, &err, &warn, (f.dir / "out/instant.glb").string())) << err;
+}
+
 // An ascii triangle whose vertices have `props` (header lines) and `values` (one row per vertex, after x y z).
 std::string triangle(const std::string& props, const std::array<std::string, 3>& values, const std::string& comments = "") {
     return "ply\nformat ascii 1.0\n" + comments + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n" +
@@ -342,13 +352,8 @@ TEST(PlyLook, RenderAtRestWritesTheLinearColoursVertexForVertex) {
     f.write("scene.json", R"({"camera": {"position": [0.3, 0.3, 4], "look_at": [0.3, 0.3, 0], "fov_deg": 60},
         "frames": {"start": 0, "end": 1, "fps": 1}, "model": "instant", "tolerance": "vertex",
         "objects": [{"mesh": "tetra.ply", "position": [0, 0, 0], "velocity": [0, 0, 0]}]})");
-    const testcli::CommandResult run = testcli::apparentRun(
-        {"render", (f.dir / "scene.json").string(), "--out", (f.dir / "out").string(), "--frames", "0:1", "--quiet"});
-    ASSERT_EQ(run.code, 0) << run.err;
-    tinygltf::TinyGLTF loader;
     tinygltf::Model model;
-    std::string err, warn;
-    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (f.dir / "out/instant.glb").string())) << err;
+    ASSERT_NO_FATAL_FAILURE(renderAtRest(f, &model));
     size_t checked = 0;
     std::set<int> seen;
     for (const tinygltf::Node& node : model.nodes) {
@@ -641,13 +646,8 @@ TEST(PlyLook, RenderAtRestWritesTheCornerTexcoordsVertexForVertex) {
     f.write("scene.json", R"({"camera": {"position": [0.5, 0.5, 4], "look_at": [0.5, 0.5, 0], "fov_deg": 60},
         "frames": {"start": 0, "end": 1, "fps": 1}, "model": "instant", "tolerance": "vertex",
         "objects": [{"mesh": "cube.ply", "position": [0, 0, 0], "velocity": [0, 0, 0]}]})");
-    const testcli::CommandResult run = testcli::apparentRun(
-        {"render", (f.dir / "scene.json").string(), "--out", (f.dir / "out").string(), "--frames", "0:1", "--quiet"});
-    ASSERT_EQ(run.code, 0) << run.err;
-    tinygltf::TinyGLTF loader;
     tinygltf::Model model;
-    std::string err, warn;
-    ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (f.dir / "out/instant.glb").string())) << err;
+    ASSERT_NO_FATAL_FAILURE(renderAtRest(f, &model));
     size_t checked = 0;
     std::set<int> faces;
     for (const tinygltf::Node& node : model.nodes) {
