@@ -285,6 +285,36 @@ TEST(GltfReader, DracoAttributeIdMissingFromThePayloadIsRefused) {
     fs::remove_all(dir);
 }
 
+// tinygltf 2.7 passes an image's bufferView to the image loader without checking its range: a view
+// that reaches past its buffer (past the BIN chunk, or past the buffer's declared byteLength inside
+// it) is refused with the image and the view named, before tinygltf reads it.
+TEST(GltfReader, ImageViewsPastTheirBufferAreRefused) {
+    const fs::path dir = testio::tempPath() / ("apparent_image_view_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::ifstream in(kAssimp / "BoxTextured-glTF-Binary/BoxTextured.glb", std::ios::binary);
+    const std::string glb((std::istreambuf_iterator<char>(in)), {});
+    const std::pair<std::function<void(nlohmann::json&)>, const char*> cases[] = {
+        {[](nlohmann::json& j) { j["bufferViews"][3]["byteLength"] = 1000000; },
+         "images[0].bufferView: bufferViews[3] (byteOffset 840, byteLength 1000000) reaches past buffers[0] (3273 bytes)"},
+        {[](nlohmann::json& j) { j["buffers"][0]["byteLength"] = 900; },
+         "images[0].bufferView: bufferViews[3] (byteOffset 840, byteLength 2433) reaches past buffers[0] (900 bytes)"},
+        {[](nlohmann::json& j) { j["images"][0]["bufferView"] = 7; }, "images[0].bufferView: 7 out of range (4 bufferViews)"},
+        {[](nlohmann::json& j) { j["bufferViews"][3]["byteOffset"] = -5; },
+         "bufferViews[3]: byteOffset and byteLength must be integers from 0 to 2^53"},
+    };
+    for (const auto& [edit, expected] : cases) {
+        std::ofstream(dir / "bad.glb", std::ios::binary) << editGlbJson(glb, edit);
+        LoadedMesh m;
+        const Status st = load((dir / "bad.glb").string(), &m);
+        EXPECT_FALSE(st.ok) << expected;
+        EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+    }
+    LoadedMesh m;
+    std::ofstream(dir / "good.glb", std::ios::binary) << editGlbJson(glb, [](nlohmann::json&) {});
+    EXPECT_TRUE(load((dir / "good.glb").string(), &m).ok);  // the unedited JSON loads
+    fs::remove_all(dir);
+}
+
 // A .gltf whose texture is a file beside it (assimp-testmodels' BoxTexcoords: one PNG, two texture
 // coordinate sets, the metallic-roughness texture read through TEXCOORD_1): the image's bytes are
 // the file's, both sets are kept, and nothing is dropped.

@@ -378,6 +378,65 @@ bool checkDracoPayloads(const nlohmann::json& j, const std::vector<unsigned char
     });
 }
 
+// tinygltf 2.7 hands an image's bufferView to the image loader without checking that it lies inside
+// its buffer (tiny_gltf.h, "Load image from the buffer view"): every image's view is checked here
+// against its buffer's actual bytes first.
+bool checkImageViews(const nlohmann::json& j, const std::vector<unsigned char>& file, bool binary, const fs::path& root,
+                     size_t max_bytes, std::string* problem) {
+    auto images = j.find("images");
+    if (images == j.end() || !images->is_array()) return true;
+    auto arraySize = [&](const char* key) {
+        auto it = j.find(key);
+        return it != j.end() && it->is_array() ? it->size() : size_t(0);
+    };
+    const size_t n_views = arraySize("bufferViews"), n_buffers = arraySize("buffers");
+    for (size_t i = 0; i < images->size(); ++i) {
+        const nlohmann::json& image = (*images)[i];
+        if (!image.is_object() || !image.contains("bufferView")) continue;
+        const std::string where = "images[" + std::to_string(i) + "].bufferView";
+        const nlohmann::json& bv = image["bufferView"];
+        if (!bv.is_number_unsigned() || bv.get<uint64_t>() >= n_views) {
+            *problem = where + ": " + jsonForMessage(bv) + " out of range (" + std::to_string(n_views) + " bufferViews)";
+            return false;
+        }
+        const nlohmann::json& view = j["bufferViews"][bv.get<size_t>()];
+        const std::string vwhere = "bufferViews[" + std::to_string(bv.get<size_t>()) + "]";
+        if (!view.is_object() || !view.contains("buffer") || !view["buffer"].is_number_unsigned() ||
+            view["buffer"].get<uint64_t>() >= n_buffers) {
+            *problem = vwhere + ".buffer: missing or out of range (" + std::to_string(n_buffers) + " buffers)";
+            return false;
+        }
+        auto field = [&](const char* key, uint64_t* value) {
+            *value = 0;
+            if (!view.contains(key)) return true;
+            if (!view[key].is_number_unsigned() || view[key].get<uint64_t>() > (uint64_t(1) << 53)) return false;
+            *value = view[key].get<uint64_t>();
+            return true;
+        };
+        uint64_t off = 0, len = 0;
+        if (!field("byteOffset", &off) || !field("byteLength", &len)) {
+            *problem = vwhere + ": byteOffset and byteLength must be integers from 0 to 2^53";
+            return false;
+        }
+        const size_t buffer = view["buffer"].get<size_t>();
+        std::vector<unsigned char> bytes;
+        if (!bufferBytes(j, buffer, file, binary, root, max_bytes, &bytes)) {
+            *problem = where + ": buffers[" + std::to_string(buffer) + "] cannot be read";
+            return false;
+        }
+        // tinygltf keeps a buffer's first byteLength bytes: the smaller of the two counts.
+        const nlohmann::json& declared = j["buffers"][buffer];
+        if (declared.is_object() && declared.contains("byteLength") && declared["byteLength"].is_number_unsigned())
+            bytes.resize(std::min<uint64_t>(bytes.size(), declared["byteLength"].get<uint64_t>()));
+        if (off > bytes.size() || len > bytes.size() - off) {
+            *problem = where + ": " + vwhere + " (byteOffset " + std::to_string(off) + ", byteLength " + std::to_string(len) +
+                       ") reaches past buffers[" + std::to_string(buffer) + "] (" + std::to_string(bytes.size()) + " bytes)";
+            return false;
+        }
+    }
+    return true;
+}
+
 // Checks and parses the bytes of glTF file `path` (resolved: `canonical`) into `doc`, file access
 // confined to its folder; `read` receives the external files tinygltf read.
 Status parseDocument(const std::string& path, const std::vector<unsigned char>& bytes, const fs::path& canonical,
@@ -403,7 +462,8 @@ Status parseDocument(const std::string& path, const std::vector<unsigned char>& 
                                           "'npx gltf-pipeline -i IN -o OUT.glb' (it upgrades 1.0 to 2.0) or re-export as glTF 2.0");
     }
     if (!checkFileUris(j, "buffers", &problem) || !checkFileUris(j, "images", &problem) || !checkDracoReferences(j, &problem) ||
-        !checkDracoPayloads(j, bytes, binary, canonical.parent_path(), limits.max_file_bytes, &problem))
+        !checkDracoPayloads(j, bytes, binary, canonical.parent_path(), limits.max_file_bytes, &problem) ||
+        !checkImageViews(j, bytes, binary, canonical.parent_path(), limits.max_file_bytes, &problem))
         return Status::failure(path + ": " + problem);
 
     // Step: parse with tinygltf, file access confined to the glTF file's folder.
