@@ -4,9 +4,12 @@
 #include "exporters/frame_spill.h"
 
 #include <algorithm>
+#include <cctype>
 #include <atomic>
 #include <cerrno>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
@@ -38,6 +41,73 @@ mesh4d::ApparentMesh mergeObjects(const ExportFrame& frame) {
     return all;
 }
 
+std::string shortestDecimal(double value) {
+#if defined(__cpp_lib_to_chars)
+    char buffer[32];
+    return std::string(buffer, std::to_chars(buffer, buffer + sizeof(buffer), value).ptr);
+#else
+    return shortestDecimalByPrintf(value);
+#endif
+}
+
+std::string shortestDecimalByPrintf(double value) {
+    if (!std::isfinite(value)) return std::isnan(value) ? "nan" : value < 0 ? "-inf" : "inf";
+    // Step: the fewest significant digits that read back as `value`: at each count the correctly
+    // rounded digits ("%.*e"), or the neighbour past `value` when only that one reads back.
+    auto readsBack = [&](const std::string& d, int exp) {
+        const std::string text = (value < 0 ? "-" : "") + d.substr(0, 1) + "." + d.substr(1) + "e" + std::to_string(exp);
+        return std::strtod(text.c_str(), nullptr) == value;
+    };
+    std::string digits;
+    int exponent = 0;
+    for (int p = 0; p < 17; ++p) {
+        char e_form[40];
+        std::snprintf(e_form, sizeof e_form, "%.*e", p, value);
+        const char* at = std::strchr(e_form, 'e');
+        digits.clear();
+        for (const char* c = e_form; c < at; ++c)
+            if (std::isdigit((unsigned char)*c)) digits += *c;
+        exponent = std::atoi(at + 1);
+        if (readsBack(digits, exponent) || p == 16) break;
+        bool found = false;
+        for (int step : {1, -1}) {
+            std::string d = digits;
+            int exp = exponent, k = int(d.size()) - 1;
+            while (k >= 0 && d[size_t(k)] == (step > 0 ? '9' : '0')) d[size_t(k--)] = step > 0 ? '0' : '9';
+            if (k < 0) continue;  // 9...9 + 1 or 0...0 - 1: not a neighbour of this length
+            d[size_t(k)] = char(d[size_t(k)] + step);
+            if (d[0] == '0') continue;
+            if (readsBack(d, exp)) {
+                digits = d;
+                exponent = exp;
+                found = true;
+                break;
+            }
+        }
+        if (found) break;
+    }
+    while (digits.size() > 1 && digits.back() == '0') digits.pop_back();
+    const std::string sign = value < 0 || (value == 0 && std::signbit(value)) ? "-" : "";
+    // Step: the scientific form as printf writes it (at least two exponent digits) ...
+    std::string sci = sign + digits.substr(0, 1) + (digits.size() > 1 ? "." + digits.substr(1) : "") + "e" +
+                      (exponent < 0 ? "-" : "+") + (std::abs(exponent) < 10 ? "0" : "") + std::to_string(std::abs(exponent));
+    // ... and the fixed form; the shorter, the fixed one on a tie (the rule of std::to_chars).
+    std::string fixed;
+    const int n = int(digits.size());
+    if (exponent >= n - 1) {
+        // An integer: its exact digits, as printf's "%.0f" (as long as the shortest ones padded with zeros).
+        char integer[400];
+        std::snprintf(integer, sizeof integer, "%.0f", std::fabs(value));
+        fixed = integer;
+    }
+    else if (exponent >= 0)
+        fixed = digits.substr(0, size_t(exponent + 1)) + "." + digits.substr(size_t(exponent + 1));
+    else
+        fixed = "0." + std::string(size_t(-exponent - 1), '0') + digits;
+    fixed = sign + fixed;
+    return fixed.size() <= sci.size() ? fixed : sci;
+}
+
 std::vector<std::string> frameFileComments(const ExportFrame& frame, const SequenceInfo& info) {
     std::vector<std::string> lines;
     if (!frame.units.empty()) lines.push_back("units: " + frame.units);
@@ -48,10 +118,7 @@ std::vector<std::string> frameFileComments(const ExportFrame& frame, const Seque
             if ((unsigned char)c < 0x20 || c == 0x7f) c = '_';
         lines.push_back("scene: " + path);
     }
-    // Step: the camera time, shortest round trip (std::to_chars without a precision: no locale).
-    char buffer[32];
-    const auto r = std::to_chars(buffer, buffer + sizeof(buffer), frame.t_c);
-    lines.push_back("camera_time: " + std::string(buffer, r.ptr));
+    lines.push_back("camera_time: " + shortestDecimal(frame.t_c));
     const size_t objects = frameObjectCount(frame, info);
     for (size_t i = 0; i < objects; ++i) lines.push_back("object " + std::to_string(i) + " " + frameObjectName(info, i));
     return lines;
@@ -235,7 +302,12 @@ void removeRunTemporaries(const char* folder, const char* infix) {
         removed = false;
         if (::lseek(fd, 0, SEEK_SET) != 0) break;
         for (;;) {
+#if defined(__EMSCRIPTEN__)
+            const long n = 0;  // the WebAssembly module has no signals to clean up after
+            (void)buffer;
+#else
             const long n = ::syscall(SYS_getdents64, fd, buffer, sizeof buffer);
+#endif
             if (n <= 0) break;
             for (long at = 0; at < n;) {
                 const auto* e = reinterpret_cast<const DirectoryEntry*>(buffer + at);

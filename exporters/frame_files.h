@@ -49,6 +49,13 @@ bool writeUncommitted(AtomicOutput* out, const std::string& bytes, std::string* 
 bool writeFrameFile(FrameSerializer serialize, const std::string& path, const ExportFrame& frame,
                     const SequenceInfo& info, std::string* error);
 
+// The shortest decimal that reads back as `value`, in std::to_chars's plain form (fixed or
+// scientific, whichever is shorter, fixed on a tie; "1e-05", "0.1", "100000"): std::to_chars where
+// the standard library has it for doubles, else shortestDecimalByPrintf (the WebAssembly build's
+// libc++), which gives the same text (tests/frame_files_test.cpp compares them).
+std::string shortestDecimal(double value);
+std::string shortestDecimalByPrintf(double value);
+
 // What both frame files say of their frame, one line each without the line break, in this order:
 // "units: U" (when the frame's units are not light-seconds), "model: M" and "scene: PATH" (when
 // the sequence names them), "camera_time: T" (the frame's t_c in seconds, the shortest decimal that

@@ -9,10 +9,10 @@
 
 #include <unistd.h>
 
-#include <tbb/parallel_for.h>
 
 #include "exporters/atomic_file.h"
 #include "exporters/frame_files.h"
+#include "mesh4d/parallel.h"
 
 namespace apparent {
 
@@ -62,7 +62,7 @@ void serializePly(const ExportFrame& frame, const SequenceInfo& info, std::strin
         vertices += frame.objects[o].positions.size();
     }
     std::vector<size_t> kept(blocks.size(), 0);
-    tbb::parallel_for(size_t(0), blocks.size(), [&](size_t i) {
+    mesh4d::parallelFor(size_t(0), blocks.size(), [&](size_t i) {
         const auto& tris = frame.objects[blocks[i].object].triangles;
         size_t n = 0;
         for (size_t f = blocks[i].begin; f < blocks[i].end; ++f) n += keptFace(tris[f]);
@@ -101,7 +101,7 @@ void serializePly(const ExportFrame& frame, const SequenceInfo& info, std::strin
     for (size_t o = 0; o < frame.objects.size(); ++o) {
         const mesh4d::ApparentMesh& part = frame.objects[o];
         char* const dst = vertex_start + vertex_bytes * base;
-        tbb::parallel_for(size_t(0), part.positions.size(), kBlock, [&](size_t first) {
+        mesh4d::parallelFor(size_t(0), part.positions.size(), kBlock, [&](size_t first) {
             const size_t last = std::min(part.positions.size(), first + kBlock);
             char* p = dst + vertex_bytes * first;
             for (size_t i = first; i < last; ++i) {
@@ -124,7 +124,7 @@ void serializePly(const ExportFrame& frame, const SequenceInfo& info, std::strin
         });
         base += part.positions.size();
     }
-    tbb::parallel_for(size_t(0), blocks.size(), [&](size_t i) {
+    mesh4d::parallelFor(size_t(0), blocks.size(), [&](size_t i) {
         const FaceBlock& b = blocks[i];
         const auto& tris = frame.objects[b.object].triangles;
         char* p = face_start + kFaceBytes * b.faces_before;

@@ -36,8 +36,16 @@ inline Vec3 cross(const Vec3& a, const Vec3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline double norm2(const Vec3& a) { return dot(a, a); }
-// Euclidean length; std::hypot avoids overflow and underflow for extreme magnitudes.
-inline double norm(const Vec3& a) { return std::hypot(a.x, a.y, a.z); }
+// Euclidean length without overflow or underflow at extreme magnitudes: a sqrt((x/a)^2 + (y/a)^2 +
+// (z/a)^2), a the largest magnitude (0 when a is 0). This is libstdc++'s std::hypot(x, y, z) written
+// out, so that every standard library gives the same bits (libc++, the WebAssembly build's, computes
+// hypot's three-argument form otherwise: docs/DESIGN.md section 14).
+inline double norm(const Vec3& v) {
+    const double x = std::fabs(v.x), y = std::fabs(v.y), z = std::fabs(v.z);
+    const double a = x < y ? (y < z ? z : y) : (x < z ? z : x);
+    if (a == 0) return 0;
+    return a * std::sqrt((x / a) * (x / a) + (y / a) * (y / a) + (z / a) * (z / a));
+}
 inline bool isFinite(const Vec3& a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 
 // A point of spacetime in the lab frame: time t (s) and position x (light-seconds).

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <charconv>
 #include <random>
 #include <sstream>
 
@@ -26,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exporters/atomic_file.h"
+#include "exporters/frame_files.h"
 #include "exporters/gltf.h"
 #include "exporters/obj.h"
 #include "exporters/ply.h"
@@ -71,6 +73,32 @@ std::string writeOn(int threads, bool ply, const ExportFrame& frame, const fs::p
 }
 
 }  // namespace
+
+// The frame files' camera time without std::to_chars for doubles (the WebAssembly build's libc++ has
+// none): the same text as std::to_chars's plain form, on edge cases, frame times k / fps and random
+// bit patterns (one wrong digit, a missing exponent zero or the wrong form on a tie fails).
+TEST(FrameExport, ShortestDecimalByPrintfIsToCharsPlainForm) {
+    auto toChars = [](double v) {
+        char buffer[32];
+        return std::string(buffer, std::to_chars(buffer, buffer + sizeof(buffer), v).ptr);
+    };
+    std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.1, 1e-5, 1e-4, 1e16, 1e15, 123456789.0, 1e21, 1e22, 5e-324,
+                                  1.7976931348623157e308, 2.2250738585072014e-308, 0.3, 1.0 / 3.0, 100000.0, 1234567.0,
+                                  0.000123, 9.5367431640625e-07, 4.35, 2.5e-3, 1e100, -7.25e-12};
+    for (int k = 0; k < 2000; ++k) values.push_back(k / 30.0), values.push_back(-5.0 + k / 24.0), values.push_back(std::ldexp(1.0, k - 1000));
+    std::mt19937_64 random(31);
+    while (values.size() < 100000) {
+        const uint64_t bits = random();
+        double v;
+        std::memcpy(&v, &bits, 8);
+        if (std::isfinite(v)) values.push_back(v);
+    }
+    size_t wrong = 0;
+    for (double v : values)
+        if (shortestDecimalByPrintf(v) != toChars(v) && ++wrong <= 5)
+            ADD_FAILURE() << toChars(v) << " written as " << shortestDecimalByPrintf(v);
+    EXPECT_EQ(wrong, 0u) << "of " << values.size();
+}
 
 TEST(FrameExport, PlyAndObjBytesDoNotDependOnTheThreadCount) {
     const fs::path dir = testio::tempPath() / ("apparent_frame_export_" + std::to_string(::getpid()));

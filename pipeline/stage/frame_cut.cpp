@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <tbb/parallel_for.h>
-
 #include "mesh4d/check.h"
 #include "mesh4d/light_factors.h"
+#include "mesh4d/parallel.h"
 #include "pipeline/input/scene_fields.h"
 #include "pipeline/stage/physics.h"
 #include "pipeline/stage/worlds.h"
@@ -62,7 +61,7 @@ void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, 
     // Objects in parallel (a short range of frames of a many-object scene), each into its own
     // slot: the result does not depend on the scheduling.
     frame->objects.assign(worlds.size(), {});
-    tbb::parallel_for(size_t(0), worlds.size(), [&](size_t o) {
+    mesh4d::parallelFor(size_t(0), worlds.size(), [&](size_t o) {
         const mesh4d::World4D& world = worlds[o];
         // --cull-view: an object wholly outside the camera's view is left empty.
         if (cull_view && !inCameraView(stage.scene.camera, mesh4d::apparentBound(world, view))) return;
