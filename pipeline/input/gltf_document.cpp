@@ -9,7 +9,9 @@
 #include <mutex>
 #include <string_view>
 
+#if !defined(APPARENT_NO_DRACO)
 #include <draco/compression/decode.h>
+#endif
 #include <nlohmann/json.hpp>
 
 #include "pipeline/input/input_file.h"
@@ -340,6 +342,15 @@ bool checkDracoReferences(const nlohmann::json& j, std::string* problem) {
 // with at most 4 components.
 bool checkDracoPayloads(const nlohmann::json& j, const std::vector<unsigned char>& file, bool binary,
                         const fs::path& root, size_t max_bytes, std::string* problem) {
+#if defined(APPARENT_NO_DRACO)
+    // Step: a build without Draco (the WebAssembly module) refuses what it cannot decode.
+    (void)file, (void)binary, (void)root, (void)max_bytes;
+    return forEachDracoPrimitive(j, [&](const json&, const json&, const std::string& prim_where) {
+        *problem = prim_where + ".extensions.KHR_draco_mesh_compression: Draco-compressed meshes are not read by this "
+                                "build (the WebAssembly module); use the plain or meshopt file";
+        return false;
+    });
+#else
     return forEachDracoPrimitive(j, [&](const json&, const json& draco, const std::string& prim_where) {
         const json* dr = &draco;
         const std::string where = prim_where + ".extensions.KHR_draco_mesh_compression";
@@ -376,6 +387,7 @@ bool checkDracoPayloads(const nlohmann::json& j, const std::vector<unsigned char
         }
         return true;
     });
+#endif
 }
 
 // tinygltf 2.7 hands an image's bufferView to the image loader without checking that it lies inside

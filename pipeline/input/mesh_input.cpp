@@ -5,8 +5,10 @@
 #include <filesystem>
 
 #include "pipeline/input/gltf_reader.h"
+#if !defined(APPARENT_NO_OPENMESH)
 #include "pipeline/input/obj_reader.h"
 #include "pipeline/input/ply_reader.h"
+#endif
 
 namespace apparent {
 
@@ -31,6 +33,11 @@ Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* o
     std::string ext = file.substr(file.find_last_of('.') == std::string::npos ? file.size() : file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".gltf" || ext == ".glb") return readGltf(path, limits, out, warnings);
+#if defined(APPARENT_NO_OPENMESH)
+    // A build without OpenMesh (the WebAssembly module) reads glTF meshes only.
+    return Status::failure(path + ": only glTF meshes (.gltf, .glb) are read by this build (the WebAssembly module); "
+                                  "write the scene's web file with 'apparent render SCENE --format web'");
+#else
     if (hash != std::string::npos) {
         // No glTF before the '#': the '#' is part of an OBJ's own path.
         std::string whole = path.substr(path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'));
@@ -41,6 +48,7 @@ Status readMesh(const std::string& path, const MeshLimits& limits, LoadedMesh* o
     if (ext == ".obj") return readObj(path, limits, &out->mesh, warnings, &out->look);
     if (ext == ".ply") return readPly(path, limits, &out->mesh, warnings, &out->look);
     return Status::failure(path + ": unknown mesh format '" + ext + "' (use .obj, .ply, .gltf or .glb)");
+#endif
 }
 
 namespace {

@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
-# mesh4d/ compiled to WebAssembly with Emscripten (Debian's emscripten: em++), from the same sources
-# as the native library, and tests/wasm/parity.cpp run by both: the WebAssembly build's cuts are
-# compared with the native ones (docs/DESIGN.md section 14). The build: the scalar forms
-# (APPARENT_NO_LANES), no TBB (APPARENT_NO_TBB: a serial path), CGAL's exact numbers from
-# Boost.Multiprecision (CGAL_DISABLE_GMP), -ffp-contract=off as the native library. The comparison:
+# mesh4d/ compiled to WebAssembly with Emscripten (Debian's emscripten: em++, scripts/build_web.sh's
+# objects and flags), from the same sources as the native library, and tests/wasm/parity.cpp run by
+# both: the WebAssembly build's cuts are compared with the native ones (docs/DESIGN.md section 14).
+# The comparison:
 # the same vertex and triangle counts and triangles in every cut, and every number within 1e-12
 # relative of the native one; how many are bit for bit the same is printed.
 # Usage: run.sh NATIVE_PARITY SOURCE_DIR WORK_DIR   (exit 77: em++ is not installed, the test skips)
@@ -12,28 +11,16 @@ native=$1
 src=$2
 work=$3
 command -v em++ > /dev/null || { echo "wasm: em++ not found (scripts/setup.sh installs Debian's emscripten)"; exit 77; }
-mkdir -p "$work/obj" "$work/include"
-# CGAL's and Boost's headers alone: the rest of /usr/include is the host's C library.
-ln -sfn /usr/include/CGAL "$work/include/CGAL"
-ln -sfn /usr/include/boost "$work/include/boost"
-# Debian's emscripten 3.1.6 finds its JavaScript optimizer's parser (node-acorn) here.
+# Step: the module's objects (scripts/build_web.sh, the same flags), then this program against mesh4d's.
+mkdir -p "$work"
+bash "$src/scripts/build_web.sh" "$work" > "$work/build.log" 2>&1 || { tail -20 "$work/build.log"; exit 1; }
 export NODE_PATH=/usr/share/nodejs${NODE_PATH:+:$NODE_PATH}
-# CGAL's filtered predicates catch an exception when the interval filter is unsure (-fexceptions),
-# and WebAssembly has no rounding modes: CGAL_ALWAYS_ROUND_TO_NEAREST makes its intervals widen by
-# one ulp each way instead (still enclosing the exact value).
-flags=(-std=c++17 -O2 -fno-math-errno -ffp-contract=off -fexceptions -DAPPARENT_NO_LANES=1 -DAPPARENT_NO_TBB=1
-       -DCGAL_DISABLE_GMP=1 -DCGAL_ALWAYS_ROUND_TO_NEAREST=1 -I "$src" -isystem "$work/include")
-# Step: every source, two at a time (an object newer than its source and than this script is kept).
-for f in $(cd "$src" && find mesh4d -name '*.cpp' | sort) tests/wasm/parity.cpp; do
-  o="$work/obj/$(echo "$f" | tr / _).o"
-  [ "$o" -nt "$src/$f" ] && [ "$o" -nt "$src/tests/wasm/run.sh" ] && continue
-  em++ "${flags[@]}" -c "$src/$f" -o "$o" &
-  if [ "$(jobs -rp | wc -l)" -ge 2 ]; then wait -n; fi
-done
-while [ "$(jobs -rp | wc -l)" -gt 0 ]; do wait -n; done
+mapfile -t flags < "$work/flags.txt"
+em++ "${flags[@]}" -c "$src/tests/wasm/parity.cpp" -o "$work/parity.o"
 # Node 18 and later have fetch(), which this Emscripten's loader would use for a file path: the
 # module is one file, its WebAssembly inside (SINGLE_FILE).
-em++ -O2 -fexceptions "$work"/obj/*.o -o "$work/parity.js" -sENVIRONMENT=node -sSINGLE_FILE=1 -sALLOW_MEMORY_GROWTH=1
+em++ -O2 -fwasm-exceptions "$work"/obj/mesh4d_*.o "$work/parity.o" -o "$work/parity.js" -sENVIRONMENT=node -sSINGLE_FILE=1 \
+  -sALLOW_MEMORY_GROWTH=1
 "$native" > "$work/native.txt"
 node "$work/parity.js" > "$work/wasm.txt"
 python3 - "$work/native.txt" "$work/wasm.txt" <<'PY'
