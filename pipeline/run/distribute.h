@@ -95,6 +95,9 @@ public:
     void sendFrame(const std::string& bytes) { sendParts({std::string_view(bytes)}); }  // one part
     virtual void sendError(int /*code*/, const std::string& /*message*/) {}
     virtual int finishSending() { return 0; }                   // DONE, then END's code
+    // Rank 0: waits until rank `from`'s next message has come, without receiving it (the loop
+    // tells its wait for a frame from its work on the frame, render --verbose).
+    virtual void awaitFrame(int /*from*/) {}
     // Rank 0: the next frame from rank `from`: its parts, or false with the rank's code and message.
     virtual bool receiveParts(int /*from*/, std::vector<std::string>* /*parts*/, int* /*code*/, std::string* /*error*/) {
         return false;

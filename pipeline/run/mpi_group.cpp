@@ -149,6 +149,8 @@ public:
         return ok;
     }
 
+    void awaitFrame(int from) override { MPI_Probe(from, MPI_ANY_TAG, comm_, MPI_STATUS_IGNORE); }
+
     bool receiveParts(int from, std::vector<std::string>* parts, int* code, std::string* error) override {
         MPI_Status status;
         MPI_Probe(from, MPI_ANY_TAG, comm_, &status);
