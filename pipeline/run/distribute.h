@@ -13,7 +13,8 @@
 // The MPI protocol (FrameGroup below, one exchange per model's frame loop), rank r > 0:
 //   for each of its frames, in order: FRAME (the EncodedFrame as parts: its header, then each
 //   sink's bytes; a synchronous send, so a rank holds at most its frame loop's tokens of frames:
-//   bounded memory), or, when it fails, ERROR (exit code and
+//   bounded memory; up to 1 MiB in all, as frames by reference and files written by their ranks
+//   are, one message, larger ones their parts' sizes and then each part), or, when it fails, ERROR (exit code and
 //   the one-line message) instead, and no more frames; before each frame it checks for END from
 //   rank 0 and stops sending when it came; then DONE; then it waits for END(code).
 // Rank 0 receives the frames in frame order from their ranks (one at a time: bounded memory) and
