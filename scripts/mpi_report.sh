@@ -4,7 +4,8 @@
 # default tolerance, to a plain .glb; one process with 1 and 2 threads, then mpirun -n 1, 2 and 4
 # with one thread per rank, side by side in one run. Prints a Markdown table: wall time, speed-up
 # against one process with one thread, rank 0's writing time and share, and the per-frame costs
-# (`render --verbose`), and checks that every run's outputs (the .glb, or with --format ply the PLY
+# (`render --verbose`; with MPI also rank 0's work on each frame another rank cut, in microseconds),
+# and checks that every run's outputs (the .glb, or with --format ply the PLY
 # frames) are byte-identical to the one-process run's.
 # With PEER=/path/to/another/apparent (e.g. a build of the commit before a change), every run is
 # made with both binaries in turn, rows marked "this" and "peer": a ratio measured side by side.
@@ -45,9 +46,10 @@ run() {  # LABEL OUTDIR COMMAND...
     line=$(grep -E '^relativistic: loop ' "$out.log") || { cat "$out.log"; exit 1; }
     # "relativistic: loop L s; per frame: cut and encode C ms (CPU c ms; F frames cut here), write W ms
     #  (CPU w ms; F frames, P% of the loop[ on rank 0]); of the writing, the files' assembly A ms (CPU
-    #  a ms)[; rank 0 waited T s for other ranks]"
+    #  a ms)[; rank 0 waited T s for other ranks][; of the writing, the frames of other ranks R us each
+    #  (CPU r us; K frames)]"
     field() { echo "$line" | sed -E "s/$1/\\1/"; }
-    local cut cut_cpu write write_cpu share assembly="-"
+    local cut cut_cpu write write_cpu share assembly="-" received="-"
     cut=$(field '.*cut and encode ([0-9.]+) ms.*')
     cut_cpu=$(field '.*cut and encode [0-9.]+ ms \(CPU ([0-9.]+) ms.*')
     write=$(field '.*, write ([0-9.]+) ms.*')
@@ -56,9 +58,12 @@ run() {  # LABEL OUTDIR COMMAND...
     if echo "$line" | grep -q "files' assembly"; then
         assembly="$(field ".*files' assembly ([0-9.]+) ms.*") ($(field ".*files' assembly [0-9.]+ ms \\(CPU ([0-9.]+) ms.*"))"
     fi
+    if echo "$line" | grep -q "frames of other ranks"; then
+        received="$(field ".*frames of other ranks ([0-9]+) us.*") ($(field ".*frames of other ranks [0-9]+ us each \\(CPU ([0-9]+) us.*"))"
+    fi
     [ "$out" = one1 ] || diff -r "$out" one1 > /dev/null || { echo "$label: outputs differ"; exit 1; }
-    printf '| %s | %.2f | %s (%s) | %s (%s) | %s | %s |\n' "$label" "$(echo "$end - $start" | bc)" "$cut" "$cut_cpu" \
-        "$write" "$write_cpu" "$assembly" "$share" >> table.md
+    printf '| %s | %.2f | %s (%s) | %s (%s) | %s | %s | %s |\n' "$label" "$(echo "$end - $start" | bc)" "$cut" "$cut_cpu" \
+        "$write" "$write_cpu" "$assembly" "$received" "$share" >> table.md
 }
 : > table.md
 # Each run with this binary, then (PEER set) with the peer, in turn.
@@ -73,8 +78,8 @@ both "1 process, 2 threads" one2 APPARENT render --threads 2
 for n in 1 2 4; do
     both "mpirun -n $n, 1 thread each" "mpi$n" mpirun --oversubscribe -n "$n" APPARENT render --threads 1
 done
-echo "| run | wall (s) | cut + encode per frame, ms (CPU) | write per frame on rank 0, ms (CPU) | of which the assembly at the end, ms (CPU) | writing share of rank 0's loop (%) |"
-echo "|---|---:|---:|---:|---:|---:|"
+echo "| run | wall (s) | cut + encode per frame, ms (CPU) | write per frame on rank 0, ms (CPU) | of which the assembly at the end, ms (CPU) | of which per frame of another rank, us (CPU) | writing share of rank 0's loop (%) |"
+echo "|---|---:|---:|---:|---:|---:|---:|"
 cat table.md
 echo
 echo "Outputs $(du -sm one1 | cut -f1) MiB, every run's byte-identical to the one-process run's. $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), $(date -u +%Y-%m-%dT%H:%M:%SZ)."

@@ -281,6 +281,14 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
             t << "; of the writing, the files' assembly " << 1e3 * result.finish_seconds << " ms (CPU "
               << 1e3 * result.finish_cpu_seconds << " ms)";
             if (distributed) t << "; rank 0 waited " << result.wait_seconds << " s for other ranks";
+            if (result.frames_received > 0) {
+                // Microseconds: rank 0's share of a frame it did not cut is far below a millisecond.
+                const double n = double(result.frames_received);
+                t.precision(0);
+                t << "; of the writing, the frames of other ranks " << 1e6 * result.received_seconds / n
+                  << " us each (CPU " << 1e6 * result.received_cpu_seconds / n << " us; " << result.frames_received
+                  << " frames)";
+            }
             log << t.str() << "\n";
         }
         if (!settings.quiet)

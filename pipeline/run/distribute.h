@@ -13,7 +13,8 @@
 // The MPI protocol (FrameGroup below, one exchange per model's frame loop), rank r > 0:
 //   for each of its frames, in order: FRAME (the EncodedFrame as parts: its header, then each
 //   sink's bytes; a synchronous send, so a rank holds at most its frame loop's tokens of frames:
-//   bounded memory), or, when it fails, ERROR (exit code and
+//   bounded memory; up to 1 MiB in all, as frames by reference and files written by their ranks
+//   are, one message, larger ones their parts' sizes and then each part), or, when it fails, ERROR (exit code and
 //   the one-line message) instead, and no more frames; before each frame it checks for END from
 //   rank 0 and stops sending when it came; then DONE; then it waits for END(code).
 // Rank 0 receives the frames in frame order from their ranks (one at a time: bounded memory) and
@@ -95,6 +96,9 @@ public:
     void sendFrame(const std::string& bytes) { sendParts({std::string_view(bytes)}); }  // one part
     virtual void sendError(int /*code*/, const std::string& /*message*/) {}
     virtual int finishSending() { return 0; }                   // DONE, then END's code
+    // Rank 0: waits until rank `from`'s next message has come, without receiving it (the loop
+    // tells its wait for a frame from its work on the frame, render --verbose).
+    virtual void awaitFrame(int /*from*/) {}
     // Rank 0: the next frame from rank `from`: its parts, or false with the rank's code and message.
     virtual bool receiveParts(int /*from*/, std::vector<std::string>* /*parts*/, int* /*code*/, std::string* /*error*/) {
         return false;

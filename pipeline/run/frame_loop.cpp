@@ -68,20 +68,26 @@ double threadCpuSeconds() {
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-// Adds the wall and CPU time of its scope to the loop's write time (FrameLoopResult), however the
-// scope is left.
+// Adds the wall and CPU time of its scope to the loop's write time (FrameLoopResult), and with
+// `received` (work on a frame of another rank) also to its received time, however the scope is left.
 class WriteTime {
 public:
-    explicit WriteTime(FrameLoopResult* r) : r_(r) {}
+    explicit WriteTime(FrameLoopResult* r, bool received = false) : r_(r), received_(received) {}
     ~WriteTime() {
-        r_->write_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-        r_->write_cpu_seconds += threadCpuSeconds() - cpu_;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        const double cpu = threadCpuSeconds() - cpu_;
+        r_->write_seconds += seconds;
+        r_->write_cpu_seconds += cpu;
+        if (!received_) return;
+        r_->received_seconds += seconds;
+        r_->received_cpu_seconds += cpu;
     }
     WriteTime(const WriteTime&) = delete;
     WriteTime& operator=(const WriteTime&) = delete;
 
 private:
     FrameLoopResult* r_;
+    bool received_;
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
     double cpu_ = threadCpuSeconds();
 };
@@ -180,6 +186,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
         bool over_budget = false;
         std::vector<std::shared_ptr<const PreparedFrame>> prepared;  // per sink, made on the worker
         std::unique_ptr<EncodedFrame> encoded;                       // with MPI
+        bool received = false;                                       // MPI rank 0: cut by another rank
     };
     using WorkPtr = std::shared_ptr<Work>;
     const size_t tokens = size_t(arena.max_concurrency()) + 1;
@@ -258,7 +265,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
     // Sink, in order: the budget checks, then every sink gets the frame.
     auto deliverOne = [&](const WorkPtr& w) {
         if (stop) return;
-        const WriteTime timed(result);
+        const WriteTime timed(result, w->received);
         const ExportFrame& frame = w->frame;
         const EncodedFrame* e = w->encoded.get();
         if (w->over_budget) {
@@ -287,6 +294,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
                 return;
             }
         }
+        if (w->received) ++result->frames_received;
         progress.update(++delivered);
     };
     // Before the first file appears: the output size estimated from the first kEstimateFrames
@@ -382,13 +390,14 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
             auto w = std::make_shared<Work>();
             w->encoded = std::make_unique<EncodedFrame>();
             const Clock::time_point wait_start = Clock::now();
-            const bool received = group.receiveParts(from, &parts, &failed_code, error);
+            group.awaitFrame(from);
             result->wait_seconds += since(wait_start);
-            // Unpacking the frame is rank 0's work on it: counted with its writing.
+            // Receiving and unpacking the frame that came are rank 0's work on it: counted with its writing.
             bool unpacked = false;
             {
-                const WriteTime timed(result);
-                unpacked = received && frameFromParts(&parts, w->encoded.get(), error);
+                const WriteTime timed(result, true);
+                unpacked = group.receiveParts(from, &parts, &failed_code, error) &&
+                           frameFromParts(&parts, w->encoded.get(), error);
             }
             if (!unpacked) {
                 if (!failed_code) failed_code = 1;
@@ -403,6 +412,7 @@ bool runLoop(const Stage& stage, std::vector<PreparedObject>* take, Model model,
                 return;
             }
             w->frame.index = remote_next;
+            w->received = true;
             w->over_budget = w->encoded->over_budget;
             deliver(std::move(w));
         }

@@ -74,15 +74,19 @@ struct FrameLoopResult {
     int group_code = 0;
     // Where the time went (wall clock, seconds): cutting, converting and encoding the frames this
     // process cut, summed over its threads; writing (the sinks' add and finish, in order, one
-    // thread; with MPI also rank 0 unpacking each received frame); with MPI, rank 0 waiting for
-    // frames of other ranks (the receive itself). render --verbose prints them.
+    // thread; with MPI also rank 0 receiving and unpacking each frame of another rank once it has
+    // come); with MPI, rank 0 waiting for frames of other ranks to come. render --verbose prints them.
     double cut_seconds = 0, write_seconds = 0, wait_seconds = 0, loop_seconds = 0;
     // The same as the CPU time of the threads that did it (not slowed by other processes sharing
     // the cores; a nested parallel loop's work stolen by another thread is not counted).
     double cut_cpu_seconds = 0, write_cpu_seconds = 0;
     // Of the writing, the sinks' finish (the .glb's assembly), wall clock and CPU.
     double finish_seconds = 0, finish_cpu_seconds = 0;
-    long long frames_cut = 0, frames_written = 0;
+    // Of the writing, with MPI: rank 0's work on the frames of other ranks (receiving, unpacking,
+    // the budget's checks, the sinks' addEncoded), wall clock and CPU, and how many such frames:
+    // what rank 0 spends per frame it did not cut, the figure that bounds how many ranks help.
+    double received_seconds = 0, received_cpu_seconds = 0;
+    long long frames_cut = 0, frames_written = 0, frames_received = 0;
 };
 
 // Runs frames [stage.first, stage.last_excl) of `model` into `sinks` (in that order per frame).

@@ -26,7 +26,12 @@ constexpr int kTagEnd = 5;    // int32: rank 0's code for the loop
 constexpr int kTagAgree = 6;  // the message of the lowest failing rank, for rank 0
 constexpr int kTagPlace = 7;  // the temporary file's path, then (source, offset, length, to) per placement
 constexpr int kTagPlaced = 8; // int32 status (0: placed), then the message
+constexpr int kTagFrameInOne = 9;  // a frame of at most kInOneBytes: 8 bytes its part count, 8 per part its size, the parts
 constexpr size_t kChunk = size_t(1) << 30;  // MPI counts are int: frames go in pieces of 1 GiB
+// A frame up to this size in all travels as one message (a description of frames by reference or
+// of a file its rank wrote is under 1 KiB an object): rank 0 receives it whole at once, instead of
+// its sizes and then each part, each of which it may have to wait for while the rank sends it.
+constexpr size_t kInOneBytes = size_t(1) << 20;
 
 class MpiFrameGroup final : public FrameGroup {
 public:
@@ -75,6 +80,16 @@ public:
         // Synchronous: it returns once rank 0 has started to receive this frame, so a rank is never
         // more than one frame ahead of the writer, however small its frames (a plain send of a
         // message under the eager limit would return at once and let frames pile up on rank 0).
+        size_t whole = 8 * (parts.size() + 1);
+        for (const std::string_view& p : parts) whole += p.size();
+        if (whole <= kInOneBytes) {
+            in_one_.clear();
+            putU64(&in_one_, parts.size());
+            for (const std::string_view& p : parts) putU64(&in_one_, p.size());
+            for (const std::string_view& p : parts) in_one_.append(p);
+            MPI_Ssend(in_one_.data(), int(in_one_.size()), MPI_BYTE, 0, kTagFrameInOne, comm_);
+            return;
+        }
         std::vector<uint64_t> sizes;
         for (const std::string_view& p : parts) sizes.push_back(p.size());
         MPI_Ssend(sizes.data(), int(8 * sizes.size()), MPI_BYTE, 0, kTagFrame, comm_);
@@ -149,11 +164,13 @@ public:
         return ok;
     }
 
+    void awaitFrame(int from) override { MPI_Probe(from, MPI_ANY_TAG, comm_, MPI_STATUS_IGNORE); }
+
     bool receiveParts(int from, std::vector<std::string>* parts, int* code, std::string* error) override {
         MPI_Status status;
         MPI_Probe(from, MPI_ANY_TAG, comm_, &status);
-        if (status.MPI_TAG == kTagFrame) {
-            receiveFrameBody(from, parts);
+        if (status.MPI_TAG == kTagFrame || status.MPI_TAG == kTagFrameInOne) {
+            receiveFrameBody(from, status.MPI_TAG, parts);
             return true;
         }
         if (status.MPI_TAG == kTagError) {
@@ -184,9 +201,9 @@ public:
             while (!done_[size_t(r)]) {
                 MPI_Status status;
                 MPI_Probe(r, MPI_ANY_TAG, comm_, &status);
-                if (status.MPI_TAG == kTagFrame) {
+                if (status.MPI_TAG == kTagFrame || status.MPI_TAG == kTagFrameInOne) {
                     std::vector<std::string> discarded;
-                    receiveFrameBody(r, &discarded);
+                    receiveFrameBody(r, status.MPI_TAG, &discarded);
                 } else {
                     receiveBytes(r, status.MPI_TAG);
                     if (status.MPI_TAG == kTagDone) done_[size_t(r)] = true;
@@ -233,8 +250,29 @@ private:
         MPI_Recv(n ? &s[0] : nullptr, n, MPI_BYTE, from, tag, comm_, MPI_STATUS_IGNORE);
         return s;
     }
-    // The sizes message of a frame, then each part's pieces, received into the part's own string.
-    void receiveFrameBody(int from, std::vector<std::string>* parts) {
+    // A frame of `tag`: in one message, its parts copied out (none when the message is malformed:
+    // frameFromParts then refuses it); else the sizes message, then each part's pieces, received
+    // into the part's own string.
+    void receiveFrameBody(int from, int tag, std::vector<std::string>* parts) {
+        if (tag == kTagFrameInOne) {
+            const std::string m = receiveBytes(from, kTagFrameInOne);
+            parts->clear();
+            const uint64_t count = m.size() >= 8 ? getU64(m, 0) : 0;
+            if (count == 0 || count > (m.size() - 8) / 8) return;
+            size_t at = 8 + 8 * size_t(count);
+            parts->resize(size_t(count));
+            for (size_t i = 0; i < parts->size(); ++i) {
+                const uint64_t n = getU64(m, 8 + 8 * i);
+                if (n > m.size() - at) {
+                    parts->clear();
+                    return;
+                }
+                (*parts)[i].assign(m, at, size_t(n));
+                at += size_t(n);
+            }
+            if (at != m.size()) parts->clear();
+            return;
+        }
         const std::string sizes = receiveBytes(from, kTagFrame);
         parts->resize(sizes.size() / 8);
         for (size_t i = 0; i < parts->size(); ++i) {
@@ -251,6 +289,7 @@ private:
     MPI_Comm comm_ = MPI_COMM_NULL;
     int rank_ = 0, size_ = 1;
     std::vector<bool> done_;  // per rank: its DONE received in this loop
+    std::string in_one_;      // a rank: its last frame sent in one message (kept: no allocation per frame)
 };
 
 bool started = false;

@@ -38,6 +38,13 @@ for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
         [ "$(echo "$out" | grep -c '^relativistic: ')" = 1 ] || fail "not one summary line (rank 0 alone): $out"
     done
 done
+# render --verbose states rank 0's work on the frames it did not cut: of frames 40:80 with 3 ranks,
+# rank 0 cuts 40, 43, ..., 79 (14 frames) and receives the other 26.
+rm -rf "$work/three"
+out=$(mpi render data/scenes/flanges.json --out "$work/three" --format ply --frames 40:80 --verbose 2> /dev/null) ||
+    fail "mpirun --verbose: $out"
+echo "$out" | grep -Eq '^relativistic: loop .*; of the writing, the frames of other ranks [0-9]+ us each \(CPU [0-9]+ us; 26 frames\)$' ||
+    fail "render --verbose without rank 0's work on the 26 frames of other ranks: $out"
 # From 10 processes meshopt frames that may be morph targets travel by reference too (each rank
 # cuts the frame before its own again: pipeline/run/distribute.cpp); below, whole. The same bytes.
 for scene in data/scenes/flanges.json data/fixtures/scene_mirror_exists.json; do
