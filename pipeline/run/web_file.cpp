@@ -1,0 +1,416 @@
+#include "pipeline/run/web_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "exporters/atomic_file.h"
+#include "mesh4d/angles.h"
+#include "pipeline/input/scene_fields.h"
+
+namespace apparent {
+
+using mesh4d::Vec3;
+using nlohmann::json;
+
+namespace {
+
+constexpr int kFloat = 5126, kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+
+json array3(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+// The BIN chunk and the views and accessors over it.
+class Buffers {
+public:
+    json views = json::array(), accessors = json::array();
+    std::string bin;
+
+    int view(const void* data, size_t bytes, int target) {
+        bin.append((const char*)data, bytes);
+        json v = {{"buffer", 0}, {"byteOffset", bin.size() - bytes}, {"byteLength", bytes}};
+        if (target) v["target"] = target;
+        bin.resize((bin.size() + 3) & ~size_t(3), '\0');  // every view starts 4-aligned
+        views.push_back(v);
+        return int(views.size()) - 1;
+    }
+
+    // A float accessor of `components` per element (VEC2, VEC3, VEC4), with min and max when asked.
+    int floats(const std::vector<float>& values, int components, int target, bool bounds) {
+        const char* types[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
+        const size_t count = values.size() / size_t(components);
+        json a = {{"bufferView", view(values.data(), values.size() * 4, target)}, {"componentType", kFloat},
+                  {"count", count}, {"type", types[components]}};
+        if (bounds) {
+            json lo = json::array(), hi = json::array();
+            for (int c = 0; c < components; ++c) {
+                float l = INFINITY, h = -INFINITY;
+                for (size_t i = 0; i < count; ++i) {
+                    l = std::min(l, values[i * size_t(components) + size_t(c)]);
+                    h = std::max(h, values[i * size_t(components) + size_t(c)]);
+                }
+                lo.push_back(double(l));
+                hi.push_back(double(h));
+            }
+            a["min"] = lo;
+            a["max"] = hi;
+        }
+        accessors.push_back(a);
+        return int(accessors.size()) - 1;
+    }
+
+    int indices(const std::vector<uint32_t>& values) {
+        accessors.push_back({{"bufferView", view(values.data(), values.size() * 4, kElementArrayBuffer)},
+                             {"componentType", kUnsignedInt}, {"count", values.size()}, {"type", "SCALAR"}});
+        return int(accessors.size()) - 1;
+    }
+};
+
+// Every textureInfo's "index" below `j` ("...Texture": {"index": i}) moved by `offset`.
+void moveTextureIndices(json* j, int offset) {
+    for (auto& [key, value] : j->items()) {
+        if (!value.is_object()) continue;
+        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index"))
+            value["index"] = value["index"].get<int>() + offset;
+        else
+            moveTextureIndices(&value, offset);
+    }
+}
+
+// The glTF document as it grows: meshes, the look's lists, and the rounding each mesh met.
+struct Document {
+    Buffers buffers;
+    json meshes = json::array(), materials = json::array(), textures = json::array(), samplers = json::array(),
+         images = json::array();
+    std::set<std::string> extensions;
+};
+
+// Float32 of a double, and whether the double was one already.
+struct Rounding {
+    double largest = 0;  // largest |float(x) - x| of positions
+    size_t attributes_changed = 0;
+    std::vector<float> of(const std::vector<double>& values, size_t* changed) {
+        std::vector<float> f(values.size());
+        for (size_t i = 0; i < values.size(); ++i) {
+            f[i] = float(values[i]);
+            if (double(f[i]) != values[i]) ++*changed;
+        }
+        return f;
+    }
+};
+
+// Writes `mesh` as one glTF mesh and returns its index; `note` gets a line when values changed.
+int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, std::string* note) {
+    const std::vector<Vec3>& p = mesh.mesh.positions;
+    const auto& tris = mesh.mesh.triangles;
+    const SurfaceLook* look = mesh.look.get();
+    // Step: the look's materials, textures, samplers and images, placed after those written so far.
+    const int material_offset = int(doc->materials.size()), texture_offset = int(doc->textures.size());
+    std::vector<int> material_index;  // look material -> glTF material (-1: glTF's default)
+    if (look) {
+        const int sampler_offset = int(doc->samplers.size()), image_offset = int(doc->images.size());
+        int written = 0;
+        for (const std::string& m : look->materials) {
+            // glTF's default material is "{}" in the look: written as none, as the input had it,
+            // unless the mesh's colour came from a material (the reader's has_color).
+            if (m == "{}" && !mesh.has_color) {
+                material_index.push_back(-1);
+                continue;
+            }
+            json j = json::parse(m);
+            moveTextureIndices(&j, texture_offset);
+            doc->materials.push_back(j);
+            material_index.push_back(material_offset + written++);
+        }
+        for (const std::string& t : look->textures) {
+            json j = json::parse(t);
+            if (j.contains("source")) j["source"] = j["source"].get<int>() + image_offset;
+            if (j.contains("sampler")) j["sampler"] = j["sampler"].get<int>() + sampler_offset;
+            doc->textures.push_back(j);
+        }
+        for (const std::string& s : look->samplers) doc->samplers.push_back(json::parse(s));
+        for (const LookImage& im : look->images) {
+            json j = {{"bufferView", doc->buffers.view(im.bytes.data(), im.bytes.size(), 0)}, {"mimeType", im.mime_type}};
+            if (!im.name.empty()) j["name"] = im.name;
+            doc->images.push_back(j);
+        }
+        doc->extensions.insert(look->extensions.begin(), look->extensions.end());
+    }
+    auto materialOf = [&](size_t t) { return look && !look->triangle_material.empty() ? int(look->triangle_material[t]) : -1; };
+
+    // Step: runs of triangles of one material, and whether their vertices are contiguous ranges.
+    struct Run {
+        size_t first, last;  // triangles [first, last)
+        uint32_t lo, hi;     // the vertices they use, [lo, hi]
+    };
+    std::vector<Run> runs;
+    for (size_t t = 0; t < tris.size(); ++t) {
+        const auto [lo, hi] = std::minmax({tris[t][0], tris[t][1], tris[t][2]});
+        if (runs.empty() || materialOf(t) != materialOf(runs.back().first)) runs.push_back({t, t, lo, hi});
+        Run& r = runs.back();
+        r.last = t + 1;
+        r.lo = std::min(r.lo, lo);
+        r.hi = std::max(r.hi, hi);
+    }
+    bool ranges = true;
+    for (size_t k = 1; k < runs.size(); ++k) ranges = ranges && runs[k].lo > runs[k - 1].hi;
+
+    // Step: one primitive per run: its vertex range (or its own vertices), float32 attributes.
+    Rounding rounding;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const Vec3& v : p)
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], v[c]);
+            hi[c] = std::max(hi[c], v[c]);
+        }
+    json primitives = json::array();
+    for (size_t k = 0; k < runs.size(); ++k) {
+        std::vector<uint32_t> vertices;  // the run's vertices, in output order
+        std::vector<uint32_t> local;
+        if (ranges) {
+            const uint32_t begin = k == 0 ? 0 : runs[k].lo, end = k + 1 == runs.size() ? uint32_t(p.size()) : runs[k + 1].lo;
+            for (uint32_t v = begin; v < end; ++v) vertices.push_back(v);
+            for (size_t t = runs[k].first; t < runs[k].last; ++t)
+                for (uint32_t v : tris[t]) local.push_back(v - begin);
+        } else {
+            std::map<uint32_t, uint32_t> place;
+            for (size_t t = runs[k].first; t < runs[k].last; ++t)
+                for (uint32_t v : tris[t]) {
+                    auto [it, fresh] = place.try_emplace(v, uint32_t(vertices.size()));
+                    if (fresh) vertices.push_back(v);
+                    local.push_back(it->second);
+                }
+        }
+        std::vector<double> pos, uv0, uv1, rgba;
+        for (uint32_t v : vertices) {
+            for (int c = 0; c < 3; ++c) {
+                pos.push_back(p[v][c]);
+                rounding.largest = std::max(rounding.largest, std::fabs(double(float(p[v][c])) - p[v][c]));
+            }
+            if (look && !look->texcoord.empty()) uv0.insert(uv0.end(), &look->texcoord[2 * v], &look->texcoord[2 * v] + 2);
+            if (look && !look->texcoord1.empty()) uv1.insert(uv1.end(), &look->texcoord1[2 * v], &look->texcoord1[2 * v] + 2);
+            if (look && !look->color.empty()) rgba.insert(rgba.end(), &look->color[4 * v], &look->color[4 * v] + 4);
+        }
+        size_t unused = 0;
+        json attributes = {{"POSITION", doc->buffers.floats(rounding.of(pos, &unused), 3, kArrayBuffer, true)}};
+        if (!uv0.empty()) attributes["TEXCOORD_0"] = doc->buffers.floats(rounding.of(uv0, &rounding.attributes_changed), 2, kArrayBuffer, false);
+        if (!uv1.empty()) attributes["TEXCOORD_1"] = doc->buffers.floats(rounding.of(uv1, &rounding.attributes_changed), 2, kArrayBuffer, false);
+        if (!rgba.empty()) attributes["COLOR_0"] = doc->buffers.floats(rounding.of(rgba, &rounding.attributes_changed), 4, kArrayBuffer, false);
+        json prim = {{"attributes", attributes}, {"indices", doc->buffers.indices(local)}, {"mode", 4}};
+        const int m = materialOf(runs[k].first);
+        if (m >= 0 && material_index[size_t(m)] >= 0) prim["material"] = material_index[size_t(m)];
+        primitives.push_back(prim);
+    }
+    doc->meshes.push_back({{"name", name}, {"primitives", primitives}});
+
+    // Step: what float32 changed, relative to the mesh's size.
+    const double diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    std::string changed;
+    if (rounding.largest > 0)
+        changed = "its vertex positions to float32 (moved up to " + formatNumber(rounding.largest) + ", " +
+                  formatNumber(rounding.largest / (diagonal > 0 ? diagonal : 1)) + " of its bounding-box diagonal)";
+    if (rounding.attributes_changed)
+        changed += (changed.empty() ? "" : "; ") + std::to_string(rounding.attributes_changed) +
+                   " texture coordinate or colour values to float32";
+    if (!ranges)
+        changed += (changed.empty() ? "" : "; ") + std::string("its vertices split where materials meet (") +
+                   std::to_string(p.size()) + " vertices become one set per material run)";
+    if (!changed.empty()) *note = name + ": the web file rounds " + changed;
+    return int(doc->meshes.size()) - 1;
+}
+
+// The object fields of one object (scene_fields.h), as its node's extras.
+json objectExtras(const ObjectSpec& o) {
+    json x = json::object();
+    x["t0"] = o.t0;
+    if (o.speed == ObjectSpec::Speed::Velocity) {
+        x["velocity"] = array3(o.velocity);
+    } else {
+        x["direction"] = array3(o.direction);
+        if (o.speed == ObjectSpec::Speed::Gamma) x["gamma"] = o.gamma;
+        else x["rapidity"] = o.rapidity;
+    }
+    if (o.rotation_deg != Vec3{}) x["rotation_deg"] = array3(o.rotation_deg);
+    if (o.scale != Vec3{1, 1, 1}) x["scale"] = array3(o.scale);
+    if (o.mirror) x["mirror"] = true;
+    if (o.exists_from > -INFINITY || o.exists_to < INFINITY)
+        x["exists"] = {o.exists_from > -INFINITY ? json(o.exists_from) : json(nullptr),
+                       o.exists_to < INFINITY ? json(o.exists_to) : json(nullptr)};
+    if (o.material.given) {
+        const ObjectSpec::Material& m = o.material;
+        x["material"] = {{"base_color", m.base_color}, {"metallic", m.metallic}, {"roughness", m.roughness},
+                         {"emissive", m.emissive}};
+    }
+    if (o.angular_velocity != Vec3{}) x["angular_velocity"] = array3(o.angular_velocity);
+    if (o.acceleration != Vec3{}) x["acceleration"] = array3(o.acceleration);
+    if (o.kinds.orbit)
+        x["orbit"] = {{"center", array3(o.kinds.orbit->center)}, {"axis", array3(o.kinds.orbit->axis)},
+                      {"speed", o.kinds.orbit->speed}, {"orientation", o.kinds.orbit->locked ? "locked" : "fixed"}};
+    return x;
+}
+
+// The camera node: glTF cameras look down their local -Z with +Y up (glTF 2.0 section 3.10.1).
+json cameraNode(const CameraSpec& c, json* cameras) {
+    const Vec3 f = (c.look_at - c.position) / mesh4d::norm(c.look_at - c.position);
+    const Vec3 r0 = mesh4d::cross(f, c.up), r = r0 / mesh4d::norm(r0), u = mesh4d::cross(r, f);
+    // The rotation whose columns are r, u, -f, as a unit quaternion (Shepperd's method).
+    const double m[3][3] = {{r.x, u.x, -f.x}, {r.y, u.y, -f.y}, {r.z, u.z, -f.z}};
+    double q[4];  // x, y, z, w
+    const double trace = m[0][0] + m[1][1] + m[2][2];
+    if (trace > 0) {
+        const double s = 2 * std::sqrt(1 + trace);
+        q[3] = s / 4, q[0] = (m[2][1] - m[1][2]) / s, q[1] = (m[0][2] - m[2][0]) / s, q[2] = (m[1][0] - m[0][1]) / s;
+    } else if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) {
+        const double s = 2 * std::sqrt(1 + m[0][0] - m[1][1] - m[2][2]);
+        q[3] = (m[2][1] - m[1][2]) / s, q[0] = s / 4, q[1] = (m[0][1] + m[1][0]) / s, q[2] = (m[0][2] + m[2][0]) / s;
+    } else if (m[1][1] > m[2][2]) {
+        const double s = 2 * std::sqrt(1 + m[1][1] - m[0][0] - m[2][2]);
+        q[3] = (m[0][2] - m[2][0]) / s, q[0] = (m[0][1] + m[1][0]) / s, q[1] = s / 4, q[2] = (m[1][2] + m[2][1]) / s;
+    } else {
+        const double s = 2 * std::sqrt(1 + m[2][2] - m[0][0] - m[1][1]);
+        q[3] = (m[1][0] - m[0][1]) / s, q[0] = (m[0][2] + m[2][0]) / s, q[1] = (m[1][2] + m[2][1]) / s, q[2] = s / 4;
+    }
+    json camera;
+    if (c.orthographic()) {
+        // xmag is half the view's width (the reader doubles it, exactly); ymag is for viewers.
+        camera = {{"type", "orthographic"},
+                  {"orthographic", {{"xmag", c.width / 2}, {"ymag", c.width / 2}, {"znear", 0.0}, {"zfar", 1e12}}}};
+    } else {
+        // yfov such that the reader's yfov * 180 / pi is fov_deg again, when a neighbour of the
+        // nearest double does it.
+        double yfov = c.fov_deg * mesh4d::kPi / 180;
+        for (int step = 0; step < 8 && yfov * 180.0 / mesh4d::kPi != c.fov_deg; ++step)
+            yfov = std::nextafter(yfov, yfov * 180.0 / mesh4d::kPi < c.fov_deg ? INFINITY : -INFINITY);
+        camera = {{"type", "perspective"}, {"perspective", {{"yfov", yfov}, {"znear", 1e-3}}}};
+    }
+    cameras->push_back(camera);
+    json node = {{"name", "camera"}, {"camera", int(cameras->size()) - 1}, {"translation", array3(c.position)},
+                 {"rotation", {q[0], q[1], q[2], q[3]}}};
+    json x = json::object();
+    if (c.instant_delay != 0) x["instant_delay"] = c.instant_delay;
+    if (c.velocity != Vec3{}) x["velocity"] = array3(c.velocity);
+    if (!x.empty()) node["extras"] = x;
+    return node;
+}
+
+// The scene's extras: frames, model, tolerance and a light other than the default.
+json sceneExtras(const Scene& s, Model model) {
+    json x = {{"frames", {{"start", s.frames.start}, {"end", s.frames.end}, {"fps", s.frames.fps}}},
+              {"model", modelName(model)}};
+    if (s.tolerance_relative > 0) x["tolerance"] = formatNumber(s.tolerance_relative) + "x";
+    else if (s.tolerance == 0) x["tolerance"] = "vertex";
+    else x["tolerance"] = s.tolerance;
+    // The default light (no `light` in the scene) is the one with a key light (scene.h LightSpec).
+    if (s.light.key_weight == 0) {
+        json light = {{"ambient", s.light.ambient}};
+        if (s.light.kind == LightSpec::Kind::Point) light["position"] = array3(s.light.position);
+        else light["direction"] = array3(s.light.direction);
+        x["light"] = light;
+    }
+    return x;
+}
+
+// The GLB container (glTF 2.0 section 4.4): header, JSON chunk (space-padded), BIN chunk.
+std::string glb(const std::string& json_text, const std::string& bin) {
+    auto u32 = [](std::string* out, uint32_t v) { out->append((const char*)&v, 4); };
+    std::string j = json_text;
+    j.resize((j.size() + 3) & ~size_t(3), ' ');
+    std::string b = bin;
+    b.resize((b.size() + 3) & ~size_t(3), '\0');
+    std::string out;
+    u32(&out, 0x46546C67);  // "glTF"
+    u32(&out, 2);
+    u32(&out, uint32_t(12 + 8 + j.size() + (b.empty() ? 0 : 8 + b.size())));
+    u32(&out, uint32_t(j.size()));
+    u32(&out, 0x4E4F534A);  // "JSON"
+    out += j;
+    if (!b.empty()) {
+        u32(&out, uint32_t(b.size()));
+        u32(&out, 0x004E4942);  // "BIN\0"
+        out += b;
+    }
+    return out;
+}
+
+}  // namespace
+
+Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, const std::string& path,
+                    WebFileReport* report) {
+    *report = WebFileReport{};
+    auto refuse = [&](const std::string& field, const std::string& problem) {
+        return Status::failure(scene.path + ": " + field + ": " + problem + " (the web file, --format web)");
+    };
+    // Step: what the web file cannot carry.
+    if (scene.units != LengthUnit::LightSecond)
+        return refuse("units", "a metre scene is not carried: a glTF scene is read in light-seconds");
+    std::set<std::string> names;
+    for (const ObjectSpec& o : scene.objects) {
+        if (o.keys) return refuse(o.keys_field, "a keyframed path is not carried yet");
+        if (o.name.empty() || o.name.find('#') != std::string::npos)
+            return refuse(o.field_path + ".name", "'" + o.name + "': an object of the web file needs a name without '#'");
+        if (!names.insert(o.name).second) return refuse(o.field_path + ".name", "'" + o.name + "' names two objects");
+    }
+
+    // Step: the rest meshes, each file once, as their readers give them.
+    Document doc;
+    std::map<std::string, int> mesh_of;
+    json nodes = json::array(), cameras = json::array(), roots = json::array();
+    MeshLimits mesh_limits = limits;
+    mesh_limits.scene_path = scene.path;
+    for (const ObjectSpec& o : scene.objects) {
+        auto [it, fresh] = mesh_of.try_emplace(o.mesh_path, 0);
+        if (fresh) {
+            LoadedMesh mesh;
+            MeshWarnings warnings;
+            if (Status s = readMesh(o.mesh_path, mesh_limits, &mesh, &warnings); !s.ok) return s;
+            std::string note;
+            it->second = writeMesh(&doc, mesh, o.name, &note);
+            if (!note.empty()) report->notes.push_back(note);
+        }
+        // Step: the object's node: translation, its linear map as a matrix, its fields in extras.
+        json node = {{"name", o.name}, {"mesh", it->second}};
+        const std::array<double, 9> identity{1, 0, 0, 0, 1, 0, 0, 0, 1};
+        if (o.linear == identity) {
+            node["translation"] = array3(o.position);
+        } else {
+            const auto& l = o.linear;
+            node["matrix"] = {l[0], l[1], l[2], 0.0, l[3], l[4], l[5], 0.0, l[6], l[7], l[8], 0.0,
+                              o.position.x, o.position.y, o.position.z, 1.0};
+        }
+        node["extras"] = objectExtras(o);
+        roots.push_back(nodes.size());
+        nodes.push_back(node);
+    }
+    roots.push_back(nodes.size());
+    nodes.push_back(cameraNode(scene.camera, &cameras));
+
+    // Step: the document and its container.
+    json gltf = {{"asset", {{"version", "2.0"}, {"generator", "apparent (web file)"}}},
+                 {"scene", 0},
+                 {"scenes", json::array({{{"name", "apparent"}, {"nodes", roots}, {"extras", sceneExtras(scene, model)}}})},
+                 {"nodes", nodes},
+                 {"cameras", cameras},
+                 {"meshes", doc.meshes},
+                 {"accessors", doc.buffers.accessors},
+                 {"bufferViews", doc.buffers.views},
+                 {"buffers", json::array({{{"byteLength", doc.buffers.bin.size()}}})}};
+    for (const auto& [key, list] : {std::pair<const char*, const json*>{"materials", &doc.materials}, {"textures", &doc.textures},
+                                    {"samplers", &doc.samplers}, {"images", &doc.images}})
+        if (!list->empty()) gltf[key] = *list;
+    if (!doc.extensions.empty()) gltf["extensionsUsed"] = std::vector<std::string>(doc.extensions.begin(), doc.extensions.end());
+    const std::string bytes = glb(gltf.dump(), doc.buffers.bin);
+    AtomicOutput out(path);
+    std::string error;
+    report->write_failed = true;
+    if (out.fd() < 0) return Status::failure(out.openError());
+    if (!out.commitBytes(bytes, &error)) return Status::failure(error);
+    report->write_failed = false;
+    report->bytes = bytes.size();
+    return Status::success();
+}
+
+}  // namespace apparent

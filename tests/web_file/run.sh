@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# The web file (`render --format web`, pipeline/run/web_file.h) carries everything the cut needs: for
+# every shipped scene, rendering its web file gives the scene's own PLY frames. Scenes whose meshes
+# are glTF, or OBJ files whose numbers are float32 already, give them byte for byte but the header
+# line `comment scene:` (it names the file rendered); the icosphere and wheel OBJ files, whose
+# vertices float32 moves (up to 1e-8 of the mesh's size, the writer's note), give the same faces
+# and every value within 1e-6 (compare_ply.py). The file's size does not depend on the frames
+# rendered (--frames 0:1 and every frame give the same bytes). The Khronos glTF-Validator finds no
+# error in the web files of the default scene and of the textured box (make_textured_box.py: three
+# materials, an image, TEXCOORD_0/1 and COLOR_0), and the box rendered from its web file passes
+# check_textured.py's closed forms as the box does. A keyframed path and a metre scene are refused
+# with exit code 2.
+# Usage: run.sh APPARENT_BINARY SOURCE_DIR
+set -euo pipefail
+apparent=$1
+src=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+cd "$src"
+frames=0:3
+roundtrip() {  # scene, mode (exact or within), label, extra options...
+  local scene=$1 mode=$2 name=$3
+  shift 3
+  "$apparent" render "$scene" --format web --out "$out/$name/web" --quiet "$@"
+  "$apparent" render "$scene" --format ply --frames $frames --out "$out/$name/scene" --quiet "$@"
+  "$apparent" render "$out/$name/web/scene.web.glb" --format ply --frames $frames --out "$out/$name/web_frames" --quiet "$@"
+  echo -n "$name: "
+  if [ "$mode" = exact ]; then
+    python3 tests/web_file/compare_ply.py "$out/$name/scene" "$out/$name/web_frames" exact
+  else
+    python3 tests/web_file/compare_ply.py "$out/$name/scene" "$out/$name/web_frames" within 1e-6
+  fi
+}
+for s in clocks flanges flyby orbit_ring rocket terrell_cube vienna_cube; do roundtrip data/scenes/$s.json exact $s; done
+roundtrip data/scenes/flanges.gltf exact flanges.gltf
+for s in penrose_sphere rolling_wheel spinning_wheel vienna_sphere; do roundtrip data/scenes/$s.json within $s; done
+# The default scene in every model and in vertex mode.
+frames=0:20 roundtrip data/scenes/flanges.json exact "flanges, every model" --model all
+frames=0:20 roundtrip data/scenes/flanges.json exact "flanges, vertex mode" --tolerance vertex
+
+# The size does not grow with the frames.
+"$apparent" render data/scenes/flanges.json --format web --frames 0:1 --out "$out/one" --quiet
+"$apparent" render data/scenes/flanges.json --format web --out "$out/all" --quiet
+cmp "$out/one/scene.web.glb" "$out/all/scene.web.glb"
+echo "web file of 1 and of 200 frames: the same $(stat -c %s "$out/all/scene.web.glb") bytes"
+
+# A textured box: its look through the web file.
+mkdir -p "$out/box"
+python3 tests/looks/make_textured_box.py "$out/box/box.glb" "$out/box/texture.png"
+cat > "$out/box/scene.json" <<JSON
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_deg": 60},
+ "frames": {"start": 16, "end": 18, "fps": 2}, "model": "relativistic",
+ "objects": [{"name": "box", "mesh": "box.glb", "position": [-2, 0.3, -4], "velocity": [0.9, 0, 0],
+              "rotation_deg": [20, 30, 0]}]}
+JSON
+frames=0:4 roundtrip "$out/box/scene.json" exact "textured box"
+"$apparent" render "$out/textured box/web/scene.web.glb" --out "$out/box/from_web" --quiet
+python3 tests/looks/check_textured.py "$out/box/from_web/relativistic.glb" "$out/box/box.glb" -2 0.3 -4 0.9 0 0 20 30 0
+node tests/validators/validate_gltf.js "$out/flanges/web/scene.web.glb" "$out/textured box/web/scene.web.glb"
+
+# What the web file cannot carry: exit code 2, one line naming the field.
+for s in keyed; do
+  set +e
+  message=$("$apparent" render data/scenes/$s.gltf --format web --out "$out/refused" 2>&1)
+  code=$?
+  set -e
+  [ $code -eq 2 ] || { echo "$s: exit code $code, expected 2: $message"; exit 1; }
+  echo "$message" | grep -q "animations\[0\].channels" || { echo "$s: message does not name the channel: $message"; exit 1; }
+done
+mkdir -p "$out/metres/scenes"
+cp data/meshes/box.obj "$out/metres/scenes/"
+sed -e 's/"model"/"units": "m", "model"/' -e 's#../meshes/box.obj#box.obj#' data/scenes/terrell_cube.json > "$out/metres/scenes/terrell_m.json"
+set +e
+message=$("$apparent" render "$out/metres/scenes/terrell_m.json" --format web --out "$out/refused" 2>&1)
+code=$?
+set -e
+[ $code -eq 2 ] && echo "$message" | grep -q ": units:" || { echo "metre scene: exit code $code: $message"; exit 1; }
+echo "refusals: exit code 2 naming the field"
