@@ -328,7 +328,7 @@ constexpr const char* kRenderFooter =
     "Outputs in DIR:\n"
     "  <model>.glb                      one animated glTF holding every frame (STEP scale channels)\n"
     "  <model>/frame_NNNNN.ply|.obj     per frame, all objects; PLY vertex 'quality' = emission time\n"
-    "  scene.web.glb                    --format web: the scene as a glTF scene (docs/OUTPUTS.md)\n"
+    "  scene.web.glb                    --format web: the scene as a glTF scene (docs/GLTF.md)\n"
     "Exit codes: 0 success, 1 internal error, 2 bad usage or bad input, 3 output could not be written.";
 
 class RenderCommand : public Command {

@@ -10,6 +10,8 @@
 
 #include "exporters/atomic_file.h"
 #include "mesh4d/angles.h"
+#include "pipeline/input/gltf_document.h"
+#include "pipeline/input/gltf_nodes.h"
 #include "pipeline/input/scene_fields.h"
 
 namespace apparent {
@@ -227,7 +229,9 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
 json objectExtras(const ObjectSpec& o) {
     json x = json::object();
     x["t0"] = o.t0;
-    if (o.speed == ObjectSpec::Speed::Velocity) {
+    if (o.keys) {
+        // A keyframed path's velocity is its mean (gltf_scene.h): the channels state the motion.
+    } else if (o.speed == ObjectSpec::Speed::Velocity) {
         x["velocity"] = array3(o.velocity);
     } else {
         x["direction"] = array3(o.direction);
@@ -314,6 +318,64 @@ json sceneExtras(const Scene& s, Model model) {
     return x;
 }
 
+// A float accessor's values as the file stores them (`components` per element), read through its
+// view's stride; false when they do not lie inside the buffer.
+bool storedFloats(const tinygltf::Model& m, int index, int components, std::vector<float>* out) {
+    if (index < 0 || size_t(index) >= m.accessors.size()) return false;
+    const tinygltf::Accessor& a = m.accessors[size_t(index)];
+    if (a.componentType != kFloat || a.sparse.isSparse || a.bufferView < 0 || size_t(a.bufferView) >= m.bufferViews.size()) return false;
+    const tinygltf::BufferView& v = m.bufferViews[size_t(a.bufferView)];
+    if (v.buffer < 0 || size_t(v.buffer) >= m.buffers.size()) return false;
+    const std::vector<unsigned char>& data = m.buffers[size_t(v.buffer)].data;
+    const size_t element = 4 * size_t(components), stride = v.byteStride ? v.byteStride : element;
+    const size_t first = v.byteOffset + a.byteOffset;
+    if (a.count > 0 && (first + (a.count - 1) * stride + element > data.size() || first + (a.count - 1) * stride + element > v.byteOffset + v.byteLength))
+        return false;
+    out->resize(a.count * size_t(components));
+    for (size_t i = 0; i < a.count; ++i) std::memcpy(out->data() + i * size_t(components), data.data() + first + i * stride, element);
+    return true;
+}
+
+// A keyframed object's node as its glTF scene gives it: the node's own translation, rotation and
+// scale (the path's keys are relative to them), and its translation and rotation channels copied
+// value for value (float32 as stored) into `animation`. The node must be a root of the scene's
+// default scene (a parent's transform would have to be written too). Fails naming the field.
+Status keyedNode(const std::string& file, const ObjectSpec& o, Buffers* buffers, json* node, json* animation) {
+    std::shared_ptr<const GltfDocument> doc;
+    if (Status s = openGltf(file, MeshLimits{}, &doc); !s.ok) return s;
+    const tinygltf::Model& m = doc->model;
+    int n = -1;
+    for (size_t i = 0; i < m.nodes.size(); ++i)
+        if (m.nodes[i].name == o.name) n = n == -1 ? int(i) : -2;
+    const int si = defaultSceneIndex(m);
+    const std::string where = "nodes[" + std::to_string(n) + "]";
+    if (n < 0 || si < 0) return Status::failure(file + ": " + o.keys_field + ": the keyframed node '" + o.name + "' is not one node of the file (the web file)");
+    const auto& roots = m.scenes[size_t(si)].nodes;
+    if (std::find(roots.begin(), roots.end(), n) == roots.end())
+        return Status::failure(file + ": " + where + ": a keyframed object under a parent node is not carried by the web file yet");
+    const tinygltf::Node& source = m.nodes[size_t(n)];
+    if (source.translation.size() == 3) (*node)["translation"] = source.translation;
+    if (source.rotation.size() == 4) (*node)["rotation"] = source.rotation;
+    if (source.scale.size() == 3) (*node)["scale"] = source.scale;
+    for (size_t ai = 0; ai < m.animations.size(); ++ai)
+        for (size_t ci = 0; ci < m.animations[ai].channels.size(); ++ci) {
+            const tinygltf::AnimationChannel& c = m.animations[ai].channels[ci];
+            if (c.target_node != n || (c.target_path != "translation" && c.target_path != "rotation")) continue;
+            const std::string field = "animations[" + std::to_string(ai) + "].channels[" + std::to_string(ci) + "]";
+            const tinygltf::AnimationSampler& sampler = m.animations[ai].samplers[size_t(c.sampler)];
+            std::vector<float> times, values;
+            if (!storedFloats(m, sampler.input, 1, &times) ||
+                !storedFloats(m, sampler.output, c.target_path == "translation" ? 3 : 4, &values))
+                return Status::failure(file + ": " + field + ": the keys are not float32 values inside their buffer (the web file)");
+            const int input = buffers->floats(times, 1, 0, true);
+            const int output = buffers->floats(values, c.target_path == "translation" ? 3 : 4, 0, false);
+            (*animation)["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", sampler.interpolation}});
+            (*animation)["channels"].push_back({{"sampler", (*animation)["samplers"].size() - 1},
+                                                {"target", {{"node", -1}, {"path", c.target_path}}}});
+        }
+    return Status::success();
+}
+
 // The GLB container (glTF 2.0 section 4.4): header, JSON chunk (space-padded), BIN chunk.
 std::string glb(const std::string& json_text, const std::string& bin) {
     auto u32 = [](std::string* out, uint32_t v) { out->append((const char*)&v, 4); };
@@ -349,7 +411,6 @@ Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, c
         return refuse("units", "a metre scene is not carried: a glTF scene is read in light-seconds");
     std::set<std::string> names;
     for (const ObjectSpec& o : scene.objects) {
-        if (o.keys) return refuse(o.keys_field, "a keyframed path is not carried yet");
         if (o.name.empty() || o.name.find('#') != std::string::npos)
             return refuse(o.field_path + ".name", "'" + o.name + "': an object of the web file needs a name without '#'");
         if (!names.insert(o.name).second) return refuse(o.field_path + ".name", "'" + o.name + "' names two objects");
@@ -359,6 +420,7 @@ Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, c
     Document doc;
     std::map<std::string, int> mesh_of;
     json nodes = json::array(), cameras = json::array(), roots = json::array();
+    json animation = {{"name", "paths"}, {"channels", json::array()}, {"samplers", json::array()}};
     MeshLimits mesh_limits = limits;
     mesh_limits.scene_path = scene.path;
     for (const ObjectSpec& o : scene.objects) {
@@ -374,7 +436,13 @@ Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, c
         // Step: the object's node: translation, its linear map as a matrix, its fields in extras.
         json node = {{"name", o.name}, {"mesh", it->second}};
         const std::array<double, 9> identity{1, 0, 0, 0, 1, 0, 0, 0, 1};
-        if (o.linear == identity) {
+        if (o.keys) {
+            // Step: a keyframed path: the source node's transform and channels (their target set below).
+            const size_t first_channel = animation["channels"].size();
+            if (Status s = keyedNode(scene.path, o, &doc.buffers, &node, &animation); !s.ok) return s;
+            for (size_t c = first_channel; c < animation["channels"].size(); ++c)
+                animation["channels"][c]["target"]["node"] = nodes.size();
+        } else if (o.linear == identity) {
             node["translation"] = array3(o.position);
         } else {
             const auto& l = o.linear;
@@ -401,6 +469,7 @@ Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, c
     for (const auto& [key, list] : {std::pair<const char*, const json*>{"materials", &doc.materials}, {"textures", &doc.textures},
                                     {"samplers", &doc.samplers}, {"images", &doc.images}})
         if (!list->empty()) gltf[key] = *list;
+    if (!animation["channels"].empty()) gltf["animations"] = json::array({animation});
     if (!doc.extensions.empty()) gltf["extensionsUsed"] = std::vector<std::string>(doc.extensions.begin(), doc.extensions.end());
     const std::string bytes = glb(gltf.dump(), doc.buffers.bin);
     AtomicOutput out(path);

@@ -1,4 +1,4 @@
-// The web file (`apparent render SCENE --format web`, issue 36; docs/OUTPUTS.md "The web file"):
+// The web file (`apparent render SCENE --format web`, issue 36; docs/GLTF.md "The web file"):
 // everything the cut needs and nothing per frame, as one self-contained .glb that is itself an
 // apparent glTF scene (docs/SCENES.md "Scenes in glTF"), so `apparent render DIR/scene.web.glb`
 // renders what the scene renders. This writer is the inverse of pipeline/input/gltf_scene.h:
@@ -10,6 +10,9 @@
 //   rapidity, rotation_deg, scale, mirror, exists, material, angular_velocity, acceleration,
 //   orbit); its translation is the position, and a linear map other than the identity (an object
 //   of a glTF scene) is the node's matrix. Objects sharing a mesh file share the glTF mesh.
+// - a keyframed object (a glTF scene's animated node, a root of its scene) keeps its node's own
+//   translation, rotation and scale and its translation and rotation channels, copied value for
+//   value (float32 as stored, interpolation as written): the reader derives the same path.
 // - the camera is the last root node (its rotation from look_at and up, yfov from fov_deg chosen
 //   so that the reader's yfov * 180 / pi gives fov_deg back; xmag = width / 2), its extras
 //   instant_delay and velocity;
@@ -25,7 +28,7 @@
 // other meshes get each run's vertices of their own (the report says so).
 //
 // Refused (one line naming the file and the field; the command exits with 2): a metre scene
-// (`units`: a glTF scene is read in light-seconds), a keyframed path (not written yet), object
+// (`units`: a glTF scene is read in light-seconds), a keyframed node under a parent node, object
 // names that repeat or hold '#' (a node name must be unique and name a subtree).
 #pragma once
 

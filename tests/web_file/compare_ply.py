@@ -6,9 +6,9 @@ usage: compare_ply.py A_DIR B_DIR exact
 
 A_DIR and B_DIR hold <model>/frame_NNNNN.ply; both must hold the same frames. `exact`: every byte
 equal except the header line `comment scene: ...` (it names the file rendered). `within REL`: the
-same header (but that line), the same faces and per-vertex values other than x, y, z byte for byte
-... no: the same vertex and face counts and faces, and every position within REL times the frame's
-bounding-box diagonal (quality, doppler and proper_time within REL relative to their range).
+same header (but that line), the same faces and `object` values, every position within REL times
+the frame's bounding-box diagonal and every other double (quality, doppler, proper_time) within REL
+relative (absolute below 1).
 Prints the largest difference found.
 """
 import glob
