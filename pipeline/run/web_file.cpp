@@ -1,6 +1,7 @@
 #include "pipeline/run/web_file.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -21,10 +22,26 @@ using nlohmann::json;
 
 namespace {
 
-constexpr int kFloat = 5126, kUnsignedInt = 5125;
+constexpr int kFloat = 5126, kUnsignedInt = 5125, kUnsignedShort = 5123;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
-json array3(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+// A number as JSON: an integral double as an integer ("2", not "2.0"; it reads back as the same
+// double), every other one as nlohmann writes doubles (the shortest form that reads back the same).
+json num(double v) {
+    if (v == std::floor(v) && std::fabs(v) < 1e15 && !(v == 0 && std::signbit(v))) return json((long long)v);
+    return json(v);
+}
+json array3(const Vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
+// A float32 bound as its shortest decimal ("0.05", which reads back as the same float).
+json shortestFloat(float f) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof(text), f).ptr;
+    return num(std::strtod(std::string(text, end).c_str(), nullptr));
+}
+
+// +0 in every component (a -0 is written: it can reach the outputs' signs).
+bool plusZero(double v) { return v == 0 && !std::signbit(v); }
+bool plusZero(const Vec3& v) { return plusZero(v.x) && plusZero(v.y) && plusZero(v.z); }
 
 // The BIN chunk and the views and accessors over it.
 class Buffers {
@@ -55,8 +72,8 @@ public:
                     l = std::min(l, values[i * size_t(components) + size_t(c)]);
                     h = std::max(h, values[i * size_t(components) + size_t(c)]);
                 }
-                lo.push_back(double(l));
-                hi.push_back(double(h));
+                lo.push_back(shortestFloat(l));
+                hi.push_back(shortestFloat(h));
             }
             a["min"] = lo;
             a["max"] = hi;
@@ -65,9 +82,17 @@ public:
         return int(accessors.size()) - 1;
     }
 
-    int indices(const std::vector<uint32_t>& values) {
-        accessors.push_back({{"bufferView", view(values.data(), values.size() * 4, kElementArrayBuffer)},
-                             {"componentType", kUnsignedInt}, {"count", values.size()}, {"type", "SCALAR"}});
+    // Indices as uint16 when `vertices` fit (half the bytes), else uint32.
+    int indices(const std::vector<uint32_t>& values, size_t vertices) {
+        int view_index = 0, type = kUnsignedInt;
+        if (vertices <= 65535) {
+            const std::vector<uint16_t> narrow(values.begin(), values.end());
+            view_index = view(narrow.data(), narrow.size() * 2, kElementArrayBuffer);
+            type = kUnsignedShort;
+        } else {
+            view_index = view(values.data(), values.size() * 4, kElementArrayBuffer);
+        }
+        accessors.push_back({{"bufferView", view_index}, {"componentType", type}, {"count", values.size()}, {"type", "SCALAR"}});
         return int(accessors.size()) - 1;
     }
 };
@@ -202,7 +227,7 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
         if (!uv0.empty()) attributes["TEXCOORD_0"] = doc->buffers.floats(rounding.of(uv0, &rounding.attributes_changed), 2, kArrayBuffer, false);
         if (!uv1.empty()) attributes["TEXCOORD_1"] = doc->buffers.floats(rounding.of(uv1, &rounding.attributes_changed), 2, kArrayBuffer, false);
         if (!rgba.empty()) attributes["COLOR_0"] = doc->buffers.floats(rounding.of(rgba, &rounding.attributes_changed), 4, kArrayBuffer, false);
-        json prim = {{"attributes", attributes}, {"indices", doc->buffers.indices(local)}, {"mode", 4}};
+        json prim = {{"attributes", attributes}, {"indices", doc->buffers.indices(local, vertices.size())}};
         const int m = materialOf(runs[k].first);
         if (m >= 0 && material_index[size_t(m)] >= 0) prim["material"] = material_index[size_t(m)];
         primitives.push_back(prim);
@@ -225,35 +250,55 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
     return int(doc->meshes.size()) - 1;
 }
 
+// Whether two meshes read are the same, values and look alike.
+bool sameMesh(const LoadedMesh& a, const LoadedMesh& b) {
+    if (a.mesh.positions != b.mesh.positions || a.mesh.triangles != b.mesh.triangles || a.has_color != b.has_color ||
+        a.color != b.color || !a.look != !b.look)
+        return false;
+    if (!a.look) return true;
+    const SurfaceLook &la = *a.look, &lb = *b.look;
+    if (la.texcoord != lb.texcoord || la.texcoord1 != lb.texcoord1 || la.color != lb.color ||
+        la.triangle_material != lb.triangle_material || la.materials != lb.materials || la.textures != lb.textures ||
+        la.samplers != lb.samplers || la.extensions != lb.extensions || la.images.size() != lb.images.size())
+        return false;
+    for (size_t i = 0; i < la.images.size(); ++i)
+        if (la.images[i].bytes != lb.images[i].bytes || la.images[i].mime_type != lb.images[i].mime_type ||
+            la.images[i].name != lb.images[i].name)
+            return false;
+    return true;
+}
+
 // The object fields of one object (scene_fields.h), as its node's extras.
 json objectExtras(const ObjectSpec& o) {
     json x = json::object();
-    x["t0"] = o.t0;
+    if (!plusZero(o.t0)) x["t0"] = num(o.t0);
     if (o.keys) {
         // A keyframed path's velocity is its mean (gltf_scene.h): the channels state the motion.
     } else if (o.speed == ObjectSpec::Speed::Velocity) {
-        x["velocity"] = array3(o.velocity);
+        if (!plusZero(o.velocity)) x["velocity"] = array3(o.velocity);
     } else {
         x["direction"] = array3(o.direction);
-        if (o.speed == ObjectSpec::Speed::Gamma) x["gamma"] = o.gamma;
-        else x["rapidity"] = o.rapidity;
+        if (o.speed == ObjectSpec::Speed::Gamma) x["gamma"] = num(o.gamma);
+        else x["rapidity"] = num(o.rapidity);
     }
-    if (o.rotation_deg != Vec3{}) x["rotation_deg"] = array3(o.rotation_deg);
+    if (!plusZero(o.rotation_deg)) x["rotation_deg"] = array3(o.rotation_deg);
     if (o.scale != Vec3{1, 1, 1}) x["scale"] = array3(o.scale);
     if (o.mirror) x["mirror"] = true;
     if (o.exists_from > -INFINITY || o.exists_to < INFINITY)
-        x["exists"] = {o.exists_from > -INFINITY ? json(o.exists_from) : json(nullptr),
-                       o.exists_to < INFINITY ? json(o.exists_to) : json(nullptr)};
+        x["exists"] = {o.exists_from > -INFINITY ? num(o.exists_from) : json(nullptr),
+                       o.exists_to < INFINITY ? num(o.exists_to) : json(nullptr)};
     if (o.material.given) {
         const ObjectSpec::Material& m = o.material;
         x["material"] = {{"base_color", m.base_color}, {"metallic", m.metallic}, {"roughness", m.roughness},
                          {"emissive", m.emissive}};
     }
-    if (o.angular_velocity != Vec3{}) x["angular_velocity"] = array3(o.angular_velocity);
-    if (o.acceleration != Vec3{}) x["acceleration"] = array3(o.acceleration);
+    if (!plusZero(o.angular_velocity)) x["angular_velocity"] = array3(o.angular_velocity);
+    if (!plusZero(o.acceleration)) x["acceleration"] = array3(o.acceleration);
     if (o.kinds.orbit)
         x["orbit"] = {{"center", array3(o.kinds.orbit->center)}, {"axis", array3(o.kinds.orbit->axis)},
-                      {"speed", o.kinds.orbit->speed}, {"orientation", o.kinds.orbit->locked ? "locked" : "fixed"}};
+                      {"speed", num(o.kinds.orbit->speed)}, {"orientation", o.kinds.orbit->locked ? "locked" : "fixed"}};
+    // A node is an object when its extras hold an object field (gltf_scene.h): t0 = 0 at least.
+    if (x.empty()) x["t0"] = 0;
     return x;
 }
 
@@ -295,22 +340,26 @@ json cameraNode(const CameraSpec& c, json* cameras) {
     json node = {{"name", "camera"}, {"camera", int(cameras->size()) - 1}, {"translation", array3(c.position)},
                  {"rotation", {q[0], q[1], q[2], q[3]}}};
     json x = json::object();
-    if (c.instant_delay != 0) x["instant_delay"] = c.instant_delay;
-    if (c.velocity != Vec3{}) x["velocity"] = array3(c.velocity);
-    if (!x.empty()) node["extras"] = x;
+    if (c.instant_delay != 0) x["instant_delay"] = num(c.instant_delay);
+    if (!plusZero(c.velocity)) x["velocity"] = array3(c.velocity);
+    // look_at and up as given: the node's rotation has an up orthogonal to the view, and the
+    // default light follows up (scene_fields.h readLight).
+    x["look_at"] = array3(c.look_at);
+    x["up"] = array3(c.up);
+    node["extras"] = x;
     return node;
 }
 
 // The scene's extras: frames, model, tolerance and a light other than the default.
 json sceneExtras(const Scene& s, Model model) {
-    json x = {{"frames", {{"start", s.frames.start}, {"end", s.frames.end}, {"fps", s.frames.fps}}},
+    json x = {{"frames", {{"start", num(s.frames.start)}, {"end", num(s.frames.end)}, {"fps", num(s.frames.fps)}}},
               {"model", modelName(model)}};
     if (s.tolerance_relative > 0) x["tolerance"] = formatNumber(s.tolerance_relative) + "x";
     else if (s.tolerance == 0) x["tolerance"] = "vertex";
-    else x["tolerance"] = s.tolerance;
+    else x["tolerance"] = num(s.tolerance);
     // The default light (no `light` in the scene) is the one with a key light (scene.h LightSpec).
     if (s.light.key_weight == 0) {
-        json light = {{"ambient", s.light.ambient}};
+        json light = {{"ambient", num(s.light.ambient)}};
         if (s.light.kind == LightSpec::Kind::Point) light["position"] = array3(s.light.position);
         else light["direction"] = array3(s.light.direction);
         x["light"] = light;
@@ -419,6 +468,7 @@ Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, c
     // Step: the rest meshes, each file once, as their readers give them.
     Document doc;
     std::map<std::string, int> mesh_of;
+    std::vector<std::pair<LoadedMesh, int>> written;  // meshes by content: two nodes of one glTF mesh
     json nodes = json::array(), cameras = json::array(), roots = json::array();
     json animation = {{"name", "paths"}, {"channels", json::array()}, {"samplers", json::array()}};
     MeshLimits mesh_limits = limits;
@@ -429,9 +479,15 @@ Status writeWebFile(const Scene& scene, Model model, const MeshLimits& limits, c
             LoadedMesh mesh;
             MeshWarnings warnings;
             if (Status s = readMesh(o.mesh_path, mesh_limits, &mesh, &warnings); !s.ok) return s;
-            std::string note;
-            it->second = writeMesh(&doc, mesh, o.name, &note);
-            if (!note.empty()) report->notes.push_back(note);
+            const auto same = std::find_if(written.begin(), written.end(), [&](const auto& w) { return sameMesh(w.first, mesh); });
+            if (same != written.end()) {
+                it->second = same->second;
+            } else {
+                std::string note;
+                it->second = writeMesh(&doc, mesh, o.name, &note);
+                if (!note.empty()) report->notes.push_back(note);
+                written.emplace_back(std::move(mesh), it->second);
+            }
         }
         // Step: the object's node: translation, its linear map as a matrix, its fields in extras.
         json node = {{"name", o.name}, {"mesh", it->second}};

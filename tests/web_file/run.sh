@@ -4,7 +4,8 @@
 # are glTF, or OBJ files whose numbers are float32 already, give them byte for byte but the header
 # line `comment scene:` (it names the file rendered); the icosphere and wheel OBJ files, whose
 # vertices float32 moves (up to 1e-8 of the mesh's size, the writer's note), give the same faces
-# and every value within 1e-6 (compare_ply.py). The file's size does not depend on the frames
+# and every value within 1e-6 (compare_ply.py). The byte-for-byte scenes' .glb are the scene's too,
+# but the extras' scene_file (compare_glb.py: frames, camera, light, materials, images). The file's size does not depend on the frames
 # rendered (--frames 0:1 and every frame give the same bytes). The Khronos glTF-Validator finds no
 # error in the web files of the default scene, of the textured box and of the keyframed spline (make_textured_box.py: three
 # materials, an image, TEXCOORD_0/1 and COLOR_0), and the box rendered from its web file passes
@@ -22,11 +23,13 @@ roundtrip() {  # scene, mode (exact or within), label, extra options...
   local scene=$1 mode=$2 name=$3
   shift 3
   "$apparent" render "$scene" --format web --out "$out/$name/web" --quiet "$@"
-  "$apparent" render "$scene" --format ply --frames $frames --out "$out/$name/scene" --quiet "$@"
-  "$apparent" render "$out/$name/web/scene.web.glb" --format ply --frames $frames --out "$out/$name/web_frames" --quiet "$@"
+  "$apparent" render "$scene" --format ply,glb --frames $frames --out "$out/$name/scene" --quiet "$@"
+  "$apparent" render "$out/$name/web/scene.web.glb" --format ply,glb --frames $frames --out "$out/$name/web_frames" --quiet "$@"
   echo -n "$name: "
   if [ "$mode" = exact ]; then
     python3 tests/web_file/compare_ply.py "$out/$name/scene" "$out/$name/web_frames" exact
+    echo -n "$name: "
+    python3 tests/web_file/compare_glb.py "$out/$name/scene" "$out/$name/web_frames"
   else
     python3 tests/web_file/compare_ply.py "$out/$name/scene" "$out/$name/web_frames" within 1e-6
   fi
