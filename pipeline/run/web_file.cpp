@@ -277,7 +277,7 @@ json objectExtras(const ObjectSpec& o) {
     } else if (o.speed == ObjectSpec::Speed::Velocity) {
         if (!plusZero(o.velocity)) x["velocity"] = array3(o.velocity);
     } else {
-        x["direction"] = array3(o.direction);
+        x["direction"] = array3(o.direction_given);  // as written: normalised again on reading
         if (o.speed == ObjectSpec::Speed::Gamma) x["gamma"] = num(o.gamma);
         else x["rapidity"] = num(o.rapidity);
     }
@@ -295,7 +295,7 @@ json objectExtras(const ObjectSpec& o) {
     if (!plusZero(o.angular_velocity)) x["angular_velocity"] = array3(o.angular_velocity);
     if (!plusZero(o.acceleration)) x["acceleration"] = array3(o.acceleration);
     if (o.kinds.orbit)
-        x["orbit"] = {{"center", array3(o.kinds.orbit->center)}, {"axis", array3(o.kinds.orbit->axis)},
+        x["orbit"] = {{"center", array3(o.kinds.orbit->center)}, {"axis", array3(o.orbit_axis_given)},
                       {"speed", num(o.kinds.orbit->speed)}, {"orientation", o.kinds.orbit->locked ? "locked" : "fixed"}};
     // A node is an object when its extras hold an object field (gltf_scene.h): t0 = 0 at least.
     if (x.empty()) x["t0"] = 0;
@@ -361,7 +361,7 @@ json sceneExtras(const Scene& s, Model model) {
     if (s.light.key_weight == 0) {
         json light = {{"ambient", num(s.light.ambient)}};
         if (s.light.kind == LightSpec::Kind::Point) light["position"] = array3(s.light.position);
-        else light["direction"] = array3(s.light.direction);
+        else light["direction"] = array3(s.light.direction_given);
         x["light"] = light;
     }
     return x;

@@ -20,7 +20,9 @@
 //   light unless it is the default.
 //
 // Exact: every number of the JSON is written as nlohmann's dump writes doubles (shortest form that
-// reads back to the same double). Vertex positions and attributes are float32 (glTF 2.0 section
+// reads back to the same double), and the vectors the reader normalises (direction, orbit.axis,
+// light.direction) as the scene gave them (ObjectSpec::direction_given, ...), so that they
+// normalise to the same bits. Vertex positions and attributes are float32 (glTF 2.0 section
 // 3.6.2.2): a glTF input's are float32 already; an OBJ or PLY input's doubles are rounded, and the
 // report says by how much (largest |float(p) - p| over the mesh's bounding-box diagonal). Vertex
 // order is kept: a mesh whose triangles run through contiguous vertex ranges per material (every

@@ -38,6 +38,20 @@ for s in clocks flanges flyby orbit_ring rocket terrell_cube vienna_cube; do rou
 roundtrip data/scenes/flanges.gltf exact flanges.gltf
 frames=0:160 roundtrip data/scenes/keyed.gltf exact keyed.gltf
 frames=0:160 roundtrip data/scenes/keyed_cubic.gltf exact keyed_cubic.gltf
+# Every object field, and a glTF scene whose object nodes turn and scale (their matrix), with an
+# exact speed, exists, a distant light and a moving camera.
+frames=0:3 roundtrip tests/web_file/every_field.json exact "every field, every model" --model all
+python3 - data/scenes/flanges.gltf "$out/turned.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["nodes"][1].update(rotation=[0.2, 0.3, 0.1, 0.927], scale=[1.5, 0.7, 1.1])
+d["nodes"][2]["rotation"] = [0, 0.7071067811865476, 0, 0.7071067811865476]
+d["nodes"][3]["extras"] = {"direction": [1, 1, 0.3], "gamma": 2.5, "t0": 0.5, "exists": [None, 12.5]}
+d["scenes"][0]["extras"]["light"] = {"direction": [0.3, 1, 0.2], "ambient": 0.25}
+d["nodes"][0]["extras"]["velocity"] = [0.1, 0.05, -0.2]
+json.dump(d, open(sys.argv[2], "w"))
+PY
+roundtrip "$out/turned.gltf" exact "turned glTF nodes"
 for s in penrose_sphere rolling_wheel spinning_wheel vienna_sphere; do roundtrip data/scenes/$s.json within $s; done
 # The default scene in every model and in vertex mode.
 frames=0:20 roundtrip data/scenes/flanges.json exact "flanges, every model" --model all
