@@ -186,32 +186,11 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
     bool ranges = true;
     for (size_t k = 1; k < runs.size(); ++k) ranges = ranges && runs[k].lo > runs[k - 1].hi;
 
-    // Step: one primitive per run: its vertex range (or its own vertices), float32 attributes.
+    // Step: the vertex attributes, once for the whole mesh when materials share vertices (every
+    // primitive then reads them: gltf_reader.h), else per run over its range.
+    json shared_attributes;
     Rounding rounding;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (const Vec3& v : p)
-        for (int c = 0; c < 3; ++c) {
-            lo[c] = std::min(lo[c], v[c]);
-            hi[c] = std::max(hi[c], v[c]);
-        }
-    json primitives = json::array();
-    for (size_t k = 0; k < runs.size(); ++k) {
-        std::vector<uint32_t> vertices;  // the run's vertices, in output order
-        std::vector<uint32_t> local;
-        if (ranges) {
-            const uint32_t begin = k == 0 ? 0 : runs[k].lo, end = k + 1 == runs.size() ? uint32_t(p.size()) : runs[k + 1].lo;
-            for (uint32_t v = begin; v < end; ++v) vertices.push_back(v);
-            for (size_t t = runs[k].first; t < runs[k].last; ++t)
-                for (uint32_t v : tris[t]) local.push_back(v - begin);
-        } else {
-            std::map<uint32_t, uint32_t> place;
-            for (size_t t = runs[k].first; t < runs[k].last; ++t)
-                for (uint32_t v : tris[t]) {
-                    auto [it, fresh] = place.try_emplace(v, uint32_t(vertices.size()));
-                    if (fresh) vertices.push_back(v);
-                    local.push_back(it->second);
-                }
-        }
+    auto attributesOf = [&](const std::vector<uint32_t>& vertices) {
         std::vector<double> pos, uv0, uv1, rgba;
         for (uint32_t v : vertices) {
             for (int c = 0; c < 3; ++c) {
@@ -227,7 +206,34 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
         if (!uv0.empty()) attributes["TEXCOORD_0"] = doc->buffers.floats(rounding.of(uv0, &rounding.attributes_changed), 2, kArrayBuffer, false);
         if (!uv1.empty()) attributes["TEXCOORD_1"] = doc->buffers.floats(rounding.of(uv1, &rounding.attributes_changed), 2, kArrayBuffer, false);
         if (!rgba.empty()) attributes["COLOR_0"] = doc->buffers.floats(rounding.of(rgba, &rounding.attributes_changed), 4, kArrayBuffer, false);
-        json prim = {{"attributes", attributes}, {"indices", doc->buffers.indices(local, vertices.size())}};
+        return attributes;
+    };
+    if (!ranges) {
+        std::vector<uint32_t> all(p.size());
+        for (uint32_t v = 0; v < all.size(); ++v) all[v] = v;
+        shared_attributes = attributesOf(all);
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const Vec3& v : p)
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], v[c]);
+            hi[c] = std::max(hi[c], v[c]);
+        }
+    // Step: one primitive per run.
+    json primitives = json::array();
+    for (size_t k = 0; k < runs.size(); ++k) {
+        std::vector<uint32_t> vertices, local;  // the run's vertices, and its triangles' corners among them
+        if (ranges) {
+            const uint32_t begin = k == 0 ? 0 : runs[k].lo, end = k + 1 == runs.size() ? uint32_t(p.size()) : runs[k + 1].lo;
+            for (uint32_t v = begin; v < end; ++v) vertices.push_back(v);
+            for (size_t t = runs[k].first; t < runs[k].last; ++t)
+                for (uint32_t v : tris[t]) local.push_back(v - begin);
+        } else {
+            for (size_t t = runs[k].first; t < runs[k].last; ++t)
+                for (uint32_t v : tris[t]) local.push_back(v);
+        }
+        const json attributes = ranges ? attributesOf(vertices) : shared_attributes;
+        json prim = {{"attributes", attributes}, {"indices", doc->buffers.indices(local, ranges ? vertices.size() : p.size())}};
         const int m = materialOf(runs[k].first);
         if (m >= 0 && material_index[size_t(m)] >= 0) prim["material"] = material_index[size_t(m)];
         primitives.push_back(prim);
@@ -243,9 +249,6 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
     if (rounding.attributes_changed)
         changed += (changed.empty() ? "" : "; ") + std::to_string(rounding.attributes_changed) +
                    " texture coordinate or colour values to float32";
-    if (!ranges)
-        changed += (changed.empty() ? "" : "; ") + std::string("its vertices split where materials meet (") +
-                   std::to_string(p.size()) + " vertices become one set per material run)";
     if (!changed.empty()) *note = name + ": the web file rounds " + changed;
     return int(doc->meshes.size()) - 1;
 }

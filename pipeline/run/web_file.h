@@ -27,7 +27,8 @@
 // report says by how much (largest |float(p) - p| over the mesh's bounding-box diagonal). Vertex
 // order is kept: a mesh whose triangles run through contiguous vertex ranges per material (every
 // glTF input, and any mesh of one material) is written as one primitive per run over its range;
-// other meshes get each run's vertices of their own (the report says so).
+// a mesh whose materials share vertices (an OBJ's) as primitives that all read one set of vertex
+// accessors, which the reader reads once (gltf_reader.h).
 //
 // Refused (one line naming the file and the field; the command exits with 2): a metre scene
 // (`units`: a glTF scene is read in light-seconds), a keyframed node under a parent node, object

@@ -75,8 +75,13 @@ JSON
 frames=0:4 roundtrip "$out/box/scene.json" exact "textured box"
 "$apparent" render "$out/textured box/web/scene.web.glb" --out "$out/box/from_web" --quiet
 python3 tests/looks/check_textured.py "$out/box/from_web/relativistic.glb" "$out/box/box.glb" -2 0.3 -4 0.9 0 0 20 30 0
+# The same box as an OBJ with a .mtl (tests/looks/make_textured_obj.py): its three materials meet at
+# shared corners, so the web file's primitives share one set of vertex accessors (gltf_reader.h).
+python3 tests/looks/make_textured_obj.py "$out/obj"
+sed 's#box.glb#box.obj#' "$out/box/scene.json" > "$out/obj/scene.json"
+frames=0:4 roundtrip "$out/obj/scene.json" exact "textured OBJ box"
 node tests/validators/validate_gltf.js "$out/flanges/web/scene.web.glb" "$out/textured box/web/scene.web.glb" \
-  "$out/keyed_cubic.gltf/web/scene.web.glb"
+  "$out/keyed_cubic.gltf/web/scene.web.glb" "$out/textured OBJ box/web/scene.web.glb"
 
 # What the web file cannot carry: exit code 2, one line naming the field.
 refused() {  # scene, expected text of the message
