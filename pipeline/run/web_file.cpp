@@ -414,6 +414,8 @@ Status keyedNode(const std::string& file, const ObjectSpec& o, Buffers* buffers,
             const tinygltf::AnimationChannel& c = m.animations[ai].channels[ci];
             if (c.target_node != n || (c.target_path != "translation" && c.target_path != "rotation")) continue;
             const std::string field = "animations[" + std::to_string(ai) + "].channels[" + std::to_string(ci) + "]";
+            if (c.sampler < 0 || size_t(c.sampler) >= m.animations[ai].samplers.size())
+                return Status::failure(file + ": " + field + ".sampler: out of range (the web file)");
             const tinygltf::AnimationSampler& sampler = m.animations[ai].samplers[size_t(c.sampler)];
             std::vector<float> times, values;
             if (!storedFloats(m, sampler.input, 1, &times) ||
