@@ -376,3 +376,47 @@ TEST(GltfReader, ImageUrisStayInTheFilesFolder) {
     ASSERT_TRUE(st.ok) << st.message;
     fs::remove_all(dir);
 }
+
+// Two primitives of one mesh that read the same POSITION accessor (a unit square, two materials
+// meeting along its diagonal, as the web file writes a mesh whose materials share vertices) read
+// its 4 vertices once: the triangles of both index them, and each keeps its material.
+//   3 ---- 2
+//   |  1 / |     triangle (0, 1, 2): material 0; triangle (0, 2, 3): material 1
+//   | / 0  |
+//   0 ---- 1
+TEST(GltfReader, PrimitivesSharingTheirVertexAccessorsShareTheVertices) {
+    const float square[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+    std::string bytes((const char*)square, sizeof(square));
+    bytes.append((const char*)indices, sizeof(indices));
+    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string uri = "data:application/octet-stream;base64,";
+    for (size_t i = 0; i < bytes.size(); i += 3) {  // 60 bytes: no padding
+        const uint32_t n = (uint32_t((unsigned char)bytes[i]) << 16) | (uint32_t((unsigned char)bytes[i + 1]) << 8) |
+                           uint32_t((unsigned char)bytes[i + 2]);
+        for (int s = 18; s >= 0; s -= 6) uri += digits[(n >> s) & 63];
+    }
+    const nlohmann::json g = {
+        {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"mesh", 0}}}},
+        {"materials", {{{"name", "a"}}, {{"name", "b"}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}, {"material", 0}},
+                                     {{"attributes", {{"POSITION", 0}}}, {"indices", 2}, {"material", 1}}}}}}},
+        {"buffers", {{{"byteLength", 60}, {"uri", uri}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}}, {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 12}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}, {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}},
+                       {{"bufferView", 1}, {"byteOffset", 6}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}}}}};
+    const fs::path file = testio::tempPath() / "shared_vertices.gltf";
+    std::ofstream(file) << g.dump();
+    LoadedMesh m;
+    const Status st = load(file.string(), &m);
+    ASSERT_TRUE(st.ok) << st.message;
+    ASSERT_EQ(m.mesh.positions.size(), 4u);
+    EXPECT_EQ(m.mesh.positions[2], (mesh4d::Vec3{1, 1, 0}));
+    ASSERT_EQ(m.mesh.triangles.size(), 2u);
+    EXPECT_EQ(m.mesh.triangles[0], (std::array<uint32_t, 3>{0, 1, 2}));
+    EXPECT_EQ(m.mesh.triangles[1], (std::array<uint32_t, 3>{0, 2, 3}));
+    ASSERT_TRUE(m.look);
+    EXPECT_EQ(m.look->triangle_material, (std::vector<uint32_t>{0, 1}));
+    fs::remove(file);
+}

@@ -395,3 +395,34 @@ TEST(GltfScene, CameraNodeExtrasGiveTheCameraVelocity) {
     EXPECT_FALSE(st.ok);
     EXPECT_NE(st.message.find(".velocity: |velocity| = 1.5 must be < 1 (the speed of light)"), std::string::npos) << st.message;
 }
+
+// The camera node's extras look_at and up (the web file writes them, pipeline/run/web_file.h) are
+// the camera's as written when they look the way the node does: an up that is not orthogonal to
+// the view stays as given (the default light follows it); one that turns the view is a warning.
+TEST(GltfScene, CameraNodeExtrasKeepLookAtAndUp) {
+    Folder dir;
+    json g = tetraGltf();
+    addNode(&g, "thing", {0, 0, -5}, json{{"velocity", {0.5, 0, 0}}});
+    g["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.1}}}}});
+    g["scenes"][0]["nodes"].push_back(g["nodes"].size());
+    // The node at (1, 2, 3) looks down its -Z (no rotation): look_at (1, 2, -7) and up (0, 1, 1).
+    g["nodes"].push_back({{"name", "cam"}, {"camera", 0}, {"translation", {1, 2, 3}},
+                          {"extras", {{"look_at", {1, 2, -7}}, {"up", {0, 1, 1}}}}});
+    Scene scene;
+    Status st = loadScene(dir.write("scene.gltf", g.dump()), &scene);
+    ASSERT_TRUE(st.ok) << st.message;
+    EXPECT_EQ(scene.camera.look_at, (mesh4d::Vec3{1, 2, -7}));
+    EXPECT_EQ(scene.camera.up, (mesh4d::Vec3{0, 1, 1}));
+    EXPECT_TRUE(scene.warnings.empty());
+    // The default light is overhead along the given up, normalised: (0, 1, 1) / sqrt(2).
+    EXPECT_NEAR(scene.light.direction.y, std::sqrt(0.5), 1e-15);
+    EXPECT_NEAR(scene.light.direction.z, std::sqrt(0.5), 1e-15);
+    // Looking along +X instead: ignored, with a warning; the node's view stays.
+    g["nodes"].back()["extras"]["look_at"] = {5, 2, 3};
+    st = loadScene(dir.write("scene.gltf", g.dump()), &scene);
+    ASSERT_TRUE(st.ok) << st.message;
+    EXPECT_EQ(scene.camera.look_at, (mesh4d::Vec3{1, 2, 2}));
+    EXPECT_EQ(scene.camera.up, (mesh4d::Vec3{0, 1, 0}));
+    ASSERT_EQ(scene.warnings.size(), 1u);
+    EXPECT_NE(scene.warnings[0].find("look_at and up ignored"), std::string::npos) << scene.warnings[0];
+}

@@ -18,6 +18,7 @@
 #include "pipeline/input/scene_fields.h"
 #include "pipeline/run/shard_header.h"
 #include "pipeline/run/shards.h"
+#include "pipeline/run/web_file.h"
 #include "pipeline/stage/frame_cut.h"
 #include "pipeline/stage/view_hints.h"
 
@@ -130,6 +131,7 @@ const std::vector<std::string>& outputFormats() {
     static const std::vector<std::string> names = [] {
         std::vector<std::string> n;
         for (const OutputFormat& f : formatTable()) n.push_back(f.name);
+        n.push_back("web");  // not a frame sink: one file for the whole scene (writeWebFile)
         return n;
     }();
     return names;
@@ -186,10 +188,32 @@ int render(const RenderSettings& settings, std::ostream& log_out, std::ostream& 
         return kExitOutputError;
     }
 
+    // Step: the web file (pipeline/run/web_file.h): the scene once, whatever the frames.
+    if (std::find(settings.formats.begin(), settings.formats.end(), "web") != settings.formats.end()) {
+        if (distributed || settings.sharded) {
+            err << "error: --format web: one file for the whole scene, written by one process (not under mpirun or --shard)\n";
+            return kExitBadInput;
+        }
+        const std::string web = (std::filesystem::path(settings.out_dir) / "scene.web.glb").string();
+        WebFileReport report;
+        const Model model = stage.models.size() == 1 ? stage.models.front() : stage.scene.model;
+        if (Status s = writeWebFile(stage.scene, model, settings.stage.limits, web, &report); !s.ok) {
+            if (!had_folder) std::filesystem::remove(settings.out_dir, ec);
+            err << "error: " << s.message << "\n";
+            return report.write_failed ? kExitOutputError : kExitBadInput;
+        }
+        if (!settings.quiet) {
+            for (const std::string& note : report.notes) err << "note: " << note << "\n";
+            log << "web: " << web << ", " << report.bytes << " bytes\n";
+        }
+        if (settings.formats.size() == 1) return kExitOk;
+    }
+
     // DIR/<model> folders of per-frame files that did not exist (seen before the ranks start: they
     // make them too, exporters/frame_files.h)
     std::vector<std::string> created, model_folders;
     for (Model model : stage.models) {
+        if (settings.formats.size() == 1 && settings.formats.front() == "web") break;
         const std::string folder = (std::filesystem::path(settings.out_dir) / modelName(model)).string();
         if (!std::filesystem::exists(folder, ec)) created.push_back(folder);
         model_folders.push_back(folder);
@@ -312,6 +336,7 @@ constexpr const char* kRenderFooter =
     "Outputs in DIR:\n"
     "  <model>.glb                      one animated glTF holding every frame (STEP scale channels)\n"
     "  <model>/frame_NNNNN.ply|.obj     per frame, all objects; PLY vertex 'quality' = emission time\n"
+    "  scene.web.glb                    --format web: the scene as a glTF scene (docs/GLTF.md)\n"
     "Exit codes: 0 success, 1 internal error, 2 bad usage or bad input, 3 output could not be written.";
 
 class RenderCommand : public Command {
@@ -325,7 +350,9 @@ public:
         cmd->add_option("--out", rs.out_dir, "Output folder (created if missing)")->capture_default_str();
         cmd->add_option("--model", model_text,
                         "instant|finite|relativistic|contracted|all, or a comma list (default: the scene's model)");
-        cmd->add_option("--format", format_text, "Comma list of glb, ply, obj")->capture_default_str();
+        cmd->add_option("--format", format_text, "Comma list of glb, ply, obj, web (DIR/scene.web.glb: the scene "
+                        "itself, rest meshes, motions, camera and light, for a viewer that cuts live; its size does "
+                        "not grow with the frames)")->capture_default_str();
         cmd->add_option("--tolerance", tolerance_text,
                         "Largest distance between output and exact apparent surface (overrides the scene's): "
                         "T light-seconds; Fx, F times each object's bounding-box diagonal (default 1e-3x); "

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <set>
 
@@ -175,6 +176,7 @@ private:
     // and glTF's default material.
     bool addLook(const tinygltf::Primitive& prim, const std::string& where, size_t nv, size_t nt) {
         look_.triangle_material.insert(look_.triangle_material.end(), nt, prim.material);
+        if (nv == 0) return true;  // vertices an earlier primitive read (addMesh), or none
         for (const auto& [name, accessor] : prim.attributes) {
             const bool uv = name == "TEXCOORD_0" || name == "TEXCOORD_1", rgba = name == "COLOR_0";
             if (!uv && !rgba) {
@@ -237,6 +239,9 @@ public:
             return fail("nodes.mesh", "mesh " + std::to_string(mesh_index) + " out of range (" + std::to_string(model_.meshes.size()) + " meshes)");
         const tinygltf::Mesh& mesh = model_.meshes[size_t(mesh_index)];
         const bool mirrored = world.det3() < 0;  // a mirroring transform flips the winding
+        // Primitives that read the same vertex accessors read the same vertices (an accessor is
+        // its data): their first vertex here, by those accessors.
+        std::map<std::vector<std::pair<std::string, int>>, std::pair<uint32_t, size_t>> shared;
         for (size_t p = 0; p < mesh.primitives.size(); ++p) {
             const tinygltf::Primitive& prim = mesh.primitives[p];
             const std::string where = "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(p) + "]";
@@ -251,14 +256,22 @@ public:
             auto pos_it = prim.attributes.find("POSITION");
             if (pos_it == prim.attributes.end()) return fail(where + ".attributes", "no POSITION");
 
-            // Step: positions, transformed to the node's world frame in double.
+            // Step: positions, transformed to the node's world frame in double (once per set of
+            // vertex accessors: a primitive sharing an earlier one's uses its vertices).
+            std::vector<std::pair<std::string, int>> vertex_accessors;
+            for (const auto& [name, accessor] : prim.attributes)
+                if (name == "POSITION" || name == "TEXCOORD_0" || name == "TEXCOORD_1" || name == "COLOR_0")
+                    vertex_accessors.emplace_back(name, accessor);
+            const auto earlier = shared.find(vertex_accessors);
+            const bool reused = earlier != shared.end();
             std::vector<double> pos;
-            if (!readAccessor(pos_it->second, where + ".attributes.POSITION", 3, false, &pos)) return false;
-            const size_t nv = pos.size() / 3;
-            const uint32_t base = uint32_t(out_->mesh.positions.size());
-            if (out_->mesh.positions.size() + nv > limits_.max_vertices)
+            if (!reused && !readAccessor(pos_it->second, where + ".attributes.POSITION", 3, false, &pos)) return false;
+            const size_t nv = reused ? earlier->second.second : pos.size() / 3;
+            const uint32_t base = reused ? earlier->second.first : uint32_t(out_->mesh.positions.size());
+            if (!reused) shared.emplace(vertex_accessors, std::make_pair(base, nv));
+            if (!reused && out_->mesh.positions.size() + nv > limits_.max_vertices)
                 return fail(where, "more than " + std::to_string(limits_.max_vertices) + " vertices in all (raise with --max-vertices)");
-            for (size_t i = 0; i < nv; ++i) {
+            for (size_t i = 0; i < pos.size() / 3; ++i) {
                 const Vec3 v{pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
                 if (!mesh4d::isFinite(v)) return fail(where + ".attributes.POSITION", "vertex " + std::to_string(i) + " is not finite");
                 // Derived, not only read: a finite node scale can still overflow the product.
@@ -302,7 +315,7 @@ public:
                 return fail(where, "more than " + std::to_string(limits_.max_faces) + " triangles in all (raise with --max-faces)");
 
             // Step: the look: texture coordinates, vertex colours and the triangles' material.
-            if (!addLook(prim, where, nv, out_->mesh.triangles.size() - triangles_before)) return false;
+            if (!addLook(prim, where, reused ? 0 : nv, out_->mesh.triangles.size() - triangles_before)) return false;
 
             // Step: the first material with a base colour gives the object's colour.
             if (!out_->has_color && prim.material >= 0 && size_t(prim.material) < model_.materials.size()) {

@@ -6,7 +6,10 @@
 // any byteStride; sparse accessors; KHR_draco_mesh_compression (decoded by tinygltf built with
 // TINYGLTF_ENABLE_DRACO). POINTS and LINES primitives are skipped and counted. "file.glb#Name"
 // reads only the subtree of the node called Name, in that node's own frame (its transform and its
-// ancestors' are not applied: the scene places the object).
+// ancestors' are not applied: the scene places the object). Primitives of one mesh that read the
+// same vertex accessors (POSITION and any TEXCOORD_0, TEXCOORD_1, COLOR_0) share those vertices,
+// as one mesh of several materials whose faces meet at shared vertices is written (the web file,
+// pipeline/run/web_file.h); other primitives each add their own.
 //
 // What is refused, with a one-line message naming the file and the glTF path (for example
 // "meshes[0].primitives[0].indices: index 9 out of range (8 vertices)"): buffer URIs that leave

@@ -244,9 +244,27 @@ Status loadGltfScene(const std::string& path, Scene* scene) {
     if (camera_node >= 0) {
         const std::string where = "nodes[" + std::to_string(camera_node) + "]";
         if (const json& cx = doc->node_extras[size_t(camera_node)]; cx.is_object() && !is_object[size_t(camera_node)]) {
-            r.warnUnknownKeys(cx, where + ".extras", {"instant_delay", "velocity"});
+            r.warnUnknownKeys(cx, where + ".extras", {"instant_delay", "velocity", "look_at", "up"});
             r.number(cx, "instant_delay", where + ".extras", &scene->camera.instant_delay);
             r.axisVec3(cx, "velocity", where + ".extras", &scene->camera.velocity);
+            // look_at and up as the JSON camera's, kept as written (the node's orientation gives an
+            // up orthogonal to the view, and the default light follows up); the node must look the
+            // same way (within 1e-6 rad) or the extras are ignored with a warning.
+            CameraSpec given = scene->camera;
+            r.axisVec3(cx, "look_at", where + ".extras", &given.look_at);
+            r.axisVec3(cx, "up", where + ".extras", &given.up);
+            if (!r.failed() && (cx.contains("look_at") || cx.contains("up"))) {
+                const Vec3 f0 = scene->camera.look_at - scene->camera.position, f1 = given.look_at - given.position;
+                const Vec3 r0 = mesh4d::cross(f0, scene->camera.up), r1 = mesh4d::cross(f1, given.up);
+                auto angle = [](const Vec3& a, const Vec3& b) {
+                    return std::atan2(mesh4d::norm(mesh4d::cross(a, b)), mesh4d::dot(a, b));
+                };
+                if (mesh4d::norm(r1) > 0 && angle(f0, f1) <= 1e-6 && angle(r0, r1) <= 1e-6)
+                    scene->camera = given;
+                else
+                    r.warn(where + ".extras", "look_at and up ignored: they do not look the way the node does "
+                                              "(the node's rotation gives the camera)");
+            }
         }
         checkCamera(r, where, scene->camera);
     }

@@ -18,7 +18,8 @@
 //   or scales unequally, a rotation spline through 0, the centre at >= c on any segment (the speed
 //   and the lab time). Channels on nodes that are not objects are warnings.
 // - Camera: the first node with a camera (glTF cameras look down local -Z, +Y up; yfov gives
-//   fov_deg); its extras may hold instant_delay.
+//   fov_deg); its extras may hold instant_delay, velocity, and look_at and up as written (kept
+//   when they look the way the node does within 1e-6 rad, else a warning).
 // - The scene's extras may hold frames, light, model and tolerance, as in the JSON file.
 // Keys the reader does not know are warnings (Scene::warnings), not errors, because other tools
 // keep custom properties in extras; a key that looks like a misspelt field names the field, and

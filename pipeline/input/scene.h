@@ -51,6 +51,7 @@ struct LightSpec {
     enum class Kind { Directional, Point } kind = Kind::Directional;
     mesh4d::Vec3 position;              // Point: lab position
     mesh4d::Vec3 direction{0, 1, 0};    // Directional: unit vector towards the light
+    mesh4d::Vec3 direction_given{0, 1, 0};  // `direction` as written (the web file writes it back)
     double ambient = 0.2;               // fraction of the base colour lit regardless of the normal
     // A scene without `light` gets two distant lights: overhead (`direction` = camera.up) and a key
     // light from the camera's upper left (`key_direction`), which gets `key_weight` of the diffuse
@@ -76,6 +77,9 @@ struct ObjectSpec {
     // The speed may instead be stated exactly: a unit `direction` with `gamma` or `rapidity`.
     enum class Speed { Velocity, Gamma, Rapidity } speed = Speed::Velocity;
     mesh4d::Vec3 direction;            // unit vector (with Speed::Gamma or Speed::Rapidity)
+    // `direction` and `orbit.axis` as written, before normalising: the web file
+    // (pipeline/run/web_file.h) writes them back, so that the reader normalises them to the same bits.
+    mesh4d::Vec3 direction_given, orbit_axis_given;
     double gamma = 1, rapidity = 0;
     // Spin (rad/s) in the object's centre frame about its origin, combined with the velocity
     // (mesh4d/motion/worldline.h); zero: uniform motion.

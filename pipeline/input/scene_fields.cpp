@@ -213,6 +213,7 @@ void readExactSpeed(FieldReader& r, const json& j, const std::string& path, cons
     r.axisVec3(j, "direction", path, &d);
     if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(path + ".direction", "must be non-zero");
     if (!r.failed()) obj->direction = d / mesh4d::norm(d);
+    obj->direction_given = d;
     if (has_gamma) {
         r.number(j, "gamma", path, &obj->gamma);
         // gamma^2 must stay finite with room to spare (1 - b^2 = 1/gamma^2).
@@ -358,6 +359,7 @@ void readOrbit(FieldReader& r, const json& j, const std::string& path, const Obj
     if (obj->speed != ObjectSpec::Speed::Velocity || mesh4d::norm(obj->velocity) != 0)
         return r.fail(p, "the orbit gives the motion: velocity must be [0, 0, 0] (no gamma or rapidity)");
     orbit.axis = axis / mesh4d::norm(axis);
+    obj->orbit_axis_given = axis;
     orbit.locked = orientation == "locked";
     obj->kinds.orbit = std::make_shared<const mesh4d::Orbit>(orbit);
 }
@@ -499,6 +501,7 @@ void readLight(FieldReader& r, const json& parent, const std::string& top, Scene
         r.axisVec3(*li, "direction", lp, &d);
         if (!r.failed() && !(mesh4d::norm(d) > 0)) r.fail(lp + ".direction", "must be non-zero");
         if (!r.failed()) scene->light.direction = d / mesh4d::norm(d);
+        scene->light.direction_given = d;
     }
     r.number(*li, "ambient", lp, &scene->light.ambient);
     if (!r.failed() && !(scene->light.ambient >= 0 && scene->light.ambient <= 1)) r.fail(lp + ".ambient", "must be in [0, 1]");
