@@ -2,7 +2,6 @@
 // (benchmarks/wasm_cut.sh): cut_time SCENE TOLERANCE N prints "native MEDIAN_MS MIN_MS TRIANGLES":
 // N cuts at the scene's frame times (spread over its range, after one cut to build the histories),
 // each timed alone, on one thread.
-#include <malloc.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -24,10 +23,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-    // Freed memory kept for the next frame, as the apparent command keeps it (pipeline/commands/main.cpp;
-    // the WebAssembly module's memory is never given back either).
-    ::mallopt(M_MMAP_THRESHOLD, 256 << 20);
-    ::mallopt(M_TRIM_THRESHOLD, 256 << 20);
+    apparent::keepFreedMemory();  // as the apparent command (the WebAssembly module never gives memory back)
     apparent::StageOptions options;
     options.scene_path = argv[1];
     options.quiet = true;

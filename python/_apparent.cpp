@@ -220,6 +220,8 @@ py::tuple runCommand(const std::vector<std::string>& args) {
 PYBIND11_MODULE(_apparent, m) {
     m.doc() = "apparent's C++ core (see the package apparent for the documented interface)";
     m.attr("__version__") = APPARENT_VERSION;
+    // Each cut's buffers reused by the next instead of faulted in again (docs/PYTHON.md).
+    apparent::keepFreedMemory();
     static py::exception<BadInput> error(m, "Error", PyExc_ValueError);
     py::register_exception_translator([](std::exception_ptr p) {
         try {

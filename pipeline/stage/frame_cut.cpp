@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#ifdef __GLIBC__
+#include <malloc.h>  // mallopt
+#endif
 
 #include "mesh4d/check.h"
 #include "mesh4d/light_factors.h"
@@ -53,6 +56,13 @@ SequenceInfo sequenceInfo(const Stage& stage, Model model) {
     info.light.key_direction = scene.light.key_direction;
     info.light.key_weight = scene.light.key_weight;
     return info;
+}
+
+void keepFreedMemory() {
+#ifdef __GLIBC__
+    ::mallopt(M_MMAP_THRESHOLD, kFreedMemoryKeep);
+    ::mallopt(M_TRIM_THRESHOLD, kFreedMemoryKeep);
+#endif
 }
 
 void cutFrameAt(const Stage& stage, const std::vector<mesh4d::World4D>& worlds, const MirrorReflections& reflections,

@@ -28,6 +28,16 @@ namespace apparent {
 constexpr long long kMinFrameTriangleBudget = 500'000;
 long long defaultFrameTriangleBudget(const Stage& stage);
 
+// Freed memory the process keeps for its next allocations, bytes: a frame's buffers (tens of MB
+// at 1M triangles) are reused in place frame after frame instead of unmapped and faulted in again
+// zero-filled (glibc's defaults map a block that large on its own and trim a heap whose free top
+// passes 128 kB; docs/PERFORMANCE.md, issue 37). More than this is given back, so one huge frame
+// does not hold its memory for the program's life (the budget of the cut's RefineScratch).
+constexpr int kFreedMemoryKeep = 256 << 20;
+// Sets that policy for the whole process (glibc's mallopt; elsewhere nothing): the apparent command
+// and the Python module call it once at start.
+void keepFreedMemory();
+
 // What the sinks are told about the sequence of `model`: objects (then the reflections, see
 // MirrorReflections::describe), camera, fps, tolerance, scene file.
 SequenceInfo sequenceInfo(const Stage& stage, Model model);
