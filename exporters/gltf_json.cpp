@@ -272,4 +272,14 @@ void write(Text* t, const Node& n) {
     t->close('}');
 }
 
+void moveTextureIndices(nlohmann::json* j, int offset) {
+    for (auto& [key, value] : j->items()) {
+        if (!value.is_object()) continue;
+        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index"))
+            value["index"] = value["index"].get<int>() + offset;
+        else
+            moveTextureIndices(&value, offset);
+    }
+}
+
 }  // namespace apparent::gltfjson

@@ -21,6 +21,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 namespace apparent::gltfjson {
 
 // JSON text in nlohmann's dump() form, written in order: the caller gives an object's keys in
@@ -133,6 +135,10 @@ void write(Text* t, const Accessor& a);
 void write(Text* t, const BufferView& v);
 void write(Text* t, const Mesh& m);
 void write(Text* t, const Node& n);
+
+// Every textureInfo's "index" below `j` ("...Texture": {"index": i}) moved by `offset`: a
+// material's textures renumbered when its file's textures are appended after others.
+void moveTextureIndices(nlohmann::json* j, int offset);
 
 }  // namespace apparent::gltfjson
 

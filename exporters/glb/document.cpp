@@ -8,6 +8,7 @@
 #include <tiny_gltf.h>
 
 #include "exporters/glb/glb.h"
+#include "exporters/gltf_json.h"
 #include "mesh4d/angles.h"
 
 namespace apparent::glb {
@@ -100,22 +101,11 @@ void SequenceModel::morphWeights() {
 
 namespace {
 
-// Every textureInfo's "index" below `j` ("...Texture": {"index": i}) moved by `offset`.
-void moveTextureIndices(nlohmann::json* j, int offset) {
-    for (auto& [key, value] : j->items()) {
-        if (!value.is_object()) continue;
-        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index"))
-            value["index"] = value["index"].get<int>() + offset;
-        else
-            moveTextureIndices(&value, offset);
-    }
-}
-
 // A look's material (JSON text) with its texture references moved by `offset`.
 std::string renumbered(const std::string& material, int offset) {
     if (offset == 0) return material;
     nlohmann::json j = nlohmann::json::parse(material);
-    moveTextureIndices(&j, offset);
+    gltfjson::moveTextureIndices(&j, offset);
     return j.dump();
 }
 

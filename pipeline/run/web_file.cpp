@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exporters/atomic_file.h"
+#include "exporters/gltf_json.h"
 #include "mesh4d/angles.h"
 #include "pipeline/input/gltf_document.h"
 #include "pipeline/input/gltf_nodes.h"
@@ -97,16 +98,6 @@ public:
     }
 };
 
-// Every textureInfo's "index" below `j` ("...Texture": {"index": i}) moved by `offset`.
-void moveTextureIndices(json* j, int offset) {
-    for (auto& [key, value] : j->items()) {
-        if (!value.is_object()) continue;
-        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0 && value.contains("index"))
-            value["index"] = value["index"].get<int>() + offset;
-        else
-            moveTextureIndices(&value, offset);
-    }
-}
 
 // The glTF document as it grows: meshes, the look's lists, and the rounding each mesh met.
 struct Document {
@@ -149,7 +140,7 @@ int writeMesh(Document* doc, const LoadedMesh& mesh, const std::string& name, st
                 continue;
             }
             json j = json::parse(m);
-            moveTextureIndices(&j, texture_offset);
+            gltfjson::moveTextureIndices(&j, texture_offset);
             doc->materials.push_back(j);
             material_index.push_back(material_offset + written++);
         }
